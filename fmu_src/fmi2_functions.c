@@ -1,0 +1,255 @@
+/* The FMI 2.0 co-simulation entry points: state machine, argument checks, then one call into
+   instance.c. Which states each function is allowed in is data: one mask per function. */
+
+#include <stddef.h>
+
+#include "instance.h"
+
+#define ANY_INITIALIZED (STATE_STEP_COMPLETE | STATE_STEP_FAILED | STATE_TERMINATED)
+#define ANY_STATE (STATE_INSTANTIATED | STATE_INITIALIZATION_MODE | ANY_INITIALIZED)
+
+#define MASK_fmi2SetDebugLogging              ANY_STATE
+#define MASK_fmi2SetupExperiment              STATE_INSTANTIATED
+#define MASK_fmi2EnterInitializationMode      STATE_INSTANTIATED
+#define MASK_fmi2ExitInitializationMode       STATE_INITIALIZATION_MODE
+#define MASK_fmi2Terminate                    (STATE_STEP_COMPLETE | STATE_STEP_FAILED)
+#define MASK_fmi2Reset                        ANY_STATE
+#define MASK_fmi2GetReal                      (STATE_INITIALIZATION_MODE | ANY_INITIALIZED)
+#define MASK_fmi2GetInteger                   MASK_fmi2GetReal
+#define MASK_fmi2GetBoolean                   MASK_fmi2GetReal
+#define MASK_fmi2GetString                    MASK_fmi2GetReal
+#define MASK_fmi2SetReal                      (STATE_INSTANTIATED | STATE_INITIALIZATION_MODE \
+                                               | STATE_STEP_COMPLETE)
+#define MASK_fmi2SetInteger                   MASK_fmi2SetReal
+#define MASK_fmi2SetBoolean                   MASK_fmi2SetReal
+#define MASK_fmi2SetString                    MASK_fmi2SetReal
+#define MASK_fmi2GetFMUstate                  ANY_STATE
+#define MASK_fmi2SetFMUstate                  ANY_STATE
+#define MASK_fmi2FreeFMUstate                 ANY_STATE
+#define MASK_fmi2SerializedFMUstateSize       ANY_STATE
+#define MASK_fmi2SerializeFMUstate            ANY_STATE
+#define MASK_fmi2DeSerializeFMUstate          ANY_STATE
+#define MASK_fmi2GetDirectionalDerivative     (STATE_INITIALIZATION_MODE | ANY_INITIALIZED)
+#define MASK_fmi2SetRealInputDerivatives      (STATE_INSTANTIATED | STATE_INITIALIZATION_MODE \
+                                               | STATE_STEP_COMPLETE)
+#define MASK_fmi2GetRealOutputDerivatives     ANY_INITIALIZED
+#define MASK_fmi2DoStep                       STATE_STEP_COMPLETE
+#define MASK_fmi2CancelStep                   0
+#define MASK_fmi2GetStatus                    ANY_INITIALIZED
+#define MASK_fmi2GetRealStatus                ANY_INITIALIZED
+#define MASK_fmi2GetIntegerStatus             ANY_INITIALIZED
+#define MASK_fmi2GetBooleanStatus             ANY_INITIALIZED
+#define MASK_fmi2GetStringStatus              ANY_INITIALIZED
+
+/* Every function with an instance starts here: NULL instance, then the state mask. */
+#define ENTER(function)                                                                \
+    Instance *instance = (Instance *)c;                                                \
+    if (!instance || !instance_state_allows(instance, MASK_##function, #function))     \
+        return fmi2Error;
+
+/* Array arguments may be NULL only when their length is 0. */
+#define REQUIRE_ARRAY(function, name, length)                                          \
+    if ((length) > 0 && instance_null_argument(instance, #function, #name, name))      \
+        return fmi2Error;
+
+const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
+
+const char *fmi2GetVersion(void) { return fmi2Version; }
+
+fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
+                              fmi2String fmuResourceLocation,
+                              const fmi2CallbackFunctions *functions, fmi2Boolean visible,
+                              fmi2Boolean loggingOn) {
+    (void)fmuResourceLocation; /* the model needs no resources */
+    (void)visible;
+    return instance_create(instanceName, fmuGUID, fmuType, functions, loggingOn);
+}
+
+void fmi2FreeInstance(fmi2Component c) {
+    instance_free((Instance *)c);
+}
+
+fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories,
+                               const fmi2String categories[]) {
+    ENTER(fmi2SetDebugLogging)
+    return instance_set_debug_logging(instance, loggingOn, nCategories, categories);
+}
+
+fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
+                               fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime) {
+    (void)stopTimeDefined; /* the pendulum can run for ever */
+    (void)stopTime;
+    ENTER(fmi2SetupExperiment)
+    return instance_setup_experiment(instance, toleranceDefined, tolerance, startTime);
+}
+
+fmi2Status fmi2EnterInitializationMode(fmi2Component c) {
+    ENTER(fmi2EnterInitializationMode)
+    instance->data.machine_state = STATE_INITIALIZATION_MODE;
+    return fmi2OK;
+}
+
+fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
+    ENTER(fmi2ExitInitializationMode)
+    return instance_exit_initialization(instance);
+}
+
+fmi2Status fmi2Terminate(fmi2Component c) {
+    ENTER(fmi2Terminate)
+    instance->data.machine_state = STATE_TERMINATED;
+    return fmi2OK;
+}
+
+fmi2Status fmi2Reset(fmi2Component c) {
+    ENTER(fmi2Reset)
+    instance_reset(instance);
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[]) {
+    ENTER(fmi2GetReal)
+    REQUIRE_ARRAY(fmi2GetReal, vr, nvr)
+    REQUIRE_ARRAY(fmi2GetReal, value, nvr)
+    return instance_get_real(instance, vr, nvr, value);
+}
+
+fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                       const fmi2Real value[]) {
+    ENTER(fmi2SetReal)
+    REQUIRE_ARRAY(fmi2SetReal, vr, nvr)
+    REQUIRE_ARRAY(fmi2SetReal, value, nvr)
+    return instance_set_real(instance, vr, nvr, value);
+}
+
+/* The model has Real variables only: any Integer, Boolean or String reference is unknown. */
+#define NO_VARIABLES_OF_TYPE(function, type)                                                   \
+    fmi2Status function(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, type value) { \
+        (void)value;                                                                         \
+        ENTER(function)                                                                      \
+        REQUIRE_ARRAY(function, vr, nvr)                                                     \
+        if (nvr == 0) return fmi2OK;                                                         \
+        return instance_error(instance, #function, "vr %u: this FMU has no variables of this type", \
+                              vr[0]);                                                        \
+    }
+
+NO_VARIABLES_OF_TYPE(fmi2GetInteger, fmi2Integer *)
+NO_VARIABLES_OF_TYPE(fmi2GetBoolean, fmi2Boolean *)
+NO_VARIABLES_OF_TYPE(fmi2GetString, fmi2String *)
+NO_VARIABLES_OF_TYPE(fmi2SetInteger, const fmi2Integer *)
+NO_VARIABLES_OF_TYPE(fmi2SetBoolean, const fmi2Boolean *)
+NO_VARIABLES_OF_TYPE(fmi2SetString, const fmi2String *)
+
+fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
+    ENTER(fmi2GetFMUstate)
+    return instance_get_state(instance, FMUstate);
+}
+
+fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate) {
+    ENTER(fmi2SetFMUstate)
+    return instance_set_state(instance, FMUstate);
+}
+
+fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
+    ENTER(fmi2FreeFMUstate)
+    return instance_free_state(instance, FMUstate);
+}
+
+fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, size_t *size) {
+    ENTER(fmi2SerializedFMUstateSize)
+    return instance_serialized_state_size(instance, FMUstate, size);
+}
+
+fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serializedState[],
+                                 size_t size) {
+    ENTER(fmi2SerializeFMUstate)
+    return instance_serialize_state(instance, FMUstate, serializedState, size);
+}
+
+fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size,
+                                   fmi2FMUstate *FMUstate) {
+    ENTER(fmi2DeSerializeFMUstate)
+    return instance_deserialize_state(instance, serializedState, size, FMUstate);
+}
+
+fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[],
+                                        size_t nUnknown, const fmi2ValueReference vKnown_ref[],
+                                        size_t nKnown, const fmi2Real dvKnown[],
+                                        fmi2Real dvUnknown[]) {
+    ENTER(fmi2GetDirectionalDerivative)
+    REQUIRE_ARRAY(fmi2GetDirectionalDerivative, vUnknown_ref, nUnknown)
+    REQUIRE_ARRAY(fmi2GetDirectionalDerivative, dvUnknown, nUnknown)
+    REQUIRE_ARRAY(fmi2GetDirectionalDerivative, vKnown_ref, nKnown)
+    REQUIRE_ARRAY(fmi2GetDirectionalDerivative, dvKnown, nKnown)
+    return instance_directional_derivative(instance, vUnknown_ref, nUnknown, vKnown_ref, nKnown,
+                                           dvKnown, dvUnknown);
+}
+
+fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                                       const fmi2Integer order[], const fmi2Real value[]) {
+    ENTER(fmi2SetRealInputDerivatives)
+    REQUIRE_ARRAY(fmi2SetRealInputDerivatives, vr, nvr)
+    REQUIRE_ARRAY(fmi2SetRealInputDerivatives, order, nvr)
+    REQUIRE_ARRAY(fmi2SetRealInputDerivatives, value, nvr)
+    return instance_set_input_derivatives(instance, vr, nvr, order, value);
+}
+
+fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                                        const fmi2Integer order[], fmi2Real value[]) {
+    ENTER(fmi2GetRealOutputDerivatives)
+    REQUIRE_ARRAY(fmi2GetRealOutputDerivatives, vr, nvr)
+    REQUIRE_ARRAY(fmi2GetRealOutputDerivatives, order, nvr)
+    REQUIRE_ARRAY(fmi2GetRealOutputDerivatives, value, nvr)
+    return instance_get_output_derivatives(instance, vr, nvr, order, value);
+}
+
+fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
+                      fmi2Real communicationStepSize, fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
+    (void)noSetFMUStatePriorToCurrentPoint; /* states are copies: nothing to release early */
+    ENTER(fmi2DoStep)
+    return instance_do_step(instance, currentCommunicationPoint, communicationStepSize);
+}
+
+fmi2Status fmi2CancelStep(fmi2Component c) {
+    ENTER(fmi2CancelStep)
+    return fmi2Error; /* unreachable: steps are never asynchronous, so no state allows it */
+}
+
+/* Only fmi2LastSuccessfulTime and fmi2Terminated mean anything for a synchronous slave. */
+fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *value) {
+    ENTER(fmi2GetStatus)
+    (void)s;
+    (void)value;
+    return instance_error(instance, "fmi2GetStatus", "no status of this kind: steps are synchronous");
+}
+
+fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *value) {
+    ENTER(fmi2GetRealStatus)
+    if (instance_null_argument(instance, "fmi2GetRealStatus", "value", value)) return fmi2Error;
+    if (s != fmi2LastSuccessfulTime)
+        return instance_error(instance, "fmi2GetRealStatus", "only fmi2LastSuccessfulTime is available");
+    *value = instance->data.last_successful_time;
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer *value) {
+    ENTER(fmi2GetIntegerStatus)
+    (void)s;
+    (void)value;
+    return instance_error(instance, "fmi2GetIntegerStatus", "no integer status is available");
+}
+
+fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value) {
+    ENTER(fmi2GetBooleanStatus)
+    if (instance_null_argument(instance, "fmi2GetBooleanStatus", "value", value)) return fmi2Error;
+    if (s != fmi2Terminated)
+        return instance_error(instance, "fmi2GetBooleanStatus", "only fmi2Terminated is available");
+    *value = fmi2False; /* the pendulum never asks to stop */
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String *value) {
+    ENTER(fmi2GetStringStatus)
+    (void)s;
+    (void)value;
+    return instance_error(instance, "fmi2GetStringStatus", "no string status is available");
+}

@@ -1,0 +1,337 @@
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "dopri5.h"
+#include "instance.h"
+
+/* A master's time arithmetic (t += h against t = n*h) may differ in the last bits from ours. */
+#define TIME_MATCH_TOLERANCE 1e-9
+
+static const char *const category_names[] = {"logStatusWarning", "logStatusDiscard",
+                                             "logStatusError", "logAll"};
+#define N_CATEGORIES (sizeof(category_names) / sizeof(category_names[0]))
+
+void instance_log(const Instance *instance, fmi2Status status, LogCategory category,
+                  const char *format, ...) {
+    char message[512];
+    va_list args;
+    if (category == LOG_ALL && !(instance->log_categories & LOG_ALL)) return;
+    va_start(args, format);
+    vsnprintf(message, sizeof(message), format, args);
+    va_end(args);
+    /* The category index is the bit's position. */
+    size_t index = 0;
+    while ((1u << index) != (unsigned)category) index++;
+    /* Passed as the format itself, because some masters (fmpy among them) print the format and
+       drop the arguments; so no '%' from a master's strings may reach a master that formats it. */
+    for (char *c = message; *c; c++)
+        if (*c == '%') *c = '#';
+    instance->logger(instance->environment, instance->name, status, category_names[index], message);
+}
+
+fmi2Status instance_error(const Instance *instance, const char *function, const char *format, ...) {
+    char message[448];
+    va_list args;
+    va_start(args, format);
+    vsnprintf(message, sizeof(message), format, args);
+    va_end(args);
+    instance_log(instance, fmi2Error, LOG_STATUS_ERROR, "%s: %s", function, message);
+    return fmi2Error;
+}
+
+static const char *state_name(int state) {
+    switch (state) {
+        case STATE_INSTANTIATED: return "instantiated";
+        case STATE_INITIALIZATION_MODE: return "initialization mode";
+        case STATE_STEP_COMPLETE: return "step complete";
+        case STATE_STEP_FAILED: return "step failed";
+        case STATE_TERMINATED: return "terminated";
+        default: return "unknown";
+    }
+}
+
+int instance_state_allows(const Instance *instance, int mask, const char *function) {
+    if (instance->data.machine_state & mask) return 1;
+    instance_error(instance, function, "illegal call sequence: not allowed in state '%s'",
+                   state_name(instance->data.machine_state));
+    return 0;
+}
+
+int instance_null_argument(const Instance *instance, const char *function, const char *argument,
+                           const void *pointer) {
+    if (pointer) return 0;
+    instance_error(instance, function, "argument %s must not be NULL", argument);
+    return 1;
+}
+
+Instance *instance_create(fmi2String name, fmi2String guid, fmi2Type type,
+                          const fmi2CallbackFunctions *callbacks, fmi2Boolean logging_on) {
+    /* Without a logger there is nobody to tell why we refuse: FMI 2.0 requires one. */
+    if (!callbacks || !callbacks->logger) return NULL;
+    Instance probe;
+    memset(&probe, 0, sizeof(probe));
+    probe.logger = callbacks->logger;
+    probe.environment = callbacks->componentEnvironment;
+    snprintf(probe.name, sizeof(probe.name), "%s", name ? name : "?");
+
+    if (!name || !name[0])
+        return instance_error(&probe, "fmi2Instantiate", "instanceName must be a non-empty string"), NULL;
+    if (!guid || strcmp(guid, MODEL_GUID) != 0)
+        return instance_error(&probe, "fmi2Instantiate",
+                              "fmuGUID %s does not match this FMU's %s (was modelDescription.xml "
+                              "taken from another FMU?)", guid ? guid : "NULL", MODEL_GUID), NULL;
+    if (type != fmi2CoSimulation)
+        return instance_error(&probe, "fmi2Instantiate",
+                              "fmuType %d is not supported: this FMU is for co-simulation only",
+                              (int)type), NULL;
+
+    Instance *instance = calloc(1, sizeof(Instance));
+    if (!instance)
+        return instance_error(&probe, "fmi2Instantiate", "out of memory"), NULL;
+    *instance = probe;
+    instance->log_categories = logging_on ? (LOG_STATUS_WARNING | LOG_STATUS_DISCARD
+                                             | LOG_STATUS_ERROR | LOG_ALL) : 0;
+    instance_reset(instance);
+    return instance;
+}
+
+void instance_free(Instance *instance) {
+    free(instance);
+}
+
+void instance_reset(Instance *instance) {
+    InstanceData *data = &instance->data;
+    memset(data, 0, sizeof(*data));
+    data->machine_state = STATE_INSTANTIATED;
+    data->tolerance = DEFAULT_TOLERANCE;
+    for (size_t vr = 0; vr < N_VARIABLES; vr++) data->values[vr] = model_variables[vr].start;
+    instance_data_changed(instance);
+}
+
+void instance_data_changed(Instance *instance) {
+    model_coefficients(instance->data.values, &instance->coefficients);
+    instance->outputs_stale = 1;
+}
+
+fmi2Status instance_set_debug_logging(Instance *instance, fmi2Boolean logging_on,
+                                      size_t n_categories, const fmi2String categories[]) {
+    int bits = 0;
+    if (n_categories == 0) {
+        bits = LOG_STATUS_WARNING | LOG_STATUS_DISCARD | LOG_STATUS_ERROR | LOG_ALL;
+    } else {
+        if (instance_null_argument(instance, "fmi2SetDebugLogging", "categories", categories))
+            return fmi2Error;
+        for (size_t i = 0; i < n_categories; i++) {
+            size_t c = 0;
+            while (c < N_CATEGORIES && !(categories[i] && strcmp(categories[i], category_names[c]) == 0)) c++;
+            if (c == N_CATEGORIES)
+                return instance_error(instance, "fmi2SetDebugLogging", "unknown log category %s",
+                                      categories[i] ? categories[i] : "NULL");
+            bits |= 1 << c;
+        }
+    }
+    instance->log_categories = logging_on ? (instance->log_categories | bits)
+                                          : (instance->log_categories & ~bits);
+    return fmi2OK;
+}
+
+fmi2Status instance_setup_experiment(Instance *instance, fmi2Boolean tolerance_defined,
+                                     fmi2Real tolerance, fmi2Real start_time) {
+    if (!isfinite(start_time))
+        return instance_error(instance, "fmi2SetupExperiment", "startTime must be finite");
+    if (tolerance_defined) {
+        if (!(tolerance > 0 && tolerance < 1))
+            return instance_error(instance, "fmi2SetupExperiment",
+                                  "tolerance %g must be in (0, 1)", tolerance);
+        instance->data.tolerance = tolerance;
+    }
+    instance->data.time = start_time;
+    instance->data.last_successful_time = start_time;
+    return fmi2OK;
+}
+
+fmi2Status instance_exit_initialization(Instance *instance) {
+    const char *problem = model_invalid_parameters(instance->data.values);
+    if (problem) return instance_error(instance, "fmi2ExitInitializationMode", "%s", problem);
+    for (size_t vr = 0; vr < N_VARIABLES; vr++) {
+        if (!isfinite(instance->data.values[vr]))
+            return instance_error(instance, "fmi2ExitInitializationMode", "%s is not finite",
+                                  model_variables[vr].name);
+    }
+    instance_data_changed(instance);
+    instance->data.machine_state = STATE_STEP_COMPLETE;
+    return fmi2OK;
+}
+
+static const char *unknown_reference(fmi2ValueReference vr) {
+    return vr < N_VARIABLES ? NULL : "is not a value reference of this FMU";
+}
+
+/* Why a variable may not be set in this state, or NULL when it may (FMI 2.0, section 3.2.3). */
+static const char *why_not_settable(const VariableInfo *variable, int state) {
+    const int input = variable->causality == CAUSALITY_INPUT;
+    const int exact = variable->initial == INITIAL_EXACT;
+    const int tunable = variable->variability == VARIABILITY_TUNABLE;
+    if (variable->variability == VARIABILITY_CONSTANT) return "it is a constant";
+    if (variable->initial == INITIAL_CALCULATED) return "it is calculated by the FMU";
+    switch (state) {
+        case STATE_INSTANTIATED:
+            return input || exact || variable->initial == INITIAL_APPROX ? NULL
+                                                                          : "not before initialization";
+        case STATE_INITIALIZATION_MODE:
+            return input || exact ? NULL : "not in initialization mode";
+        default:
+            if (input || (variable->causality == CAUSALITY_PARAMETER && tunable)) return NULL;
+            return variable->causality == CAUSALITY_PARAMETER
+                       ? "a fixed parameter cannot change after initialization"
+                       : "it can be set only before initialization ends";
+    }
+}
+
+fmi2Status instance_set_real(Instance *instance, const fmi2ValueReference vr[], size_t nvr,
+                             const fmi2Real value[]) {
+    /* All checked before any is set, so a refused call changes nothing. */
+    for (size_t i = 0; i < nvr; i++) {
+        const char *problem = unknown_reference(vr[i]);
+        if (problem) return instance_error(instance, "fmi2SetReal", "vr %u %s", vr[i], problem);
+        const VariableInfo *variable = &model_variables[vr[i]];
+        problem = why_not_settable(variable, instance->data.machine_state);
+        if (problem) return instance_error(instance, "fmi2SetReal", "cannot set %s: %s",
+                                           variable->name, problem);
+        if (!isfinite(value[i]))
+            return instance_error(instance, "fmi2SetReal",
+                                  "%s = %g refused: values must be finite; %s keeps %.17g",
+                                  variable->name, value[i], variable->name,
+                                  instance->data.values[vr[i]]);
+    }
+    for (size_t i = 0; i < nvr; i++) instance->data.values[vr[i]] = value[i];
+    if (nvr > 0) {
+        /* Parameters can change only before initialization ends, when steps do not run yet. */
+        if (instance->data.machine_state != STATE_STEP_COMPLETE)
+            model_coefficients(instance->data.values, &instance->coefficients);
+        instance->outputs_stale = 1;
+    }
+    return fmi2OK;
+}
+
+fmi2Status instance_get_real(Instance *instance, const fmi2ValueReference vr[], size_t nvr,
+                             fmi2Real value[]) {
+    for (size_t i = 0; i < nvr; i++) {
+        if (unknown_reference(vr[i]))
+            return instance_error(instance, "fmi2GetReal", "vr %u %s", vr[i], unknown_reference(vr[i]));
+    }
+    if (instance->outputs_stale && nvr > 0) {
+        model_update_outputs(&instance->coefficients, instance->data.values);
+        instance->outputs_stale = 0;
+    }
+    for (size_t i = 0; i < nvr; i++) value[i] = instance->data.values[vr[i]];
+    return fmi2OK;
+}
+
+fmi2Status instance_set_input_derivatives(Instance *instance, const fmi2ValueReference vr[],
+                                          size_t nvr, const fmi2Integer order[],
+                                          const fmi2Real value[]) {
+    const char *function = "fmi2SetRealInputDerivatives";
+    for (size_t i = 0; i < nvr; i++) {
+        if (unknown_reference(vr[i]))
+            return instance_error(instance, function, "vr %u %s", vr[i], unknown_reference(vr[i]));
+        const VariableInfo *variable = &model_variables[vr[i]];
+        if (variable->causality != CAUSALITY_INPUT)
+            return instance_error(instance, function, "%s is not an input", variable->name);
+        if (order[i] != 1)
+            return instance_error(instance, function,
+                                  "order %d for %s: only first derivatives (a linear ramp over the "
+                                  "step) are supported", (int)order[i], variable->name);
+        if (!isfinite(value[i]))
+            return instance_error(instance, function, "derivative of %s = %g refused: must be finite",
+                                  variable->name, value[i]);
+    }
+    for (size_t i = 0; i < nvr; i++) instance->data.input_rates[vr[i]] = value[i];
+    return fmi2OK;
+}
+
+fmi2Status instance_get_output_derivatives(Instance *instance, const fmi2ValueReference vr[],
+                                           size_t nvr, const fmi2Integer order[], fmi2Real value[]) {
+    for (size_t i = 0; i < nvr; i++) {
+        if (unknown_reference(vr[i]) ||
+            !model_output_derivative(&instance->coefficients, instance->data.values,
+                                     instance->data.input_rates, vr[i], order[i], &value[i]))
+            return instance_error(instance, "fmi2GetRealOutputDerivatives",
+                                  "no derivative of order %d for vr %u (outputs theta, omega, alpha; "
+                                  "orders 1 and 2)", (int)order[i], vr[i]);
+    }
+    return fmi2OK;
+}
+
+fmi2Status instance_directional_derivative(Instance *instance, const fmi2ValueReference unknown[],
+                                           size_t n_unknown, const fmi2ValueReference known[],
+                                           size_t n_known, const fmi2Real known_delta[],
+                                           fmi2Real unknown_delta[]) {
+    for (size_t i = 0; i < n_unknown; i++) {
+        double sum = 0.0;
+        for (size_t j = 0; j < n_known; j++) {
+            double partial;
+            if (unknown_reference(unknown[i]) || unknown_reference(known[j]) ||
+                !model_partial_derivative(&instance->coefficients, instance->data.values,
+                                          unknown[i], known[j], &partial))
+                return instance_error(instance, "fmi2GetDirectionalDerivative",
+                                      "no partial derivative of vr %u with respect to vr %u",
+                                      unknown[i], known[j]);
+            sum += partial * known_delta[j];
+        }
+        unknown_delta[i] = sum;
+    }
+    return fmi2OK;
+}
+
+static void derivatives(const void *context, double offset, const double x[N_STATES],
+                        double dx[N_STATES]) {
+    const Instance *instance = context;
+    model_derivatives(&instance->coefficients, instance->data.values, instance->data.input_rates,
+                      offset, x, dx);
+}
+
+fmi2Status instance_do_step(Instance *instance, fmi2Real communication_point,
+                            fmi2Real communication_step) {
+    InstanceData *data = &instance->data;
+    if (!(communication_step > 0) || !isfinite(communication_step))
+        return instance_error(instance, "fmi2DoStep",
+                              "communicationStepSize %g must be positive and finite",
+                              communication_step);
+    if (!(fabs(communication_point - data->time) <= TIME_MATCH_TOLERANCE * fmax(1.0, fabs(data->time))))
+        return instance_error(instance, "fmi2DoStep",
+                              "currentCommunicationPoint %.17g is not where the instance stands "
+                              "(%.17g)", communication_point, data->time);
+
+    double x[N_STATES];
+    double step_size = data->step_size;
+    long steps;
+    model_get_states(data->values, x);
+    const Dopri5Result result = dopri5_integrate(derivatives, instance, x, communication_step,
+                                                 data->tolerance, data->tolerance,
+                                                 MAX_INTERNAL_STEPS, &step_size, &steps);
+    if (result != DOPRI5_OK) {
+        data->machine_state = STATE_STEP_FAILED;
+        instance_log(instance, fmi2Discard, LOG_STATUS_DISCARD,
+                     "fmi2DoStep: step from t = %.17g of size %g discarded after %ld internal steps: "
+                     "%s at tolerance %g; the instance stays at t = %.17g (roll back with "
+                     "fmi2SetFMUstate or take smaller steps)",
+                     communication_point, communication_step, steps,
+                     result == DOPRI5_STEP_BUDGET_EXHAUSTED ? "step budget exhausted"
+                                                            : "step size underflow",
+                     data->tolerance, data->time);
+        return fmi2Discard;
+    }
+    model_set_states(data->values, x);
+    /* A ramped input is where the ramp has taken it. */
+    for (size_t vr = 0; vr < N_VARIABLES; vr++)
+        data->values[vr] += data->input_rates[vr] * communication_step;
+    data->step_size = step_size;
+    data->time = communication_point + communication_step;
+    data->last_successful_time = data->time;
+    instance->outputs_stale = 1;
+    return fmi2OK;
+}

@@ -1,0 +1,45 @@
+#ifndef MODEL_H
+#define MODEL_H
+
+/* The interface between the FMI plumbing and the physics. The plumbing stores every variable in
+   one array indexed by value reference (values[]) and never looks at what the numbers mean. */
+
+#include "model_variables.h"
+
+#define N_STATES 2
+
+/* Derived once from the fixed parameters, so a right-hand side costs one sin(). */
+typedef struct {
+    double gravity_moment;   /* mass*gravity*length */
+    double damping;
+    double inverse_inertia;  /* 1/(inertia + mass*length^2) */
+} ModelCoefficients;
+
+/* NULL when the parameters describe a physical pendulum, else what is wrong with them. */
+const char *model_invalid_parameters(const double values[N_VARIABLES]);
+
+void model_coefficients(const double values[N_VARIABLES], ModelCoefficients *coefficients);
+
+void model_get_states(const double values[N_VARIABLES], double x[N_STATES]);
+void model_set_states(double values[N_VARIABLES], const double x[N_STATES]);
+
+/* dx/dt at `offset` seconds into a communication step: each input starts at values[] and
+   ramps with input_rates[] (zero rates hold it), as fmi2SetRealInputDerivatives asks. */
+void model_derivatives(const ModelCoefficients *coefficients, const double values[N_VARIABLES],
+                       const double input_rates[N_VARIABLES], double offset,
+                       const double x[N_STATES], double dx[N_STATES]);
+
+/* Brings the calculated outputs in values[] up to date with the states and inputs. */
+void model_update_outputs(const ModelCoefficients *coefficients, double values[N_VARIABLES]);
+
+/* The order-th time derivative of an output; returns 0 when vr or order is not supported. */
+int model_output_derivative(const ModelCoefficients *coefficients, const double values[N_VARIABLES],
+                            const double input_rates[N_VARIABLES], unsigned int vr, int order,
+                            double *derivative);
+
+/* d(unknown)/d(known) for unknown an output or state derivative and known an input or state;
+   returns 0 when the pair is not one the model provides. */
+int model_partial_derivative(const ModelCoefficients *coefficients, const double values[N_VARIABLES],
+                             unsigned int unknown, unsigned int known, double *partial);
+
+#endif

@@ -1,0 +1,199 @@
+"""Build Pendulum.fmu from fmu_src/ and modelDescription.xml.
+
+The C code takes its value references, names and start values from modelDescription.xml: this
+module generates them (model_variables.h/.c), so the XML stays the single source of truth.
+"""
+
+from __future__ import annotations
+
+import html
+import os
+import shutil
+import subprocess
+import tempfile
+import zipfile
+from pathlib import Path
+
+import fmpy
+from fmpy import read_model_description
+
+ROOT = Path(__file__).resolve().parent.parent
+SOURCE_DIR = ROOT / "fmu_src"
+MODEL_DESCRIPTION = ROOT / "modelDescription.xml"
+DEFAULT_FMU = ROOT / "dist" / "Pendulum.fmu"
+GENERATED_SOURCES = ("model_variables.h", "model_variables.c")
+# The FMI 2.0 headers fmpy ships, rather than a vendored copy.
+FMI_HEADERS = Path(fmpy.__file__).parent / "c-code"
+
+
+class BuildError(RuntimeError):
+    """The FMU could not be built; the message says why."""
+
+
+def _check_sources_present() -> None:
+    if not SOURCE_DIR.is_dir() or not MODEL_DESCRIPTION.is_file():
+        raise BuildError(
+            f"FMU sources not found at {ROOT} (fmu_src/ and modelDescription.xml): build from a "
+            "clone of the repository, installed with pip install -e ."
+        )
+
+
+def generate_variables(model_description, out_dir: Path) -> list[Path]:
+    """Write model_variables.h (GUID, value reference enum) and model_variables.c (the table)."""
+    variables = model_description.modelVariables
+    for index, variable in enumerate(variables):
+        if variable.valueReference != index or variable.type != "Real":
+            raise BuildError(
+                f"{MODEL_DESCRIPTION}: variable {variable.name!r} must be Real with valueReference "
+                f"{index}: the C code indexes one array of Reals by value reference"
+            )
+    enum = ",\n".join(f"    VR_{v.name.upper()} = {v.valueReference}" for v in variables)
+    header = f"""/* Generated from modelDescription.xml by pendulum_fmu/build.py: edit the XML, not this. */
+#ifndef MODEL_VARIABLES_H
+#define MODEL_VARIABLES_H
+
+#include "variable.h"
+
+#define MODEL_GUID "{model_description.guid}"
+#define N_VARIABLES {len(variables)}
+
+typedef enum {{
+{enum}
+}} ValueReference;
+
+extern const VariableInfo model_variables[N_VARIABLES];
+
+#endif
+"""
+    rows = ",\n".join(
+        f'    {{"{v.name}", CAUSALITY_{_enum_name(v.causality)}, VARIABILITY_{v.variability.upper()}, '
+        f"INITIAL_{(v.initial or 'none').upper()}, {float(v.start or 0.0)!r}}}"
+        for v in variables
+    )
+    table = f"""/* Generated from modelDescription.xml by pendulum_fmu/build.py: edit the XML, not this. */
+#include "model_variables.h"
+
+const VariableInfo model_variables[N_VARIABLES] = {{
+{rows}
+}};
+"""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    paths = [out_dir / name for name in GENERATED_SOURCES]
+    paths[0].write_text(header)
+    paths[1].write_text(table)
+    return paths
+
+
+def _enum_name(causality: str) -> str:
+    return "CALCULATED_PARAMETER" if causality == "calculatedParameter" else causality.upper()
+
+
+def _check_source_files(model_description) -> None:
+    listed = set(model_description.buildConfigurations[0].sourceFileSets[0].sourceFiles)
+    present = {p.name for p in SOURCE_DIR.glob("*.c")} | {"model_variables.c"}
+    if listed != present:
+        raise BuildError(
+            f"<SourceFiles> in {MODEL_DESCRIPTION} lists {sorted(listed)} but fmu_src/ has "
+            f"{sorted(present)}: fmpy compile needs them to agree"
+        )
+
+
+def compile_linux64(source_dir: Path, out_file: Path, compiler: str | None = None) -> Path:
+    """Compile every C file in source_dir into a shared library exporting only fmi2* symbols."""
+    compiler = compiler or os.environ.get("CC", "gcc")
+    if shutil.which(compiler) is None:
+        raise BuildError(f"C compiler {compiler!r} not found: install gcc (apt-get install gcc)")
+    version_script = out_file.parent / "exports.map"
+    version_script.write_text("{ global: fmi2*; local: *; };\n")
+    command = [
+        compiler, "-std=c99", "-O2", "-fPIC", "-shared", "-fvisibility=hidden",
+        "-Wall", "-Wextra", "-Werror",
+        f"-I{source_dir}", f"-I{FMI_HEADERS}",
+        *sorted(str(p) for p in source_dir.glob("*.c")),
+        f"-Wl,--version-script={version_script}", "-lm",
+        "-o", str(out_file),
+    ]
+    result = subprocess.run(command, capture_output=True, text=True)
+    if result.returncode != 0:
+        raise BuildError(f"compiling failed:\n{' '.join(command)}\n{result.stderr}")
+    return out_file
+
+
+def documentation_html(model_description) -> str:
+    """documentation/index.html: the equation and every variable with its unit and meaning."""
+    rows = "\n".join(
+        "<tr>" + "".join(f"<td>{html.escape(str(cell))}</td>" for cell in (
+            v.name, v.valueReference, v.causality, v.variability, v.unit or "",
+            "" if v.start is None else v.start, v.description or "")) + "</tr>"
+        for v in model_description.modelVariables
+    )
+    cs = model_description.coSimulation
+    return f"""<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8"><title>Pendulum FMU</title>
+<style>body{{font-family:sans-serif;max-width:60em;margin:2em auto}}
+table{{border-collapse:collapse}}td,th{{border:1px solid #999;padding:.2em .5em}}</style></head>
+<body>
+<h1>Pendulum: a rigid pendulum driven by a torque at its pivot</h1>
+<p>FMI 2.0 Co-Simulation, model identifier <code>{cs.modelIdentifier}</code>.</p>
+<pre>I_total * alpha = torque - mass*gravity*length*sin(theta) - damping*omega
+I_total = inertia + mass*length^2</pre>
+<h2>Inside a communication step</h2>
+<p>Each <code>fmi2DoStep(t, h)</code> integrates exactly [t, t+h] with an error-controlled
+Dormand-Prince 5(4) Runge-Kutta method: internal steps end on t+h and never cross it, and the
+internal step size carries over between calls. The torque is held over the step (zero-order
+hold) or, after <code>fmi2SetRealInputDerivatives</code> (order 1), ramps linearly from its value
+at t; a derivative holds until it is set again. The relative tolerance is
+<code>fmi2SetupExperiment</code>'s when defined, else 1e-10; the absolute tolerance equals it.
+A step that needs more than 100000 internal steps returns fmi2Discard and leaves the instance
+where it was.</p>
+<h2>Variables</h2>
+<table><tr><th>name</th><th>value reference</th><th>causality</th><th>variability</th>
+<th>unit</th><th>start</th><th>description</th></tr>
+{rows}
+</table>
+</body></html>
+"""
+
+
+def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, compiler: str | None = None) -> Path:
+    """Build the FMU (binaries/linux64 and sources/) and return its path."""
+    _check_sources_present()
+    model_description = read_model_description(str(MODEL_DESCRIPTION))
+    _check_source_files(model_description)
+    identifier = model_description.coSimulation.modelIdentifier
+    out_file = Path(out_file)
+    out_file.parent.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        sources = tmp / "sources"
+        shutil.copytree(SOURCE_DIR, sources)
+        generate_variables(model_description, sources)
+        binary = compile_linux64(sources, tmp / f"{identifier}.so", compiler)
+        documentation = documentation_html(model_description)
+        # Write to a temporary name first so a failed build never leaves half an FMU behind.
+        partial = out_file.with_suffix(".fmu.partial")
+        with zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as fmu:
+            fmu.write(MODEL_DESCRIPTION, "modelDescription.xml")
+            fmu.write(binary, f"binaries/linux64/{identifier}.so")
+            for source in sorted(sources.iterdir()):
+                fmu.write(source, f"sources/{source.name}")
+            fmu.writestr("documentation/index.html", documentation)
+        partial.replace(out_file)
+    return out_file
+
+
+def fmu_is_stale(fmu: Path = DEFAULT_FMU) -> bool:
+    """True when fmu is missing or older than any of its sources."""
+    if not fmu.exists():
+        return True
+    built = fmu.stat().st_mtime
+    inputs = [MODEL_DESCRIPTION, Path(__file__), *SOURCE_DIR.iterdir()]
+    return any(p.stat().st_mtime > built for p in inputs)
+
+
+def default_fmu() -> Path:
+    """The FMU built from this checkout, rebuilt first when its sources changed."""
+    _check_sources_present()
+    if fmu_is_stale(DEFAULT_FMU):
+        build_fmu(DEFAULT_FMU)
+    return DEFAULT_FMU
