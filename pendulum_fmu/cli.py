@@ -1,0 +1,249 @@
+"""pendulum-fmu: build, simulate and compare the torque-driven pendulum FMU."""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from .build import DEFAULT_FMU, BuildError, build_fmu
+
+TUTORIAL_TORQUE = 20.0
+
+
+def _assignment(text: str) -> tuple[str, str]:
+    name, equals, value = text.partition("=")
+    if not equals or not name or not value:
+        raise argparse.ArgumentTypeError(f"expected name=value, got {text!r}")
+    return name.strip(), value.strip()
+
+
+def _float(text: str) -> float:
+    try:
+        return float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+
+
+def _parameters(assignments) -> dict[str, float]:
+    parameters = {}
+    for name, value in assignments or ():
+        try:
+            parameters[name] = float(value)
+        except ValueError:
+            raise ValueError(f"--set {name}={value}: {value!r} is not a number") from None
+    return parameters
+
+
+def _torque_signal(args):
+    return args.torque_file if args.torque_file is not None else args.torque
+
+
+def _add_signal_arguments(parser, required=True):
+    group = parser.add_mutually_exclusive_group(required=required)
+    group.add_argument("--torque", type=_float, help="constant torque in N.m")
+    group.add_argument("--torque-file", type=Path,
+                       help="CSV with columns time,torque in fmpy's convention: linear between "
+                            "rows, a step where a time repeats")
+    parser.add_argument("--stop-time", type=_float, default=None,
+                        help="end of the simulation in s (default: 3, or the CSV's last time)")
+    parser.add_argument("--step-size", type=_float, default=1e-3,
+                        help="communication step in s (default: %(default)s)")
+    parser.add_argument("--set", dest="assignments", type=_assignment, action="append",
+                        metavar="NAME=VALUE",
+                        help="parameter: mass, length, inertia, gravity, damping (repeatable)")
+    parser.add_argument("--theta0", type=_float, default=0.0, help="initial angle in rad")
+    parser.add_argument("--omega0", type=_float, default=0.0, help="initial rate in rad/s")
+
+
+def cmd_build(args) -> int:
+    print(f"wrote {build_fmu(args.output)}")
+    return 0
+
+
+def cmd_simulate(args) -> int:
+    from . import results
+    from .plot import plot_overlay
+    from .simulate import simulate
+
+    run = simulate(_torque_signal(args), stop_time=args.stop_time, step_size=args.step_size,
+                   ramp=args.ramp, parameters=_parameters(args.assignments), theta0=args.theta0,
+                   omega0=args.omega0, tolerance=args.tolerance)
+    last = run[-1]
+    print(f"{len(run) - 1} steps to t = {last['time']:g} s: theta = {last['theta']:.12g} rad, "
+          f"omega = {last['omega']:.12g} rad/s, alpha = {last['alpha']:.12g} rad/s2; "
+          f"max |theta| = {np.max(np.abs(run['theta'])):.6g} rad")
+    if args.output:
+        header = ",".join(results.FIELDS)
+        np.savetxt(args.output, run.view(np.float64).reshape(len(run), -1), delimiter=",",
+                   header=header, comments="", fmt="%.17g")
+        print(f"wrote {args.output} ({header}; units {', '.join(results.UNITS.values())})")
+    if args.plot:
+        print(f"wrote {plot_overlay({'FMU': run}, args.plot, 'Torque-driven pendulum')}")
+    return 0
+
+
+def _print_comparison(comparison) -> None:
+    from .compare import format_table
+
+    print(format_table(comparison.differences))
+    verdict = "agree" if comparison.agree else "DIFFER"
+    print(f"tools {verdict}: worst difference {comparison.worst:.3e} against tolerance "
+          f"{comparison.tolerance:g}")
+
+
+def cmd_compare(args) -> int:
+    from .compare import compare
+
+    tools = [tool.strip() for tool in args.tools.split(",") if tool.strip()]
+    comparison = compare(_torque_signal(args), tools, output_dir=args.output_dir,
+                         step_size=args.step_size, stop_time=args.stop_time,
+                         parameters=_parameters(args.assignments), theta0=args.theta0,
+                         omega0=args.omega0, tolerance=args.tol)
+    _print_comparison(comparison)
+    for path in (comparison.trajectories, comparison.table, comparison.figure):
+        print(f"wrote {path}")
+    return 0 if comparison.agree else 1
+
+
+def _sweep_values(assignments) -> dict[str, list[float]]:
+    values = {}
+    for name, text in assignments or ():
+        try:
+            values[name] = [float(v) for v in text.split(",")]
+        except ValueError:
+            raise ValueError(f"--set {name}={text}: expected comma-separated numbers") from None
+    return values
+
+
+def cmd_sweep(args) -> int:
+    from .sweep import run_sweep, sweep_grid
+
+    cases = sweep_grid(args.torque, args.gravity, _sweep_values(args.assignments))
+    summary = run_sweep(cases, output_dir=args.output_dir, stop_time=args.stop_time,
+                        step_size=args.step_size, scheduler=args.scheduler, workers=args.workers)
+    print(f"{summary['cases']} cases in {summary['seconds']:.1f} s")
+    print(f"wrote {summary['results']}\nwrote {summary['figure']}")
+    return 0
+
+
+def cmd_demo(args) -> int:
+    """The tutorial end to end."""
+    from .compare import compare
+    from .parameters import default_parameters, total_inertia
+    from .plot import plot_overlay
+    from .sweep import run_sweep, sweep_grid
+
+    out = Path(args.output_dir)
+    tools = ["fmu", "reference"]
+    if importlib.util.find_spec("opensim") is not None:
+        tools.append("opensim")
+    else:
+        print("OpenSim is not installed, so it is left out (pip install -e '.[opensim]')")
+    torque = TUTORIAL_TORQUE
+    print(f"Tutorial case: constant torque {torque:g} N.m, 3 s in 1 ms steps; tools: {', '.join(tools)}")
+    runs, agree = {}, True
+    for label, gravity, folder in (("No Gravity", 0.0, "no_gravity"), ("With Gravity", 9.81, "gravity")):
+        comparison = compare(torque, tools, output_dir=out / folder, parameters={"gravity": gravity},
+                             title=rf"Constant Torque $\tau = {torque:g}$ Nm — {label}")
+        print(f"\n{label} (gravity = {gravity:g} m/s2)")
+        _print_comparison(comparison)
+        fmu = comparison.runs["fmu"]
+        if gravity == 0.0:
+            parabola = 0.5 * torque / total_inertia(default_parameters()) * fmu["time"] ** 2
+            print(f"fmu vs analytic theta = tau t^2 / (2 I): {np.max(np.abs(fmu['theta'] - parabola)):.3e} rad")
+        print(f"theta(3 s) = {fmu['theta'][-1]:.10f} rad, omega(3 s) = {fmu['omega'][-1]:.10f} rad/s")
+        print(f"wrote {comparison.figure}")
+        runs[label] = fmu
+        agree &= comparison.agree
+    overlay = plot_overlay({rf"No gravity ($\tau = {torque:g}$ Nm)": runs["No Gravity"],
+                            rf"With gravity ($\tau = {torque:g}$ Nm)": runs["With Gravity"]},
+                           out / "gravity_effect.png", "Effect of Gravity on Torque-Driven Pendulum")
+    print(f"\nwrote {overlay}")
+    print("\nParameter study: torque 5, 10, 20, 40 N.m with gravity, on a local dask cluster")
+    summary = run_sweep(sweep_grid([5.0, 10.0, 20.0, 40.0], [9.81]), output_dir=out / "parameter_study",
+                        workers=args.workers)
+    print(f"{summary['cases']} cases in {summary['seconds']:.1f} s\nwrote {summary['results']}\n"
+          f"wrote {summary['figure']}")
+    return 0 if agree else 1
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="pendulum-fmu",
+        description="A torque-driven pendulum as an FMI 2.0 Co-Simulation FMU: build it, "
+                    "simulate it, and compare it with scipy and OpenSim.")
+    commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    build = commands.add_parser("build", help="build the FMU (same as python build_fmu.py)",
+                                description="Build the FMU from fmu_src/ and modelDescription.xml.")
+    build.add_argument("--output", type=Path, default=DEFAULT_FMU, help="default: %(default)s")
+    build.set_defaults(run=cmd_build)
+
+    simulate = commands.add_parser("simulate", help="simulate the FMU under a torque signal",
+                                   description="Simulate the FMU through fmpy; the torque is held "
+                                               "over each communication step unless --ramp.")
+    _add_signal_arguments(simulate)
+    simulate.add_argument("--ramp", action="store_true",
+                          help="ramp the torque linearly over each step (input derivatives)")
+    simulate.add_argument("--tolerance", type=_float, default=None,
+                          help="relative tolerance of the FMU's integrator (default: 1e-10)")
+    simulate.add_argument("--output", type=Path, help="write time,torque,theta,omega,alpha CSV")
+    simulate.add_argument("--plot", type=Path, help="write a PNG of theta and omega")
+    simulate.set_defaults(run=cmd_simulate)
+
+    compare = commands.add_parser("compare", help="run one torque signal through several tools",
+                                  description="Run one torque signal through the FMU, the scipy "
+                                              "reference and OpenSim; write trajectories, a table "
+                                              "of max differences and a figure. Exits 1 when two "
+                                              "tools differ by more than --tol.")
+    _add_signal_arguments(compare)
+    compare.add_argument("--tools", default="fmu,reference,opensim",
+                         help="comma-separated: fmu, reference, opensim (default: %(default)s)")
+    compare.add_argument("--output-dir", type=Path, required=True)
+    compare.add_argument("--tol", type=_float, default=1e-9,
+                         help="largest allowed |dtheta| or |domega| (default: %(default)s)")
+    compare.set_defaults(run=cmd_compare)
+
+    sweep = commands.add_parser("sweep", help="parameter study as a grid, on dask",
+                                description="Run every combination of the given values on dask: a "
+                                            "local cluster, or an existing scheduler.")
+    sweep.add_argument("--torque", type=_float, nargs="+", required=True, help="torques in N.m")
+    sweep.add_argument("--gravity", type=_float, nargs="+", default=[9.81], help="default: 9.81")
+    sweep.add_argument("--set", dest="assignments", type=_assignment, action="append",
+                       metavar="NAME=V1,V2", help="more values of a parameter or theta0/omega0")
+    sweep.add_argument("--stop-time", type=_float, default=3.0, help="default: %(default)s s")
+    sweep.add_argument("--step-size", type=_float, default=1e-3, help="default: %(default)s s")
+    sweep.add_argument("--output-dir", type=Path, required=True)
+    sweep.add_argument("--scheduler", help="address of a running dask.distributed scheduler")
+    sweep.add_argument("--workers", type=int, default=None, help="local cluster workers (default: 2)")
+    sweep.set_defaults(run=cmd_sweep)
+
+    demo = commands.add_parser("demo", help="the OpenSim tutorial end to end",
+                               description="Gravity off and on against the reference (and "
+                                           "OpenSim when installed), the overlay and the "
+                                           "parameter study; prints the error table and writes "
+                                           "the figures.")
+    demo.add_argument("--output-dir", type=Path, default=Path("demo"), help="default: %(default)s")
+    demo.add_argument("--workers", type=int, default=None, help="local dask workers (default: 2)")
+    demo.set_defaults(run=cmd_demo)
+    return parser
+
+
+def main(argv=None) -> int:
+    from .signal import TorqueFileError
+    from .simulate import FmuError
+
+    args = build_parser().parse_args(argv)
+    try:
+        return args.run(args)
+    except (ValueError, TorqueFileError, FmuError, BuildError, ImportError, OSError) as error:
+        print(f"pendulum-fmu {args.command}: error: {error}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())
