@@ -180,7 +180,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     build = commands.add_parser("build", help="build the FMU (same as python build_fmu.py)",
                                 description="Build the FMU from fmu_src/ and modelDescription.xml.")
-    build.add_argument("--output", type=Path, default=DEFAULT_FMU, help="default: %(default)s")
+    build.add_argument("--output", type=Path, default=DEFAULT_FMU,
+                       help="where to write the FMU (default: %(default)s)")
     build.set_defaults(run=cmd_build)
 
     simulate = commands.add_parser("simulate", help="simulate the FMU under a torque signal",
@@ -203,7 +204,8 @@ def build_parser() -> argparse.ArgumentParser:
     _add_signal_arguments(compare)
     compare.add_argument("--tools", default="fmu,reference,opensim",
                          help="comma-separated: fmu, reference, opensim (default: %(default)s)")
-    compare.add_argument("--output-dir", type=Path, required=True)
+    compare.add_argument("--output-dir", type=Path, required=True,
+                         help="folder for trajectories.csv, differences.csv and comparison.png")
     compare.add_argument("--tol", type=_float, default=1e-9,
                          help="largest allowed |dtheta| or |domega| (default: %(default)s)")
     compare.set_defaults(run=cmd_compare)
@@ -217,7 +219,8 @@ def build_parser() -> argparse.ArgumentParser:
                        metavar="NAME=V1,V2", help="more values of a parameter or theta0/omega0")
     sweep.add_argument("--stop-time", type=_float, default=3.0, help="default: %(default)s s")
     sweep.add_argument("--step-size", type=_float, default=1e-3, help="default: %(default)s s")
-    sweep.add_argument("--output-dir", type=Path, required=True)
+    sweep.add_argument("--output-dir", type=Path, required=True,
+                       help="folder for sweep.csv (one tidy file) and sweep.png")
     sweep.add_argument("--scheduler", help="address of a running dask.distributed scheduler")
     sweep.add_argument("--workers", type=int, default=None, help="local cluster workers (default: 2)")
     sweep.set_defaults(run=cmd_sweep)
@@ -227,7 +230,8 @@ def build_parser() -> argparse.ArgumentParser:
                                            "OpenSim when installed), the overlay and the "
                                            "parameter study; prints the error table and writes "
                                            "the figures.")
-    demo.add_argument("--output-dir", type=Path, default=Path("demo"), help="default: %(default)s")
+    demo.add_argument("--output-dir", type=Path, default=Path("demo"),
+                      help="folder for the figures and tables (default: %(default)s)")
     demo.add_argument("--workers", type=int, default=None, help="local dask workers (default: 2)")
     demo.set_defaults(run=cmd_demo)
     return parser

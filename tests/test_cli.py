@@ -1,0 +1,87 @@
+"""The pendulum-fmu command line, run in-process through main(argv)."""
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from pendulum_fmu.cli import build_parser, main
+from pendulum_fmu.reference import reference
+
+I_TOTAL = 30.0
+
+
+def test_every_command_has_help():
+    parser = build_parser()
+    commands = parser._subparsers._group_actions[0].choices
+    assert set(commands) == {"build", "simulate", "compare", "sweep", "demo"}
+    for name, command in commands.items():
+        assert command.description, name
+        for action in command._actions:
+            assert action.help, f"{name} {action.option_strings}"
+
+
+def test_build(tmp_path, capsys):
+    assert main(["build", "--output", str(tmp_path / "P.fmu")]) == 0
+    assert (tmp_path / "P.fmu").stat().st_size > 10_000
+    assert "wrote" in capsys.readouterr().out
+
+
+def test_simulate_writes_csv_and_plot(tmp_path, capsys):
+    out, png = tmp_path / "out.csv", tmp_path / "out.png"
+    assert main(["simulate", "--torque", "20", "--set", "gravity=0", "--theta0", "0.1",
+                 "--output", str(out), "--plot", str(png)]) == 0
+    data = np.genfromtxt(out, delimiter=",", names=True)
+    assert data.dtype.names == ("time", "torque", "theta", "omega", "alpha")
+    assert np.max(np.abs(data["theta"] - (0.1 + 10 / I_TOTAL * data["time"] ** 2))) < 1e-12
+    assert png.read_bytes()[:4] == b"\x89PNG"
+    assert "theta = 3.1" in capsys.readouterr().out
+
+
+def test_simulate_torque_file(tmp_path):
+    csv = tmp_path / "t.csv"
+    csv.write_text("time,torque\n0,5\n1,5\n1,-5\n2,-5\n")
+    out = tmp_path / "out.csv"
+    assert main(["simulate", "--torque-file", str(csv), "--step-size", "0.01", "--output", str(out)]) == 0
+    data = np.genfromtxt(out, delimiter=",", names=True)
+    assert data["time"][-1] == 2.0
+    assert np.max(np.abs(data["theta"] - reference(csv, step_size=0.01)["theta"])) < 1e-10
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["simulate", "--torque-file", "{bad}"], "bad.csv:3: torque 'x' is not a number"),
+    (["simulate", "--torque", "1", "--set", "mas=2"], "unknown parameter 'mas'"),
+    (["simulate", "--torque", "1", "--set", "mass=heavy"], "'heavy' is not a number"),
+    (["simulate", "--torque", "1", "--set", "mass=-1"], "mass must be > 0"),
+    (["simulate", "--torque", "1", "--step-size", "0"], "step size 0.0 must be positive"),
+    (["compare", "--torque", "1", "--tools", "fmu,matlab", "--output-dir", "{tmp}"], "unknown tool(s) matlab"),
+])
+def test_bad_input_gives_one_clear_line(tmp_path, capsys, argv, message):
+    bad = tmp_path / "bad.csv"
+    bad.write_text("time,torque\n0,1\n1,x\n")
+    argv = [a.format(bad=bad, tmp=tmp_path) for a in argv]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert message in err and "Traceback" not in err
+    assert err.count("\n") == 1
+
+
+def test_argument_errors_exit_2_without_traceback():
+    result = subprocess.run([sys.executable, "-m", "pendulum_fmu.cli", "simulate", "--torque", "abc"],
+                            capture_output=True, text=True)
+    assert result.returncode == 2
+    assert "'abc' is not a number" in result.stderr and "Traceback" not in result.stderr
+
+
+def test_compare_passes_and_fails_on_tolerance(tmp_path, capsys):
+    args = ["compare", "--torque", "20", "--tools", "fmu,reference", "--stop-time", "1",
+            "--output-dir", str(tmp_path)]
+    assert main(args) == 0
+    table = np.genfromtxt(tmp_path / "differences.csv", delimiter=",", names=True, dtype=None, encoding=None)
+    assert float(table["theta"]) < 1e-10
+    trajectories = np.genfromtxt(tmp_path / "trajectories.csv", delimiter=",", names=True)
+    assert {"theta_fmu", "omega_reference", "alpha_fmu"} <= set(trajectories.dtype.names)
+    assert (tmp_path / "comparison.png").exists()
+    assert main(args + ["--tol", "1e-16"]) == 1
+    assert "DIFFER" in capsys.readouterr().out

@@ -1,0 +1,68 @@
+"""Torque signals: schedules from constants, callables and CSVs; clear errors for bad files."""
+
+import numpy as np
+import pytest
+
+from pendulum_fmu.signal import TorqueFileError, read_torque_csv, schedule, write_torque_csv
+
+
+def test_csv_jumps_become_communication_points(tmp_path):
+    csv = tmp_path / "t.csv"
+    csv.write_text("time,torque\n0,1\n0.0105,1\n0.0105,-2\n0.02,-2\n")
+    plan = schedule(csv, step_size=0.002)
+    assert plan.time[0] == 0 and plan.time[-1] == 0.02
+    assert 0.0105 in plan.time
+    jump = np.flatnonzero(plan.time == 0.0105)[0]
+    assert np.all(plan.torque[:jump] == 1) and np.all(plan.torque[jump:] == -2)
+    assert np.all(plan.torque_rate == 0)
+
+
+def test_ramp_follows_a_linear_csv_segment(tmp_path):
+    csv = tmp_path / "t.csv"
+    csv.write_text("time,torque\n0,0\n1,10\n")
+    plan = schedule(csv, step_size=0.25, ramp=True)
+    assert np.allclose(plan.torque, [0, 2.5, 5, 7.5]) and np.allclose(plan.torque_rate, 10)
+    held = schedule(csv, step_size=0.25)
+    assert np.allclose(held.torque, [0, 2.5, 5, 7.5]) and not held.torque_rate.any()
+
+
+def test_written_schedule_reads_back(tmp_path):
+    plan = schedule(lambda t: 3.0 if t < 0.5 else -1.0, stop_time=1.0, step_size=0.1)
+    table = read_torque_csv(write_torque_csv(tmp_path / "t.csv", plan))
+    again = schedule(table, step_size=0.1)
+    assert np.allclose(again.time, plan.time) and np.array_equal(again.torque, plan.torque)
+
+
+@pytest.mark.parametrize("content, message", [
+    ("", "the file is empty"),
+    ("t,torque\n0,1\n", "t.csv:1: missing column 'time'"),
+    ("time,force\n0,1\n", "t.csv:1: missing column 'torque'"),
+    ("time,torque\n0,1\n1,abc\n", "t.csv:3: torque 'abc' is not a number"),
+    ("time,torque\n0,1\n1\n", "t.csv:3: torque '' is not a number"),
+    ("time,torque\n0,1\n2,1\n1,1\n", "t.csv:4: time 1 goes backwards"),
+    ("time,torque\n0,1\n1,nan\n", "t.csv:3: torque is nan"),
+    ("time,torque\n0,1\ninf,1\n", "t.csv:3: time is inf"),
+    ("time,torque\n0,1\n1,1\n1,2\n1,3\n", "t.csv:5: time 1 appears three times"),
+    ("time,torque\n", "no data rows"),
+])
+def test_bad_files_name_file_row_and_problem(tmp_path, content, message):
+    csv = tmp_path / "t.csv"
+    csv.write_text(content)
+    with pytest.raises(TorqueFileError, match=message.replace("(", r"\(")) as error:
+        read_torque_csv(csv)
+    assert str(error.value).startswith(str(csv))
+    assert "\n" not in str(error.value)
+
+
+def test_missing_file(tmp_path):
+    with pytest.raises(TorqueFileError, match="cannot read"):
+        read_torque_csv(tmp_path / "absent.csv")
+
+
+def test_bad_arguments():
+    with pytest.raises(ValueError, match="step size"):
+        schedule(1.0, step_size=0)
+    with pytest.raises(ValueError, match="stop time"):
+        schedule(1.0, stop_time=-1)
+    with pytest.raises(ValueError, match="returned nan"):
+        schedule(lambda t: float("nan"), stop_time=0.1)
