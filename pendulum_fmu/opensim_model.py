@@ -7,10 +7,14 @@ the torque in N.m) whose value is set through ``setOverrideActuation``.
 Visual geometry is left out. OpenSim is an optional dependency.
 """
 
+import os
+
 import numpy as np
 
 
 def _import_opensim():
+    # Importing opensim otherwise drops an opensim.log into the working directory.
+    os.environ.setdefault("OPENSIM_DISABLE_LOG_FILE", "1")
     try:
         import opensim
     except ImportError as error:
