@@ -1,25 +1,28 @@
-/* The FMI 2.0 co-simulation entry points: state machine, argument checks, then one call into
-   instance.c. Which states each function is allowed in is data: one mask per function. */
+/* The FMI 2.0 entry points, co-simulation and model exchange: state machine, argument checks,
+   then one call into instance.c. Which states each function is allowed in is data: one mask
+   per function (FMI 2.0, tables in sections 3.2.3 and 4.2.4). */
 
 #include <stddef.h>
 
 #include "instance.h"
 
-#define ANY_INITIALIZED (STATE_STEP_COMPLETE | STATE_STEP_FAILED | STATE_TERMINATED)
+#define ANY_INITIALIZED (STATE_STEP_COMPLETE | STATE_STEP_FAILED | STATE_TERMINATED \
+                         | STATE_EVENT_MODE | STATE_CONTINUOUS_TIME_MODE)
 #define ANY_STATE (STATE_INSTANTIATED | STATE_INITIALIZATION_MODE | ANY_INITIALIZED)
+#define RUNNING (STATE_STEP_COMPLETE | STATE_EVENT_MODE | STATE_CONTINUOUS_TIME_MODE)
 
 #define MASK_fmi2SetDebugLogging              ANY_STATE
 #define MASK_fmi2SetupExperiment              STATE_INSTANTIATED
 #define MASK_fmi2EnterInitializationMode      STATE_INSTANTIATED
 #define MASK_fmi2ExitInitializationMode       STATE_INITIALIZATION_MODE
-#define MASK_fmi2Terminate                    (STATE_STEP_COMPLETE | STATE_STEP_FAILED)
+#define MASK_fmi2Terminate                    (RUNNING | STATE_STEP_FAILED)
 #define MASK_fmi2Reset                        ANY_STATE
 #define MASK_fmi2GetReal                      (STATE_INITIALIZATION_MODE | ANY_INITIALIZED)
 #define MASK_fmi2GetInteger                   MASK_fmi2GetReal
 #define MASK_fmi2GetBoolean                   MASK_fmi2GetReal
 #define MASK_fmi2GetString                    MASK_fmi2GetReal
 #define MASK_fmi2SetReal                      (STATE_INSTANTIATED | STATE_INITIALIZATION_MODE \
-                                               | STATE_STEP_COMPLETE)
+                                               | RUNNING)
 #define MASK_fmi2SetInteger                   MASK_fmi2SetReal
 #define MASK_fmi2SetBoolean                   MASK_fmi2SetReal
 #define MASK_fmi2SetString                    MASK_fmi2SetReal
@@ -32,14 +35,29 @@
 #define MASK_fmi2GetDirectionalDerivative     (STATE_INITIALIZATION_MODE | ANY_INITIALIZED)
 #define MASK_fmi2SetRealInputDerivatives      (STATE_INSTANTIATED | STATE_INITIALIZATION_MODE \
                                                | STATE_STEP_COMPLETE)
-#define MASK_fmi2GetRealOutputDerivatives     ANY_INITIALIZED
+#define MASK_fmi2GetRealOutputDerivatives     (STATE_STEP_COMPLETE | STATE_STEP_FAILED \
+                                               | STATE_TERMINATED)
 #define MASK_fmi2DoStep                       STATE_STEP_COMPLETE
 #define MASK_fmi2CancelStep                   0
-#define MASK_fmi2GetStatus                    ANY_INITIALIZED
-#define MASK_fmi2GetRealStatus                ANY_INITIALIZED
-#define MASK_fmi2GetIntegerStatus             ANY_INITIALIZED
-#define MASK_fmi2GetBooleanStatus             ANY_INITIALIZED
-#define MASK_fmi2GetStringStatus              ANY_INITIALIZED
+#define MASK_fmi2GetStatus                    (STATE_STEP_COMPLETE | STATE_STEP_FAILED \
+                                               | STATE_TERMINATED)
+#define MASK_fmi2GetRealStatus                MASK_fmi2GetStatus
+#define MASK_fmi2GetIntegerStatus             MASK_fmi2GetStatus
+#define MASK_fmi2GetBooleanStatus             MASK_fmi2GetStatus
+#define MASK_fmi2GetStringStatus              MASK_fmi2GetStatus
+#define MASK_fmi2EnterEventMode               (STATE_EVENT_MODE | STATE_CONTINUOUS_TIME_MODE)
+#define MASK_fmi2NewDiscreteStates            STATE_EVENT_MODE
+#define MASK_fmi2EnterContinuousTimeMode      STATE_EVENT_MODE
+#define MASK_fmi2CompletedIntegratorStep      STATE_CONTINUOUS_TIME_MODE
+#define MASK_fmi2SetTime                      (STATE_EVENT_MODE | STATE_CONTINUOUS_TIME_MODE)
+#define MASK_fmi2SetContinuousStates          STATE_CONTINUOUS_TIME_MODE
+#define MASK_fmi2GetEventIndicators           (STATE_INITIALIZATION_MODE | STATE_EVENT_MODE \
+                                               | STATE_CONTINUOUS_TIME_MODE | STATE_TERMINATED)
+#define MASK_fmi2GetContinuousStates          MASK_fmi2GetEventIndicators
+#define MASK_fmi2GetDerivatives               (STATE_EVENT_MODE | STATE_CONTINUOUS_TIME_MODE \
+                                               | STATE_TERMINATED)
+#define MASK_fmi2GetNominalsOfContinuousStates (STATE_INSTANTIATED | STATE_EVENT_MODE \
+                                               | STATE_CONTINUOUS_TIME_MODE | STATE_TERMINATED)
 
 /* Every function with an instance starts here: NULL instance, then the state mask. */
 #define ENTER(function)                                                                \
@@ -252,4 +270,86 @@ fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2Stri
     (void)s;
     (void)value;
     return instance_error(instance, "fmi2GetStringStatus", "no string status is available");
+}
+
+/* Model exchange. The pendulum has no events: event mode only passes through. */
+
+fmi2Status fmi2EnterEventMode(fmi2Component c) {
+    ENTER(fmi2EnterEventMode)
+    instance->data.machine_state = STATE_EVENT_MODE;
+    return fmi2OK;
+}
+
+fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *fmi2eventInfo) {
+    ENTER(fmi2NewDiscreteStates)
+    if (instance_null_argument(instance, "fmi2NewDiscreteStates", "fmi2eventInfo", fmi2eventInfo))
+        return fmi2Error;
+    fmi2eventInfo->newDiscreteStatesNeeded = fmi2False;
+    fmi2eventInfo->terminateSimulation = fmi2False;
+    fmi2eventInfo->nominalsOfContinuousStatesChanged = fmi2False;
+    fmi2eventInfo->valuesOfContinuousStatesChanged = fmi2False;
+    fmi2eventInfo->nextEventTimeDefined = fmi2False;
+    fmi2eventInfo->nextEventTime = 0.0;
+    return fmi2OK;
+}
+
+fmi2Status fmi2EnterContinuousTimeMode(fmi2Component c) {
+    ENTER(fmi2EnterContinuousTimeMode)
+    instance->data.machine_state = STATE_CONTINUOUS_TIME_MODE;
+    return fmi2OK;
+}
+
+fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, fmi2Boolean noSetFMUStatePriorToCurrentPoint,
+                                       fmi2Boolean *enterEventMode, fmi2Boolean *terminateSimulation) {
+    (void)noSetFMUStatePriorToCurrentPoint;
+    ENTER(fmi2CompletedIntegratorStep)
+    if (instance_null_argument(instance, "fmi2CompletedIntegratorStep", "enterEventMode", enterEventMode) ||
+        instance_null_argument(instance, "fmi2CompletedIntegratorStep", "terminateSimulation",
+                               terminateSimulation))
+        return fmi2Error;
+    *enterEventMode = fmi2False;
+    *terminateSimulation = fmi2False;
+    return fmi2OK;
+}
+
+fmi2Status fmi2SetTime(fmi2Component c, fmi2Real time) {
+    ENTER(fmi2SetTime)
+    return instance_set_time(instance, time);
+}
+
+fmi2Status fmi2SetContinuousStates(fmi2Component c, const fmi2Real x[], size_t nx) {
+    ENTER(fmi2SetContinuousStates)
+    REQUIRE_ARRAY(fmi2SetContinuousStates, x, nx)
+    return instance_set_states(instance, x, nx);
+}
+
+fmi2Status fmi2GetDerivatives(fmi2Component c, fmi2Real derivatives[], size_t nx) {
+    ENTER(fmi2GetDerivatives)
+    REQUIRE_ARRAY(fmi2GetDerivatives, derivatives, nx)
+    return instance_get_derivatives(instance, derivatives, nx);
+}
+
+fmi2Status fmi2GetEventIndicators(fmi2Component c, fmi2Real eventIndicators[], size_t ni) {
+    (void)eventIndicators;
+    ENTER(fmi2GetEventIndicators)
+    if (ni == 0) return fmi2OK;
+    return instance_error(instance, "fmi2GetEventIndicators", "ni = %lu, but the model has no "
+                          "event indicators", (unsigned long)ni);
+}
+
+fmi2Status fmi2GetContinuousStates(fmi2Component c, fmi2Real x[], size_t nx) {
+    ENTER(fmi2GetContinuousStates)
+    REQUIRE_ARRAY(fmi2GetContinuousStates, x, nx)
+    return instance_get_states(instance, x, nx);
+}
+
+fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, fmi2Real x_nominal[], size_t nx) {
+    ENTER(fmi2GetNominalsOfContinuousStates)
+    REQUIRE_ARRAY(fmi2GetNominalsOfContinuousStates, x_nominal, nx)
+    if (nx != N_STATES)
+        return instance_error(instance, "fmi2GetNominalsOfContinuousStates",
+                              "nx = %lu, but the model has %d continuous states", (unsigned long)nx,
+                              N_STATES);
+    for (size_t i = 0; i < nx; i++) x_nominal[i] = 1.0; /* radians and radians per second */
+    return fmi2OK;
 }

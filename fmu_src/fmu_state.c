@@ -16,8 +16,7 @@
 #define SERIALIZED_SIZE (HEADER_SIZE + sizeof(InstanceData) + CHECKSUM_SIZE)
 
 /* States an FMU state may be taken in and restored to. */
-#define RESTORABLE_STATES (STATE_INSTANTIATED | STATE_INITIALIZATION_MODE | STATE_STEP_COMPLETE \
-                           | STATE_STEP_FAILED | STATE_TERMINATED)
+#define RESTORABLE_STATES (CO_SIMULATION_STATES | MODEL_EXCHANGE_STATES)
 
 static uint64_t fnv1a(const unsigned char *bytes, size_t size) {
     uint64_t hash = 14695981039346656037ull;
@@ -63,7 +62,13 @@ fmi2Status instance_get_state(Instance *instance, fmi2FMUstate *state) {
 
 fmi2Status instance_set_state(Instance *instance, fmi2FMUstate state) {
     if (instance_null_argument(instance, "fmi2SetFMUstate", "FMUstate", state)) return fmi2Error;
-    instance->data = *(const InstanceData *)state;
+    const InstanceData *data = state;
+    const int own_states = instance->type == fmi2CoSimulation ? CO_SIMULATION_STATES
+                                                                : MODEL_EXCHANGE_STATES;
+    if (!(data->machine_state & own_states))
+        return instance_error(instance, "fmi2SetFMUstate",
+                              "the state comes from an instance of the other FMI interface");
+    instance->data = *data;
     instance_data_changed(instance);
     return fmi2OK;
 }

@@ -49,6 +49,8 @@ static const char *state_name(int state) {
         case STATE_STEP_COMPLETE: return "step complete";
         case STATE_STEP_FAILED: return "step failed";
         case STATE_TERMINATED: return "terminated";
+        case STATE_EVENT_MODE: return "event mode";
+        case STATE_CONTINUOUS_TIME_MODE: return "continuous-time mode";
         default: return "unknown";
     }
 }
@@ -83,10 +85,11 @@ Instance *instance_create(fmi2String name, fmi2String guid, fmi2Type type,
         return instance_error(&probe, "fmi2Instantiate",
                               "fmuGUID %s does not match this FMU's %s (was modelDescription.xml "
                               "taken from another FMU?)", guid ? guid : "NULL", MODEL_GUID), NULL;
-    if (type != fmi2CoSimulation)
+    if (type != fmi2CoSimulation && type != fmi2ModelExchange)
         return instance_error(&probe, "fmi2Instantiate",
-                              "fmuType %d is not supported: this FMU is for co-simulation only",
+                              "fmuType %d is neither fmi2ModelExchange (0) nor fmi2CoSimulation (1)",
                               (int)type), NULL;
+    probe.type = type;
 
     Instance *instance = calloc(1, sizeof(Instance));
     if (!instance)
@@ -162,7 +165,8 @@ fmi2Status instance_exit_initialization(Instance *instance) {
                                   model_variables[vr].name);
     }
     instance_data_changed(instance);
-    instance->data.machine_state = STATE_STEP_COMPLETE;
+    instance->data.machine_state =
+        instance->type == fmi2CoSimulation ? STATE_STEP_COMPLETE : STATE_EVENT_MODE;
     return fmi2OK;
 }
 
@@ -235,6 +239,8 @@ fmi2Status instance_set_input_derivatives(Instance *instance, const fmi2ValueRef
                                           size_t nvr, const fmi2Integer order[],
                                           const fmi2Real value[]) {
     const char *function = "fmi2SetRealInputDerivatives";
+    if (instance->type != fmi2CoSimulation)
+        return instance_error(instance, function, "input derivatives are for co-simulation only");
     for (size_t i = 0; i < nvr; i++) {
         if (unknown_reference(vr[i]))
             return instance_error(instance, function, "vr %u %s", vr[i], unknown_reference(vr[i]));
@@ -333,5 +339,45 @@ fmi2Status instance_do_step(Instance *instance, fmi2Real communication_point,
     data->time = communication_point + communication_step;
     data->last_successful_time = data->time;
     instance->outputs_stale = 1;
+    return fmi2OK;
+}
+
+static int wrong_state_count(const Instance *instance, const char *function, size_t nx) {
+    if (nx == N_STATES) return 0;
+    instance_error(instance, function, "nx = %lu, but the model has %d continuous states "
+                   "(theta, omega)", (unsigned long)nx, N_STATES);
+    return 1;
+}
+
+fmi2Status instance_set_time(Instance *instance, fmi2Real time) {
+    if (!isfinite(time)) return instance_error(instance, "fmi2SetTime", "time must be finite");
+    instance->data.time = time;
+    return fmi2OK;
+}
+
+fmi2Status instance_set_states(Instance *instance, const fmi2Real x[], size_t nx) {
+    if (wrong_state_count(instance, "fmi2SetContinuousStates", nx)) return fmi2Error;
+    for (size_t i = 0; i < nx; i++) {
+        if (!isfinite(x[i]))
+            return instance_error(instance, "fmi2SetContinuousStates",
+                                  "x[%lu] = %g refused: states must be finite", (unsigned long)i, x[i]);
+    }
+    model_set_states(instance->data.values, x);
+    instance->outputs_stale = 1;
+    return fmi2OK;
+}
+
+fmi2Status instance_get_states(Instance *instance, fmi2Real x[], size_t nx) {
+    if (wrong_state_count(instance, "fmi2GetContinuousStates", nx)) return fmi2Error;
+    model_get_states(instance->data.values, x);
+    return fmi2OK;
+}
+
+fmi2Status instance_get_derivatives(Instance *instance, fmi2Real dx[], size_t nx) {
+    if (wrong_state_count(instance, "fmi2GetDerivatives", nx)) return fmi2Error;
+    double x[N_STATES];
+    model_get_states(instance->data.values, x);
+    model_derivatives(&instance->coefficients, instance->data.values, instance->data.input_rates,
+                      0.0, x, dx);
     return fmi2OK;
 }

@@ -9,14 +9,23 @@
 #include "fmi2Functions.h"
 #include "model.h"
 
-/* The FMI 2.0 co-simulation states, as bits so that each function's allowed states are a mask. */
+/* The FMI 2.0 states, as bits so that each function's allowed states are a mask. Co-simulation
+   instances never reach the model-exchange states and vice versa, so the masks also keep each
+   interface's functions to its own instances. */
 typedef enum {
     STATE_INSTANTIATED = 1 << 0,
     STATE_INITIALIZATION_MODE = 1 << 1,
     STATE_STEP_COMPLETE = 1 << 2,
     STATE_STEP_FAILED = 1 << 3,
-    STATE_TERMINATED = 1 << 4
+    STATE_TERMINATED = 1 << 4,
+    STATE_EVENT_MODE = 1 << 5,
+    STATE_CONTINUOUS_TIME_MODE = 1 << 6
 } MachineState;
+
+#define CO_SIMULATION_STATES (STATE_INSTANTIATED | STATE_INITIALIZATION_MODE | STATE_STEP_COMPLETE \
+                              | STATE_STEP_FAILED | STATE_TERMINATED)
+#define MODEL_EXCHANGE_STATES (STATE_INSTANTIATED | STATE_INITIALIZATION_MODE | STATE_EVENT_MODE \
+                               | STATE_CONTINUOUS_TIME_MODE | STATE_TERMINATED)
 
 #define DEFAULT_TOLERANCE 1e-10
 /* Internal steps one fmi2DoStep may try before it gives up with fmi2Discard. */
@@ -47,6 +56,7 @@ typedef struct {
     /* Derived from data: recomputed whenever data changes outside a step. */
     ModelCoefficients coefficients;
     int outputs_stale;
+    fmi2Type type;                       /* co-simulation or model exchange, fixed at instantiation */
     fmi2CallbackLogger logger;
     fmi2ComponentEnvironment environment;
     int log_categories;                  /* LogCategory bits switched on by the master */
@@ -89,6 +99,12 @@ fmi2Status instance_directional_derivative(Instance *instance, const fmi2ValueRe
                                            fmi2Real unknown_delta[]);
 fmi2Status instance_do_step(Instance *instance, fmi2Real communication_point,
                             fmi2Real communication_step);
+
+/* Model exchange: the continuous states and their derivatives. */
+fmi2Status instance_set_time(Instance *instance, fmi2Real time);
+fmi2Status instance_set_states(Instance *instance, const fmi2Real x[], size_t nx);
+fmi2Status instance_get_states(Instance *instance, fmi2Real x[], size_t nx);
+fmi2Status instance_get_derivatives(Instance *instance, fmi2Real dx[], size_t nx);
 
 /* FMU states (fmu_state.c). */
 fmi2Status instance_get_state(Instance *instance, fmi2FMUstate *state);
