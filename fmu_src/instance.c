@@ -227,11 +227,14 @@ fmi2Status instance_get_real(Instance *instance, const fmi2ValueReference vr[], 
         if (unknown_reference(vr[i]))
             return instance_error(instance, "fmi2GetReal", "vr %u %s", vr[i], unknown_reference(vr[i]));
     }
-    if (instance->outputs_stale && nvr > 0) {
-        model_update_outputs(&instance->coefficients, instance->data.values);
-        instance->outputs_stale = 0;
+    for (size_t i = 0; i < nvr; i++) {
+        /* Calculated outputs are brought up to date only when one is asked for. */
+        if (instance->outputs_stale && model_variables[vr[i]].initial == INITIAL_CALCULATED) {
+            model_update_outputs(&instance->coefficients, instance->data.values);
+            instance->outputs_stale = 0;
+        }
+        value[i] = instance->data.values[vr[i]];
     }
-    for (size_t i = 0; i < nvr; i++) value[i] = instance->data.values[vr[i]];
     return fmi2OK;
 }
 

@@ -2,6 +2,9 @@
 
 The C code takes its value references, names and start values from modelDescription.xml: this
 module generates them (model_variables.h/.c), so the XML stays the single source of truth.
+fmu_src/ holds the FMI plumbing, which knows nothing of pendulums, and the pendulum's model.h and
+model.c; another model (fmu_src/pid_controller/) is built over the same plumbing by naming its
+folder and modelDescription.xml.
 """
 
 from __future__ import annotations
@@ -22,6 +25,8 @@ SOURCE_DIR = ROOT / "fmu_src"
 MODEL_DESCRIPTION = ROOT / "modelDescription.xml"
 DEFAULT_FMU = ROOT / "dist" / "Pendulum.fmu"
 GENERATED_SOURCES = ("model_variables.h", "model_variables.c")
+MODEL_FILES = ("model.h", "model.c")
+PID_CONTROLLER_DIR = SOURCE_DIR / "pid_controller"
 # The FMI 2.0 headers fmpy ships, rather than a vendored copy.
 FMI_HEADERS = Path(fmpy.__file__).parent / "c-code"
 
@@ -88,14 +93,26 @@ def _enum_name(causality: str) -> str:
     return "CALCULATED_PARAMETER" if causality == "calculatedParameter" else causality.upper()
 
 
-def _check_source_files(model_description) -> None:
-    listed = set(model_description.buildConfigurations[0].sourceFileSets[0].sourceFiles)
-    present = {p.name for p in SOURCE_DIR.glob("*.c")} | {"model_variables.c"}
-    if listed != present:
-        raise BuildError(
-            f"<SourceFiles> in {MODEL_DESCRIPTION} lists {sorted(listed)} but fmu_src/ has "
-            f"{sorted(present)}: fmpy compile needs them to agree"
-        )
+def _check_source_files(model_description, xml: Path, sources: Path) -> None:
+    for configuration in model_description.buildConfigurations:
+        listed = set(configuration.sourceFileSets[0].sourceFiles)
+        present = {p.name for p in sources.glob("*.c")}
+        if listed != present:
+            raise BuildError(
+                f"<SourceFiles> in {xml} lists {sorted(listed)} but the sources are "
+                f"{sorted(present)}: fmpy compile needs them to agree"
+            )
+
+
+def _assemble_sources(model_dir: Path, model_description, sources: Path) -> None:
+    """The plumbing from fmu_src/, the model from model_dir, the generated variables."""
+    sources.mkdir()
+    for path in SOURCE_DIR.iterdir():
+        if path.is_file() and path.name not in MODEL_FILES:
+            shutil.copy2(path, sources)
+    for name in MODEL_FILES:
+        shutil.copy2(model_dir / name, sources)
+    generate_variables(model_description, sources)
 
 
 def compile_linux64(source_dir: Path, out_file: Path, compiler: str | None = None) -> Path:
@@ -106,7 +123,8 @@ def compile_linux64(source_dir: Path, out_file: Path, compiler: str | None = Non
     version_script = out_file.parent / "exports.map"
     version_script.write_text("{ global: fmi2*; local: *; };\n")
     command = [
-        compiler, "-std=c99", "-O2", "-fPIC", "-shared", "-fvisibility=hidden",
+        # -flto lets the integrator inline the model's right-hand side across files.
+        compiler, "-std=c99", "-O2", "-flto", "-fPIC", "-shared", "-fvisibility=hidden",
         "-Wall", "-Wextra", "-Werror",
         f"-I{source_dir}", f"-I{FMI_HEADERS}",
         *sorted(str(p) for p in source_dir.glob("*.c")),
@@ -120,29 +138,31 @@ def compile_linux64(source_dir: Path, out_file: Path, compiler: str | None = Non
 
 
 def documentation_html(model_description) -> str:
-    """documentation/index.html: the equation and every variable with its unit and meaning."""
+    """documentation/index.html: what the model is and every variable with its unit and meaning."""
     rows = "\n".join(
         "<tr>" + "".join(f"<td>{html.escape(str(cell))}</td>" for cell in (
             v.name, v.valueReference, v.causality, v.variability, v.unit or "",
             "" if v.start is None else v.start, v.description or "")) + "</tr>"
         for v in model_description.modelVariables
     )
-    cs = model_description.coSimulation
+    interfaces = " and ".join(name for name, present in (
+        ("Model Exchange", model_description.modelExchange), ("Co-Simulation", model_description.coSimulation))
+        if present)
+    name = html.escape(model_description.modelName)
     return f"""<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8"><title>Pendulum FMU</title>
+<html lang="en"><head><meta charset="utf-8"><title>{name} FMU</title>
 <style>body{{font-family:sans-serif;max-width:60em;margin:2em auto}}
 table{{border-collapse:collapse}}td,th{{border:1px solid #999;padding:.2em .5em}}</style></head>
 <body>
-<h1>Pendulum: a rigid pendulum driven by a torque at its pivot</h1>
-<p>FMI 2.0 Co-Simulation, model identifier <code>{cs.modelIdentifier}</code>.</p>
-<pre>I_total * alpha = torque - mass*gravity*length*sin(theta) - damping*omega
-I_total = inertia + mass*length^2</pre>
+<h1>{name}</h1>
+<p>{html.escape(model_description.description or "")}</p>
+<p>FMI 2.0 {interfaces}, model identifier <code>{name}</code>.</p>
 <h2>Inside a communication step</h2>
 <p>Each <code>fmi2DoStep(t, h)</code> integrates exactly [t, t+h] with an error-controlled
 Dormand-Prince 5(4) Runge-Kutta method: internal steps end on t+h and never cross it, and the
-internal step size carries over between calls. The torque is held over the step (zero-order
-hold) or, after <code>fmi2SetRealInputDerivatives</code> (order 1), ramps linearly from its value
-at t; a derivative holds until it is set again. The relative tolerance is
+internal step size carries over between calls. Inputs are held over the step (zero-order
+hold) or, after <code>fmi2SetRealInputDerivatives</code> (order 1), ramp linearly from their
+values at t; a derivative holds until it is set again. The relative tolerance is
 <code>fmi2SetupExperiment</code>'s when defined, else 1e-10; the absolute tolerance equals it.
 A step that needs more than 100000 internal steps returns fmi2Discard and leaves the instance
 where it was.</p>
@@ -155,31 +175,40 @@ where it was.</p>
 """
 
 
-def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, compiler: str | None = None) -> Path:
-    """Build the FMU (binaries/linux64 and sources/) and return its path."""
+def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, compiler: str | None = None, *,
+              model_dir: Path = SOURCE_DIR, model_description_file: Path = MODEL_DESCRIPTION) -> Path:
+    """Build an FMU (binaries/linux64, sources/, documentation/) and return its path.
+
+    By default the pendulum; model_dir and model_description_file name another model's
+    model.h/model.c and XML to build over the same plumbing.
+    """
     _check_sources_present()
-    model_description = read_model_description(str(MODEL_DESCRIPTION))
-    _check_source_files(model_description)
+    model_description = read_model_description(str(model_description_file))
     identifier = model_description.coSimulation.modelIdentifier
     out_file = Path(out_file)
     out_file.parent.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         sources = tmp / "sources"
-        shutil.copytree(SOURCE_DIR, sources)
-        generate_variables(model_description, sources)
+        _assemble_sources(Path(model_dir), model_description, sources)
+        _check_source_files(model_description, model_description_file, sources)
         binary = compile_linux64(sources, tmp / f"{identifier}.so", compiler)
-        documentation = documentation_html(model_description)
         # Write to a temporary name first so a failed build never leaves half an FMU behind.
         partial = out_file.with_suffix(".fmu.partial")
         with zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as fmu:
-            fmu.write(MODEL_DESCRIPTION, "modelDescription.xml")
+            fmu.write(model_description_file, "modelDescription.xml")
             fmu.write(binary, f"binaries/linux64/{identifier}.so")
             for source in sorted(sources.iterdir()):
                 fmu.write(source, f"sources/{source.name}")
-            fmu.writestr("documentation/index.html", documentation)
+            fmu.writestr("documentation/index.html", documentation_html(model_description))
         partial.replace(out_file)
     return out_file
+
+
+def build_pid_controller(out_file: str | os.PathLike, compiler: str | None = None) -> Path:
+    """The PID controller FMU that closes the loop around the pendulum in co-simulation."""
+    return build_fmu(out_file, compiler, model_dir=PID_CONTROLLER_DIR,
+                     model_description_file=PID_CONTROLLER_DIR / "modelDescription.xml")
 
 
 def fmu_is_stale(fmu: Path = DEFAULT_FMU) -> bool:
@@ -187,7 +216,7 @@ def fmu_is_stale(fmu: Path = DEFAULT_FMU) -> bool:
     if not fmu.exists():
         return True
     built = fmu.stat().st_mtime
-    inputs = [MODEL_DESCRIPTION, Path(__file__), *SOURCE_DIR.iterdir()]
+    inputs = [MODEL_DESCRIPTION, Path(__file__), *(p for p in SOURCE_DIR.iterdir() if p.is_file())]
     return any(p.stat().st_mtime > built for p in inputs)
 
 

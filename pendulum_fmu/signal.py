@@ -173,18 +173,14 @@ def schedule(torque: TorqueSignal, *, start_time: float = 0.0, stop_time: float 
         start_values = np.array([table.value_after(t) for t in time[:-1]])
         end_values = np.array([table.value_before(t) for t in time[1:]])
     else:
-        if callable(torque):
-            function = torque
-        else:
-            value = float(torque)
-            if not math.isfinite(value):
-                raise ValueError(f"torque {value} must be finite")
-            function = lambda t: value  # noqa: E731
         time = communication_points(start_time, 3.0 if stop_time is None else stop_time, step_size)
-        samples = np.array([float(function(float(t))) for t in time])
+        if callable(torque):
+            samples = np.array([float(torque(float(t))) for t in time])
+        else:
+            samples = np.full(len(time), float(torque))
         if not np.all(np.isfinite(samples)):
             bad = time[~np.isfinite(samples)][0]
-            raise ValueError(f"the torque function returned {samples[~np.isfinite(samples)][0]} at t = {bad}")
+            raise ValueError(f"the torque is {samples[~np.isfinite(samples)][0]} at t = {bad}; it must be finite")
         start_values, end_values = samples[:-1], samples[1:]
     rate = (end_values - start_values) / np.diff(time) if ramp else np.zeros(len(time) - 1)
     return TorqueSchedule(time=time, torque=start_values, torque_rate=rate)

@@ -29,9 +29,9 @@ def test_cvode_agrees_with_co_simulation(fmu, gravity):
 
 
 @pytest.fixture
-def model(fmu):
+def model(fmu, tmp_path):
     description = read_model_description(str(fmu))
-    model = FMU2Model(guid=description.guid, unzipDirectory=extract(str(fmu)),
+    model = FMU2Model(guid=description.guid, unzipDirectory=extract(str(fmu), unzipdir=tmp_path),
                       modelIdentifier="Pendulum", instanceName="me")
     model.instantiate()
     model.setupExperiment(startTime=0.0)

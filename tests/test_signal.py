@@ -64,5 +64,5 @@ def test_bad_arguments():
         schedule(1.0, step_size=0)
     with pytest.raises(ValueError, match="stop time"):
         schedule(1.0, stop_time=-1)
-    with pytest.raises(ValueError, match="returned nan"):
+    with pytest.raises(ValueError, match="the torque is nan at t = 0.0"):
         schedule(lambda t: float("nan"), stop_time=0.1)

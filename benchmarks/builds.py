@@ -1,0 +1,75 @@
+"""What the benchmarks run: the pendulum FMU from this checkout, the null FMU, the C master.
+
+Everything is built fresh into a scratch directory, so the figures are always of the sources as
+they are, never of a stale dist/Pendulum.fmu.
+"""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+import zipfile
+from dataclasses import dataclass
+from pathlib import Path
+
+from fmpy import extract, read_model_description
+
+from pendulum_fmu.build import FMI_HEADERS, BuildError, build_fmu, compile_linux64
+
+HERE = Path(__file__).resolve().parent
+NULL_FMU_SOURCES = HERE / "null_fmu"
+STEP_MASTER_SOURCE = HERE / "step_master.c"
+
+
+@dataclass(frozen=True)
+class BuiltFmu:
+    """An FMU, unzipped once, with what a master needs to instantiate it."""
+
+    path: Path
+    unzip_dir: Path
+    guid: str
+    model_identifier: str
+    value_references: dict[str, int]
+
+    @property
+    def library(self) -> Path:
+        return self.unzip_dir / "binaries" / "linux64" / f"{self.model_identifier}.so"
+
+
+def unzipped(fmu: Path, out_dir: Path) -> BuiltFmu:
+    description = read_model_description(str(fmu))
+    unzip_dir = Path(extract(str(fmu), str(out_dir / f"{fmu.stem}_unzipped")))
+    references = {v.name: v.valueReference for v in description.modelVariables}
+    return BuiltFmu(fmu, unzip_dir, description.guid, description.coSimulation.modelIdentifier,
+                    references)
+
+
+def build_pendulum_fmu(out_dir: Path) -> BuiltFmu:
+    return unzipped(build_fmu(out_dir / "Pendulum.fmu"), out_dir)
+
+
+def build_null_fmu(out_dir: Path) -> BuiltFmu:
+    """Compile null_fmu/ with the pendulum's compiler flags and zip it as NullFmu.fmu."""
+    work = out_dir / "null_fmu_build"
+    work.mkdir(parents=True, exist_ok=True)
+    library = compile_linux64(NULL_FMU_SOURCES, work / "NullFmu.so")
+    fmu = out_dir / "NullFmu.fmu"
+    with zipfile.ZipFile(fmu, "w", zipfile.ZIP_DEFLATED) as archive:
+        archive.write(NULL_FMU_SOURCES / "modelDescription.xml", "modelDescription.xml")
+        archive.write(library, "binaries/linux64/NullFmu.so")
+        archive.write(NULL_FMU_SOURCES / "null.c", "sources/null.c")
+    return unzipped(fmu, out_dir)
+
+
+def build_step_master(out_dir: Path) -> Path:
+    """Compile step_master.c, the bare C master that callgrind runs."""
+    compiler = shutil.which("gcc")
+    if compiler is None:
+        raise BuildError("gcc not found: install it (apt-get install gcc)")
+    master = out_dir / "step_master"
+    command = [compiler, "-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", f"-I{FMI_HEADERS}",
+               str(STEP_MASTER_SOURCE), "-ldl", "-o", str(master)]
+    result = subprocess.run(command, capture_output=True, text=True)
+    if result.returncode != 0:
+        raise BuildError(f"compiling the step master failed:\n{' '.join(command)}\n{result.stderr}")
+    return master
