@@ -211,13 +211,13 @@ fmi2Status instance_set_real(Instance *instance, const fmi2ValueReference vr[], 
                                   variable->name, value[i], variable->name,
                                   instance->data.values[vr[i]]);
     }
-    for (size_t i = 0; i < nvr; i++) instance->data.values[vr[i]] = value[i];
-    if (nvr > 0) {
-        /* Parameters can change only before initialization ends, when steps do not run yet. */
-        if (instance->data.machine_state != STATE_STEP_COMPLETE)
-            model_coefficients(instance->data.values, &instance->coefficients);
-        instance->outputs_stale = 1;
+    int parameters_changed = 0;
+    for (size_t i = 0; i < nvr; i++) {
+        instance->data.values[vr[i]] = value[i];
+        parameters_changed |= model_variables[vr[i]].causality == CAUSALITY_PARAMETER;
     }
+    if (parameters_changed) model_coefficients(instance->data.values, &instance->coefficients);
+    if (nvr > 0) instance->outputs_stale = 1;
     return fmi2OK;
 }
 

@@ -1,21 +1,14 @@
 #ifndef MODEL_H
 #define MODEL_H
 
-/* The interface between the FMI plumbing and the physics. The plumbing stores every variable in
-   one array indexed by value reference (values[]) and never looks at what the numbers mean. */
+/* The interface between the FMI plumbing and a model. The plumbing stores every variable in one
+   array indexed by value reference (values[]) and never looks at what the numbers mean. Each
+   model brings config.h (N_STATES and its ModelCoefficients) and model.c. */
 
+#include "config.h"
 #include "model_variables.h"
 
-#define N_STATES 2
-
-/* Derived once from the fixed parameters, so a right-hand side costs one sin(). */
-typedef struct {
-    double gravity_moment;   /* mass*gravity*length */
-    double damping;
-    double inverse_inertia;  /* 1/(inertia + mass*length^2) */
-} ModelCoefficients;
-
-/* NULL when the parameters describe a physical pendulum, else what is wrong with them. */
+/* NULL when the parameters make sense, else what is wrong with them. */
 const char *model_invalid_parameters(const double values[N_VARIABLES]);
 
 void model_coefficients(const double values[N_VARIABLES], ModelCoefficients *coefficients);

@@ -25,7 +25,7 @@ SOURCE_DIR = ROOT / "fmu_src"
 MODEL_DESCRIPTION = ROOT / "modelDescription.xml"
 DEFAULT_FMU = ROOT / "dist" / "Pendulum.fmu"
 GENERATED_SOURCES = ("model_variables.h", "model_variables.c")
-MODEL_FILES = ("model.h", "model.c")
+MODEL_FILES = ("config.h", "model.c")
 PID_CONTROLLER_DIR = SOURCE_DIR / "pid_controller"
 # The FMI 2.0 headers fmpy ships, rather than a vendored copy.
 FMI_HEADERS = Path(fmpy.__file__).parent / "c-code"

@@ -1,0 +1,102 @@
+"""The pendulum under the PID controller FMU: the co-simulation the tutorial closes on.
+
+Both FMUs advance in lock-step: at each communication point the controller reads the
+pendulum's theta and omega and the pendulum the controller's torque, all held over the step.
+create_closed_loop_fmu() packs the two into one FMU with fmpy's container; sampled_loop_reference()
+is the same sampled loop computed with scipy, the oracle for any master that runs it.
+"""
+
+from __future__ import annotations
+
+import copy
+import tempfile
+from pathlib import Path
+
+import numpy as np
+from fmpy import read_model_description
+from fmpy.container_fmu.cli import create_container_fmu
+from fmpy.container_fmu.config import Component, Configuration, Connection
+from fmpy.model_description import CoSimulation, DefaultExperiment, ModelDescription, ModelVariable
+from scipy.integrate import solve_ivp
+
+from .build import PID_CONTROLLER_DIR, build_fmu, build_pid_controller
+from .parameters import resolve_parameters, total_inertia
+
+# Pendulum output -> controller input, and back.
+WIRES = (("pendulum", "theta", "controller", "theta"),
+         ("pendulum", "omega", "controller", "omega"),
+         ("controller", "torque", "pendulum", "torque"))
+
+
+def controller_defaults() -> dict[str, float]:
+    """setpoint, kp, ki, kd as the controller's modelDescription.xml sets them."""
+    variables = read_model_description(str(PID_CONTROLLER_DIR / "modelDescription.xml")).modelVariables
+    return {v.name: float(v.start) for v in variables if v.causality == "parameter"}
+
+
+def _connector(variable: ModelVariable) -> ModelVariable:
+    # fmpy writes an FMI 2 connection's type as "Real", which its container binary rejects; it
+    # reads the FMI 3 name.
+    connector = copy.copy(variable)
+    connector.type = "Float64"
+    return connector
+
+
+def create_closed_loop_fmu(out_file: str | Path, *, step_size: float = 1e-3) -> Path:
+    """One FMU (fmpy's container) holding the pendulum and the PID controller, wired together,
+    with outputs theta and torque."""
+    out_file = Path(out_file)
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        files = {"pendulum": build_fmu(tmp / "Pendulum.fmu"),
+                 "controller": build_pid_controller(tmp / "PIDController.fmu")}
+        components, variables = {}, {}
+        for name, path in files.items():
+            description = read_model_description(str(path))
+            components[name] = Component(name=name, filename=path, modelDescription=description)
+            variables[name] = {v.name: v for v in description.modelVariables}
+        exported = {name: ModelVariable(type="Real", variability="continuous", causality="output",
+                                        initial="calculated", name=name) for name in ("theta", "torque")}
+        container = ModelDescription(
+            fmiVersion="2.0", modelName="PendulumClosedLoop", instantiationToken="",
+            defaultExperiment=DefaultExperiment(stopTime="6", stepSize=str(step_size)),
+            coSimulation=CoSimulation(fixedInternalStepSize=step_size),
+            modelVariables=[ModelVariable(type="Real", variability="continuous",
+                                          causality="independent", name="time"), *exported.values()])
+        configuration = Configuration(
+            parallelDoStep=False, modelDescription=container, components=list(components.values()),
+            connections=[Connection(components[a], [_connector(variables[a][out])],
+                                    components[b], [_connector(variables[b][into])])
+                         for a, out, b, into in WIRES],
+            variableMappings={exported["theta"]: [(components["pendulum"], variables["pendulum"]["theta"])],
+                              exported["torque"]: [(components["controller"], variables["controller"]["torque"])]})
+        work = tmp / "container"
+        work.mkdir()
+        create_container_fmu(configuration, work, out_file)
+    return out_file
+
+
+def sampled_loop_reference(stop_time: float = 6.0, step_size: float = 1e-3, *,
+                           controller: dict | None = None, parameters: dict | None = None,
+                           rtol: float = 1e-12) -> np.ndarray:
+    """time, theta, omega, torque of the sampled loop: each step the controller's torque from
+    the angle, rate and error integral at the step's start, held while scipy integrates the
+    pendulum; the integral of a held error is exact."""
+    gains = {**controller_defaults(), **(controller or {})}
+    p = resolve_parameters(parameters)
+    inverse_inertia = 1.0 / total_inertia(p)
+    gravity_moment = p["mass"] * p["gravity"] * p["length"]
+    n = int(round(stop_time / step_size))
+    out = np.zeros(n + 1, dtype=[("time", "f8"), ("theta", "f8"), ("omega", "f8"), ("torque", "f8")])
+    state, integral = np.zeros(2), 0.0
+    for k in range(n + 1):
+        error = gains["setpoint"] - state[0]
+        torque = gains["kp"] * error + gains["ki"] * integral - gains["kd"] * state[1]
+        out[k] = (k * step_size, state[0], state[1], torque)
+        if k == n:
+            break
+        rhs = lambda t, y, u=torque: (y[1], (u - gravity_moment * np.sin(y[0])  # noqa: E731
+                                              - p["damping"] * y[1]) * inverse_inertia)
+        state = solve_ivp(rhs, (0.0, step_size), state, method="DOP853", rtol=rtol, atol=rtol).y[:, -1]
+        integral += step_size * error
+    return out
