@@ -11,9 +11,13 @@ def main(argv=None) -> int:
     parser.add_argument("--output", default=str(DEFAULT_FMU),
                         help="where to write the FMU (default: %(default)s)")
     parser.add_argument("--cc", default=None, help="C compiler (default: $CC or gcc)")
+    parser.add_argument("--platforms", default="linux64",
+                        help="comma-separated, among linux64 and win64 (cross-compiled with "
+                             "mingw-w64) (default: %(default)s)")
     args = parser.parse_args(argv)
     try:
-        path = build_fmu(args.output, compiler=args.cc)
+        path = build_fmu(args.output, compiler=args.cc,
+                         platforms=tuple(p.strip() for p in args.platforms.split(",")))
     except BuildError as error:
         print(f"build_fmu.py: {error}", file=sys.stderr)
         return 1

@@ -14,7 +14,7 @@ from pathlib import Path
 
 from fmpy import extract, read_model_description
 
-from pendulum_fmu.build import FMI_HEADERS, BuildError, build_fmu, compile_linux64
+from pendulum_fmu.build import FMI_HEADERS, MINGW_COMPILER, BuildError, build_fmu, compile_linux64
 
 HERE = Path(__file__).resolve().parent
 NULL_FMU_SOURCES = HERE / "null_fmu"
@@ -61,14 +61,15 @@ def build_null_fmu(out_dir: Path) -> BuiltFmu:
     return unzipped(fmu, out_dir)
 
 
-def build_step_master(out_dir: Path) -> Path:
-    """Compile step_master.c, the bare C master that callgrind runs."""
-    compiler = shutil.which("gcc")
+def build_step_master(out_dir: Path, platform: str = "linux64") -> Path:
+    """Compile step_master.c, the bare C master: natively, or for win64 with mingw-w64 (the
+    tests run that one under wine)."""
+    compiler = shutil.which(MINGW_COMPILER if platform == "win64" else "gcc")
     if compiler is None:
-        raise BuildError("gcc not found: install it (apt-get install gcc)")
-    master = out_dir / "step_master"
+        raise BuildError(f"no compiler for {platform}: install gcc (and gcc-mingw-w64-x86-64 for win64)")
+    master = out_dir / ("step_master.exe" if platform == "win64" else "step_master")
     command = [compiler, "-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", f"-I{FMI_HEADERS}",
-               str(STEP_MASTER_SOURCE), "-ldl", "-o", str(master)]
+               str(STEP_MASTER_SOURCE), *([] if platform == "win64" else ["-ldl"]), "-o", str(master)]
     result = subprocess.run(command, capture_output=True, text=True)
     if result.returncode != 0:
         raise BuildError(f"compiling the step master failed:\n{' '.join(command)}\n{result.stderr}")

@@ -1,16 +1,34 @@
 /* A bare FMI 2.0 co-simulation master, so that callgrind sees the FMU's instructions and almost
    nothing else: no interpreter, no wrapper. It runs the tutorial loop (set the torque, step, read
-   theta) and prints the final theta, so a run can be checked.
+   theta) and can write theta at every step, so a run can be checked. It builds for Linux and,
+   cross-compiled, for Windows, where the tests run it under wine against the DLL.
 
    usage: step_master LIBRARY GUID STEPS STEP_SIZE TOLERANCE [TORQUE]
    TOLERANCE 0 leaves it undefined, so the FMU uses its default. */
 
-#include <dlfcn.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 
 #include "fmi2Functions.h"
+
+#ifdef _WIN32
+#include <windows.h>
+typedef HMODULE Library;
+static Library open_library(const char *path) { return LoadLibraryA(path); }
+static void *find_symbol(Library library, const char *name) {
+    return (void *)(INT_PTR)GetProcAddress(library, name);
+}
+static void close_library(Library library) { FreeLibrary(library); }
+static const char *library_error(void) { return "LoadLibrary/GetProcAddress failed"; }
+#else
+#include <dlfcn.h>
+typedef void *Library;
+static Library open_library(const char *path) { return dlopen(path, RTLD_NOW | RTLD_LOCAL); }
+static void *find_symbol(Library library, const char *name) { return dlsym(library, name); }
+static void close_library(Library library) { dlclose(library); }
+static const char *library_error(void) { return dlerror(); }
+#endif
 
 /* The interface every FMU benchmarked here shares (see benchmarks/null_fmu/). */
 #define VR_TORQUE 0
@@ -23,10 +41,10 @@ static void logger(fmi2ComponentEnvironment environment, fmi2String instance_nam
     fprintf(stderr, "%s [%s] status %d: %s\n", instance_name, category, (int)status, message);
 }
 
-static void *symbol(void *library, const char *name) {
-    void *pointer = dlsym(library, name);
+static void *symbol(Library library, const char *name) {
+    void *pointer = find_symbol(library, name);
     if (!pointer) {
-        fprintf(stderr, "step_master: %s not found: %s\n", name, dlerror());
+        fprintf(stderr, "step_master: %s not found: %s\n", name, library_error());
         exit(2);
     }
     return pointer;
@@ -53,9 +71,9 @@ int main(int argc, char **argv) {
         return 2;
     }
 
-    void *library = dlopen(argv[1], RTLD_NOW | RTLD_LOCAL);
+    Library library = open_library(argv[1]);
     if (!library) {
-        fprintf(stderr, "step_master: %s\n", dlerror());
+        fprintf(stderr, "step_master: cannot load %s: %s\n", argv[1], library_error());
         return 2;
     }
     fmi2InstantiateTYPE *instantiate = symbol(library, "fmi2Instantiate");
@@ -98,6 +116,6 @@ int main(int argc, char **argv) {
 
     terminate(fmu);
     free_instance(fmu);
-    dlclose(library);
+    close_library(library);
     return 0;
 }

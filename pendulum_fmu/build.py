@@ -14,6 +14,7 @@ import os
 import shutil
 import subprocess
 import tempfile
+import warnings
 import zipfile
 from pathlib import Path
 
@@ -29,6 +30,9 @@ MODEL_FILES = ("config.h", "model.c")
 PID_CONTROLLER_DIR = SOURCE_DIR / "pid_controller"
 # The FMI 2.0 headers fmpy ships, rather than a vendored copy.
 FMI_HEADERS = Path(fmpy.__file__).parent / "c-code"
+# Debian's gcc-mingw-w64-x86-64 cross-compiles the Windows binary.
+MINGW_COMPILER = "x86_64-w64-mingw32-gcc"
+PLATFORMS = ("linux64", "win64")
 
 
 class BuildError(RuntimeError):
@@ -115,6 +119,12 @@ def _assemble_sources(model_dir: Path, model_description, sources: Path) -> None
     generate_variables(model_description, sources)
 
 
+def _compile(command: list[str], what: str) -> None:
+    result = subprocess.run(command, capture_output=True, text=True)
+    if result.returncode != 0:
+        raise BuildError(f"compiling {what} failed:\n{' '.join(command)}\n{result.stderr}")
+
+
 def compile_linux64(source_dir: Path, out_file: Path, compiler: str | None = None) -> Path:
     """Compile every C file in source_dir into a shared library exporting only fmi2* symbols."""
     compiler = compiler or os.environ.get("CC", "gcc")
@@ -122,7 +132,7 @@ def compile_linux64(source_dir: Path, out_file: Path, compiler: str | None = Non
         raise BuildError(f"C compiler {compiler!r} not found: install gcc (apt-get install gcc)")
     version_script = out_file.parent / "exports.map"
     version_script.write_text("{ global: fmi2*; local: *; };\n")
-    command = [
+    _compile([
         # -flto lets the integrator inline the model's right-hand side across files.
         compiler, "-std=c99", "-O2", "-flto", "-fPIC", "-shared", "-fvisibility=hidden",
         "-Wall", "-Wextra", "-Werror",
@@ -130,10 +140,21 @@ def compile_linux64(source_dir: Path, out_file: Path, compiler: str | None = Non
         *sorted(str(p) for p in source_dir.glob("*.c")),
         f"-Wl,--version-script={version_script}", "-lm",
         "-o", str(out_file),
-    ]
-    result = subprocess.run(command, capture_output=True, text=True)
-    if result.returncode != 0:
-        raise BuildError(f"compiling failed:\n{' '.join(command)}\n{result.stderr}")
+    ], out_file.name)
+    return out_file
+
+
+def compile_win64(source_dir: Path, out_file: Path) -> Path:
+    """Cross-compile the Windows DLL with mingw-w64. fmi2Functions.h marks the fmi2 functions
+    __declspec(dllexport) on Windows, so they are all the DLL exports."""
+    if shutil.which(MINGW_COMPILER) is None:
+        raise BuildError(f"{MINGW_COMPILER} not found: install Debian's gcc-mingw-w64-x86-64")
+    _compile([
+        MINGW_COMPILER, "-std=c99", "-O2", "-flto", "-shared", "-Wall", "-Wextra", "-Werror",
+        # No dependency on the mingw runtime DLLs: the FMU must load on any Windows machine.
+        "-static-libgcc", "-s", f"-I{source_dir}", f"-I{FMI_HEADERS}",
+        *sorted(str(p) for p in source_dir.glob("*.c")), "-o", str(out_file),
+    ], out_file.name)
     return out_file
 
 
@@ -176,12 +197,18 @@ where it was.</p>
 
 
 def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, compiler: str | None = None, *,
-              model_dir: Path = SOURCE_DIR, model_description_file: Path = MODEL_DESCRIPTION) -> Path:
-    """Build an FMU (binaries/linux64, sources/, documentation/) and return its path.
+              model_dir: Path = SOURCE_DIR, model_description_file: Path = MODEL_DESCRIPTION,
+              platforms: tuple[str, ...] = ("linux64",)) -> Path:
+    """Build an FMU (binaries/, sources/, documentation/) and return its path.
 
-    By default the pendulum; model_dir and model_description_file name another model's
-    model.h/model.c and XML to build over the same plumbing.
+    By default the pendulum for linux64; model_dir and model_description_file name another
+    model's config.h/model.c and XML to build over the same plumbing. A platform other than
+    linux64 whose cross-compiler is missing is left out with a warning.
     """
+    unknown = set(platforms) - set(PLATFORMS)
+    if unknown or "linux64" not in platforms:
+        raise BuildError(f"platforms must include linux64 and be among {', '.join(PLATFORMS)}; "
+                         f"got {', '.join(platforms)}")
     _check_sources_present()
     model_description = read_model_description(str(model_description_file))
     identifier = model_description.coSimulation.modelIdentifier
@@ -192,12 +219,19 @@ def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, compiler: str | None = 
         sources = tmp / "sources"
         _assemble_sources(Path(model_dir), model_description, sources)
         _check_source_files(model_description, model_description_file, sources)
-        binary = compile_linux64(sources, tmp / f"{identifier}.so", compiler)
+        binaries = {f"binaries/linux64/{identifier}.so":
+                    compile_linux64(sources, tmp / f"{identifier}.so", compiler)}
+        if "win64" in platforms:
+            try:
+                binaries[f"binaries/win64/{identifier}.dll"] = compile_win64(sources, tmp / f"{identifier}.dll")
+            except BuildError as error:
+                warnings.warn(f"win64 left out: {error}", stacklevel=2)
         # Write to a temporary name first so a failed build never leaves half an FMU behind.
         partial = out_file.with_suffix(".fmu.partial")
         with zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as fmu:
             fmu.write(model_description_file, "modelDescription.xml")
-            fmu.write(binary, f"binaries/linux64/{identifier}.so")
+            for name, binary in binaries.items():
+                fmu.write(binary, name)
             for source in sorted(sources.iterdir()):
                 fmu.write(source, f"sources/{source.name}")
             fmu.writestr("documentation/index.html", documentation_html(model_description))
