@@ -78,10 +78,17 @@ def create_closed_loop_fmu(out_file: str | Path, *, step_size: float = 1e-3) -> 
 
 def sampled_loop_reference(stop_time: float = 6.0, step_size: float = 1e-3, *,
                            controller: dict | None = None, parameters: dict | None = None,
-                           rtol: float = 1e-12) -> np.ndarray:
-    """time, theta, omega, torque of the sampled loop: each step the controller's torque from
-    the angle, rate and error integral at the step's start, held while scipy integrates the
-    pendulum; the integral of a held error is exact."""
+                           feedthrough_delay: bool = False, rtol: float = 1e-12) -> np.ndarray:
+    """time, theta, omega, torque of the sampled loop: each step a torque from the controller is
+    held while scipy integrates the pendulum; the controller's error integral of a held error is
+    exact.
+
+    Masters differ in when they read the controller's torque, a direct feedthrough of theta:
+    fmpy's container sets the controller's new inputs first, so the torque for step k comes from
+    theta_k (feedthrough_delay=False). libcosim reads each slave's outputs right after its step,
+    before the new inputs reach it, so the torque for step k comes from theta_(k-1) and the
+    integral at t_k (feedthrough_delay=True).
+    """
     gains = {**controller_defaults(), **(controller or {})}
     p = resolve_parameters(parameters)
     inverse_inertia = 1.0 / total_inertia(p)
@@ -89,14 +96,18 @@ def sampled_loop_reference(stop_time: float = 6.0, step_size: float = 1e-3, *,
     n = int(round(stop_time / step_size))
     out = np.zeros(n + 1, dtype=[("time", "f8"), ("theta", "f8"), ("omega", "f8"), ("torque", "f8")])
     state, integral = np.zeros(2), 0.0
+    measured = state  # what the controller's inputs hold when its torque is read
     for k in range(n + 1):
-        error = gains["setpoint"] - state[0]
-        torque = gains["kp"] * error + gains["ki"] * integral - gains["kd"] * state[1]
+        if not feedthrough_delay:
+            measured = state
+        torque = (gains["kp"] * (gains["setpoint"] - measured[0]) + gains["ki"] * integral
+                  - gains["kd"] * measured[1])
         out[k] = (k * step_size, state[0], state[1], torque)
         if k == n:
             break
         rhs = lambda t, y, u=torque: (y[1], (u - gravity_moment * np.sin(y[0])  # noqa: E731
                                               - p["damping"] * y[1]) * inverse_inertia)
+        integral += step_size * (gains["setpoint"] - state[0])
+        measured = state
         state = solve_ivp(rhs, (0.0, step_size), state, method="DOP853", rtol=rtol, atol=rtol).y[:, -1]
-        integral += step_size * error
     return out
