@@ -65,3 +65,18 @@ def plot_comparison(runs: dict[str, np.ndarray], path: str | Path, title: str) -
     for ax in axes[1]:
         ax.set_xlabel(TIME_LABEL)
     return _finish(fig, axes, title, path)
+
+
+def plot_cases(runs: dict[str, np.ndarray], path: str | Path, title: str) -> Path:
+    """theta and omega of many cases, coloured along a colormap; labelled when few enough."""
+    fig, axes = plt.subplots(2, 1, figsize=(10, 6), sharex=True)
+    colors = plt.cm.viridis(np.linspace(0, 0.9, max(len(runs), 1)))
+    labelled = len(runs) <= 12
+    for color, (label, run) in zip(colors, runs.items()):
+        axes[0].plot(run["time"], run["theta"], color=color, linewidth=1.5,
+                     label=label if labelled else None)
+        axes[1].plot(run["time"], run["omega"], color=color, linewidth=1.5)
+    axes[0].set_ylabel(THETA_LABEL)
+    axes[1].set_ylabel(OMEGA_LABEL)
+    axes[1].set_xlabel(TIME_LABEL)
+    return _finish(fig, axes, title, path)

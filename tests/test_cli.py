@@ -85,3 +85,16 @@ def test_compare_passes_and_fails_on_tolerance(tmp_path, capsys):
     assert (tmp_path / "comparison.png").exists()
     assert main(args + ["--tol", "1e-16"]) == 1
     assert "DIFFER" in capsys.readouterr().out
+
+
+def test_demo_runs_the_tutorial_end_to_end(tmp_path, capsys):
+    assert main(["demo", "--output-dir", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert out.count("tools agree") == 2
+    assert "theta(3 s) = 3.0000000000 rad" in out  # gravity off: tau t^2 / (2 I) = 3 rad at 3 s
+    assert "theta(3 s) = 0.0814310965 rad" in out
+    for figure in ("no_gravity/comparison.png", "gravity/comparison.png", "gravity_effect.png",
+                   "parameter_study/sweep.png"):
+        assert (tmp_path / figure).read_bytes()[:4] == b"\x89PNG"
+    study = np.genfromtxt(tmp_path / "parameter_study/sweep.csv", delimiter=",", names=True)
+    assert sorted(set(study["torque"])) == [5.0, 10.0, 20.0, 40.0]
