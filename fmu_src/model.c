@@ -15,8 +15,9 @@ const char *model_invalid_parameters(const double values[N_VARIABLES]) {
     if (!(values[VR_INERTIA] >= 0)) return "inertia must be >= 0";
     if (!(values[VR_DAMPING] >= 0)) return "damping must be >= 0";
     if (!isfinite(values[VR_GRAVITY])) return "gravity must be finite";
-    if (!isfinite(values[VR_MASS] * values[VR_LENGTH] * values[VR_LENGTH] + values[VR_INERTIA]))
-        return "inertia + mass*length^2 must be finite";
+    const double inertia_total = values[VR_INERTIA] + values[VR_MASS] * values[VR_LENGTH] * values[VR_LENGTH];
+    if (!(inertia_total > 0) || !isfinite(inertia_total))
+        return "inertia + mass*length^2 (the inertia about the pivot) must be > 0 and finite";
     return NULL;
 }
 

@@ -1,0 +1,368 @@
+"""Every bad call a master can make, as data: run by tests/test_robustness.py, and written as the
+table in docs/robustness.md by `python tests/bad_calls.py docs/robustness.md`.
+
+The calls go straight to the FMU's binary through ctypes, so that NULL pointers and calls in the
+wrong state reach it exactly as a foreign master would make them (fmpy guards some itself).
+"""
+
+from __future__ import annotations
+
+import ctypes
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+from fmpy.fmi2 import fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, fmi2EventInfo
+
+OK, WARNING, DISCARD, ERROR = 0, 1, 2, 3
+STATUS_NAMES = ["fmi2OK", "fmi2Warning", "fmi2Discard", "fmi2Error", "fmi2Fatal", "fmi2Pending"]
+CO_SIMULATION, MODEL_EXCHANGE = 1, 0
+TORQUE, THETA, OMEGA, ALPHA, MASS, LENGTH, INERTIA, GRAVITY, DAMPING = range(9)
+
+
+def reals(*values):
+    return (ctypes.c_double * len(values))(*values)
+
+
+def refs(*references):
+    return (ctypes.c_uint * len(references))(*references)
+
+
+class Harness:
+    """The FMU's library through ctypes, with a logger that keeps what the FMU says."""
+
+    def __init__(self, library: Path, guid: str):
+        self.lib = ctypes.CDLL(str(library))
+        self.lib.fmi2Instantiate.restype = ctypes.c_void_p
+        self.lib.fmi2Instantiate.argtypes = [ctypes.c_char_p, ctypes.c_int, ctypes.c_char_p, ctypes.c_char_p,
+                                             ctypes.c_void_p, ctypes.c_int, ctypes.c_int]
+        self.guid = guid.encode()
+        self.messages: list[str] = []
+        self.callbacks = fmi2CallbackFunctions()
+        self.callbacks.logger = fmi2CallbackLoggerTYPE(self._log)
+        try:
+            from fmpy.logging import addLoggerProxy  # formats printf-style arguments
+            addLoggerProxy(ctypes.byref(self.callbacks))
+        except Exception:
+            pass
+        self.live: list[int] = []
+
+    def _log(self, environment, name, status, category, message):
+        self.messages.append(message.decode("utf-8", "replace"))
+
+    def __getattr__(self, name):
+        return getattr(self.lib, name)
+
+    def instantiate(self, name=b"robust", kind=CO_SIMULATION, guid=None, callbacks="default"):
+        callbacks = ctypes.byref(self.callbacks) if callbacks == "default" else callbacks
+        component = self.lib.fmi2Instantiate(name, kind, self.guid if guid is None else guid, b"",
+                                             callbacks, 0, 0)
+        if component:
+            self.live.append(component)
+        return ctypes.c_void_p(component) if component else None
+
+    def initializing(self):
+        """An instance in initialization mode, where start values can be set and read."""
+        component = self.instantiate()
+        assert self.fmi2EnterInitializationMode(component) == OK
+        return component
+
+    def ready(self, kind=CO_SIMULATION, **parameters):
+        """An instance after initialization: step complete (or event mode)."""
+        component = self.instantiate(kind=kind)
+        for name, value in parameters.items():
+            assert self.fmi2SetReal(component, refs(globals()[name.upper()]), 1, reals(value)) == OK
+        assert self.fmi2SetupExperiment(component, 0, ctypes.c_double(0), ctypes.c_double(0), 0, ctypes.c_double(0)) == OK
+        assert self.fmi2EnterInitializationMode(component) == OK
+        assert self.fmi2ExitInitializationMode(component) == OK
+        return component
+
+    def get(self, component, reference) -> float:
+        value = reals(0.0)
+        assert self.fmi2GetReal(component, refs(reference), 1, value) == OK
+        return value[0]
+
+    def step(self, component, time, size):
+        return self.fmi2DoStep(component, ctypes.c_double(time), ctypes.c_double(size), 1)
+
+    def last_message(self) -> str:
+        return self.messages[-1] if self.messages else ""
+
+    def close(self):
+        for component in self.live:
+            self.lib.fmi2FreeInstance(ctypes.c_void_p(component))
+        self.live.clear()
+
+
+@dataclass(frozen=True)
+class Case:
+    group: str
+    bad_input: str
+    call: str
+    expected_status: int
+    expected_message: str
+    run: Callable[[Harness], int]  # makes the bad call, returns its status; asserts what must hold after
+
+
+def _unchanged_after(harness, component, reference, bad_value, state_call=None):
+    before = harness.get(component, reference)
+    status = harness.fmi2SetReal(component, refs(reference), 1, reals(bad_value))
+    assert harness.get(component, reference) == before, "a refused value must leave the old one"
+    return status
+
+
+def _batch_with_one_nan(h):
+    component = h.initializing()
+    status = h.fmi2SetReal(component, refs(MASS, DAMPING), 2, reals(3.0, NAN))
+    assert h.get(component, MASS) == 40.0, "no part of a refused batch is set"
+    return status
+
+
+def _exit_with(**values):
+    def run(h):
+        component = h.instantiate()
+        references = [globals()[name.upper()] for name in values]
+        assert h.fmi2SetReal(component, refs(*references), len(values), reals(*values.values())) == OK
+        h.fmi2EnterInitializationMode(component)
+        status = h.fmi2ExitInitializationMode(component)
+        # The instance stays in initialization mode: the master can correct the value.
+        assert h.fmi2SetReal(component, refs(MASS, LENGTH, INERTIA, DAMPING), 4, reals(40, 0.5, 20, 0)) == OK
+        assert h.fmi2ExitInitializationMode(component) == OK
+        return status
+    return run
+
+
+def _step_then(check):
+    def run(h):
+        component = h.ready()
+        assert h.step(component, 0.0, 0.01) == OK
+        return check(h, component)
+    return run
+
+
+def _discarded_huge_step(h):
+    component = h.ready()
+    # A swinging pendulum: at rest without torque the solution is constant and any step is exact.
+    assert h.fmi2SetReal(component, refs(TORQUE), 1, reals(20.0)) == OK
+    assert h.step(component, 0.0, 0.5) == OK
+    theta = h.get(component, THETA)
+    status = h.step(component, 0.5, 1e9)
+    last = reals(0.0)
+    assert h.fmi2GetRealStatus(component, 2, last) == OK and last[0] == 0.5  # fmi2LastSuccessfulTime
+    assert h.get(component, THETA) == theta, "a discarded step must leave the instance where it was"
+    return status
+
+
+def _serialized(h):
+    component = h.ready()
+    h.step(component, 0.0, 0.1)
+    state, size = ctypes.c_void_p(), ctypes.c_size_t()
+    assert h.fmi2GetFMUstate(component, ctypes.byref(state)) == OK
+    assert h.fmi2SerializedFMUstateSize(component, state, ctypes.byref(size)) == OK
+    blob = (ctypes.c_char * size.value)()
+    assert h.fmi2SerializeFMUstate(component, state, blob, size) == OK
+    h.fmi2FreeFMUstate(component, ctypes.byref(state))
+    return component, bytearray(blob.raw)
+
+
+def _deserialize(mangle):
+    def run(h):
+        component, blob = _serialized(h)
+        blob = mangle(blob)
+        buffer = (ctypes.c_char * max(len(blob), 1)).from_buffer_copy(bytes(blob) or b"\0")
+        state = ctypes.c_void_p()
+        status = h.fmi2DeSerializeFMUstate(component, buffer, len(blob), ctypes.byref(state))
+        assert not state, "a refused blob must not yield a state"
+        return status
+    return run
+
+
+def _flip(index):
+    def mangle(blob):
+        blob[index] ^= 0x40
+        return blob
+    return mangle
+
+
+def _illegal(call, *arguments, state="instantiated"):
+    def run(h):
+        component = h.instantiate() if state == "instantiated" else h.ready()
+        if state == "terminated":
+            assert h.fmi2Terminate(component) == OK
+        return getattr(h, call)(component, *(a() if callable(a) else a for a in arguments))
+    return run
+
+
+def _no_instance(check):
+    def run(h):
+        return 0 if check(h) else 3
+    return run
+
+
+NAN, INF = float("nan"), float("inf")
+
+CASES = [
+    # Non-finite values
+    Case("non-finite values", "torque = NaN after initialization", "fmi2SetReal", ERROR, "torque = nan refused",
+         lambda h: _unchanged_after(h, h.ready(), TORQUE, NAN)),
+    Case("non-finite values", "torque = +inf", "fmi2SetReal", ERROR, "torque = inf refused",
+         lambda h: _unchanged_after(h, h.ready(), TORQUE, INF)),
+    Case("non-finite values", "start angle theta = -inf", "fmi2SetReal", ERROR, "theta = -inf refused",
+         lambda h: _unchanged_after(h, h.initializing(), THETA, -INF)),
+    Case("non-finite values", "start rate omega = NaN", "fmi2SetReal", ERROR, "omega = nan refused",
+         lambda h: _unchanged_after(h, h.initializing(), OMEGA, NAN)),
+    Case("non-finite values", "mass = +inf", "fmi2SetReal", ERROR, "mass = inf refused",
+         lambda h: _unchanged_after(h, h.initializing(), MASS, INF)),
+    Case("non-finite values", "gravity = NaN", "fmi2SetReal", ERROR, "gravity = nan refused",
+         lambda h: _unchanged_after(h, h.initializing(), GRAVITY, NAN)),
+    Case("non-finite values", "a batch with one NaN: nothing of it is set", "fmi2SetReal", ERROR, "damping = nan refused",
+         lambda h: _batch_with_one_nan(h)),
+    Case("non-finite values", "torque input derivative = inf", "fmi2SetRealInputDerivatives", ERROR,
+         "derivative of torque = inf refused",
+         lambda h: h.fmi2SetRealInputDerivatives(h.ready(), refs(TORQUE), 1, (ctypes.c_int * 1)(1), reals(INF))),
+    # Physical nonsense, refused when initialization ends
+    Case("physical nonsense", "mass = 0", "fmi2ExitInitializationMode", ERROR, "mass must be > 0", _exit_with(mass=0.0)),
+    Case("physical nonsense", "mass = -1", "fmi2ExitInitializationMode", ERROR, "mass must be > 0", _exit_with(mass=-1.0)),
+    Case("physical nonsense", "length = -0.1", "fmi2ExitInitializationMode", ERROR, "length must be >= 0", _exit_with(length=-0.1)),
+    Case("physical nonsense", "inertia = -1", "fmi2ExitInitializationMode", ERROR, "inertia must be >= 0", _exit_with(inertia=-1.0)),
+    Case("physical nonsense", "damping = -0.5", "fmi2ExitInitializationMode", ERROR, "damping must be >= 0", _exit_with(damping=-0.5)),
+    Case("physical nonsense", "length = 0 and inertia = 0: no inertia about the pivot", "fmi2ExitInitializationMode", ERROR,
+         "the inertia about the pivot", _exit_with(length=0.0, inertia=0.0)),
+    # The state machine
+    Case("state machine", "fmi2DoStep before initialization", "fmi2DoStep", ERROR, "not allowed in state 'instantiated'",
+         lambda h: h.step(h.instantiate(), 0.0, 0.001)),
+    Case("state machine", "fmi2DoStep in initialization mode", "fmi2DoStep", ERROR, "not allowed in state 'initialization mode'",
+         lambda h: (lambda c: (h.fmi2EnterInitializationMode(c), h.step(c, 0.0, 0.001))[-1])(h.instantiate())),
+    Case("state machine", "fmi2DoStep after fmi2Terminate", "fmi2DoStep", ERROR, "not allowed in state 'terminated'",
+         lambda h: (lambda c: (h.fmi2Terminate(c), h.step(c, 0.0, 0.001))[-1])(h.ready())),
+    Case("state machine", "fixed parameter mass set after initialization", "fmi2SetReal", ERROR,
+         "a fixed parameter cannot change after initialization", lambda h: _unchanged_after(h, h.ready(), MASS, 1.0)),
+    Case("state machine", "start value theta set after initialization", "fmi2SetReal", ERROR,
+         "can be set only before initialization ends", lambda h: _unchanged_after(h, h.ready(), THETA, 1.0)),
+    Case("state machine", "output alpha set", "fmi2SetReal", ERROR, "it is calculated by the FMU",
+         lambda h: h.fmi2SetReal(h.ready(), refs(ALPHA), 1, reals(1.0))),
+    Case("state machine", "unknown value reference 99 set", "fmi2SetReal", ERROR, "vr 99 is not a value reference",
+         lambda h: h.fmi2SetReal(h.ready(), refs(99), 1, reals(1.0))),
+    Case("state machine", "unknown value reference 4000000000 read", "fmi2GetReal", ERROR, "is not a value reference",
+         lambda h: h.fmi2GetReal(h.ready(), refs(4000000000), 1, reals(0.0))),
+    Case("state machine", "fmi2GetReal before initialization", "fmi2GetReal", ERROR, "not allowed in state 'instantiated'",
+         _illegal("fmi2GetReal", refs(THETA), 1, lambda: reals(0.0))),
+    Case("state machine", "fmi2ExitInitializationMode twice", "fmi2ExitInitializationMode", ERROR, "not allowed in state 'step complete'",
+         _illegal("fmi2ExitInitializationMode", state="ready")),
+    Case("state machine", "fmi2SetupExperiment after initialization", "fmi2SetupExperiment", ERROR, "not allowed in state",
+         _illegal("fmi2SetupExperiment", 0, ctypes.c_double(0), ctypes.c_double(0), 0, ctypes.c_double(0), state="ready")),
+    Case("state machine", "model-exchange call on a co-simulation instance", "fmi2SetContinuousStates", ERROR,
+         "not allowed in state 'step complete'", _illegal("fmi2SetContinuousStates", lambda: reals(0.0, 0.0), 2, state="ready")),
+    Case("state machine", "fmi2DoStep on a model-exchange instance", "fmi2DoStep", ERROR, "not allowed in state 'event mode'",
+         lambda h: h.step(h.ready(kind=MODEL_EXCHANGE), 0.0, 0.001)),
+    Case("state machine", "fmi2CancelStep (steps are never asynchronous)", "fmi2CancelStep", ERROR, "illegal call sequence",
+         _illegal("fmi2CancelStep", state="ready")),
+    Case("state machine", "output derivative of order 3", "fmi2GetRealOutputDerivatives", ERROR, "no derivative of order 3",
+         lambda h: h.fmi2GetRealOutputDerivatives(h.ready(), refs(THETA), 1, (ctypes.c_int * 1)(3), reals(0.0))),
+    Case("state machine", "input derivative on an output", "fmi2SetRealInputDerivatives", ERROR, "theta is not an input",
+         lambda h: h.fmi2SetRealInputDerivatives(h.ready(), refs(THETA), 1, (ctypes.c_int * 1)(1), reals(1.0))),
+    Case("state machine", "directional derivative of alpha by mass", "fmi2GetDirectionalDerivative", ERROR,
+         "no partial derivative of vr 3 with respect to vr 4",
+         lambda h: h.fmi2GetDirectionalDerivative(h.ready(), refs(ALPHA), 1, refs(MASS), 1, reals(1.0), reals(0.0))),
+    Case("state machine", "unknown log category", "fmi2SetDebugLogging", ERROR, "unknown log category logNonsense",
+         lambda h: h.fmi2SetDebugLogging(h.ready(), 1, 1, (ctypes.c_char_p * 1)(b"logNonsense"))),
+    # fmi2DoStep arguments
+    Case("fmi2DoStep", "step size 0", "fmi2DoStep", ERROR, "must be positive and finite", lambda h: h.step(h.ready(), 0.0, 0.0)),
+    Case("fmi2DoStep", "step size -0.001", "fmi2DoStep", ERROR, "must be positive and finite", lambda h: h.step(h.ready(), 0.0, -1e-3)),
+    Case("fmi2DoStep", "step size NaN", "fmi2DoStep", ERROR, "must be positive and finite", lambda h: h.step(h.ready(), 0.0, NAN)),
+    Case("fmi2DoStep", "currentCommunicationPoint 0.5 where the instance stands at 0.01", "fmi2DoStep", ERROR,
+         "is not where the instance stands", _step_then(lambda h, c: h.step(c, 0.5, 0.001))),
+    Case("fmi2DoStep", "a step of 1e9 s: more than the 100000 internal steps allowed", "fmi2DoStep", DISCARD,
+         "step budget exhausted", _discarded_huge_step),
+    # NULL pointers and counts
+    Case("NULL and counts", "vr = NULL with nvr = 1", "fmi2GetReal", ERROR, "argument vr must not be NULL",
+         lambda h: h.fmi2GetReal(h.ready(), None, 1, reals(0.0))),
+    Case("NULL and counts", "value = NULL with nvr = 1", "fmi2SetReal", ERROR, "argument value must not be NULL",
+         lambda h: h.fmi2SetReal(h.ready(), refs(TORQUE), 1, None)),
+    Case("NULL and counts", "NULL instance", "fmi2DoStep", ERROR, "",
+         lambda h: h.fmi2DoStep(None, ctypes.c_double(0), ctypes.c_double(0.001), 1)),
+    Case("NULL and counts", "nx = 3 for 2 continuous states", "fmi2GetContinuousStates", ERROR, "nx = 3, but the model has 2",
+         lambda h: h.fmi2GetContinuousStates(h.ready(kind=MODEL_EXCHANGE), reals(0, 0, 0), 3)),
+    Case("NULL and counts", "NULL event info", "fmi2NewDiscreteStates", ERROR, "argument fmi2eventInfo must not be NULL",
+         lambda h: h.fmi2NewDiscreteStates(h.ready(kind=MODEL_EXCHANGE), None)),
+    Case("NULL and counts", "NULL FMU state pointer", "fmi2GetFMUstate", ERROR, "argument FMUstate must not be NULL",
+         lambda h: h.fmi2GetFMUstate(h.ready(), None)),
+    Case("NULL and counts", "NULL FMU state", "fmi2SetFMUstate", ERROR, "argument FMUstate must not be NULL",
+         lambda h: h.fmi2SetFMUstate(h.ready(), None)),
+    # fmi2Instantiate
+    Case("fmi2Instantiate", "a GUID from another FMU", "fmi2Instantiate", ERROR, "does not match this FMU's",
+         _no_instance(lambda h: h.instantiate(guid=b"{00000000-0000-0000-0000-000000000000}") is None)),
+    Case("fmi2Instantiate", "NULL GUID", "fmi2Instantiate", ERROR, "fmuGUID NULL does not match",
+         _no_instance(lambda h: h.lib.fmi2Instantiate(b"x", 1, None, b"", ctypes.byref(h.callbacks), 0, 0) is None)),
+    Case("fmi2Instantiate", "empty instance name", "fmi2Instantiate", ERROR, "instanceName must be a non-empty string",
+         _no_instance(lambda h: h.instantiate(name=b"") is None)),
+    Case("fmi2Instantiate", "fmuType 7", "fmi2Instantiate", ERROR, "fmuType 7 is neither",
+         _no_instance(lambda h: h.instantiate(kind=7) is None)),
+    Case("fmi2Instantiate", "NULL callbacks struct", "fmi2Instantiate", ERROR, "",
+         _no_instance(lambda h: h.instantiate(callbacks=None) is None)),
+    Case("fmi2Instantiate", "callbacks struct without a logger", "fmi2Instantiate", ERROR, "",
+         _no_instance(lambda h: h.instantiate(callbacks=ctypes.byref(fmi2CallbackFunctions())) is None)),
+    # Serialized FMU states
+    Case("FMU state blobs", "garbage bytes", "fmi2DeSerializeFMUstate", ERROR, "bad magic",
+         _deserialize(lambda blob: bytearray(b"\xde\xad\xbe\xef" * (len(blob) // 4)))),
+    Case("FMU state blobs", "an empty blob", "fmi2DeSerializeFMUstate", ERROR, "bad magic", _deserialize(lambda blob: bytearray())),
+    Case("FMU state blobs", "truncated by one byte", "fmi2DeSerializeFMUstate", ERROR, "truncated, or from another build",
+         _deserialize(lambda blob: blob[:-1])),
+    Case("FMU state blobs", "truncated to the header", "fmi2DeSerializeFMUstate", ERROR, "truncated, or from another build",
+         _deserialize(lambda blob: blob[:12])),
+    Case("FMU state blobs", "another format version", "fmi2DeSerializeFMUstate", ERROR, "state format version",
+         _deserialize(_flip(5))),
+    Case("FMU state blobs", "one payload bit flipped", "fmi2DeSerializeFMUstate", ERROR, "checksum mismatch", _deserialize(_flip(40))),
+    Case("FMU state blobs", "a state of another FMU (payload size differs)", "fmi2DeSerializeFMUstate", ERROR,
+         "truncated, or from another build", _deserialize(lambda blob: blob[:8] + (len(blob) - 28).to_bytes(4, "little") + blob[12:-8])),
+]
+
+
+def run_case(harness: Harness, case: Case) -> tuple[int, str]:
+    """(status, what the FMU logged for the call)."""
+    harness.messages.clear()
+    status = case.run(harness)
+    message = next((m for m in reversed(harness.messages) if case.expected_message in m), harness.last_message())
+    harness.close()
+    return status, message
+
+
+def markdown(rows: list[tuple[Case, int, str]]) -> str:
+    lines = ["# What the FMU answers to bad calls", "",
+             "Generated by `python tests/bad_calls.py docs/robustness.md` from the cases that "
+             "`tests/test_robustness.py` asserts; do not edit by hand. Each call goes to the binary through "
+             "ctypes. After every refused call the instance keeps its last good state and can go on.", "",
+             "| group | bad input | call | answer | message logged through the master's logger |",
+             "|---|---|---|---|---|"]
+    for case, status, message in rows:
+        shown = message.replace("|", "\\|") if message else "(no instance, so nothing to log to)" \
+            if case.call in ("fmi2Instantiate", "fmi2DoStep") else ""
+        answer = "NULL" if case.call == "fmi2Instantiate" else STATUS_NAMES[status]
+        lines.append(f"| {case.group} | {case.bad_input} | `{case.call}` | {answer} | {shown} |")
+    return "\n".join(lines) + "\n"
+
+
+def main(argv=None):
+    """Build the FMU, run every case, write the markdown table."""
+    import tempfile
+    import zipfile
+
+    from fmpy import read_model_description
+
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+    from pendulum_fmu.build import build_fmu
+
+    out = Path((argv or sys.argv[1:] or ["docs/robustness.md"])[0])
+    with tempfile.TemporaryDirectory() as tmp:
+        fmu = build_fmu(Path(tmp) / "Pendulum.fmu")
+        zipfile.ZipFile(fmu).extractall(tmp)
+        harness = Harness(Path(tmp) / "binaries/linux64/Pendulum.so", read_model_description(str(fmu)).guid)
+        rows = [(case, *run_case(harness, case)) for case in CASES]
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(markdown(rows))
+    print(f"wrote {out}: {len(rows)} cases")
+
+
+if __name__ == "__main__":
+    main()
