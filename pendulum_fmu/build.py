@@ -108,6 +108,15 @@ def _check_source_files(model_description, xml: Path, sources: Path) -> None:
             )
 
 
+def assemble_sources(sources: Path, model_dir: Path = SOURCE_DIR,
+                     model_description_file: Path = MODEL_DESCRIPTION) -> Path:
+    """Everything that compiles into the FMU, in one folder: what the FMU's sources/ holds, and
+    what the tests' C driver and fuzzers link."""
+    _check_sources_present()
+    _assemble_sources(Path(model_dir), read_model_description(str(model_description_file)), Path(sources))
+    return Path(sources)
+
+
 def _assemble_sources(model_dir: Path, model_description, sources: Path) -> None:
     """The plumbing from fmu_src/, the model from model_dir, the generated variables."""
     sources.mkdir()

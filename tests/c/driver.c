@@ -1,0 +1,270 @@
+/* Drives the FMU's sources, linked in, through the bad calls and loads a master can inflict,
+   so AddressSanitizer, UndefinedBehaviorSanitizer and valgrind watch every access.
+
+   usage: driver bad-calls | instances N | threads N | energy STEPS | churn N [MAX_GROWTH_KIB]
+   Prints one line of figures per case; exits non-zero on the first failed expectation. */
+
+#include <math.h>
+#include <pthread.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "fmi2Functions.h"
+#include "model_variables.h"
+
+static int messages_logged;
+
+static void logger(fmi2ComponentEnvironment environment, fmi2String instance_name,
+                   fmi2Status status, fmi2String category, fmi2String message, ...) {
+    (void)environment, (void)instance_name, (void)status, (void)category, (void)message;
+    __atomic_add_fetch(&messages_logged, 1, __ATOMIC_RELAXED);
+}
+
+static const fmi2CallbackFunctions callbacks = {logger, NULL, NULL, NULL, NULL};
+
+#define EXPECT(condition)                                                                    \
+    do {                                                                                     \
+        if (!(condition)) {                                                                  \
+            fprintf(stderr, "%s:%d: expected %s\n", __FILE__, __LINE__, #condition);         \
+            exit(1);                                                                         \
+        }                                                                                    \
+    } while (0)
+
+static fmi2Component ready(const char *name, double torque_start) {
+    fmi2Component c = fmi2Instantiate(name, fmi2CoSimulation, MODEL_GUID, "", &callbacks, fmi2False, fmi2False);
+    EXPECT(c != NULL);
+    EXPECT(fmi2SetupExperiment(c, fmi2False, 0, 0, fmi2False, 0) == fmi2OK);
+    EXPECT(fmi2EnterInitializationMode(c) == fmi2OK);
+    const fmi2ValueReference torque = VR_TORQUE;
+    EXPECT(fmi2SetReal(c, &torque, 1, &torque_start) == fmi2OK);
+    EXPECT(fmi2ExitInitializationMode(c) == fmi2OK);
+    return c;
+}
+
+/* theta after `steps` 1 ms steps under a constant torque. */
+static double run(fmi2Component c, double torque, long steps) {
+    const fmi2ValueReference torque_vr = VR_TORQUE, theta_vr = VR_THETA;
+    double theta = 0;
+    for (long k = 0; k < steps; k++) {
+        EXPECT(fmi2SetReal(c, &torque_vr, 1, &torque) == fmi2OK);
+        EXPECT(fmi2DoStep(c, k * 1e-3, 1e-3, fmi2True) == fmi2OK);
+    }
+    EXPECT(fmi2GetReal(c, &theta_vr, 1, &theta) == fmi2OK);
+    return theta;
+}
+
+static void bad_calls(void) {
+    const fmi2ValueReference theta = VR_THETA, mass = VR_MASS, unknown = 1000;
+    double value = NAN, one = 1.0;
+    int refused = 0;
+#define REFUSED(call) do { EXPECT((call) == fmi2Error); refused++; } while (0)
+    EXPECT(fmi2Instantiate("x", fmi2CoSimulation, MODEL_GUID, "", NULL, 0, 0) == NULL);
+    fmi2CallbackFunctions no_logger = {NULL, NULL, NULL, NULL, NULL};
+    EXPECT(fmi2Instantiate("x", fmi2CoSimulation, MODEL_GUID, "", &no_logger, 0, 0) == NULL);
+    EXPECT(fmi2Instantiate(NULL, fmi2CoSimulation, MODEL_GUID, "", &callbacks, 0, 0) == NULL);
+    EXPECT(fmi2Instantiate("x", fmi2CoSimulation, "{wrong}", "", &callbacks, 0, 0) == NULL);
+    EXPECT(fmi2Instantiate("x", (fmi2Type)42, MODEL_GUID, "", &callbacks, 0, 0) == NULL);
+    fmi2FreeInstance(NULL);
+    REFUSED(fmi2DoStep(NULL, 0, 1e-3, 0));
+    REFUSED(fmi2GetReal(NULL, &theta, 1, &value));
+
+    fmi2Component c = fmi2Instantiate("bad", fmi2CoSimulation, MODEL_GUID, "", &callbacks, 0, 0);
+    REFUSED(fmi2DoStep(c, 0, 1e-3, 0));
+    REFUSED(fmi2GetReal(c, &theta, 1, &value));
+    REFUSED(fmi2SetReal(c, &theta, 1, &value));           /* NaN start value */
+    REFUSED(fmi2SetReal(c, &unknown, 1, &one));
+    REFUSED(fmi2SetReal(c, NULL, 1, &one));
+    REFUSED(fmi2SetReal(c, &theta, 1, NULL));
+    EXPECT(fmi2SetReal(c, NULL, 0, NULL) == fmi2OK);      /* nothing to set is fine */
+    double zero = 0;
+    EXPECT(fmi2SetReal(c, &mass, 1, &zero) == fmi2OK);
+    EXPECT(fmi2EnterInitializationMode(c) == fmi2OK);
+    REFUSED(fmi2ExitInitializationMode(c));               /* mass 0 */
+    EXPECT(fmi2SetReal(c, &mass, 1, &one) == fmi2OK);
+    EXPECT(fmi2ExitInitializationMode(c) == fmi2OK);
+    REFUSED(fmi2SetReal(c, &mass, 1, &one));              /* fixed after initialization */
+    REFUSED(fmi2DoStep(c, 0, -1, 0));
+    REFUSED(fmi2DoStep(c, 0, NAN, 0));
+    REFUSED(fmi2DoStep(c, 5, 1e-3, 0));
+    REFUSED(fmi2GetFMUstate(c, NULL));
+    REFUSED(fmi2SetFMUstate(c, NULL));
+    REFUSED(fmi2GetDirectionalDerivative(c, &theta, 1, &mass, 1, &one, &value));
+    REFUSED(fmi2SetContinuousStates(c, &one, 1));
+    REFUSED(fmi2CancelStep(c));
+
+    /* Serialized states: every truncation, and every single-byte corruption, refused. */
+    fmi2FMUstate state = NULL, restored = NULL;
+    size_t size = 0;
+    EXPECT(fmi2DoStep(c, 0, 1e-3, 0) == fmi2OK);
+    EXPECT(fmi2GetFMUstate(c, &state) == fmi2OK);
+    EXPECT(fmi2SerializedFMUstateSize(c, state, &size) == fmi2OK);
+    fmi2Byte *blob = malloc(size);
+    EXPECT(fmi2SerializeFMUstate(c, state, blob, size) == fmi2OK);
+    REFUSED(fmi2SerializeFMUstate(c, state, blob, size - 1));
+    for (size_t length = 0; length < size; length++) {
+        fmi2Byte *truncated = malloc(length ? length : 1); /* exactly length bytes: ASan sees any overread */
+        memcpy(truncated, blob, length);
+        REFUSED(fmi2DeSerializeFMUstate(c, truncated, length, &restored));
+        free(truncated);
+    }
+    for (size_t i = 0; i < size; i++) {
+        blob[i] ^= 0x5a;
+        REFUSED(fmi2DeSerializeFMUstate(c, blob, size, &restored));
+        blob[i] ^= 0x5a;
+    }
+    EXPECT(restored == NULL);
+    EXPECT(fmi2DeSerializeFMUstate(c, blob, size, &restored) == fmi2OK);
+    EXPECT(fmi2SetFMUstate(c, restored) == fmi2OK);
+    EXPECT(fmi2FreeFMUstate(c, &restored) == fmi2OK && restored == NULL);
+    EXPECT(fmi2FreeFMUstate(c, &state) == fmi2OK);
+    free(blob);
+    EXPECT(fmi2DoStep(c, 1e-3, 1e-3, 0) == fmi2OK);       /* still usable after all that */
+    fmi2FreeInstance(c);
+    printf("bad-calls: %d refused calls, %d messages logged, %zu truncations and %zu corruptions of a "
+           "%zu-byte state refused\n", refused, messages_logged, size, size, size);
+#undef REFUSED
+}
+
+static void instances(long n) {
+    fmi2Component *all = malloc(n * sizeof(*all));
+    char name[32];
+    for (long i = 0; i < n; i++) {
+        snprintf(name, sizeof(name), "pendulum %ld", i);
+        all[i] = ready(name, 0.0);
+    }
+    /* All live at once, each with its own torque, stepped in turn. */
+    const fmi2ValueReference torque_vr = VR_TORQUE, theta_vr = VR_THETA;
+    for (long k = 0; k < 100; k++) {
+        for (long i = 0; i < n; i++) {
+            const double torque = (double)(i % 50);
+            EXPECT(fmi2SetReal(all[i], &torque_vr, 1, &torque) == fmi2OK);
+            EXPECT(fmi2DoStep(all[i], k * 1e-3, 1e-3, fmi2True) == fmi2OK);
+        }
+    }
+    for (long i = 0; i < n; i++) {
+        double theta, alone;
+        EXPECT(fmi2GetReal(all[i], &theta_vr, 1, &theta) == fmi2OK);
+        if (i < 50) {
+            fmi2Component single = ready("alone", 0.0);
+            alone = run(single, (double)i, 100);
+            fmi2FreeInstance(single);
+            EXPECT(theta == alone);
+        }
+        fmi2FreeInstance(all[i]);
+    }
+    free(all);
+    printf("instances: %ld live at once, each equal to the same run alone\n", n);
+}
+
+typedef struct {
+    double torque;
+    double theta;
+} ThreadJob;
+
+static void *thread_main(void *argument) {
+    ThreadJob *job = argument;
+    fmi2Component c = ready("thread", 0.0);
+    job->theta = run(c, job->torque, 3000);
+    fmi2FreeInstance(c);
+    return NULL;
+}
+
+static void threads(int n) {
+    pthread_t *ids = malloc(n * sizeof(*ids));
+    ThreadJob *jobs = calloc(n, sizeof(*jobs));
+    for (int i = 0; i < n; i++) {
+        jobs[i].torque = 5.0 * (i + 1);
+        EXPECT(pthread_create(&ids[i], NULL, thread_main, &jobs[i]) == 0);
+    }
+    for (int i = 0; i < n; i++) EXPECT(pthread_join(ids[i], NULL) == 0);
+    for (int i = 0; i < n; i++) {
+        fmi2Component c = ready("one thread", 0.0);
+        EXPECT(run(c, jobs[i].torque, 3000) == jobs[i].theta);
+        fmi2FreeInstance(c);
+    }
+    printf("threads: %d threads, each instance's theta(3 s) equal to the single-thread run\n", n);
+    free(ids);
+    free(jobs);
+}
+
+/* Released at 1 rad with no torque and no damping, the pendulum must keep its energy. */
+static void energy(long steps) {
+    fmi2Component c = fmi2Instantiate("energy", fmi2CoSimulation, MODEL_GUID, "", &callbacks, 0, 0);
+    const fmi2ValueReference theta_vr = VR_THETA, omega_vr = VR_OMEGA;
+    const double theta0 = 1.0;
+    EXPECT(fmi2SetReal(c, &theta_vr, 1, &theta0) == fmi2OK);
+    EXPECT(fmi2SetupExperiment(c, 0, 0, 0, 0, 0) == fmi2OK);
+    EXPECT(fmi2EnterInitializationMode(c) == fmi2OK);
+    EXPECT(fmi2ExitInitializationMode(c) == fmi2OK);
+    const double mass = model_variables[VR_MASS].start, length = model_variables[VR_LENGTH].start;
+    const double inertia = model_variables[VR_INERTIA].start + mass * length * length;
+    const double weight_moment = mass * model_variables[VR_GRAVITY].start * length;
+    const double energy0 = weight_moment * (1 - cos(theta0));
+    double worst = 0, theta, omega;
+    for (long k = 0; k < steps; k++) {
+        EXPECT(fmi2DoStep(c, k * 1e-3, 1e-3, fmi2True) == fmi2OK);
+        if (k % 1000 == 999 || k == steps - 1) {
+            EXPECT(fmi2GetReal(c, &theta_vr, 1, &theta) == fmi2OK);
+            EXPECT(fmi2GetReal(c, &omega_vr, 1, &omega) == fmi2OK);
+            const double drift = fabs(0.5 * inertia * omega * omega + weight_moment * (1 - cos(theta)) - energy0) / energy0;
+            if (drift > worst) worst = drift;
+        }
+    }
+    fmi2FreeInstance(c);
+    /* The default tolerance allows 1e-10 per internal step; 1 ms steps are far inside it. */
+    printf("energy: %ld steps of 1 ms (%.0f s), worst relative energy drift %.3e\n", steps, steps * 1e-3, worst);
+    EXPECT(worst < 1e-6);
+}
+
+static long resident_pages(void) {
+    long size = 0, resident = 0;
+    FILE *statm = fopen("/proc/self/statm", "r");
+    if (statm) {
+        EXPECT(fscanf(statm, "%ld %ld", &size, &resident) == 2);
+        fclose(statm);
+    }
+    return resident;
+}
+
+static void churn(long n, long max_growth_kib) {
+    long after_warmup = 0;
+    for (long i = 0; i < n; i++) {
+        fmi2Component c = ready("churn", 1.0);
+        EXPECT(fmi2DoStep(c, 0, 1e-3, fmi2True) == fmi2OK);
+        fmi2FMUstate state = NULL;
+        EXPECT(fmi2GetFMUstate(c, &state) == fmi2OK && fmi2FreeFMUstate(c, &state) == fmi2OK);
+        fmi2FreeInstance(c);
+        if (i == 999) after_warmup = resident_pages();
+    }
+#ifdef __SANITIZE_ADDRESS__
+    /* AddressSanitizer keeps freed memory in quarantine, so resident size says nothing here; its
+       LeakSanitizer checks for leaks at exit instead. */
+    (void)after_warmup, (void)max_growth_kib;
+    printf("churn: %ld instantiate/step/free cycles (leaks: LeakSanitizer at exit)\n", n);
+#else
+    const long growth_kib = (resident_pages() - after_warmup) * sysconf(_SC_PAGESIZE) / 1024;
+    printf("churn: %ld instantiate/step/free cycles, resident memory grew %ld KiB after the first 1000\n",
+           n, growth_kib);
+    /* Only meaningful natively: valgrind's allocator grows on its own. */
+    if (max_growth_kib > 0) EXPECT(growth_kib <= max_growth_kib);
+#endif
+}
+
+int main(int argc, char **argv) {
+    if (argc < 2) {
+        fprintf(stderr, "usage: %s bad-calls | instances N | threads N | energy STEPS | churn N [MAX_GROWTH_KIB]\n",
+                argv[0]);
+        return 2;
+    }
+    const long n = argc > 2 ? atol(argv[2]) : 0;
+    if (!strcmp(argv[1], "bad-calls")) bad_calls();
+    else if (!strcmp(argv[1], "instances")) instances(n);
+    else if (!strcmp(argv[1], "threads")) threads((int)n);
+    else if (!strcmp(argv[1], "energy")) energy(n);
+    else if (!strcmp(argv[1], "churn")) churn(n, argc > 3 ? atol(argv[3]) : 0);
+    else return 2;
+    return 0;
+}
