@@ -18,8 +18,9 @@ from .own_cost import own_cost_rows
 from .peers import opensim_rows, pythonfmu_rows
 from .python_loop import python_loop_rows
 from .report import as_markdown, as_text, main_table
+from .scale import scale_rows
 
-PARTS = ("floor", "own-cost", "accuracy", "python-loop", "opensim", "pythonfmu")
+PARTS = ("floor", "own-cost", "accuracy", "python-loop", "opensim", "pythonfmu", "scale")
 DEFAULT_FIGURE = Path(__file__).resolve().parent / "accuracy_cost.png"
 
 
@@ -66,6 +67,8 @@ def main(argv=None) -> int:
                 rows += opensim_rows(pendulum, repetitions)
             elif part == "pythonfmu":
                 rows += pythonfmu_rows(pendulum, scratch, repetitions)
+            elif part == "scale":
+                rows += scale_rows(pendulum, args.quick)
     tables = [main_table(rows)] + ([grid] if grid else [])
     print("\n\n".join(as_text(table) for table in tables))
     if args.markdown:

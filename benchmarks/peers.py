@@ -18,6 +18,9 @@ from .report import Row, microseconds, ratio, skipped
 from .timing import interleaved, median, timed
 from .tutorial import STEP, STEPS, STOP_TIME, TORQUE, max_theta_error
 
+# How much faster per step the FMU should be than each peer, at equal or smaller error.
+OPENSIM_TARGET, PYTHONFMU_TARGET = 30.0, 20.0
+
 
 def opensim_rows(fmu: BuiltFmu, repetitions: int) -> list[Row]:
     """OpenSim's tutorial pendulum against simulate(), each end to end (building or opening the
@@ -50,7 +53,8 @@ def opensim_rows(fmu: BuiltFmu, repetitions: int) -> list[Row]:
     return [
         Row(part, f"OpenSim opensim_simulate(), {case}", f"{microseconds(opensim_step)}/step"),
         Row(part, f"Pendulum FMU simulate(), {case}", f"{microseconds(fmu_step)}/step"),
-        Row(part, "OpenSim / FMU time", ratio(opensim_step / fmu_step)),
+        Row(part, "OpenSim / FMU time", ratio(opensim_step / fmu_step), f">= {OPENSIM_TARGET:g}",
+            opensim_step / fmu_step >= OPENSIM_TARGET),
         Row(part, "max |theta error| rad: OpenSim / FMU", f"{opensim_error:.1e} / {fmu_error:.1e}",
             "FMU <= OpenSim", fmu_error <= opensim_error),
     ]
@@ -81,10 +85,12 @@ def pythonfmu_rows(pendulum: BuiltFmu, out_dir: Path, repetitions: int) -> list[
     peer_step = median(seconds["pythonfmu"]) / STEPS
     ours_step = median(seconds["ours"]) / STEPS
     loop = f"fmpy FMU2Slave loop, {STEPS} x 1 ms, median of {repetitions}"
+    peer_error, ours_error = max_theta_error(theta["pythonfmu"]), max_theta_error(theta["ours"])
     return [
         Row(part, f"PythonFMU pendulum, {loop}", f"{microseconds(peer_step)}/step"),
         Row(part, f"Pendulum FMU, {loop}", f"{microseconds(ours_step)}/step"),
-        Row(part, "PythonFMU / ours time", ratio(peer_step / ours_step)),
-        Row(part, "max |theta error| rad: PythonFMU / ours",
-            f"{max_theta_error(theta['pythonfmu']):.1e} / {max_theta_error(theta['ours']):.1e}"),
+        Row(part, "PythonFMU / ours time", ratio(peer_step / ours_step), f">= {PYTHONFMU_TARGET:g}",
+            peer_step / ours_step >= PYTHONFMU_TARGET),
+        Row(part, "max |theta error| rad: PythonFMU / ours", f"{peer_error:.1e} / {ours_error:.1e}",
+            "ours <= PythonFMU", ours_error <= peer_error),
     ]

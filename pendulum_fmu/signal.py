@@ -35,18 +35,14 @@ class TorqueTable:
 
     def value_after(self, t: float) -> float:
         """The torque just after t: at a jump, the value after it."""
-        i = np.searchsorted(self.time, t, side="right")
-        if i == 0:
-            return float(self.torque[0])
-        if i == len(self.time):
-            return float(self.torque[-1])
-        t0, t1 = self.time[i - 1], self.time[i]
-        u0, u1 = self.torque[i - 1], self.torque[i]
-        return float(u0 + (u1 - u0) * (t - t0) / (t1 - t0))
+        return self._value(t, "right")
 
     def value_before(self, t: float) -> float:
         """The torque just before t: at a jump, the value before it."""
-        i = np.searchsorted(self.time, t, side="left")
+        return self._value(t, "left")
+
+    def _value(self, t: float, side: str) -> float:
+        i = np.searchsorted(self.time, t, side=side)
         if i == 0:
             return float(self.torque[0])
         if i == len(self.time):

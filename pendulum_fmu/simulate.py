@@ -22,8 +22,8 @@ class FmuError(RuntimeError):
     """An FMI call failed; the message carries what the FMU logged."""
 
 
-class _Messages:
-    """Collects what the FMU logs so a failure can say why."""
+class MessageLog:
+    """FMI callbacks whose logger keeps what the FMU says, so a failure can say why."""
 
     def __init__(self):
         self.lines: list[str] = []
@@ -73,7 +73,7 @@ def open_fmu(fmu_path: str | Path | None = None, *, parameters: dict | None = No
     slave = FMU2Slave(guid=description.guid, unzipDirectory=folder,
                       modelIdentifier=description.coSimulation.modelIdentifier,
                       instanceName=instance_name)
-    messages = _Messages()
+    messages = MessageLog()
     slave.instantiate(callbacks=messages.callbacks)
     slave.messages = messages  # keeps the logger callback alive as long as the slave
     start = {**resolve_parameters(parameters), "theta": float(theta0), "omega": float(omega0)}

@@ -1,8 +1,10 @@
-"""Parameter studies as a grid of cases, run on dask.
+"""Parameter studies: a grid of cases run on dask.distributed.
 
-A local cluster by default; with a scheduler address, an existing dask.distributed cluster,
-which is how a study grows past one machine (every worker needs this package and the FMU path).
-Cases go out in chunks so each task amortizes its scheduling over several simulations.
+A local cluster by default; with a scheduler address, an existing cluster, which is how a study
+grows past one machine (every worker needs this package installed and the FMU path readable).
+Cases go out in chunks, so a task amortizes its scheduling over several simulations, and each
+worker formats its chunk's CSV rows: printing floats exactly costs about as much as simulating
+them, so the client only concatenates.
 """
 
 from __future__ import annotations
@@ -10,6 +12,8 @@ from __future__ import annotations
 import itertools
 import logging
 import math
+import numbers
+import sys
 import time
 from pathlib import Path
 
@@ -18,98 +22,171 @@ import numpy as np
 from .build import default_fmu
 from .parameters import default_parameters
 from .plot import plot_cases
-from .simulate import simulate
+from .signal import communication_points
+from .simulate import FmuError, simulate
 
 START_VALUES = ("theta0", "omega0")
-# Enough chunks per worker to balance the load, few enough that scheduling stays cheap.
+OUTPUTS = ("time", "theta", "omega", "alpha")
+# Enough chunks per worker to even out the load and show progress, few enough that per-task
+# overhead stays small next to the simulations.
 CHUNKS_PER_WORKER = 4
 
 
-def sweep_grid(torques, gravities=(9.81,), extra: dict[str, list[float]] | None = None) -> list[dict]:
-    """Every combination of torque, gravity and the extra values (parameters mass, length,
-    inertia, damping, or start values theta0, omega0) as a list of case dicts."""
-    axes = {"torque": list(torques), "gravity": list(gravities), **(extra or {})}
-    allowed = set(default_parameters()) | set(START_VALUES) | {"torque"}
-    for name, values in axes.items():
-        if name not in allowed:
-            raise ValueError(f"cannot sweep {name!r}: choose from {', '.join(sorted(allowed))}")
-        if not values:
-            raise ValueError(f"no values given for {name}")
-        if not all(math.isfinite(float(v)) for v in values):
-            raise ValueError(f"{name} values must be finite, got {values}")
-    return [dict(zip(axes, map(float, combination))) for combination in itertools.product(*axes.values())]
+def _sweepable() -> list[str]:
+    return ["torque", *default_parameters(), *START_VALUES]
 
 
-def _run_case(case: dict, fmu_path: str, stop_time: float, step_size: float) -> np.ndarray:
-    parameters = {k: v for k, v in case.items() if k not in START_VALUES and k != "torque"}
-    return simulate(case["torque"], parameters=parameters, theta0=case.get("theta0", 0.0),
-                    omega0=case.get("omega0", 0.0), stop_time=stop_time, step_size=step_size,
-                    fmu_path=fmu_path)
+def _values(name: str, values) -> list[float]:
+    try:
+        array = np.asarray(values, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} values must be numbers, got {values!r}") from None
+    if array.ndim != 1:
+        raise ValueError(f"{name} values must be a flat list of numbers, got {values!r}")
+    if array.size == 0:
+        raise ValueError(f"no values given for {name}")
+    if not np.all(np.isfinite(array)):
+        raise ValueError(f"{name} values must be finite, got {array[~np.isfinite(array)][0]}")
+    return array.tolist()
 
 
-def _run_chunk(cases: list[dict], fmu_path: str, stop_time: float, step_size: float) -> list[np.ndarray]:
-    return [_run_case(case, fmu_path, stop_time, step_size) for case in cases]
+def sweep_grid(torques, gravities=(9.81,), extra: dict | None = None) -> list[dict]:
+    """Every combination of the torques, gravities and extra values as a list of cases.
+
+    extra: {name: [values, ...]} for the parameters mass, length, inertia, damping and the start
+    values theta0, omega0. A case is a dict {'torque': .., 'gravity': .., <extra names>: ..}.
+    """
+    extra = dict(extra or {})
+    for name in extra:
+        if name in ("torque", "gravity"):
+            argument = {"torque": "torques", "gravity": "gravities"}[name]
+            raise ValueError(f"give {name} values as the {argument} argument, not in extra")
+        if name not in _sweepable():
+            raise ValueError(f"cannot sweep {name!r}: choose from {', '.join(_sweepable()[1:])}")
+    axes = {"torque": torques, "gravity": gravities, **extra}
+    axes = {name: _values(name, values) for name, values in axes.items()}
+    return [dict(zip(axes, combination)) for combination in itertools.product(*axes.values())]
 
 
-def _write_tidy(path: Path, cases: list[dict], runs: list[np.ndarray]) -> Path:
-    """One row per case and communication point: case, the case's values, the result fields."""
+def _check_cases(cases) -> list[str]:
+    """The cases' common keys, which become the CSV's case columns."""
+    if not cases:
+        raise ValueError("no cases to run")
     names = list(cases[0])
-    fields = ("time", "theta", "omega", "alpha")
-    blocks = [np.column_stack([np.full(len(run), number), np.tile([case[n] for n in names], (len(run), 1)),
-                               *(run[field] for field in fields)])
-              for number, (case, run) in enumerate(zip(cases, runs))]
-    header = ",".join(["case", *names, *fields])
-    formats = ["%d"] + ["%.17g"] * (len(names) + len(fields))
-    np.savetxt(path, np.vstack(blocks), delimiter=",", header=header, comments="", fmt=formats)
-    return path
+    if "torque" not in names:
+        raise ValueError("every case needs a 'torque'")
+    for number, case in enumerate(cases):
+        if list(case) != names:
+            raise ValueError(f"case {number} has keys {list(case)}; every case needs {names}")
+        for name, value in case.items():
+            if name not in _sweepable():
+                raise ValueError(f"cannot sweep {name!r}: choose from {', '.join(_sweepable())}")
+            if not isinstance(value, numbers.Real) or not math.isfinite(value):
+                raise ValueError(f"case {number}: {name} = {value!r} must be a finite number")
+    return names
 
 
 def _label(case: dict) -> str:
     return ", ".join(f"{name} = {value:g}" for name, value in case.items())
 
 
+def _run_chunk(numbered_cases: list[tuple[int, dict]], fmu_path: str, stop_time: float,
+               step_size: float) -> tuple[str, np.ndarray, np.ndarray]:
+    """Simulate a chunk of cases on a worker.
+
+    Returns the chunk's CSV rows, the common time points and theta and omega of each case
+    (shape cases x 2 x points) for the figure.
+    """
+    text, curves, row_templates = [], [], None
+    for number, case in numbered_cases:
+        parameters = {k: v for k, v in case.items() if k != "torque" and k not in START_VALUES}
+        try:
+            run = simulate(case["torque"], parameters=parameters, theta0=case.get("theta0", 0.0),
+                           omega0=case.get("omega0", 0.0), stop_time=stop_time,
+                           step_size=step_size, fmu_path=fmu_path)
+        except FmuError as error:
+            raise FmuError(f"case {number} ({_label(case)}): {error}") from None
+        if row_templates is None:
+            # Every case shares the time points, so they are printed once per chunk.
+            row_templates = [f"{t!r},%r,%r,%r\n" for t in run["time"].tolist()]
+        # One %-formatting of the whole case: repr, the shortest exact form, done in C.
+        prefix = ",".join([str(number), *map(repr, case.values())]) + ","
+        values = np.column_stack([run["theta"], run["omega"], run["alpha"]]).ravel().tolist()
+        text.append((prefix + prefix.join(row_templates)) % tuple(values))
+        curves.append((run["theta"], run["omega"]))
+    return "".join(text), run["time"], np.array(curves)
+
+
+def _show_progress(done: int, total: int, seconds: float) -> None:
+    # On a terminal the line redraws in place; in a log, a line per finished chunk.
+    end = "\r" if sys.stderr.isatty() and done < total else "\n"
+    bar = "#" * (30 * done // total)
+    print(f"sweep [{bar:<30}] {done}/{total} cases, {seconds:.1f} s", end=end, file=sys.stderr,
+          flush=True)
+
+
 def run_sweep(cases: list[dict], *, output_dir: str | Path, stop_time: float = 3.0,
               step_size: float = 1e-3, scheduler: str | None = None, workers: int | None = None,
               progress: bool = True, fmu_path: str | Path | None = None) -> dict:
-    """Run the cases on dask; write output_dir/sweep.csv (tidy) and sweep.png.
+    """Run every case on dask; write output_dir/sweep.csv and output_dir/sweep.png.
 
-    Returns {'results', 'figure', 'cases', 'seconds'}.
+    sweep.csv is tidy: columns case, the case's keys (torque, gravity, ...), time, theta, omega,
+    alpha, one row per case and communication point. scheduler: the address of a running
+    dask.distributed scheduler; without one a local cluster of `workers` processes (default 2)
+    runs for this call. progress: a progress line on stderr.
+    Returns {'results': csv path, 'figure': png path, 'cases': count, 'seconds': wall time}.
     """
-    from dask.distributed import Client, LocalCluster
-    from dask.distributed import progress as progress_bar
+    from dask.distributed import Client, LocalCluster, as_completed
 
-    if not cases:
-        raise ValueError("no cases to run")
-    if workers is not None and workers < 1:
-        raise ValueError(f"workers must be >= 1, got {workers}")
+    started = time.perf_counter()
+    names = _check_cases(cases)
+    if not (isinstance(stop_time, numbers.Real) and math.isfinite(stop_time)):
+        raise ValueError(f"stop time {stop_time} must be a finite number")
+    communication_points(0.0, stop_time, step_size)  # refuses a bad stop time or step here, not on a worker
+    if scheduler is not None and workers is not None:
+        raise ValueError("workers sizes the local cluster; with a scheduler the cluster has its own")
+    if workers is not None and (not isinstance(workers, numbers.Integral) or workers < 1):
+        raise ValueError(f"workers must be a positive integer, got {workers!r}")
     output_dir = Path(output_dir)
     output_dir.mkdir(parents=True, exist_ok=True)
-    # Built once here, so workers only read it.
+    # Built here once: workers only read it, each extracting it once per process.
     fmu = str(Path(fmu_path).resolve() if fmu_path else default_fmu())
-    started = time.perf_counter()
-    cluster = None
-    if scheduler:
-        client = Client(scheduler)
-    else:
+
+    if scheduler is None:
+        # Port 0 for the scheduler's HTTP server: another cluster may hold dask's usual 8787.
         cluster = LocalCluster(n_workers=workers or 2, threads_per_worker=1, processes=True,
-                               dashboard_address=None, silence_logs=logging.WARNING)
-        client = Client(cluster)
+                               dashboard_address=":0", silence_logs=logging.WARNING)
+    else:
+        cluster = None
     try:
-        n_workers = max(len(client.scheduler_info()["workers"]), 1)
-        chunk_size = max(1, math.ceil(len(cases) / (n_workers * CHUNKS_PER_WORKER)))
-        chunks = [cases[i:i + chunk_size] for i in range(0, len(cases), chunk_size)]
-        futures = client.map(_run_chunk, chunks, fmu_path=fmu, stop_time=stop_time,
-                             step_size=step_size, pure=False)
-        if progress:
-            progress_bar(futures)
-            print()
-        runs = [run for chunk in client.gather(futures) for run in chunk]
+        with Client(cluster if cluster is not None else scheduler) as client:
+            slots = max(sum(client.nthreads().values()), 1)
+            size = math.ceil(len(cases) / (slots * CHUNKS_PER_WORKER))
+            numbered = list(enumerate(cases))
+            chunks = [numbered[i:i + size] for i in range(0, len(numbered), size)]
+            futures = client.map(_run_chunk, chunks, fmu_path=fmu, stop_time=stop_time,
+                                 step_size=step_size, pure=False)
+            position = {future.key: i for i, future in enumerate(futures)}
+            outputs, done = [None] * len(chunks), 0
+            for future, output in as_completed(futures, with_results=True):
+                index = position[future.key]
+                outputs[index] = output
+                done += len(chunks[index])
+                if progress:
+                    _show_progress(done, len(cases), time.perf_counter() - started)
     finally:
-        client.close()
         if cluster is not None:
             cluster.close()
-    seconds = time.perf_counter() - started
-    table = _write_tidy(output_dir / "sweep.csv", cases, runs)
-    figure = plot_cases({_label(case): run for case, run in zip(cases, runs)}, output_dir / "sweep.png",
-                        "Parameter study: torque-driven pendulum")
-    return {"results": table, "figure": figure, "cases": len(cases), "seconds": seconds}
+
+    results = output_dir / "sweep.csv"
+    with open(results, "w") as file:
+        file.write(",".join(["case", *names, *OUTPUTS]) + "\n")
+        file.writelines(text for text, _, _ in outputs)
+    times = outputs[0][1]
+    curves = np.concatenate([chunk_curves for _, _, chunk_curves in outputs])
+    runs = {_label(case): {"time": times, "theta": theta, "omega": omega}
+            for case, (theta, omega) in zip(cases, curves)}
+    figure = plot_cases(runs, output_dir / "sweep.png",
+                        f"Parameter study: {len(cases)} cases of the torque-driven pendulum")
+    return {"results": results, "figure": figure, "cases": len(cases),
+            "seconds": time.perf_counter() - started}

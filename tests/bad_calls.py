@@ -13,7 +13,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
-from fmpy.fmi2 import fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, fmi2EventInfo
+from fmpy.fmi2 import fmi2CallbackFunctions
+
+from pendulum_fmu.simulate import MessageLog
 
 OK, WARNING, DISCARD, ERROR = 0, 1, 2, 3
 STATUS_NAMES = ["fmi2OK", "fmi2Warning", "fmi2Discard", "fmi2Error", "fmi2Fatal", "fmi2Pending"]
@@ -38,18 +40,13 @@ class Harness:
         self.lib.fmi2Instantiate.argtypes = [ctypes.c_char_p, ctypes.c_int, ctypes.c_char_p, ctypes.c_char_p,
                                              ctypes.c_void_p, ctypes.c_int, ctypes.c_int]
         self.guid = guid.encode()
-        self.messages: list[str] = []
-        self.callbacks = fmi2CallbackFunctions()
-        self.callbacks.logger = fmi2CallbackLoggerTYPE(self._log)
-        try:
-            from fmpy.logging import addLoggerProxy  # formats printf-style arguments
-            addLoggerProxy(ctypes.byref(self.callbacks))
-        except Exception:
-            pass
+        self.log = MessageLog()
+        self.callbacks = self.log.callbacks
         self.live: list[int] = []
 
-    def _log(self, environment, name, status, category, message):
-        self.messages.append(message.decode("utf-8", "replace"))
+    @property
+    def messages(self) -> list[str]:
+        return self.log.lines
 
     def __getattr__(self, name):
         return getattr(self.lib, name)
@@ -350,7 +347,6 @@ def main(argv=None):
 
     from fmpy import read_model_description
 
-    sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
     from pendulum_fmu.build import build_fmu
 
     out = Path((argv or sys.argv[1:] or ["docs/robustness.md"])[0])
