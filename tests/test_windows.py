@@ -12,9 +12,10 @@ import pytest
 from fmpy import read_model_description
 
 from benchmarks.builds import build_step_master
+import pendulum_fmu.build
 from pendulum_fmu.build import MINGW_COMPILER, build_fmu
 
-pytestmark = pytest.mark.skipif(
+needs_mingw_and_wine = pytest.mark.skipif(
     shutil.which(MINGW_COMPILER) is None or shutil.which("wine") is None,
     reason="needs Debian's gcc-mingw-w64-x86-64 and wine (.ci/run installs them)")
 
@@ -43,6 +44,7 @@ def _exports_of_so(library):
     return {line.split()[-1] for line in symbols.splitlines()}
 
 
+@needs_mingw_and_wine
 def test_dll_exports_exactly_the_fmi2_functions_of_the_linux_binary(both_platforms):
     work, _ = both_platforms
     exports = _exports_of_dll(work / "unzipped/binaries/win64/Pendulum.dll")
@@ -50,6 +52,7 @@ def test_dll_exports_exactly_the_fmi2_functions_of_the_linux_binary(both_platfor
     assert all(name.startswith("fmi2") for name in exports) and "fmi2DoStep" in exports
 
 
+@needs_mingw_and_wine
 def test_dll_under_wine_matches_linux64(both_platforms):
     work, guid = both_platforms
     unzipped = work / "unzipped" / "binaries"
@@ -65,3 +68,12 @@ def test_dll_under_wine_matches_linux64(both_platforms):
     assert len(runs["win64"]) == STEPS + 1
     assert np.max(np.abs(runs["win64"] - runs["linux64"])) < 1e-12
     assert abs(runs["linux64"][-1] - 0.0814310964678) < 1e-12  # theta(3 s), as in the tutorial case
+
+
+def test_without_mingw_the_build_says_so_and_still_builds_linux64(tmp_path, monkeypatch):
+    monkeypatch.setattr(pendulum_fmu.build, "MINGW_COMPILER", "no-such-mingw-gcc")
+    with pytest.warns(UserWarning, match="win64 left out: no-such-mingw-gcc not found: install Debian's gcc-mingw-w64"):
+        fmu = build_fmu(tmp_path / "Pendulum.fmu", platforms=("linux64", "win64"))
+    with zipfile.ZipFile(fmu) as archive:
+        binaries = [name for name in archive.namelist() if name.startswith("binaries/")]
+    assert binaries == ["binaries/linux64/Pendulum.so"]
