@@ -3,8 +3,8 @@
 A local cluster by default; with a scheduler address, an existing cluster, which is how a study
 grows past one machine (every worker needs this package installed and the FMU path readable).
 Cases go out in chunks, so a task amortizes its scheduling over several simulations, and each
-worker formats its chunk's CSV rows: printing floats exactly costs about as much as simulating
-them, so the client only concatenates.
+worker formats its chunk's CSV rows: printing floats exactly costs over half as much as
+simulating them, so the client only concatenates.
 """
 
 from __future__ import annotations
@@ -36,6 +36,10 @@ def _sweepable() -> list[str]:
     return ["torque", *default_parameters(), *START_VALUES]
 
 
+def _extra_names() -> list[str]:
+    return [name for name in _sweepable() if name not in ("torque", "gravity")]
+
+
 def _values(name: str, values) -> list[float]:
     try:
         array = np.asarray(values, dtype=float)
@@ -47,6 +51,8 @@ def _values(name: str, values) -> list[float]:
         raise ValueError(f"no values given for {name}")
     if not np.all(np.isfinite(array)):
         raise ValueError(f"{name} values must be finite, got {array[~np.isfinite(array)][0]}")
+    if len(np.unique(array)) < array.size:
+        raise ValueError(f"{name} values repeat: {values!r}")
     return array.tolist()
 
 
@@ -61,8 +67,8 @@ def sweep_grid(torques, gravities=(9.81,), extra: dict | None = None) -> list[di
         if name in ("torque", "gravity"):
             argument = {"torque": "torques", "gravity": "gravities"}[name]
             raise ValueError(f"give {name} values as the {argument} argument, not in extra")
-        if name not in _sweepable():
-            raise ValueError(f"cannot sweep {name!r}: choose from {', '.join(_sweepable()[1:])}")
+        if name not in _extra_names():
+            raise ValueError(f"cannot sweep {name!r}: extra takes {', '.join(_extra_names())}")
     axes = {"torque": torques, "gravity": gravities, **extra}
     axes = {name: _values(name, values) for name, values in axes.items()}
     return [dict(zip(axes, combination)) for combination in itertools.product(*axes.values())]
@@ -75,6 +81,7 @@ def _check_cases(cases) -> list[str]:
     names = list(cases[0])
     if "torque" not in names:
         raise ValueError("every case needs a 'torque'")
+    seen = {}
     for number, case in enumerate(cases):
         if list(case) != names:
             raise ValueError(f"case {number} has keys {list(case)}; every case needs {names}")
@@ -83,6 +90,10 @@ def _check_cases(cases) -> list[str]:
                 raise ValueError(f"cannot sweep {name!r}: choose from {', '.join(_sweepable())}")
             if not isinstance(value, numbers.Real) or not math.isfinite(value):
                 raise ValueError(f"case {number}: {name} = {value!r} must be a finite number")
+        # A repeat would only cost time, and share the first one's line in the figure.
+        first = seen.setdefault(tuple(case.values()), number)
+        if first != number:
+            raise ValueError(f"case {number} repeats case {first}")
     return names
 
 
@@ -108,9 +119,9 @@ def _run_chunk(numbered_cases: list[tuple[int, dict]], fmu_path: str, stop_time:
             raise FmuError(f"case {number} ({_label(case)}): {error}") from None
         if row_templates is None:
             # Every case shares the time points, so they are printed once per chunk.
-            row_templates = [f"{t!r},%r,%r,%r\n" for t in run["time"].tolist()]
-        # One %-formatting of the whole case: repr, the shortest exact form, done in C.
-        prefix = ",".join([str(number), *map(repr, case.values())]) + ","
+            row_templates = [f"{t!r},%.17g,%.17g,%.17g\n" for t in run["time"].tolist()]
+        # One %-formatting of the whole case, done in C; 17 digits read back as the same double.
+        prefix = ",".join([str(number), *(repr(float(v)) for v in case.values())]) + ","
         values = np.column_stack([run["theta"], run["omega"], run["alpha"]]).ravel().tolist()
         text.append((prefix + prefix.join(row_templates)) % tuple(values))
         curves.append((run["theta"], run["omega"]))
@@ -133,7 +144,8 @@ def run_sweep(cases: list[dict], *, output_dir: str | Path, stop_time: float = 3
     sweep.csv is tidy: columns case, the case's keys (torque, gravity, ...), time, theta, omega,
     alpha, one row per case and communication point. scheduler: the address of a running
     dask.distributed scheduler; without one a local cluster of `workers` processes (default 2)
-    runs for this call. progress: a progress line on stderr.
+    runs for this call (its workers are spawned, so a script calling this needs the
+    `if __name__ == "__main__":` guard). progress: a progress line on stderr.
     Returns {'results': csv path, 'figure': png path, 'cases': count, 'seconds': wall time}.
     """
     from dask.distributed import Client, LocalCluster, as_completed
@@ -158,8 +170,10 @@ def run_sweep(cases: list[dict], *, output_dir: str | Path, stop_time: float = 3
                                dashboard_address=":0", silence_logs=logging.WARNING)
     else:
         cluster = None
+    results = output_dir / "sweep.csv"
+    partial = results.with_suffix(".csv.partial")  # so a failed run leaves no half table
     try:
-        with Client(cluster if cluster is not None else scheduler) as client:
+        with Client(cluster if cluster is not None else scheduler) as client, open(partial, "w") as file:
             slots = max(sum(client.nthreads().values()), 1)
             size = math.ceil(len(cases) / (slots * CHUNKS_PER_WORKER))
             numbered = list(enumerate(cases))
@@ -167,25 +181,27 @@ def run_sweep(cases: list[dict], *, output_dir: str | Path, stop_time: float = 3
             futures = client.map(_run_chunk, chunks, fmu_path=fmu, stop_time=stop_time,
                                  step_size=step_size, pure=False)
             position = {future.key: i for i, future in enumerate(futures)}
-            outputs, done = [None] * len(chunks), 0
-            for future, output in as_completed(futures, with_results=True):
+            file.write(",".join(["case", *names, *OUTPUTS]) + "\n")
+            texts, curves, written, done = {}, [None] * len(chunks), 0, 0
+            for future, (text, times, chunk_curves) in as_completed(futures, with_results=True):
                 index = position[future.key]
-                outputs[index] = output
+                texts[index], curves[index] = text, chunk_curves
+                # Rows go out in case order as soon as the chunks before them are in, so the
+                # text, the bulk of the results, never piles up in the client.
+                while written in texts:
+                    file.write(texts.pop(written))
+                    written += 1
                 done += len(chunks[index])
                 if progress:
                     _show_progress(done, len(cases), time.perf_counter() - started)
+        partial.replace(results)
     finally:
+        partial.unlink(missing_ok=True)
         if cluster is not None:
             cluster.close()
 
-    results = output_dir / "sweep.csv"
-    with open(results, "w") as file:
-        file.write(",".join(["case", *names, *OUTPUTS]) + "\n")
-        file.writelines(text for text, _, _ in outputs)
-    times = outputs[0][1]
-    curves = np.concatenate([chunk_curves for _, _, chunk_curves in outputs])
     runs = {_label(case): {"time": times, "theta": theta, "omega": omega}
-            for case, (theta, omega) in zip(cases, curves)}
+            for case, (theta, omega) in zip(cases, np.concatenate(curves))}
     figure = plot_cases(runs, output_dir / "sweep.png",
                         f"Parameter study: {len(cases)} cases of the torque-driven pendulum")
     return {"results": results, "figure": figure, "cases": len(cases),

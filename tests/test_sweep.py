@@ -70,10 +70,11 @@ def test_a_case_the_fmu_refuses_names_the_case(fmu, tmp_path, scheduler):
     with pytest.raises(simulate.FmuError, match=r"case 1 \(torque = 1, mass = 0\).*mass must be > 0"):
         run_sweep([{"torque": 1.0, "mass": 1.0}, {"torque": 1.0, "mass": 0.0}], output_dir=tmp_path,
                   stop_time=0.01, scheduler=scheduler, progress=False, fmu_path=fmu)
+    assert list(tmp_path.iterdir()) == []  # no half-written table
 
 
 @pytest.mark.parametrize("arguments, message", [
-    (([1.0], [9.81], {"colour": [1.0]}), "cannot sweep 'colour'"),
+    (([1.0], [9.81], {"colour": [1.0]}), "cannot sweep 'colour': extra takes mass, length, inertia, damping"),
     (([1.0], [9.81], {"gravity": [1.0]}), "give gravity values as the gravities argument"),
     (([], [9.81]), "no values given for torque"),
     (([1.0], [9.81], {"mass": []}), "no values given for mass"),
@@ -81,6 +82,7 @@ def test_a_case_the_fmu_refuses_names_the_case(fmu, tmp_path, scheduler):
     (([float("inf")],), "torque values must be finite"),
     ((["heavy"],), "torque values must be numbers"),
     (([[1.0, 2.0]],), "torque values must be a flat list"),
+    (([1.0, 2.0, 1.0],), "torque values repeat"),
 ])
 def test_bad_grids(arguments, message):
     with pytest.raises(ValueError, match=message):
@@ -93,6 +95,8 @@ def test_bad_grids(arguments, message):
     ([{"torque": 1.0}, {"torque": 1.0, "mass": 2.0}], {}, "case 1 has keys"),
     ([{"torque": 1.0, "colour": 2.0}], {}, "cannot sweep 'colour'"),
     ([{"torque": float("nan")}], {}, "case 0: torque = nan must be a finite number"),
+    ([{"torque": "5"}], {}, "case 0: torque = '5' must be a finite number"),
+    ([{"torque": 1.0}, {"torque": 2.0}, {"torque": 1.0}], {}, "case 2 repeats case 0"),
     ([{"torque": 1.0}], {"step_size": 0.0}, "step size 0.0 must be positive"),
     ([{"torque": 1.0}], {"stop_time": float("inf")}, "stop time inf must be a finite number"),
     ([{"torque": 1.0}], {"workers": 0}, "workers must be a positive integer"),
