@@ -1,0 +1,66 @@
+"""Files that appear whole or not at all.
+
+Everything the project writes goes through `replacing`: the content is written to a unique
+temporary beside the target (same folder, so the rename is atomic on one file system) and renamed
+into place only when the writer finished without an exception. An interrupted or failed write
+leaves the old file, or none, and no temporary.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+from pathlib import Path
+
+
+def _read_umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+# Read once at import: os.umask can only be read by setting it, which races with other threads.
+_UMASK = _read_umask()
+
+
+def _temporary_beside(path: Path, suffix: str) -> tuple[int, str]:
+    """A new file beside path with the permissions a plain open() would give (mkstemp's are 0600,
+    which would hide an FMU or a table from the other users of a shared folder)."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    descriptor, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
+    os.chmod(temporary, 0o666 & ~_UMASK)
+    return descriptor, temporary
+
+
+@contextlib.contextmanager
+def replacing(path: str | os.PathLike, mode: str = "w", **open_arguments):
+    """Open a unique temporary beside path for writing; on success rename it to path.
+
+    with replacing("out.csv", newline="") as file: ...
+    """
+    descriptor, temporary = _temporary_beside(Path(path), ".partial")
+    try:
+        with os.fdopen(descriptor, mode, **open_arguments) as file:
+            yield file
+        os.replace(temporary, path)
+    except BaseException:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(temporary)
+        raise
+
+
+@contextlib.contextmanager
+def replacing_path(path: str | os.PathLike):
+    """A unique temporary path beside path, for writers that want a file name (savefig, zip);
+    renamed to path on success, removed otherwise."""
+    path = Path(path)
+    descriptor, temporary = _temporary_beside(path, f".partial{path.suffix}")
+    os.close(descriptor)
+    try:
+        yield Path(temporary)
+        os.replace(temporary, path)
+    except BaseException:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(temporary)
+        raise
