@@ -10,7 +10,7 @@ import numpy as np
 
 from pendulum_fmu.build import default_fmu
 from pendulum_fmu.reference import reference
-from pendulum_fmu.signal import read_torque_csv, schedule, write_torque_csv
+from pendulum_fmu.signal import schedule, write_torque_csv
 
 
 def run(stop_time=3.0, output_dir="out/fmpy_command_line"):
@@ -26,7 +26,7 @@ def run(stop_time=3.0, output_dir="out/fmpy_command_line"):
     result = np.genfromtxt(result_csv, delimiter=",", names=True)
     # fmpy writes both sides of each torque step; the first row of a repeated time is the step's end.
     first = np.unique(result["time"], return_index=True)[1]
-    oracle = reference(read_torque_csv(torque_csv), stop_time=stop_time)
+    oracle = reference(torque_csv, stop_time=stop_time, at=result["time"][first])
     difference = np.max(np.abs(result["theta"][first] - oracle["theta"]))
     print(f"fmpy simulate against scipy: max |dtheta| = {difference:.2e} rad over {len(first)} points")
     return difference

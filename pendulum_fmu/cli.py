@@ -47,7 +47,8 @@ def _add_signal_arguments(parser, required=True):
     group.add_argument("--torque", type=_float, help="constant torque in N.m")
     group.add_argument("--torque-file", type=Path,
                        help="CSV with columns time,torque in fmpy's convention: linear between "
-                            "rows, a step where a time repeats")
+                            "rows, a jump where a time repeats, held outside; each step holds the "
+                            "value just after its start unless --ramp (docs/signals.md)")
     parser.add_argument("--stop-time", type=_float, default=None,
                         help="end of the simulation in s (default: 3, or the CSV's last time)")
     parser.add_argument("--step-size", type=_float, default=1e-3,
@@ -92,7 +93,8 @@ def _print_comparison(comparison) -> None:
     print(format_table(comparison.differences))
     verdict = "agree" if comparison.agree else "DIFFER"
     print(f"tools {verdict}: worst difference {comparison.worst:.3e} against tolerance "
-          f"{comparison.tolerance:g}")
+          f"{comparison.tolerance:g}; torque received vs the signal: {comparison.torque_worst:.3e} N.m "
+          f"(allowed {comparison.torque_limit:.1e})")
 
 
 def cmd_compare(args) -> int:
@@ -100,7 +102,7 @@ def cmd_compare(args) -> int:
 
     tools = [tool.strip() for tool in args.tools.split(",") if tool.strip()]
     comparison = compare(_torque_signal(args), tools, output_dir=args.output_dir,
-                         step_size=args.step_size, stop_time=args.stop_time,
+                         step_size=args.step_size, stop_time=args.stop_time, ramp=args.ramp,
                          parameters=_parameters(args.assignments), theta0=args.theta0,
                          omega0=args.omega0, tolerance=args.tol)
     _print_comparison(comparison)
@@ -197,17 +199,25 @@ def build_parser() -> argparse.ArgumentParser:
     simulate.set_defaults(run=cmd_simulate)
 
     compare = commands.add_parser("compare", help="run one torque signal through several tools",
-                                  description="Run one torque signal through the FMU, the scipy "
-                                              "reference and OpenSim; write trajectories, a table "
-                                              "of max differences and a figure. Exits 1 when two "
-                                              "tools differ by more than --tol.")
+                                  description="Run one torque signal through the FMU and OpenSim "
+                                              "and judge each against the independent scipy "
+                                              "reference, which reads the signal itself: write "
+                                              "trajectories, a table of max and RMS differences "
+                                              "(and of the torque each tool received against the "
+                                              "signal) and a figure. Exits 1 when a tool differs "
+                                              "by more than --tol or received another torque.")
     _add_signal_arguments(compare)
+    compare.add_argument("--ramp", action="store_true",
+                         help="ramp the torque along the CSV's piecewise-linear signal in every "
+                              "tool that can (the FMU, the reference); OpenSim cannot and says so")
     compare.add_argument("--tools", default="fmu,reference,opensim",
-                         help="comma-separated: fmu, reference, opensim (default: %(default)s)")
+                         help="comma-separated, each once: fmu, reference, opensim; the reference "
+                              "always runs as the judge (default: %(default)s)")
     compare.add_argument("--output-dir", type=Path, required=True,
                          help="folder for trajectories.csv, differences.csv and comparison.png")
     compare.add_argument("--tol", type=_float, default=1e-9,
-                         help="largest allowed |dtheta| or |domega| (default: %(default)s)")
+                         help="largest allowed |dtheta| (rad) or |domega| (rad/s), positive and "
+                              "finite (default: %(default)s)")
     compare.set_defaults(run=cmd_compare)
 
     sweep = commands.add_parser("sweep", help="parameter study as a grid, on dask",

@@ -10,6 +10,8 @@ matplotlib.use("Agg")  # files only: works on machines without a display
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from .files import replacing_path  # noqa: E402
+
 THETA_LABEL = r"Position $\theta$ in rad"
 OMEGA_LABEL = r"Velocity $\omega$ in rad/s"
 TIME_LABEL = r"Time $t$ in s"
@@ -23,9 +25,11 @@ def _finish(fig, axes, title: str, path: str | Path) -> Path:
     fig.suptitle(title, fontsize=13)
     fig.tight_layout()
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    try:
+        with replacing_path(path) as partial:
+            fig.savefig(partial, dpi=120, format=path.suffix.lstrip(".") or "png")
+    finally:
+        plt.close(fig)
     return path
 
 

@@ -1,64 +1,239 @@
-"""The independent oracle: the same schedule through scipy's solve_ivp at tight tolerance."""
+"""The independent oracle: a torque signal as docs/signals.md defines it, through scipy.
+
+`reference()` shares no code with the path that feeds the tools (`signal.schedule`). It reads a
+CSV with its own small reader, keeps the times as exact fractions of the decimals written in the
+file, and finds the communication points and the torque of each step from the written
+definition. A schedule that does not carry the user's signal to the tools then shows as a
+difference between them and this oracle. `reference_schedule()` integrates a given schedule, to
+judge a tool on exactly the torques it was fed.
+
+Both integrate the equation of motion with solve_ivp (DOP853, rtol = atol = 1e-12) over pieces
+on which the torque is linear (held or ramped), restarting at every piece boundary.
+"""
 
 from __future__ import annotations
+
+import bisect
+import csv
+import math
+from fractions import Fraction
+from pathlib import Path
+from typing import Callable
 
 import numpy as np
 from scipy.integrate import solve_ivp
 
 from . import results
 from .parameters import resolve_parameters, total_inertia
-from .signal import TorqueSchedule, TorqueSignal, schedule
+
+# docs/signals.md: an event within max(1e-9 step, 64 ulp of its time) of a communication point
+# is that point. Written again here on purpose: the oracle must not borrow the schedule's code.
+_TOLERANCE_STEPS, _TOLERANCE_ULPS = Fraction(1, 10**9), 64
+_DEFAULT_STOP_TIME = Fraction(3)
 
 
-def reference_schedule(plan: TorqueSchedule, *, parameters: dict | None = None, theta0: float = 0.0,
-                       omega0: float = 0.0, rtol: float = 1e-12, atol: float = 1e-12) -> np.ndarray:
-    """Integrate the equation of motion over each run of steps with the same held torque.
+def _exact(value) -> Fraction:
+    """A number as the decimal a person wrote: 0.009 is 9/1000, not the double nearest it."""
+    return Fraction(repr(float(value))) if not isinstance(value, (str, Fraction)) else Fraction(value)
 
-    Steps are merged only where the torque does not change, so solve_ivp never integrates across
-    a jump; each run reports at every communication point inside it.
-    """
+
+def _tolerance(time: Fraction, step: Fraction) -> Fraction:
+    return max(_TOLERANCE_STEPS * step, Fraction(_TOLERANCE_ULPS * math.ulp(float(time))))
+
+
+class _TorqueFile:
+    """A time,torque CSV as exact times and float torques: linear between rows, a jump where a
+    time repeats, held outside."""
+
+    def __init__(self, path: Path):
+        with open(path, newline="", encoding="utf-8-sig") as file:
+            rows = [row for row in csv.reader(file) if any(cell.strip() for cell in row)]
+        header = [cell.strip() for cell in rows[0]]
+        time_column, torque_column = header.index("time"), header.index("torque")
+        self.times = [Fraction(row[time_column].strip()) for row in rows[1:]]
+        self.torques = [float(row[torque_column]) for row in rows[1:]]
+
+    def after(self, t: Fraction) -> float:
+        times, torques = self.times, self.torques
+        if t >= times[-1]:
+            return torques[-1]
+        if t < times[0]:
+            return torques[0]
+        j = bisect.bisect_right(times, t)  # times[j-1] <= t < times[j]
+        return self._between(j, t)
+
+    def before(self, t: Fraction) -> float:
+        times, torques = self.times, self.torques
+        if t > times[-1]:
+            return torques[-1]
+        if t <= times[0]:
+            return torques[0]
+        j = bisect.bisect_left(times, t)  # times[j-1] < t <= times[j]
+        return self._between(j, t)
+
+    def _between(self, j: int, t: Fraction) -> float:
+        t0, t1, u0, u1 = self.times[j - 1], self.times[j], self.torques[j - 1], self.torques[j]
+        return u0 + (u1 - u0) * float((t - t0) / (t1 - t0))
+
+    def jumps(self) -> list[Fraction]:
+        return sorted({a for a, b in zip(self.times, self.times[1:]) if a == b})
+
+    def latest_event_near(self, t: Fraction, step: Fraction) -> Fraction:
+        """t, or the latest row time within the tolerance of t: that event is at t."""
+        tolerance = _tolerance(t, step)
+        j = bisect.bisect_right(self.times, t + tolerance)
+        return max(t, self.times[j - 1]) if j and self.times[j - 1] >= t - tolerance else t
+
+
+def _grid(start: Fraction, stop: Fraction, step: Fraction) -> list[Fraction]:
+    """start + k*step up to stop; stop itself ends a shorter last step unless it is on the grid."""
+    points, k = [], 0
+    while start + k * step < stop - _tolerance(stop, step):
+        points.append(start + k * step)
+        k += 1
+    return points + [stop]
+
+
+def _with_events(grid: list[Fraction], events: list[Fraction], step: Fraction) -> list[Fraction]:
+    """The grid plus every event inside it that is not within the tolerance of a grid point."""
+    extra = []
+    for event in events:
+        if not grid[0] < event < grid[-1]:
+            continue
+        j = bisect.bisect_left(grid, event)
+        if min(grid[j] - event, event - grid[j - 1]) > _tolerance(event, step):
+            extra.append(event)
+    return sorted(set(grid) | set(extra))
+
+
+class _Pieces:
+    """The torque as pieces [start, end) on which it is u0 + rate * (t - start), the
+    communication points the signal defines, and the torque just after any time."""
+
+    def __init__(self, starts: list[Fraction], stop: Fraction, u0: list[float], rate: list[float],
+                 points: list[Fraction], value_after: Callable[[Fraction], float]):
+        self.starts, self.stop, self.u0, self.rate = starts, stop, u0, rate
+        self.points, self.value_after = points, value_after
+
+
+def _signal_pieces(torque, start: Fraction, stop: Fraction | None, step: Fraction, ramp: bool) -> _Pieces:
+    if isinstance(torque, (str, Path)):
+        signal = _TorqueFile(Path(torque))
+        stop = signal.times[-1] if stop is None else stop
+        grid = _grid(start, stop, step)
+        if ramp:
+            # The file's own piecewise-linear signal: a piece between consecutive row times.
+            points = sorted({start, stop} | {t for t in signal.times if start < t < stop})
+            u0 = [signal.after(a) for a in points[:-1]]
+            rate = [(signal.before(b) - signal.after(a)) / float(b - a) for a, b in zip(points, points[1:])]
+            return _Pieces(points[:-1], stop, u0, rate, _with_events(grid, signal.times, step),
+                           lambda t: signal.after(signal.latest_event_near(t, step)))
+        points = _with_events(grid, signal.jumps(), step)
+        held = [signal.after(signal.latest_event_near(p, step)) for p in points[:-1]]
+        return _Pieces(points[:-1], stop, held, [0.0] * len(held), points, _holding(points, held, step))
+
+    if isinstance(torque, (list, tuple, np.ndarray)):
+        values = [float(u) for u in torque]
+        points = _grid(start, start + len(values) * step if stop is None else stop, step)
+        if len(points) - 1 != len(values):
+            raise ValueError(f"the torque array has {len(values)} values for {len(points) - 1} steps")
+    else:
+        points = _grid(start, _DEFAULT_STOP_TIME if stop is None else stop, step)
+        sample = torque if callable(torque) else (lambda t, u=float(torque): u)
+        values = [float(sample(float(p))) for p in points]
+    if ramp:
+        rate = [(b - a) / float(t1 - t0) for a, b, t0, t1 in zip(values, values[1:], points, points[1:])]
+    else:
+        rate = [0.0] * (len(points) - 1)
+    u0 = values[:len(points) - 1]
+    return _Pieces(points[:-1], points[-1], u0, rate, points, _holding(points, u0, step))
+
+
+def _holding(points: list[Fraction], values: list[float], step: Fraction) -> Callable[[Fraction], float]:
+    """The torque just after t of a signal holding values[k] from points[k]: the step holding t
+    is the one starting at the latest point at or (within the tolerance) just after t."""
+
+    def value_after(t: Fraction) -> float:
+        j = max(bisect.bisect_right(points, t + _tolerance(t, step)) - 1, 0)
+        return values[min(j, len(values) - 1)]
+
+    return value_after
+
+
+def _integrate(pieces: _Pieces, at: np.ndarray, parameters: dict | None, theta0: float, omega0: float,
+               rtol: float, atol: float) -> np.ndarray:
     p = resolve_parameters(parameters)
     inverse_inertia = 1.0 / total_inertia(p)
-    gravity_moment = p["mass"] * p["gravity"] * p["length"]
-    damping = p["damping"]
-    time, torque, rate = plan.time, plan.torque, plan.torque_rate
+    gravity_moment, damping = p["mass"] * p["gravity"] * p["length"], p["damping"]
 
     def acceleration(theta, omega, u):
         return (u - gravity_moment * np.sin(theta) - damping * omega) * inverse_inertia
 
-    # A new run starts wherever the step's torque differs from a continuation of the previous one.
-    continues = np.zeros(len(torque), dtype=bool)
-    continues[1:] = (rate[1:] == 0) & (rate[:-1] == 0) & (torque[1:] == torque[:-1])
-    starts = np.flatnonzero(~continues)
-    ends = np.append(starts[1:], len(torque))
-
-    out = results.empty(len(time))
-    out["time"] = time
+    starts = [float(s) for s in pieces.starts]
+    ends = starts[1:] + [float(pieces.stop)]
+    # Each reported time belongs to the first piece that reaches it (a time a rounding past the
+    # end of the run belongs to the last).
+    owner = np.minimum(np.searchsorted(ends, at, side="left"), len(ends) - 1)
+    out = results.empty(len(at))
+    out["time"] = at
     state = np.array([theta0, omega0], dtype=float)
-    out["theta"][0], out["omega"][0] = state
-    for first, stop in zip(starts, ends):
-        t0, u0, r = time[first], torque[first], rate[first]
-        rhs = lambda t, y: (y[1], acceleration(y[0], y[1], u0 + r * (t - t0)))  # noqa: E731
-        points = time[first:stop + 1]
-        solution = solve_ivp(rhs, (points[0], points[-1]), state, method="DOP853", rtol=rtol,
-                             atol=atol, t_eval=points)
-        if not solution.success:
-            raise RuntimeError(f"solve_ivp failed from t = {t0}: {solution.message}")
-        out["theta"][first + 1:stop + 1] = solution.y[0, 1:]
-        out["omega"][first + 1:stop + 1] = solution.y[1, 1:]
-        state = solution.y[:, -1].copy()
-    out["torque"][:-1] = torque
-    out["torque"][-1] = torque[-1] + rate[-1] * (time[-1] - time[-2])
+    first = 0
+    while first < len(starts):
+        # Merge pieces that continue one another (the same held torque), so solve_ivp restarts
+        # only where the torque changes.
+        last = first
+        while (last + 1 < len(starts) and pieces.rate[first] == 0 and pieces.rate[last + 1] == 0
+               and pieces.u0[last + 1] == pieces.u0[first]):
+            last += 1
+        t0, t1, u0, rate = starts[first], ends[last], pieces.u0[first], pieces.rate[first]
+        mine = np.flatnonzero((owner >= first) & (owner <= last))
+        if t1 > t0:
+            report = np.clip(at[mine], t0, t1)
+            times = np.unique(np.append(report, t1))  # solve_ivp wants them strictly increasing
+            solution = solve_ivp(lambda t, y: (y[1], acceleration(y[0], y[1], u0 + rate * (t - t0))),
+                                 (t0, t1), state, method="DOP853", rtol=rtol, atol=atol, t_eval=times)
+            if not solution.success:
+                raise RuntimeError(f"solve_ivp failed from t = {t0}: {solution.message}")
+            row = np.searchsorted(times, report)
+            out["theta"][mine], out["omega"][mine] = solution.y[0, row], solution.y[1, row]
+            state = solution.y[:, -1].copy()
+        else:
+            out["theta"][mine], out["omega"][mine] = state
+        first = last + 1
+    out["torque"] = [pieces.value_after(_exact(t)) for t in at.tolist()]
+    # The end of the run reports the torque the last piece reached, as a master reads it back.
+    at_end = at >= ends[-1]
+    out["torque"][at_end] = pieces.u0[-1] + pieces.rate[-1] * (ends[-1] - starts[-1])
     out["alpha"] = acceleration(out["theta"], out["omega"], out["torque"])
     return out
 
 
-def reference(torque: TorqueSignal = 20.0, *, start_time: float = 0.0, stop_time: float | None = None,
+def reference(torque=20.0, *, start_time: float = 0.0, stop_time: float | None = None,
               step_size: float = 1e-3, ramp: bool = False, parameters: dict | None = None,
-              theta0: float = 0.0, omega0: float = 0.0, rtol: float = 1e-12,
-              atol: float = 1e-12) -> np.ndarray:
-    """The same signal and arguments as simulate(), through scipy DOP853; same result format."""
-    plan = schedule(torque, start_time=start_time, stop_time=stop_time, step_size=step_size,
-                    ramp=ramp)
-    return reference_schedule(plan, parameters=parameters, theta0=theta0, omega0=omega0,
-                              rtol=rtol, atol=atol)
+              theta0: float = 0.0, omega0: float = 0.0, at: np.ndarray | None = None,
+              rtol: float = 1e-12, atol: float = 1e-12) -> np.ndarray:
+    """The trajectory under a signal as docs/signals.md defines it, through scipy DOP853.
+
+    Takes the signal and the arguments of simulate(): a constant, a callable of time, a per-step
+    array or a CSV path. at: the times to report (default: the signal's communication points).
+    Same result format as simulate().
+    """
+    if isinstance(torque, (list, tuple, np.ndarray)) and ramp:
+        raise ValueError("a per-step torque array is held over each step; ramp needs a CSV or a callable")
+    step = _exact(step_size)
+    start = _exact(start_time)
+    pieces = _signal_pieces(torque, start, None if stop_time is None else _exact(stop_time), step, ramp)
+    if at is None:
+        at = np.array([float(t) for t in pieces.points])
+    return _integrate(pieces, np.asarray(at, dtype=float), parameters, theta0, omega0, rtol, atol)
+
+
+def reference_schedule(plan, *, parameters: dict | None = None, theta0: float = 0.0,
+                       omega0: float = 0.0, rtol: float = 1e-12, atol: float = 1e-12) -> np.ndarray:
+    """Integrate exactly the torques of a schedule (time, torque, torque_rate), reported at its
+    communication points: the judge of a tool that was fed that schedule."""
+    points = [Fraction(float(t)) for t in plan.time]
+    u0, rate = plan.torque.tolist(), plan.torque_rate.tolist()
+    # The schedule's points are the tools' own: no tolerance beyond rounding.
+    pieces = _Pieces(points[:-1], points[-1], u0, rate, points, _holding(points, u0, Fraction(0)))
+    return _integrate(pieces, np.asarray(plan.time, dtype=float), parameters, theta0, omega0, rtol, atol)

@@ -17,9 +17,3 @@ DTYPE = np.dtype([(name, "f8") for name in FIELDS])
 def empty(n_points: int) -> np.ndarray:
     return np.zeros(n_points, dtype=DTYPE)
 
-
-def max_differences(a: np.ndarray, b: np.ndarray) -> dict[str, float]:
-    """max |a - b| of theta, omega and alpha over the common communication points."""
-    if len(a) != len(b) or not np.allclose(a["time"], b["time"], rtol=0, atol=1e-9):
-        raise ValueError("results are on different communication points")
-    return {name: float(np.max(np.abs(a[name] - b[name]))) for name in ("theta", "omega", "alpha")}

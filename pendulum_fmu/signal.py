@@ -1,29 +1,59 @@
 """Torque signals and the step-wise schedule a master feeds the FMU.
 
-A signal is a constant, a callable of time, or a CSV file in fmpy's convention: columns
-``time,torque``, linear between rows, jumping where a time repeats. A schedule is what one
-simulation applies: communication points ``time[0..N]`` and for each step k the torque at its
-start, ``torque[k]``, and its rate ``torque_rate[k]`` (zero when the torque is held).
+A signal is one of:
+- a constant (N.m);
+- a callable of time, sampled at each step's start;
+- a per-step array (one held value per communication step);
+- a CSV file in fmpy's convention.
+
+A CSV defines torque(t) for every t:
+- held before its first row and after its last;
+- linear between rows;
+- a jump where a time repeats.
+
+Its row times are events: jumps, and kinks where the slope may change. An event within
+`event_tolerance` of a communication point *is* that point, so the step that starts there gets
+the value after a jump. This holds for decimal times and for running-sum times alike
+(0.39100000000000029 is 0.391). docs/signals.md states the definition in full.
+
+A schedule is what one simulation applies:
+- communication points `time[0..N]`;
+- for each step k, the torque at its start, `torque[k]`;
+- for each step k, its rate, `torque_rate[k]` (zero when the torque is held).
+
+Held mode holds the signal's value just after each step's start, and a jump between grid points
+becomes a communication point. Ramp mode makes every row time a communication point, so the
+FMU's linear ramp over each step is the CSV's own piecewise-linear signal, exactly.
 """
 
 from __future__ import annotations
 
-import csv
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable, Union
+from typing import Callable, Sequence, Union
 
 import numpy as np
 
-TorqueSignal = Union[float, int, Callable[[float], float], str, Path, "TorqueTable"]
+TorqueSignal = Union[float, int, Callable[[float], float], str, Path, Sequence[float], np.ndarray,
+                     "TorqueTable"]
 
-# Communication points closer than this (relative to the step) are one point.
-_MERGE_FRACTION = 1e-9
+# Events closer than this to a communication point are that point: a billionth of a step, or 64
+# ulp of the time where times are so large that a grid point's own rounding is bigger.
+EVENT_TOLERANCE_STEPS = 1e-9
+EVENT_TOLERANCE_ULPS = 64
+# stop_time without a CSV to take it from.
+DEFAULT_STOP_TIME = 3.0
+
+
+def event_tolerance(time, step_size: float):
+    """How close an event must be to a communication point to be that point (s)."""
+    return np.maximum(EVENT_TOLERANCE_STEPS * step_size,
+                      EVENT_TOLERANCE_ULPS * np.spacing(np.abs(np.asarray(time, dtype=float))))
 
 
 class TorqueFileError(ValueError):
-    """A torque CSV that cannot be read; the message names the file, row and problem."""
+    """A torque CSV that cannot be read; the message names the file, line and problem."""
 
 
 @dataclass(frozen=True)
@@ -33,27 +63,40 @@ class TorqueTable:
     time: np.ndarray
     torque: np.ndarray
 
-    def value_after(self, t: float) -> float:
-        """The torque just after t: at a jump, the value after it."""
-        return self._value(t, "right")
+    def value_after(self, t: np.ndarray) -> np.ndarray:
+        """The torque just after each t: at a jump, the value after it."""
+        return self._values(np.asarray(t, dtype=float), "right")
 
-    def value_before(self, t: float) -> float:
-        """The torque just before t: at a jump, the value before it."""
-        return self._value(t, "left")
+    def value_before(self, t: np.ndarray) -> np.ndarray:
+        """The torque just before each t: at a jump, the value before it."""
+        return self._values(np.asarray(t, dtype=float), "left")
 
-    def _value(self, t: float, side: str) -> float:
-        i = np.searchsorted(self.time, t, side=side)
-        if i == 0:
-            return float(self.torque[0])
-        if i == len(self.time):
-            return float(self.torque[-1])
-        t0, t1 = self.time[i - 1], self.time[i]
-        u0, u1 = self.torque[i - 1], self.torque[i]
-        return float(u0 + (u1 - u0) * (t - t0) / (t1 - t0))
+    def _values(self, t: np.ndarray, side: str) -> np.ndarray:
+        # np.interp takes the last of equal times, so look the segment up ourselves. Just after
+        # t (side "right") the segment is time[i-1] <= t < time[i]; just before it,
+        # time[i-1] < t <= time[i]: either way a segment of positive length, never the jump.
+        time, torque = self.time, self.torque
+        if len(time) == 1:
+            return np.full(t.shape, torque[0])
+        i = np.clip(np.searchsorted(time, t, side=side), 1, len(time) - 1)
+        t0, t1, u0, u1 = time[i - 1], time[i], torque[i - 1], torque[i]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            inside = u0 + (u1 - u0) * (t - t0) / (t1 - t0)
+        if side == "right":
+            return np.where(t < time[0], torque[0], np.where(t >= time[-1], torque[-1], inside))
+        return np.where(t <= time[0], torque[0], np.where(t > time[-1], torque[-1], inside))
 
     def jumps(self) -> np.ndarray:
-        """Times where the torque jumps (a repeated time row)."""
+        """Times where the torque jumps (a repeated time)."""
         return self.time[1:][np.diff(self.time) == 0]
+
+    def snapped(self, points: np.ndarray, step_size: float) -> "TorqueTable":
+        """The same table with every row time within event_tolerance of a point moved onto it."""
+        i = np.clip(np.searchsorted(points, self.time), 1, len(points) - 1)
+        nearest = np.where(np.abs(points[i] - self.time) < np.abs(points[i - 1] - self.time),
+                           points[i], points[i - 1])
+        close = np.abs(nearest - self.time) <= event_tolerance(self.time, step_size)
+        return TorqueTable(np.where(close, nearest, self.time), self.torque)
 
 
 @dataclass(frozen=True)
@@ -67,116 +110,221 @@ class TorqueSchedule:
         return np.diff(self.time)
 
 
-def read_torque_csv(path: str | Path) -> TorqueTable:
-    """Read a ``time,torque`` CSV; a bad file raises TorqueFileError naming file, row and problem."""
-    path = Path(path)
+def _decode(path: Path, raw: bytes) -> str:
     try:
-        with open(path, newline="") as file:
-            rows = list(csv.reader(file))
-    except OSError as error:
-        raise TorqueFileError(f"{path}: cannot read: {error.strerror}") from None
-    if not rows:
-        raise TorqueFileError(f"{path}: the file is empty; expected a header 'time,torque'")
-    header = [name.strip() for name in rows[0]]
-    for column in ("time", "torque"):
-        if column not in header:
-            raise TorqueFileError(f"{path}:1: missing column {column!r} (header is {','.join(header)})")
-    time_col, torque_col = header.index("time"), header.index("torque")
-    times, torques = [], []
-    for number, row in enumerate(rows[1:], start=2):
-        if not any(cell.strip() for cell in row):
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as error:
+        line = raw[:error.start].count(b"\n") + 1
+        raise TorqueFileError(f"{path}:{line}: byte 0x{raw[error.start]:02x} is not UTF-8; save the "
+                              "file as UTF-8 (with or without a byte-order mark)") from None
+
+
+def _first_bad_row(path: Path, lines: list[str], columns: tuple[int, int]) -> TorqueFileError | None:
+    """The one-line error for the first row that is not two finite numbers, or None."""
+    for number, line in enumerate(lines[1:], start=2):
+        if not line.strip():
             continue
-        values = []
-        for column, name in ((time_col, "time"), (torque_col, "torque")):
-            cell = row[column].strip() if column < len(row) else ""
+        cells = line.split(",")
+        for column, name in zip(columns, ("time", "torque")):
+            cell = cells[column].strip() if column < len(cells) else ""
             try:
                 value = float(cell)
             except ValueError:
-                raise TorqueFileError(f"{path}:{number}: {name} {cell!r} is not a number") from None
+                return TorqueFileError(f"{path}:{number}: {name} {cell!r} is not a number")
             if not math.isfinite(value):
-                raise TorqueFileError(f"{path}:{number}: {name} is {cell}; values must be finite")
-            values.append(value)
-        if times and values[0] < times[-1]:
-            raise TorqueFileError(
-                f"{path}:{number}: time {values[0]:g} goes backwards (previous row: {times[-1]:g})")
-        if len(times) >= 2 and values[0] == times[-1] == times[-2]:
-            raise TorqueFileError(f"{path}:{number}: time {values[0]:g} appears three times; a step "
-                                  "is two rows with the same time")
-        times.append(values[0])
-        torques.append(values[1])
-    if not times:
-        raise TorqueFileError(f"{path}: no data rows after the header")
-    return TorqueTable(np.array(times), np.array(torques))
+                return TorqueFileError(f"{path}:{number}: {name} is {cell}; values must be finite")
+    return None
 
 
-def write_torque_csv(path: str | Path, schedule: TorqueSchedule) -> Path:
-    """Write a schedule in fmpy's convention: a row where each run of equal steps starts and
-    ends, so a held torque reads as steps and a ramp as a line."""
+def _line_of_row(lines: list[str], row: int) -> int:
+    """The file line (1-based) of data row `row` (0-based), skipping blank lines."""
+    seen = -1
+    for number, line in enumerate(lines[1:], start=2):
+        if line.strip():
+            seen += 1
+            if seen == row:
+                return number
+    return len(lines)
+
+
+def _parse_numbers(raw: bytes, names: list[str], columns: tuple[int, int]) -> tuple[np.ndarray, np.ndarray] | None:
+    """The time and torque columns as float arrays, parsed by pyarrow's multi-threaded C
+    reader; None when a cell is not a number (the caller then finds the line)."""
+    import pyarrow as pa
+    import pyarrow.csv as pa_csv
+
+    # Positional names, so a header with spaces or repeated names still reads.
+    positional = [f"c{i}" for i in range(len(names))]
+    wanted = [positional[i] for i in columns]
+    try:
+        table = pa_csv.read_csv(
+            pa.py_buffer(raw),
+            read_options=pa_csv.ReadOptions(skip_rows=1, column_names=positional),
+            convert_options=pa_csv.ConvertOptions(include_columns=wanted,
+                                                  column_types={name: pa.float64() for name in wanted}))
+    except pa.ArrowInvalid:
+        return None
+    return tuple(table.column(name).to_numpy() for name in wanted)
+
+
+def read_torque_csv(path: str | Path) -> TorqueTable:
+    """Read a ``time,torque`` CSV (UTF-8, with or without a byte-order mark; other columns are
+    ignored). A bad file raises TorqueFileError naming the file, line and problem. The numbers
+    are parsed in C in one pass, with no Python object per row."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    end = schedule.torque + schedule.torque_rate * schedule.step_size
+    try:
+        raw = path.read_bytes()
+    except OSError as error:
+        raise TorqueFileError(f"{path}: cannot read: {error.strerror}") from None
+    raw = raw[3:] if raw.startswith(b"\xef\xbb\xbf") else raw  # spreadsheets write a byte-order mark
+    _decode(path, raw)  # only to refuse another encoding here, with its line
+    header_line = raw[:raw.find(b"\n") if b"\n" in raw else len(raw)].decode("utf-8")
+    if not header_line.strip():
+        raise TorqueFileError(f"{path}: the file is empty; expected a header 'time,torque'")
+    header = [name.strip() for name in header_line.split(",")]
+    for column in ("time", "torque"):
+        if column not in header:
+            raise TorqueFileError(f"{path}:1: missing column {column!r} (header is {','.join(header)}); "
+                                  "the first line must name the columns, e.g. time,torque")
+    columns = (header.index("time"), header.index("torque"))
+    data = _parse_numbers(raw, header, columns)
+    if data is None or not all(np.all(np.isfinite(column)) for column in data):
+        lines = _decode(path, raw).splitlines()
+        error = _first_bad_row(path, lines, columns)
+        raise error or TorqueFileError(f"{path}: rows must have as many columns as the header "
+                                       f"({len(header)})")
+    times, torques = data
+    if len(times) == 0:
+        raise TorqueFileError(f"{path}: no data rows after the header")
+    backwards = np.flatnonzero(np.diff(times) < 0)
+    triple = np.flatnonzero((times[2:] == times[1:-1]) & (times[1:-1] == times[:-2]))
+    if len(backwards) or len(triple):
+        lines = _decode(path, raw).splitlines()
+        if len(backwards) and (not len(triple) or backwards[0] < triple[0] + 1):
+            row = backwards[0] + 1
+            raise TorqueFileError(f"{path}:{_line_of_row(lines, row)}: time {times[row]:g} goes backwards "
+                                  f"(previous row: {times[row - 1]:g}); sort the rows by time")
+        row = triple[0] + 2
+        raise TorqueFileError(f"{path}:{_line_of_row(lines, row)}: time {times[row]:g} appears three "
+                              "times; a jump is two rows with the same time")
+    return TorqueTable(np.ascontiguousarray(times), np.ascontiguousarray(torques))
+
+
+def write_torque_csv(path: str | Path, plan: TorqueSchedule) -> Path:
+    """Write a schedule in fmpy's convention: a row where each run of equal steps starts and
+    ends, so a held torque reads as steps and a ramp as a line. Times are written with 17
+    significant digits, so they read back as the same doubles."""
+    from .files import replacing
+
+    end = plan.torque + plan.torque_rate * plan.step_size
     points = []
-    for t0, t1, u0, u1 in zip(schedule.time[:-1], schedule.time[1:], schedule.torque, end):
+    for t0, t1, u0, u1 in zip(plan.time[:-1].tolist(), plan.time[1:].tolist(), plan.torque.tolist(),
+                              end.tolist()):
         if not points or points[-1] != (t0, u0):
             points.append((t0, u0))
         points.append((t1, u1))
     # A point inside a run of constant torque adds nothing.
     rows = [p for i, p in enumerate(points)
             if i in (0, len(points) - 1) or not points[i - 1][1] == p[1] == points[i + 1][1]]
-    with open(path, "w", newline="") as file:
-        writer = csv.writer(file)
-        writer.writerow(["time", "torque"])
-        writer.writerows((repr(float(t)), repr(float(u))) for t, u in rows)
-    return path
+    with replacing(path, newline="") as file:
+        file.write("time,torque\n")
+        file.writelines(f"{t!r},{u!r}\n" for t, u in rows)
+    return Path(path)
+
+
+def _check_times(start_time: float, stop_time: float, step_size: float) -> None:
+    for name, value in (("start time", start_time), ("stop time", stop_time), ("step size", step_size)):
+        if not math.isfinite(value):
+            raise ValueError(f"{name} {value} must be a finite number of seconds")
+    if not step_size > 0:
+        raise ValueError(f"step size {step_size} must be positive")
+    if not stop_time > start_time:
+        raise ValueError(f"stop time {stop_time} must be after start time {start_time}")
+
+
+def step_count(start_time: float, stop_time: float, step_size: float) -> int:
+    """The number of grid steps from start to stop (the last one shorter when stop is off the grid)."""
+    _check_times(start_time, stop_time, step_size)
+    span = stop_time - start_time
+    steps = math.floor(span / step_size)
+    # stop within the event tolerance past a grid point is that point, not a sliver of a step.
+    if span - steps * step_size > event_tolerance(stop_time, step_size):
+        steps += 1
+    return max(steps, 1)
 
 
 def communication_points(start_time: float, stop_time: float, step_size: float,
-                         extra: np.ndarray | None = None) -> np.ndarray:
-    """start, start+h, ... up to stop (a shorter last step if needed), plus the extra points."""
-    if not (step_size > 0 and math.isfinite(step_size)):
-        raise ValueError(f"step size {step_size} must be positive and finite")
-    if not stop_time > start_time:
-        raise ValueError(f"stop time {stop_time} must be after start time {start_time}")
-    n = int(math.floor((stop_time - start_time) / step_size + 1e-9))
-    points = start_time + step_size * np.arange(n + 1)
-    if extra is not None and len(extra):
-        inside = extra[(extra > start_time) & (extra < stop_time)]
-        points = np.union1d(points, inside)
-    points = np.append(points[points < stop_time], stop_time)
-    keep = np.concatenate([[True], np.diff(points) > _MERGE_FRACTION * step_size])
-    keep[-1] = True
-    points = points[keep]
-    if len(points) > 2 and points[-1] - points[-2] <= _MERGE_FRACTION * step_size:
-        points = np.delete(points, -2)
-    return points
+                         events: np.ndarray | None = None) -> np.ndarray:
+    """start, start + h, ... up to stop, plus the events that are not within event_tolerance of a
+    grid point (those are the grid point). A grid point is start + k*h, never a running sum, so
+    no rounding accumulates over a long run."""
+    steps = step_count(start_time, stop_time, step_size)
+    grid = start_time + step_size * np.arange(steps + 1, dtype=float)
+    grid[-1] = stop_time if abs(grid[-1] - stop_time) > event_tolerance(stop_time, step_size) else grid[-1]
+    if events is None or not len(events):
+        return grid
+    events = np.unique(events[(events > grid[0]) & (events < grid[-1])])
+    if len(events):
+        i = np.clip(np.searchsorted(grid, events), 1, len(grid) - 1)
+        distance = np.minimum(np.abs(grid[i] - events), np.abs(events - grid[i - 1]))
+        events = events[distance > event_tolerance(events, step_size)]
+    return np.union1d(grid, events)
+
+
+def _array_schedule(values, start_time: float, stop_time: float | None, step_size: float,
+                    ramp: bool) -> TorqueSchedule:
+    torque = np.asarray(values, dtype=float)
+    if torque.ndim != 1 or len(torque) == 0:
+        raise ValueError(f"a torque array needs one value per step (a flat list of numbers); got shape {torque.shape}")
+    if ramp:
+        raise ValueError("a per-step torque array is held over each step; ramp needs a CSV or a callable")
+    if stop_time is None:
+        stop_time = start_time + len(torque) * step_size
+    steps = step_count(start_time, stop_time, step_size)
+    if steps != len(torque):
+        raise ValueError(f"the torque array has {len(torque)} values but {start_time:g} to {stop_time:g} s "
+                         f"in steps of {step_size:g} s is {steps} steps; give one value per step or "
+                         "leave out the stop time")
+    bad = np.flatnonzero(~np.isfinite(torque))
+    if len(bad):
+        raise ValueError(f"the torque array's value {bad[0]} is {torque[bad[0]]}; values must be finite")
+    time = communication_points(start_time, stop_time, step_size)
+    return TorqueSchedule(time=time, torque=torque, torque_rate=np.zeros(len(torque)))
 
 
 def schedule(torque: TorqueSignal, *, start_time: float = 0.0, stop_time: float | None = None,
              step_size: float = 1e-3, ramp: bool = False) -> TorqueSchedule:
-    """The schedule of a signal: a constant, a callable of time, or a torque CSV (path or table).
-
-    The torque of each step is the signal at the step's start (a CSV's value after a jump). With
-    ramp=True it instead moves linearly over the step to the signal's value at the step's end.
-    Jumps in a CSV become communication points, so no step straddles one. stop_time defaults to
-    3 s, or to a CSV's last time.
-    """
+    """The schedule of a signal: a constant, a callable of time, a per-step array, or a torque
+    CSV (path or table); see the module's docstring for what each step applies. stop_time
+    defaults to a CSV's last time, an array's last step, or 3 s."""
     if isinstance(torque, (str, Path)):
         torque = read_torque_csv(torque)
+    if isinstance(torque, (list, tuple, np.ndarray)):
+        return _array_schedule(torque, start_time, stop_time, step_size, ramp)
     if isinstance(torque, TorqueTable):
-        table = torque
-        stop = float(table.time[-1]) if stop_time is None else stop_time
-        time = communication_points(start_time, stop, step_size, table.jumps())
-        start_values = np.array([table.value_after(t) for t in time[:-1]])
-        end_values = np.array([table.value_before(t) for t in time[1:]])
+        stop = float(torque.time[-1]) if stop_time is None else stop_time
+        if stop <= start_time and stop_time is None:
+            raise ValueError(f"the torque file ends at {stop:g} s, not after the start time "
+                             f"{start_time:g} s; give a stop time")
+        grid = communication_points(start_time, stop, step_size)
+        table = torque.snapped(grid, step_size)
+        time = communication_points(start_time, stop, step_size, table.time if ramp else table.jumps())
+        start_values = table.value_after(time[:-1])
+        end_values = table.value_before(time[1:])
     else:
-        time = communication_points(start_time, 3.0 if stop_time is None else stop_time, step_size)
+        time = communication_points(start_time, DEFAULT_STOP_TIME if stop_time is None else stop_time,
+                                    step_size)
         if callable(torque):
-            samples = np.array([float(torque(float(t))) for t in time])
+            samples = np.array([float(torque(t)) for t in time.tolist()])
         else:
-            samples = np.full(len(time), float(torque))
+            try:
+                samples = np.full(len(time), float(torque))
+            except (TypeError, ValueError):
+                raise ValueError(f"a torque is a number, a callable of time, a per-step array or a CSV "
+                                 f"path; got {type(torque).__name__}") from None
         if not np.all(np.isfinite(samples)):
-            bad = time[~np.isfinite(samples)][0]
-            raise ValueError(f"the torque is {samples[~np.isfinite(samples)][0]} at t = {bad}; it must be finite")
+            bad = np.flatnonzero(~np.isfinite(samples))[0]
+            raise ValueError(f"the torque is {samples[bad]} at t = {time[bad]}; it must be finite")
         start_values, end_values = samples[:-1], samples[1:]
     rate = (end_values - start_values) / np.diff(time) if ramp else np.zeros(len(time) - 1)
     return TorqueSchedule(time=time, torque=start_values, torque_rate=rate)

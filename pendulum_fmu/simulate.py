@@ -100,15 +100,16 @@ def run_schedule(slave: FMU2Slave, plan: TorqueSchedule) -> np.ndarray:
         dll[name] for name in ("fmi2SetReal", "fmi2GetReal", "fmi2SetRealInputDerivatives", "fmi2DoStep"))
     component = ctypes.c_void_p(slave.component)
     torque_vr = (ctypes.c_uint * 1)(value_reference("torque"))
-    output_vr = (ctypes.c_uint * 3)(*(value_reference(n) for n in ("theta", "omega", "alpha")))
-    one, three = ctypes.c_size_t(1), ctypes.c_size_t(3)
+    # The torque is read back with the outputs: the result records what the FMU received.
+    recorded_vr = (ctypes.c_uint * 4)(*(value_reference(n) for n in ("torque", "theta", "omega", "alpha")))
+    one, four = ctypes.c_size_t(1), ctypes.c_size_t(4)
     first_order = (ctypes.c_int * 1)(1)
     no_rollback = ctypes.c_int(1)
-    torque, rate, outputs = (ctypes.c_double * 1)(), (ctypes.c_double * 1)(), (ctypes.c_double * 3)()
+    torque, rate, recorded = (ctypes.c_double * 1)(), (ctypes.c_double * 1)(), (ctypes.c_double * 4)()
     time, step = ctypes.c_double(), ctypes.c_double()
     ramped = bool(np.any(plan.torque_rate))
 
-    recorded = []
+    rows = []
     for t, h, u, r in zip(plan.time.tolist(), plan.step_size.tolist(), plan.torque.tolist(),
                           plan.torque_rate.tolist()):
         torque[0] = u
@@ -120,26 +121,23 @@ def run_schedule(slave: FMU2Slave, plan: TorqueSchedule) -> np.ndarray:
             status = set_rate(component, torque_vr, one, first_order, rate)
             if status > 1:
                 raise messages.error(status, f"fmi2SetRealInputDerivatives at t = {t:.17g}")
-        status = get_real(component, output_vr, three, outputs)
+        status = get_real(component, recorded_vr, four, recorded)
         if status > 1:
             raise messages.error(status, f"fmi2GetReal at t = {t:.17g}")
-        recorded.append(outputs[:])
+        rows.append(recorded[:])
         time.value, step.value = t, h
         status = do_step(component, time, step, no_rollback)
         if status > 1:
             raise messages.error(status, f"fmi2DoStep at t = {t:.17g}")
     # After a ramp the FMU's torque is where the ramp ended.
-    status = max(get_real(component, torque_vr, one, torque),
-                 get_real(component, output_vr, three, outputs))
+    status = get_real(component, recorded_vr, four, recorded)
     if status > 1:
         raise messages.error(status, "fmi2GetReal at the end")
-    recorded.append(outputs[:])
+    rows.append(recorded[:])
 
     out = results.empty(len(plan.time))
     out["time"] = plan.time
-    out["torque"][:-1] = plan.torque
-    out["torque"][-1] = torque[0]
-    for name, column in zip(("theta", "omega", "alpha"), np.array(recorded).T):
+    for name, column in zip(("torque", "theta", "omega", "alpha"), np.array(rows).T):
         out[name] = column
     return out
 
@@ -150,9 +148,10 @@ def simulate(torque: TorqueSignal = 20.0, *, start_time: float = 0.0, stop_time:
              fmu_path: str | Path | None = None) -> np.ndarray:
     """Simulate the pendulum FMU under a torque signal.
 
-    torque: a constant (N.m), a callable of time, or a CSV path (fmpy's convention). Each
-    communication step holds the signal's value at its start, or ramps (ramp=True) through
-    fmi2SetRealInputDerivatives. parameters: overrides of mass, length, inertia, gravity, damping.
+    torque: a constant (N.m), a callable of time, a per-step array (one held value per step) or
+    a CSV path (fmpy's convention; docs/signals.md). Each communication step holds the signal's
+    value just after its start, or ramps (ramp=True) through fmi2SetRealInputDerivatives along
+    the CSV's own piecewise-linear signal. parameters: overrides of mass, length, inertia, gravity, damping.
     tolerance: relative tolerance for fmi2SetupExperiment (None: the FMU's 1e-10).
     Returns a structured array with fields time, torque, theta, omega, alpha (see results.py).
     """

@@ -79,9 +79,9 @@ def test_compare_passes_and_fails_on_tolerance(tmp_path, capsys):
             "--output-dir", str(tmp_path)]
     assert main(args) == 0
     table = np.genfromtxt(tmp_path / "differences.csv", delimiter=",", names=True, dtype=None, encoding=None)
-    assert float(table["theta"]) < 1e-10
+    assert float(table["theta_max"]) < 1e-10 and str(table["against"]) == "reference"
     trajectories = np.genfromtxt(tmp_path / "trajectories.csv", delimiter=",", names=True)
-    assert {"theta_fmu", "omega_reference", "alpha_fmu"} <= set(trajectories.dtype.names)
+    assert {"theta_fmu", "omega_reference", "alpha_fmu", "torque_fmu"} <= set(trajectories.dtype.names)
     assert (tmp_path / "comparison.png").exists()
     assert main(args + ["--tol", "1e-16"]) == 1
     assert "DIFFER" in capsys.readouterr().out

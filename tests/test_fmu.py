@@ -2,7 +2,6 @@
 
 import ctypes
 import subprocess
-import sys
 import zipfile
 
 import numpy as np
@@ -12,7 +11,7 @@ from fmpy.validation import validate_fmu
 
 from pendulum_fmu.parameters import default_parameters, total_inertia, value_reference
 from pendulum_fmu.reference import reference
-from pendulum_fmu.signal import read_torque_csv, schedule, write_torque_csv
+from pendulum_fmu.signal import schedule
 from pendulum_fmu.simulate import FmuError, open_fmu, run_schedule, simulate
 
 I_TOTAL = 20.0 + 40.0 * 0.5**2  # the tutorial's pendulum about its pivot
@@ -223,20 +222,6 @@ def test_directional_derivative_of_alpha_by_torque(fmu):
     slave.doStep(0.0, 0.01)
     (d_alpha,) = slave.getDirectionalDerivative([ALPHA], [TORQUE], [1.0])
     assert d_alpha == pytest.approx(1.0 / total_inertia({"mass": 2.0, "length": 1.5, "inertia": 0.5}), rel=1e-15)
-
-
-def test_fmpy_simulate_command_line_with_stepwise_csv(fmu, tmp_path):
-    plan = schedule(lambda t: 20.0 if t < 1.0 else (-10.0 if t < 2.0 else 35.0), step_size=0.5)
-    csv = write_torque_csv(tmp_path / "torque.csv", plan)
-    out = tmp_path / "out.csv"
-    subprocess.run([sys.executable, "-m", "fmpy", "simulate", str(fmu), "--input-file", str(csv),
-                    "--output-interval", "0.001", "--output-file", str(out)], check=True, capture_output=True)
-    result = np.genfromtxt(out, delimiter=",", names=True)
-    expected = reference(read_torque_csv(csv), step_size=1e-3, stop_time=3.0)
-    # fmpy reports both sides of an input jump; compare at the regular points.
-    regular = np.unique(result["time"], return_index=True)[1]
-    assert np.allclose(result["time"][regular], expected["time"], atol=1e-12, rtol=0)
-    assert np.max(np.abs(result["theta"][regular] - expected["theta"])) < 1e-10
 
 
 def test_invalid_parameters_are_refused_at_initialization(fmu):

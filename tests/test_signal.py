@@ -66,3 +66,32 @@ def test_bad_arguments():
         schedule(1.0, stop_time=-1)
     with pytest.raises(ValueError, match="the torque is nan at t = 0.0"):
         schedule(lambda t: float("nan"), stop_time=0.1)
+
+
+def test_a_byte_order_mark_is_accepted(tmp_path):
+    # What spreadsheet programs write when they save UTF-8.
+    csv = tmp_path / "t.csv"
+    csv.write_bytes("\ufefftime,torque\r\n0,1\r\n2,3\r\n".encode("utf-8"))
+    table = read_torque_csv(csv)
+    assert table.time.tolist() == [0, 2] and table.torque.tolist() == [1, 3]
+
+
+def test_another_encoding_names_file_and_line(tmp_path):
+    csv = tmp_path / "t.csv"
+    csv.write_bytes("time,torque\n0,1\n1,2 # Drehmoment \u00fcber\n".encode("latin-1"))
+    with pytest.raises(TorqueFileError, match=r"t.csv:3: byte 0xfc is not UTF-8; save the file as UTF-8"):
+        read_torque_csv(csv)
+
+
+def test_extra_columns_and_blank_lines_are_ignored(tmp_path):
+    csv = tmp_path / "t.csv"
+    csv.write_text("label,torque,time\na,1,0\n\nb,2,0.5\n")
+    table = read_torque_csv(csv)
+    assert table.time.tolist() == [0, 0.5] and table.torque.tolist() == [1, 2]
+
+
+def test_errors_after_blank_lines_name_the_file_line(tmp_path):
+    csv = tmp_path / "t.csv"
+    csv.write_text("time,torque\n0,1\n\n\n2,1\n1,1\n")
+    with pytest.raises(TorqueFileError, match="t.csv:6: time 1 goes backwards"):
+        read_torque_csv(csv)
