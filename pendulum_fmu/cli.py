@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import argparse
 import importlib.util
+import signal
 import sys
+import threading
 from pathlib import Path
 
 import numpy as np
@@ -26,6 +28,16 @@ def _float(text: str) -> float:
         return float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{text} must be at least 1")
+    return value
 
 
 def _parameters(assignments) -> dict[str, float]:
@@ -58,6 +70,8 @@ def _add_signal_arguments(parser, required=True):
                         help="parameter: mass, length, inertia, gravity, damping (repeatable)")
     parser.add_argument("--theta0", type=_float, default=0.0, help="initial angle in rad")
     parser.add_argument("--omega0", type=_float, default=0.0, help="initial rate in rad/s")
+    parser.add_argument("--max-steps", type=_positive_int, default=None,
+                        help="refuse runs longer than this many steps (default: 10,000,000)")
 
 
 def cmd_build(args) -> int:
@@ -67,20 +81,22 @@ def cmd_build(args) -> int:
 
 def cmd_simulate(args) -> int:
     from . import results
+    from .files import replacing
     from .plot import plot_overlay
     from .simulate import simulate
 
     run = simulate(_torque_signal(args), stop_time=args.stop_time, step_size=args.step_size,
                    ramp=args.ramp, parameters=_parameters(args.assignments), theta0=args.theta0,
-                   omega0=args.omega0, tolerance=args.tolerance)
+                   omega0=args.omega0, tolerance=args.tolerance, max_steps=args.max_steps)
     last = run[-1]
     print(f"{len(run) - 1} steps to t = {last['time']:g} s: theta = {last['theta']:.12g} rad, "
           f"omega = {last['omega']:.12g} rad/s, alpha = {last['alpha']:.12g} rad/s2; "
           f"max |theta| = {np.max(np.abs(run['theta'])):.6g} rad")
     if args.output:
         header = ",".join(results.FIELDS)
-        np.savetxt(args.output, run.view(np.float64).reshape(len(run), -1), delimiter=",",
-                   header=header, comments="", fmt="%.17g")
+        with replacing(args.output) as file:
+            np.savetxt(file, run.view(np.float64).reshape(len(run), -1), delimiter=",",
+                       header=header, comments="", fmt="%.17g")
         print(f"wrote {args.output} ({header}; units {', '.join(results.UNITS.values())})")
     if args.plot:
         print(f"wrote {plot_overlay({'FMU': run}, args.plot, 'Torque-driven pendulum')}")
@@ -104,7 +120,7 @@ def cmd_compare(args) -> int:
     comparison = compare(_torque_signal(args), tools, output_dir=args.output_dir,
                          step_size=args.step_size, stop_time=args.stop_time, ramp=args.ramp,
                          parameters=_parameters(args.assignments), theta0=args.theta0,
-                         omega0=args.omega0, tolerance=args.tol)
+                         omega0=args.omega0, tolerance=args.tol, max_steps=args.max_steps)
     _print_comparison(comparison)
     for path in (comparison.trajectories, comparison.table, comparison.figure):
         print(f"wrote {path}")
@@ -178,6 +194,8 @@ def build_parser() -> argparse.ArgumentParser:
         prog="pendulum-fmu",
         description="A torque-driven pendulum as an FMI 2.0 Co-Simulation FMU: build it, "
                     "simulate it, and compare it with scipy and OpenSim.")
+    parser.add_argument("--debug", action="store_true", default=False,
+                        help="show the Python traceback of an error instead of one line")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     build = commands.add_parser("build", help="build the FMU (same as python build_fmu.py)",
@@ -244,7 +262,20 @@ def build_parser() -> argparse.ArgumentParser:
                       help="folder for the figures and tables (default: %(default)s)")
     demo.add_argument("--workers", type=int, default=None, help="local dask workers (default: 2)")
     demo.set_defaults(run=cmd_demo)
+    for command in commands.choices.values():
+        # Also after the command's name; SUPPRESS keeps it from hiding one given before it.
+        command.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
+                             help="show the Python traceback of an error instead of one line")
     return parser
+
+
+class Terminated(BaseException):
+    """SIGTERM, raised where the program is, so that every file being written is cleaned up on
+    the way out as it is for Ctrl-C."""
+
+
+def _terminate(signum, frame):
+    raise Terminated()
 
 
 def main(argv=None) -> int:
@@ -252,11 +283,36 @@ def main(argv=None) -> int:
     from .simulate import FmuError
 
     args = build_parser().parse_args(argv)
+    command = f"pendulum-fmu {args.command}"
+    handling_sigterm = threading.current_thread() is threading.main_thread()
+    if handling_sigterm:
+        previous = signal.signal(signal.SIGTERM, _terminate)
     try:
         return args.run(args)
+    except KeyboardInterrupt:
+        if args.debug:
+            raise
+        print(f"{command}: interrupted; no output file was left half written", file=sys.stderr)
+        return 130
+    except Terminated:
+        if args.debug:
+            raise
+        print(f"{command}: terminated; no output file was left half written", file=sys.stderr)
+        return 143
     except (ValueError, TorqueFileError, FmuError, BuildError, ImportError, OSError) as error:
-        print(f"pendulum-fmu {args.command}: error: {error}", file=sys.stderr)
+        if args.debug:
+            raise
+        print(f"{command}: error: {error}", file=sys.stderr)
         return 2
+    except Exception as error:  # a bug of ours: still one line, the traceback on request
+        if args.debug:
+            raise
+        print(f"{command}: internal error: {type(error).__name__}: {error} (run again with --debug "
+              "for the traceback, and report it)", file=sys.stderr)
+        return 3
+    finally:
+        if handling_sigterm:
+            signal.signal(signal.SIGTERM, previous)
 
 
 if __name__ == "__main__":

@@ -161,7 +161,7 @@ def compare(torque: TorqueSignal, tools=TOOLS, *, output_dir: str | Path, step_s
             start_time: float = 0.0, stop_time: float | None = None, ramp: bool = False,
             parameters: dict | None = None, theta0: float = 0.0, omega0: float = 0.0,
             tolerance: float = 1e-9, title: str | None = None,
-            fmu_path: str | Path | None = None) -> Comparison:
+            fmu_path: str | Path | None = None, max_steps: int | None = None) -> Comparison:
     """Run one signal through each tool and judge each against the reference.
 
     The reference is always run, as the judge, whether or not `tools` names it. Writes to
@@ -176,7 +176,8 @@ def compare(torque: TorqueSignal, tools=TOOLS, *, output_dir: str | Path, step_s
     tools = check_tools(tools)
     tolerance = check_tolerance(tolerance)
     resolve_parameters(parameters)  # a bad parameter is refused before any tool runs
-    plan = schedule(torque, start_time=start_time, stop_time=stop_time, step_size=step_size, ramp=ramp)
+    plan = schedule(torque, start_time=start_time, stop_time=stop_time, step_size=step_size, ramp=ramp,
+                    max_steps=max_steps)
     runs, seconds = {}, {}
     for tool in [REFERENCE] + [tool for tool in tools if tool != REFERENCE]:
         started = clock.perf_counter()

@@ -27,6 +27,10 @@ _UMASK = _read_umask()
 def _temporary_beside(path: Path, suffix: str) -> tuple[int, str]:
     """A new file beside path with the permissions a plain open() would give (mkstemp's are 0600,
     which would hide an FMU or a table from the other users of a shared folder)."""
+    for folder in (path.parent, *path.parent.parents):
+        if folder.exists() and not folder.is_dir():
+            raise NotADirectoryError(f"cannot write {path}: {folder} is a file, not a folder; "
+                                     "choose another output path")
     path.parent.mkdir(parents=True, exist_ok=True)
     descriptor, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
     os.chmod(temporary, 0o666 & ~_UMASK)

@@ -29,6 +29,7 @@ FMU's linear ramp over each step is the CSV's own piecewise-linear signal, exact
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Sequence, Union
@@ -44,6 +45,13 @@ EVENT_TOLERANCE_STEPS = 1e-9
 EVENT_TOLERANCE_ULPS = 64
 # stop_time without a CSV to take it from.
 DEFAULT_STOP_TIME = 3.0
+# A run longer than this is refused unless asked for (max_steps, --max-steps): at 1 ms it is
+# close to 3 hours of simulated time, and a typo in a time (epoch seconds, 1e-8 s steps) is
+# likelier than a run that long.
+DEFAULT_MAX_STEPS = 10_000_000
+# Memory one step takes in simulate(): the schedule's three doubles, the result's five and the
+# four recorded outputs.
+BYTES_PER_STEP = 8 * (3 + 5 + 4)
 
 
 def event_tolerance(time, step_size: float):
@@ -242,23 +250,48 @@ def _check_times(start_time: float, stop_time: float, step_size: float) -> None:
         raise ValueError(f"stop time {stop_time} must be after start time {start_time}")
 
 
-def step_count(start_time: float, stop_time: float, step_size: float) -> int:
-    """The number of grid steps from start to stop (the last one shorter when stop is off the grid)."""
+def _available_memory() -> int:
+    """Bytes the machine can still give (MemAvailable), or its physical memory where unknown."""
+    try:
+        with open("/proc/meminfo") as meminfo:
+            for line in meminfo:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+
+
+def step_count(start_time: float, stop_time: float, step_size: float,
+               max_steps: int | None = None) -> int:
+    """The number of grid steps from start to stop (the last one shorter when stop is off the
+    grid). A run over max_steps (default DEFAULT_MAX_STEPS), or one whose arrays would not fit in
+    the memory the machine has left, is refused here, before anything is allocated."""
     _check_times(start_time, stop_time, step_size)
     span = stop_time - start_time
     steps = math.floor(span / step_size)
     # stop within the event tolerance past a grid point is that point, not a sliver of a step.
     if span - steps * step_size > event_tolerance(stop_time, step_size):
         steps += 1
-    return max(steps, 1)
+    steps = max(steps, 1)
+    limit = DEFAULT_MAX_STEPS if max_steps is None else max_steps
+    what = f"{start_time:g} to {stop_time:g} s in steps of {step_size:g} s is {steps:,} steps"
+    if steps > limit:
+        raise ValueError(f"{what}, over the limit of {limit:,}: use a coarser step size or a shorter "
+                         "stop time, or raise the limit (--max-steps) if the run is meant to be that long")
+    needed, available = steps * BYTES_PER_STEP, _available_memory()
+    if needed > available:
+        raise ValueError(f"{what}, which needs {needed / 2**30:.1f} GiB and the machine has "
+                         f"{available / 2**30:.1f} GiB free: use a coarser step size or a shorter stop time")
+    return steps
 
 
 def communication_points(start_time: float, stop_time: float, step_size: float,
-                         events: np.ndarray | None = None) -> np.ndarray:
+                         events: np.ndarray | None = None, max_steps: int | None = None) -> np.ndarray:
     """start, start + h, ... up to stop, plus the events that are not within event_tolerance of a
     grid point (those are the grid point). A grid point is start + k*h, never a running sum, so
-    no rounding accumulates over a long run."""
-    steps = step_count(start_time, stop_time, step_size)
+    no rounding accumulates over a long run. max_steps: see step_count."""
+    steps = step_count(start_time, stop_time, step_size, max_steps)
     grid = start_time + step_size * np.arange(steps + 1, dtype=float)
     grid[-1] = stop_time if abs(grid[-1] - stop_time) > event_tolerance(stop_time, step_size) else grid[-1]
     if events is None or not len(events):
@@ -272,7 +305,7 @@ def communication_points(start_time: float, stop_time: float, step_size: float,
 
 
 def _array_schedule(values, start_time: float, stop_time: float | None, step_size: float,
-                    ramp: bool) -> TorqueSchedule:
+                    ramp: bool, max_steps: int | None) -> TorqueSchedule:
     torque = np.asarray(values, dtype=float)
     if torque.ndim != 1 or len(torque) == 0:
         raise ValueError(f"a torque array needs one value per step (a flat list of numbers); got shape {torque.shape}")
@@ -280,7 +313,7 @@ def _array_schedule(values, start_time: float, stop_time: float | None, step_siz
         raise ValueError("a per-step torque array is held over each step; ramp needs a CSV or a callable")
     if stop_time is None:
         stop_time = start_time + len(torque) * step_size
-    steps = step_count(start_time, stop_time, step_size)
+    steps = step_count(start_time, stop_time, step_size, max_steps)
     if steps != len(torque):
         raise ValueError(f"the torque array has {len(torque)} values but {start_time:g} to {stop_time:g} s "
                          f"in steps of {step_size:g} s is {steps} steps; give one value per step or "
@@ -288,32 +321,34 @@ def _array_schedule(values, start_time: float, stop_time: float | None, step_siz
     bad = np.flatnonzero(~np.isfinite(torque))
     if len(bad):
         raise ValueError(f"the torque array's value {bad[0]} is {torque[bad[0]]}; values must be finite")
-    time = communication_points(start_time, stop_time, step_size)
+    time = communication_points(start_time, stop_time, step_size, max_steps=max_steps)
     return TorqueSchedule(time=time, torque=torque, torque_rate=np.zeros(len(torque)))
 
 
 def schedule(torque: TorqueSignal, *, start_time: float = 0.0, stop_time: float | None = None,
-             step_size: float = 1e-3, ramp: bool = False) -> TorqueSchedule:
+             step_size: float = 1e-3, ramp: bool = False, max_steps: int | None = None) -> TorqueSchedule:
     """The schedule of a signal: a constant, a callable of time, a per-step array, or a torque
     CSV (path or table); see the module's docstring for what each step applies. stop_time
-    defaults to a CSV's last time, an array's last step, or 3 s."""
+    defaults to a CSV's last time, an array's last step, or 3 s. max_steps: see step_count."""
+    source = "the torque table"
     if isinstance(torque, (str, Path)):
-        torque = read_torque_csv(torque)
+        source, torque = str(torque), read_torque_csv(torque)
     if isinstance(torque, (list, tuple, np.ndarray)):
-        return _array_schedule(torque, start_time, stop_time, step_size, ramp)
+        return _array_schedule(torque, start_time, stop_time, step_size, ramp, max_steps)
     if isinstance(torque, TorqueTable):
         stop = float(torque.time[-1]) if stop_time is None else stop_time
         if stop <= start_time and stop_time is None:
-            raise ValueError(f"the torque file ends at {stop:g} s, not after the start time "
-                             f"{start_time:g} s; give a stop time")
-        grid = communication_points(start_time, stop, step_size)
+            raise ValueError(f"{source} ends at {stop:g} s, not after the start time {start_time:g} s; "
+                             "give a stop time")
+        grid = communication_points(start_time, stop, step_size, max_steps=max_steps)
         table = torque.snapped(grid, step_size)
-        time = communication_points(start_time, stop, step_size, table.time if ramp else table.jumps())
+        time = communication_points(start_time, stop, step_size, table.time if ramp else table.jumps(),
+                                    max_steps=max_steps)
         start_values = table.value_after(time[:-1])
         end_values = table.value_before(time[1:])
     else:
         time = communication_points(start_time, DEFAULT_STOP_TIME if stop_time is None else stop_time,
-                                    step_size)
+                                    step_size, max_steps=max_steps)
         if callable(torque):
             samples = np.array([float(torque(t)) for t in time.tolist()])
         else:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import array
 import ctypes
 import tempfile
 from pathlib import Path
@@ -106,10 +107,11 @@ def run_schedule(slave: FMU2Slave, plan: TorqueSchedule) -> np.ndarray:
     first_order = (ctypes.c_int * 1)(1)
     no_rollback = ctypes.c_int(1)
     torque, rate, recorded = (ctypes.c_double * 1)(), (ctypes.c_double * 1)(), (ctypes.c_double * 4)()
+    recorded_bytes = memoryview(recorded).cast("B")
     time, step = ctypes.c_double(), ctypes.c_double()
     ramped = bool(np.any(plan.torque_rate))
 
-    rows = []
+    rows = array.array("d")  # 32 bytes a step, not a Python list of floats
     for t, h, u, r in zip(plan.time.tolist(), plan.step_size.tolist(), plan.torque.tolist(),
                           plan.torque_rate.tolist()):
         torque[0] = u
@@ -124,7 +126,7 @@ def run_schedule(slave: FMU2Slave, plan: TorqueSchedule) -> np.ndarray:
         status = get_real(component, recorded_vr, four, recorded)
         if status > 1:
             raise messages.error(status, f"fmi2GetReal at t = {t:.17g}")
-        rows.append(recorded[:])
+        rows.frombytes(recorded_bytes)
         time.value, step.value = t, h
         status = do_step(component, time, step, no_rollback)
         if status > 1:
@@ -133,11 +135,11 @@ def run_schedule(slave: FMU2Slave, plan: TorqueSchedule) -> np.ndarray:
     status = get_real(component, recorded_vr, four, recorded)
     if status > 1:
         raise messages.error(status, "fmi2GetReal at the end")
-    rows.append(recorded[:])
+    rows.frombytes(recorded_bytes)
 
     out = results.empty(len(plan.time))
     out["time"] = plan.time
-    for name, column in zip(("torque", "theta", "omega", "alpha"), np.array(rows).T):
+    for name, column in zip(("torque", "theta", "omega", "alpha"), np.frombuffer(rows).reshape(-1, 4).T):
         out[name] = column
     return out
 
@@ -145,7 +147,7 @@ def run_schedule(slave: FMU2Slave, plan: TorqueSchedule) -> np.ndarray:
 def simulate(torque: TorqueSignal = 20.0, *, start_time: float = 0.0, stop_time: float | None = None,
              step_size: float = 1e-3, ramp: bool = False, parameters: dict | None = None,
              theta0: float = 0.0, omega0: float = 0.0, tolerance: float | None = None,
-             fmu_path: str | Path | None = None) -> np.ndarray:
+             fmu_path: str | Path | None = None, max_steps: int | None = None) -> np.ndarray:
     """Simulate the pendulum FMU under a torque signal.
 
     torque: a constant (N.m), a callable of time, a per-step array (one held value per step) or
@@ -153,10 +155,12 @@ def simulate(torque: TorqueSignal = 20.0, *, start_time: float = 0.0, stop_time:
     value just after its start, or ramps (ramp=True) through fmi2SetRealInputDerivatives along
     the CSV's own piecewise-linear signal. parameters: overrides of mass, length, inertia, gravity, damping.
     tolerance: relative tolerance for fmi2SetupExperiment (None: the FMU's 1e-10).
+    max_steps: the longest run accepted (default signal.DEFAULT_MAX_STEPS); a longer one, or one
+    that would not fit in memory, is refused before anything is allocated.
     Returns a structured array with fields time, torque, theta, omega, alpha (see results.py).
     """
     plan = schedule(torque, start_time=start_time, stop_time=stop_time, step_size=step_size,
-                    ramp=ramp)
+                    ramp=ramp, max_steps=max_steps)
     slave = open_fmu(fmu_path, parameters=parameters, theta0=theta0, omega0=omega0,
                      tolerance=tolerance, start_time=float(plan.time[0]))
     try:

@@ -1,0 +1,136 @@
+"""Every bad input a user can give the command line, as data: run by tests/test_bad_inputs.py,
+and written as the table in docs/bad_inputs.md by `python tests/bad_inputs.py docs/bad_inputs.md`.
+
+Each case is a `pendulum-fmu` command line, with `{files}` standing for a folder of the input
+files below, the exit code it must give and a part of the one line it must print."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+# Input files the cases name, written into {files} before they run.
+FILES = {
+    "bad_number.csv": "time,torque\n0,1\n1,x\n",
+    "epoch.csv": "time,torque\n1700000000,1\n1700000100,2\n",
+    "latin1.csv": "time,torque\n0,1\n1,2 # Drehmoment \u00fcber\n".encode("latin-1"),
+    "empty.csv": "",
+    "header_only.csv": "time,torque\n",
+    "no_torque.csv": "time,force\n0,1\n",
+    "backwards.csv": "time,torque\n0,1\n2,1\n1,1\n",
+    "three_times.csv": "time,torque\n0,1\n1,1\n1,2\n1,3\n",
+    "nan.csv": "time,torque\n0,1\n1,nan\n",
+    "one_row.csv": "time,torque\n0,5\n",
+    "short_row.csv": "time,torque\n0,1\n1\n",
+}
+
+
+@dataclass(frozen=True)
+class Case:
+    group: str
+    argv: tuple[str, ...]
+    exit_code: int
+    message: str
+
+
+def _case(group, command, exit_code, message):
+    return Case(group, tuple(command.split()), exit_code, message)
+
+
+CASES = [
+    _case("run length", "simulate --torque 1 --stop-time inf", 2, "stop time inf must be a finite number"),
+    _case("run length", "simulate --torque 1 --stop-time nan", 2, "stop time nan must be a finite number"),
+    _case("run length", "simulate --torque 1 --stop-time -1", 2, "stop time -1.0 must be after start time 0.0"),
+    _case("run length", "simulate --torque 1 --step-size 0", 2, "step size 0.0 must be positive"),
+    _case("run length", "simulate --torque 1 --step-size 1e-8 --stop-time 7200", 2,
+          "0 to 7200 s in steps of 1e-08 s is 720,000,000,000 steps, over the limit of 10,000,000"),
+    _case("run length", "simulate --torque-file {files}/epoch.csv", 2,
+          "0 to 1.7e+09 s in steps of 0.001 s is 1,700,000,100,000 steps, over the limit"),
+    _case("run length", "simulate --torque 1 --max-steps 0", 2, "argument --max-steps: 0 must be at least 1"),
+    _case("torque file", "simulate --torque-file {files}/absent.csv", 2, "absent.csv: cannot read: No such file"),
+    _case("torque file", "simulate --torque-file {files}/bad_number.csv", 2, "bad_number.csv:3: torque 'x' is not a number"),
+    _case("torque file", "simulate --torque-file {files}/latin1.csv", 2,
+          "latin1.csv:3: byte 0xfc is not UTF-8; save the file as UTF-8"),
+    _case("torque file", "simulate --torque-file {files}/empty.csv", 2, "empty.csv: the file is empty"),
+    _case("torque file", "simulate --torque-file {files}/header_only.csv", 2, "header_only.csv: no data rows"),
+    _case("torque file", "simulate --torque-file {files}/no_torque.csv", 2, "no_torque.csv:1: missing column 'torque'"),
+    _case("torque file", "simulate --torque-file {files}/backwards.csv", 2, "backwards.csv:4: time 1 goes backwards"),
+    _case("torque file", "simulate --torque-file {files}/three_times.csv", 2,
+          "three_times.csv:5: time 1 appears three times"),
+    _case("torque file", "simulate --torque-file {files}/nan.csv", 2, "nan.csv:3: torque is nan; values must be finite"),
+    _case("torque file", "simulate --torque-file {files}/short_row.csv", 2, "short_row.csv:3: torque '' is not a number"),
+    _case("torque file", "simulate --torque-file {files}/one_row.csv", 2,
+          "one_row.csv ends at 0 s, not after the start time 0 s; give a stop time"),
+    _case("arguments", "simulate --torque abc", 2, "argument --torque: 'abc' is not a number"),
+    _case("arguments", "simulate", 2, "one of the arguments --torque --torque-file is required"),
+    _case("parameters", "simulate --torque 1 --set mas=2", 2, "unknown parameter 'mas'"),
+    _case("parameters", "simulate --torque 1 --set mass=heavy", 2, "'heavy' is not a number"),
+    _case("parameters", "simulate --torque 1 --set mass=-1", 2, "mass must be > 0"),
+    _case("parameters", "simulate --torque 1 --set damping=inf", 2, "parameter damping = inf must be finite"),
+    _case("parameters", "simulate --torque 1 --set mass", 2, "expected name=value, got 'mass'"),
+    _case("compare", "compare --torque 1 --tools fmu,matlab --output-dir {files}/out", 2, "unknown tool(s) matlab"),
+    _case("compare", "compare --torque 1 --tools fmu,fmu --output-dir {files}/out", 2,
+          "tool(s) fmu given more than once"),
+    _case("compare", "compare --torque 1 --tools fmu --output-dir {files}/out", 2,
+          "compare needs at least two tools, got fmu"),
+    _case("compare", "compare --torque 1 --tools fmu,reference --tol nan --output-dir {files}/out", 2,
+          "the tolerance nan must be a positive finite number"),
+    _case("compare", "compare --torque 1 --tools fmu,reference --tol -1 --output-dir {files}/out", 2,
+          "the tolerance -1.0 must be a positive finite number"),
+    _case("output", "simulate --torque 1 --stop-time 0.01 --output {files}/bad_number.csv/out.csv", 2,
+          "bad_number.csv is a file, not a folder; choose another output path"),
+]
+
+
+def write_files(folder: Path) -> None:
+    for name, content in FILES.items():
+        path = folder / name
+        path.write_bytes(content) if isinstance(content, bytes) else path.write_text(content)
+
+
+def run_case(case: Case, folder: Path) -> tuple[int, str]:
+    """(exit code, what the command printed on stderr), run in-process."""
+    from pendulum_fmu.cli import main
+
+    argv = [part.format(files=folder) for part in case.argv]
+    stderr = io.StringIO()
+    with contextlib.redirect_stderr(stderr), contextlib.redirect_stdout(io.StringIO()):
+        try:
+            code = main(argv)
+        except SystemExit as exit_:  # argparse's own refusals
+            code = exit_.code
+    return code, stderr.getvalue().replace(str(folder), "{files}")
+
+
+def markdown(rows: list[tuple[Case, int, str]]) -> str:
+    lines = ["# What the command line answers to bad input", "",
+             "Generated by `python tests/bad_inputs.py docs/bad_inputs.md` from the cases that "
+             "`tests/test_bad_inputs.py` asserts; do not edit by hand. Every answer is one line on "
+             "stderr (argparse's own refusals add the usage line before it), never a traceback; "
+             "`--debug` shows the traceback instead. Nothing is written when a run is refused.", "",
+             "| group | command | exit | answer |", "|---|---|---|---|"]
+    for case, code, printed in rows:
+        answer = printed.strip().splitlines()[-1].replace("|", "\\|")
+        lines.append(f"| {case.group} | `pendulum-fmu {' '.join(case.argv)}` | {code} | {answer} |")
+    return "\n".join(lines) + "\n"
+
+
+def main(argv=None):
+    import tempfile
+
+    out = Path((argv or sys.argv[1:] or ["docs/bad_inputs.md"])[0])
+    with tempfile.TemporaryDirectory() as folder:
+        write_files(Path(folder))
+        rows = [(case, *run_case(case, Path(folder))) for case in CASES]
+    from pendulum_fmu.files import replacing
+
+    with replacing(out) as file:
+        file.write(markdown(rows))
+    print(f"wrote {out}: {len(rows)} cases")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,63 @@
+"""Ctrl-C and SIGTERM at any moment of a real `pendulum-fmu` process leave the old file or the
+whole new one at the target, no temporary beside it, and one line on stderr (exit 130 or 143)."""
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+OLD = "the file from before\n"
+STEPS = 400_000  # a few seconds on a loaded 2-core machine, writing included
+
+
+def start(arguments, folder):
+    return subprocess.Popen([sys.executable, "-m", "pendulum_fmu.cli", *arguments], cwd=folder,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+
+def check_target(target, complete_rows):
+    """The target is the old file or the complete new one, and nothing else is beside it."""
+    text = target.read_text()
+    if text != OLD:
+        data = np.genfromtxt(target, delimiter=",", names=True)
+        assert len(data) == complete_rows and data["time"][-1] == pytest.approx(1.0)
+    assert sorted(p.name for p in target.parent.iterdir()) == [target.name]
+
+
+@pytest.mark.parametrize("signal_number, exit_code, word", [
+    (signal.SIGINT, 130, "interrupted"), (signal.SIGTERM, 143, "terminated")])
+@pytest.mark.parametrize("delay", [1.5, 3.0, 6.0])
+def test_simulate_output_survives_a_signal(tmp_path, signal_number, exit_code, word, delay):
+    out = tmp_path / "out"
+    out.mkdir()
+    target = out / "result.csv"
+    target.write_text(OLD)
+    process = start(["simulate", "--torque", "1", "--step-size", str(1 / STEPS), "--stop-time", "1",
+                     "--output", str(target)], tmp_path)
+    time.sleep(delay)
+    process.send_signal(signal_number)
+    _, stderr = process.communicate(timeout=120)
+    assert "Traceback" not in stderr
+    if delay < 2:  # too early for any machine to have finished: the signal must have been seen
+        assert process.returncode == exit_code, stderr
+    if process.returncode != 0:  # the signal arrived before the run ended
+        assert process.returncode == exit_code, stderr
+        assert stderr.strip().splitlines() == [f"pendulum-fmu simulate: {word}; no output file was left half written"]
+    check_target(target, STEPS + 1)
+
+
+def test_compare_outputs_survive_ctrl_c(tmp_path):
+    out = tmp_path / "out"
+    process = start(["compare", "--torque", "20", "--tools", "fmu,reference", "--step-size", "1e-5",
+                     "--stop-time", "2", "--output-dir", str(out)], tmp_path)
+    time.sleep(4.0)
+    os.kill(process.pid, signal.SIGINT)
+    _, stderr = process.communicate(timeout=120)
+    assert "Traceback" not in stderr
+    assert process.returncode in (0, 130), stderr
+    for path in out.iterdir() if out.exists() else ():
+        assert ".partial" not in path.name
