@@ -218,6 +218,9 @@ def reference(torque=20.0, *, start_time: float = 0.0, stop_time: float | None =
     array or a CSV path. at: the times to report (default: the signal's communication points).
     Same result format as simulate().
     """
+    if not (isinstance(torque, (str, Path, list, tuple, np.ndarray, int, float)) or callable(torque)):
+        raise ValueError(f"the reference takes a constant, a callable, a per-step array or a CSV path, "
+                         f"not a {type(torque).__name__}: it reads the signal itself")
     if isinstance(torque, (list, tuple, np.ndarray)) and ramp:
         raise ValueError("a per-step torque array is held over each step; ramp needs a CSV or a callable")
     step = _exact(step_size)
