@@ -27,7 +27,7 @@ def check_held(plan: TorqueSchedule, tool: str) -> None:
     """Refuse a schedule whose torque ramps within a step: the tool can only hold it."""
     if np.any(plan.torque_rate):
         raise ToolCannotRamp(f"{tool} holds the torque over each step and cannot ramp it: compare "
-                             f"held torques (no --ramp) or leave {tool} out of --tools")
+                             f"held torques only (no --ramp), or leave {tool} out of --tools")
 
 
 def check_mode(mode: str, tool: str) -> None:
