@@ -10,54 +10,20 @@ from pathlib import Path
 import numpy as np
 
 from . import results
-from .parameters import resolve_parameters
 from .plot import plot_comparison
-from .reference import reference_schedule
 from .signal import TorqueSchedule, TorqueSignal, schedule
-from .simulate import open_fmu, run_schedule
+from .tools import parse_tools
 
 TOOLS = ("fmu", "reference", "opensim")
 
 
-def _run_fmu(plan, parameters, theta0, omega0, fmu_path=None):
-    slave = open_fmu(fmu_path, parameters=parameters, theta0=theta0, omega0=omega0,
-                     start_time=float(plan.time[0]))
-    try:
-        return run_schedule(slave, plan)
-    finally:
-        slave.terminate()
-        slave.freeInstance()
-
-
-def _run_reference(plan, parameters, theta0, omega0, fmu_path=None):
-    return reference_schedule(plan, parameters=parameters, theta0=theta0, omega0=omega0)
-
-
-def _run_opensim(plan, parameters, theta0, omega0, fmu_path=None):
-    from .opensim_model import opensim_simulate
-
-    if np.any(plan.torque_rate):
-        raise ValueError("OpenSim's overrideActuation holds the torque over a step: compare held "
-                         "torques only (no ramp)")
-    run = opensim_simulate(plan.time, plan.torque, theta0=theta0, omega0=omega0,
-                           **resolve_parameters(parameters))
-    out = results.empty(len(plan.time))
-    for name in results.FIELDS:
-        out[name] = run[name]
-    return out
-
-
-_RUNNERS = {"fmu": _run_fmu, "reference": _run_reference, "opensim": _run_opensim}
-
-
 def run_tools(plan: TorqueSchedule, tools=TOOLS, *, parameters: dict | None = None,
-              theta0: float = 0.0, omega0: float = 0.0,
-              fmu_path: str | Path | None = None) -> dict[str, np.ndarray]:
-    """{tool: result array} for the same schedule, parameters and start values."""
-    unknown = [tool for tool in tools if tool not in _RUNNERS]
-    if unknown:
-        raise ValueError(f"unknown tool(s) {', '.join(unknown)}: choose from {', '.join(TOOLS)}")
-    return {tool: _RUNNERS[tool](plan, parameters, theta0, omega0, fmu_path) for tool in tools}
+              theta0: float = 0.0, omega0: float = 0.0, fmu_path: str | Path | None = None,
+              mapping: str | None = None) -> dict[str, np.ndarray]:
+    """{tool label: result array} for the same schedule, parameters and start values; tools as
+    --tools gives them (see tools.py), mapping the --map of other FMUs."""
+    return {tool.label: tool.run(plan, parameters=parameters, theta0=theta0, omega0=omega0)
+            for tool in parse_tools(tools, mapping=mapping, fmu_path=fmu_path)}
 
 
 def pairwise_differences(runs: dict[str, np.ndarray]) -> list[dict]:
