@@ -45,6 +45,7 @@ class Setup:
     # Apply the torque before every stepSimulation, not only when it changes (a TORQUE_CONTROL
     # force lasts one stepSimulation).
     reapply_torque: bool = True
+    raise_velocity_limit: bool = True
 
 
 # 10 us substeps (100 per 1 ms step): semi-implicit Euler's error is first order in the step;
@@ -88,7 +89,10 @@ def _step_through(plan, parameters, theta0, omega0, setup, client, body):
     joint = 0
     if setup.set_gravity:
         pybullet.setGravity(0, 0, -parameters["gravity"], physicsClientId=client)
-    dynamics = {"jointDamping": parameters["damping"], "maxJointVelocity": _NO_VELOCITY_LIMIT}
+    # Two calls: PyBullet drops a jointDamping given in the same call as maxJointVelocity.
+    if setup.raise_velocity_limit:
+        pybullet.changeDynamics(body, joint, maxJointVelocity=_NO_VELOCITY_LIMIT, physicsClientId=client)
+    dynamics = {"jointDamping": parameters["damping"]}
     if setup.remove_hidden_damping:
         dynamics.update(linearDamping=0.0, angularDamping=0.0)
     pybullet.changeDynamics(body, joint, physicsClientId=client, **dynamics)
