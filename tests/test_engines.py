@@ -116,3 +116,54 @@ def test_parameters_and_start_values_reach_the_engine(name, quantity, value, ref
     moved = error(expected, reference_1s)
     assert moved > 1e-2
     assert error(run, expected) <= ACCURATE_BOUND[name]
+
+
+def _pybullet_without(flag):
+    return lambda m: m.Setup(m.DEFAULT.largest_step, **{flag: False})
+
+
+# (engine, trap, the correct setup, the setup with the trap turned back on, field, the trap's
+# error at least) on ONE_SECOND; docs/engines.md states the measured figures.
+TRAPS = [
+    ("mujoco", "MuJoCo's own 2 ms timestep", lambda m: m.DEFAULT, lambda m: m.Setup("Euler", None), "theta", 0.3),
+    ("mujoco", "ctrlrange -100..100", lambda m: m.ACCURATE,
+     lambda m: m.Setup("RK4", 1e-3, ctrlrange=(-100, 100)), "theta", 0.1),
+    ("mujoco", "sensors read after mj_step", lambda m: m.ACCURATE,
+     lambda m: m.Setup("RK4", 1e-3, read_sensors=True), "theta", 1e-3),
+    ("drake", "sampled output ports", lambda m: m.SETUPS["default"],
+     lambda m: m.Setup(True, sampled_outputs=True), "alpha", 5.0),
+    ("drake", "actuation port left unfixed", lambda m: m.SETUPS["accurate"],
+     lambda m: m.Setup(False, fix_input=False), "theta", 0.3),
+    ("pybullet", "no setGravity", lambda m: m.DEFAULT, _pybullet_without("set_gravity"), "theta", 0.1),
+    ("pybullet", "inertia from the shapes", lambda m: m.DEFAULT, _pybullet_without("inertia_from_file"), "theta", 0.1),
+    ("pybullet", "hidden link damping", lambda m: m.DEFAULT, _pybullet_without("remove_hidden_damping"), "theta", 1e-2),
+    ("pybullet", "default velocity motor", lambda m: m.DEFAULT, _pybullet_without("disable_velocity_motor"), "theta", 0.3),
+    ("pybullet", "torque applied only when it changes", lambda m: m.DEFAULT,
+     _pybullet_without("reapply_torque"), "theta", 0.3),
+]
+
+
+@pytest.mark.parametrize("name, trap, correct, trapped, field, at_least", TRAPS,
+                         ids=[f"{case[0]}: {case[1]}" for case in TRAPS])
+def test_each_trap_turned_back_on_grows_the_error(name, trap, correct, trapped, field, at_least,
+                                                  reference_1s):
+    module = engine(name)
+    parameters = resolve_parameters({})
+    right = error(module.simulate(ONE_SECOND, parameters, THETA0, OMEGA0, correct(module)), reference_1s, field)
+    wrong = error(module.simulate(ONE_SECOND, parameters, THETA0, OMEGA0, trapped(module)), reference_1s, field)
+    print(f"\n{name}, {trap}: max |d{field}| {wrong:.2e} (handled: {right:.2e})")
+    assert wrong >= at_least
+    assert wrong >= 10 * right
+
+
+def test_pybullet_velocity_limit_is_raised():
+    # Gravity off, no torque, 150 rad/s: theta = 150 t. PyBullet clamps at 100 rad/s by default.
+    pybullet = engine("pybullet")
+    parameters = resolve_parameters({"gravity": 0.0})
+    coasting = schedule(0.0, stop_time=0.1, step_size=1e-3)
+    expected = 150.0 * coasting.time
+    run = pybullet.simulate(coasting, parameters, 0.0, 150.0, pybullet.DEFAULT)
+    clamped = pybullet.simulate(coasting, parameters, 0.0, 150.0,
+                                pybullet.Setup(pybullet.DEFAULT.largest_step, raise_velocity_limit=False))
+    assert np.max(np.abs(run["theta"] - expected)) < 1e-12
+    assert np.max(np.abs(clamped["theta"] - expected)) > 4.0
