@@ -30,8 +30,7 @@ from fmpy import extract, read_model_description, simulate_fmu
 from fmpy.fmi2 import FMU2Slave
 from fmpy.fmi3 import FMU3Slave
 
-from . import results
-from .engines import check_held, check_mode
+from .engines import check_held, check_mode, held_results
 from .parameters import default_parameters, resolve_parameters
 from .signal import TorqueSchedule
 
@@ -148,10 +147,7 @@ class OtherFmu:
         start = self._start_values(parameters, theta0, omega0)
         step = self._co_simulation if self.interface == "CoSimulation" else self._model_exchange
         raw = step(plan, start, TOLERANCE[mode])
-        out = results.empty(len(plan.time))
-        out["time"] = plan.time
-        out["torque"][:-1] = plan.torque
-        out["torque"][-1] = plan.torque[-1]
+        out = held_results(plan)
         for name in OUTPUTS:
             mapped = self.mapping.get(name)
             out[name] = raw[name] * mapped.factor if mapped else np.nan

@@ -12,8 +12,12 @@ each adapter sets and why. The engine modules import their engine, so import the
 
 from __future__ import annotations
 
+from typing import Callable
+
 import numpy as np
 
+from .. import results
+from ..parameters import resolve_parameters
 from ..signal import TorqueSchedule
 
 MODES = ("accurate", "default")
@@ -38,3 +42,27 @@ def check_mode(mode: str, tool: str) -> None:
 def substeps(step_size: np.ndarray, largest: float) -> np.ndarray:
     """For each communication step, the number of equal substeps no longer than largest."""
     return np.maximum(1, np.ceil(step_size / largest * (1 - 1e-12))).astype(int)
+
+
+def held_results(plan: TorqueSchedule) -> np.ndarray:
+    """A result array with the times and held torques of a schedule filled in; the last row
+    repeats the last step's torque."""
+    out = results.empty(len(plan.time))
+    out["time"] = plan.time
+    out["torque"][:-1] = plan.torque
+    out["torque"][-1] = plan.torque[-1]
+    return out
+
+
+def runner(tool: str, simulate: Callable[..., np.ndarray], setups: dict) -> Callable[..., np.ndarray]:
+    """The uniform run() of an engine module from its simulate(plan, parameters, theta0, omega0,
+    setup) and its setup per mode."""
+
+    def run(plan: TorqueSchedule, *, parameters: dict | None = None, theta0: float = 0.0,
+            omega0: float = 0.0, mode: str = "accurate") -> np.ndarray:
+        check_held(plan, tool)
+        check_mode(mode, tool)
+        return simulate(plan, resolve_parameters(parameters), theta0, omega0, setups[mode])
+
+    run.__doc__ = f"The schedule through {tool} in mode accurate or default; see docs/engines.md."
+    return run

@@ -29,10 +29,8 @@ from pydrake.multibody.tree import FixedOffsetFrame, RevoluteJoint, SpatialInert
 from pydrake.systems.analysis import ResetIntegratorFromFlags, Simulator
 from pydrake.systems.framework import DiagramBuilder
 
-from .. import results
-from ..parameters import resolve_parameters
 from ..signal import TorqueSchedule
-from . import check_held, check_mode
+from . import held_results, runner
 
 
 @dataclass(frozen=True)
@@ -98,11 +96,7 @@ def simulate(plan: TorqueSchedule, parameters: dict, theta0: float, omega0: floa
     actuation = plant.get_actuation_input_port()
     acceleration = plant.get_generalized_acceleration_output_port()
 
-    n_points = len(plan.time)
-    out = results.empty(n_points)
-    out["time"] = plan.time
-    out["torque"][:-1] = plan.torque
-    out["torque"][-1] = plan.torque[-1]
+    out = held_results(plan)
 
     def record(k):
         if setup.fix_input:
@@ -119,8 +113,4 @@ def simulate(plan: TorqueSchedule, parameters: dict, theta0: float, omega0: floa
     return out
 
 
-def run(plan: TorqueSchedule, *, parameters: dict | None = None, theta0: float = 0.0,
-        omega0: float = 0.0, mode: str = "accurate") -> np.ndarray:
-    check_held(plan, "drake")
-    check_mode(mode, "drake")
-    return simulate(plan, resolve_parameters(parameters), theta0, omega0, SETUPS[mode])
+run = runner("drake", simulate, SETUPS)

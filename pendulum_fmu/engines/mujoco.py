@@ -20,10 +20,8 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from .. import results
-from ..parameters import resolve_parameters
 from ..signal import TorqueSchedule
-from . import check_held, check_mode, substeps
+from . import held_results, runner, substeps
 
 
 @dataclass(frozen=True)
@@ -76,12 +74,8 @@ def simulate(plan: TorqueSchedule, parameters: dict, theta0: float, omega0: floa
     model = mujoco.MjModel.from_xml_string(model_xml(parameters, setup))
     data = mujoco.MjData(model)
     data.qpos[0], data.qvel[0] = theta0, omega0
-    n_points = len(plan.time)
-    out = results.empty(n_points)
-    out["time"] = plan.time
-    out["torque"][:-1] = plan.torque
-    out["torque"][-1] = plan.torque[-1]
-    counts = (np.ones(n_points - 1, dtype=int) if setup.largest_step is None
+    out = held_results(plan)
+    counts = (np.ones(len(plan.step_size), dtype=int) if setup.largest_step is None
               else substeps(plan.step_size, setup.largest_step))
 
     def record(k, fresh):
@@ -104,8 +98,4 @@ def simulate(plan: TorqueSchedule, parameters: dict, theta0: float, omega0: floa
     return out
 
 
-def run(plan: TorqueSchedule, *, parameters: dict | None = None, theta0: float = 0.0,
-        omega0: float = 0.0, mode: str = "accurate") -> np.ndarray:
-    check_held(plan, "mujoco")
-    check_mode(mode, "mujoco")
-    return simulate(plan, resolve_parameters(parameters), theta0, omega0, SETUPS[mode])
+run = runner("mujoco", simulate, SETUPS)

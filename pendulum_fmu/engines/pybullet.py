@@ -26,10 +26,8 @@ from pathlib import Path
 import numpy as np
 import pybullet
 
-from .. import results
-from ..parameters import resolve_parameters
 from ..signal import TorqueSchedule
-from . import check_held, check_mode, substeps
+from . import held_results, runner, substeps
 
 
 @dataclass(frozen=True)
@@ -109,11 +107,7 @@ def _step_through(plan, parameters, theta0, omega0, setup, client, body):
         theta, omega, _, _ = pybullet.getJointState(body, joint, physicsClientId=client)
         return theta, omega
 
-    n_points = len(plan.time)
-    out = results.empty(n_points)
-    out["time"] = plan.time
-    out["torque"][:-1] = plan.torque
-    out["torque"][-1] = plan.torque[-1]
+    out = held_results(plan)
     counts = substeps(plan.step_size, setup.largest_step)
     out["theta"][0], out["omega"][0] = theta0, omega0
     applied = None
@@ -138,8 +132,4 @@ def _step_through(plan, parameters, theta0, omega0, setup, client, body):
     return out
 
 
-def run(plan: TorqueSchedule, *, parameters: dict | None = None, theta0: float = 0.0,
-        omega0: float = 0.0, mode: str = "accurate") -> np.ndarray:
-    check_held(plan, "pybullet")
-    check_mode(mode, "pybullet")
-    return simulate(plan, resolve_parameters(parameters), theta0, omega0, SETUPS[mode])
+run = runner("pybullet", simulate, SETUPS)
