@@ -167,3 +167,26 @@ def test_pybullet_velocity_limit_is_raised():
                                 pybullet.Setup(pybullet.DEFAULT.largest_step, raise_velocity_limit=False))
     assert np.max(np.abs(run["theta"] - expected)) < 1e-12
     assert np.max(np.abs(clamped["theta"] - expected)) > 4.0
+
+
+def off_grid_plan():
+    """A CSV jump off the 1 ms grid and a short last step: communication steps of three sizes."""
+    from pendulum_fmu.signal import TorqueTable
+
+    table = TorqueTable(np.array([0.0, 0.0305, 0.0305, 0.1003]), np.array([40.0, 40.0, -60.0, -60.0]))
+    plan = schedule(table, step_size=1e-3)
+    assert len(set(np.round(plan.step_size, 12))) == 3
+    return plan
+
+
+@pytest.mark.parametrize("name", ["mujoco", "drake", "pybullet"])
+def test_accurate_modes_take_unequal_steps(name):
+    plan = off_grid_plan()
+    run = engine(name).run(plan, theta0=THETA0, omega0=OMEGA0)
+    assert error(run, reference_schedule(plan, theta0=THETA0, omega0=OMEGA0)) <= ACCURATE_BOUND[name]
+
+
+def test_drake_default_refuses_unequal_steps():
+    drake = engine("drake")
+    with pytest.raises(drake.UnequalSteps, match="drake:default steps a discrete plant at one period"):
+        drake.run(off_grid_plan(), mode="default")
