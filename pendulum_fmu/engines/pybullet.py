@@ -19,12 +19,31 @@ accurate mode can only shrink the step. What the adapter sets, and the traps it 
 from __future__ import annotations
 
 import math
+import os
+import sys
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import pybullet
+
+
+def _import_quietly():
+    """import pybullet, which prints its build time on stderr from C, where a user error is
+    one line."""
+    sys.stderr.flush()
+    saved, devnull = os.dup(2), os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, 2)
+    try:
+        import pybullet
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+        os.close(devnull)
+    return pybullet
+
+
+pybullet = _import_quietly()
 
 from ..signal import TorqueSchedule
 from . import held_results, runner, substeps
