@@ -124,3 +124,24 @@ def test_compare_runs_another_fmu_beside_ours(renamed_fmu):
     assert list(runs) == ["fmu", "reference", "theirs"]
     assert max_error(runs["theirs"], runs["fmu"]) < 1e-12
     assert max_error(runs["theirs"], runs["reference"]) < 1e-9
+
+
+DEGREE = 0.017453292519943295
+DEGREES_MAP = (f"torque=tau,theta=phi*{DEGREE!r},omega=w*{DEGREE!r},alpha=a*{DEGREE!r},"
+               f"theta0=phi_start*{DEGREE!r},omega0=w_start*{DEGREE!r},"
+               "mass=m,length=L,inertia=J,gravity=g,damping=c")
+
+
+def test_an_fmi3_fmu_in_degrees_matches_the_reference(tmp_path):
+    # tests/fmus/degrees_pendulum.py: FMI 3.0 Co-Simulation, angles in degrees, the start values
+    # as parameters of its own.
+    builder = pytest.importorskip("pythonfmu3.builder")
+    fmu = builder.FmuBuilder.build_FMU(SOURCE_DIR.parent / "tests" / "fmus" / "degrees_pendulum.py",
+                                       dest=tmp_path)
+    parameters = {"damping": 3.0, "mass": 25.0}
+    (theirs,) = tools.parse_tools(f"theirs={fmu}", mapping=DEGREES_MAP)
+    run = theirs.run(PLAN, parameters=parameters, theta0=0.2, omega0=-1.0)
+    expected = reference_schedule(PLAN, parameters=parameters, theta0=0.2, omega0=-1.0)
+    assert max_error(run, expected) < 1e-10
+    assert max_error(run, expected, "omega") < 1e-9
+    assert max_error(run, expected, "alpha") < 1e-9
