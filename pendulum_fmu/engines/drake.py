@@ -7,8 +7,7 @@ damping, gravity is along -z, so theta is measured from the downward vertical. A
 takes the torque. What the adapter sets, and the traps it avoids:
 
 - the actuation input port is fixed to the step's torque before each step: an input port must be
-  fixed or connected (Drake refuses to evaluate an unconnected actuation port's dynamics with a
-  torque; an unconnected port means zero actuation in recent releases);
+  fixed or connected, and Drake 1.51 takes an unconnected actuation port as zero torque, silently;
 - theta and omega are read from the plant's state, and a discrete plant's sampled output ports
   are switched off: a sampled port (the generalized acceleration among them) reports the value of
   the previous step, so alpha would lag a step;

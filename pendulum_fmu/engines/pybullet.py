@@ -7,7 +7,7 @@ accurate mode can only shrink the step. What the adapter sets, and the traps it 
 
 - setGravity: a new PyBullet world has no gravity;
 - URDF_USE_INERTIA_FROM_FILE: without it loadURDF replaces the file's inertia by one computed
-  from the collision shapes (here none: a tiny box), whatever the file says;
+  from the collision shapes (here, with none, 2.7e-5 kg.m2 instead of 20), whatever the file says;
 - changeDynamics(linearDamping=0, angularDamping=0): every link has a hidden velocity damping of
   0.04 by default; the FMU's damping goes in as jointDamping;
 - setJointMotorControl2(VELOCITY_CONTROL, force=0): every joint starts with a velocity motor that
