@@ -8,8 +8,9 @@ accurate mode can only shrink the step. What the adapter sets, and the traps it 
 - setGravity: a new PyBullet world has no gravity;
 - URDF_USE_INERTIA_FROM_FILE: without it loadURDF replaces the file's inertia by one computed
   from the collision shapes (here, with none, 2.7e-5 kg.m2 instead of 20), whatever the file says;
-- changeDynamics(linearDamping=0, angularDamping=0): every link has a hidden velocity damping of
-  0.04 by default; the FMU's damping goes in as jointDamping;
+- changeDynamics(linearDamping=0, angularDamping=0): every link has a hidden velocity damping by
+  default (here it slows the pendulum as a joint damping of 2.2 N.m.s/rad would); the FMU's
+  damping goes in as jointDamping;
 - setJointMotorControl2(VELOCITY_CONTROL, force=0): every joint starts with a velocity motor that
   holds it still;
 - the torque is applied again before every stepSimulation: a TORQUE_CONTROL force lasts one step;
