@@ -134,16 +134,26 @@ DEGREES_MAP = (f"torque=tau,theta=phi*{DEGREE!r},omega=w*{DEGREE!r},alpha=a*{DEG
                "mass=m,length=L,inertia=J,gravity=g,damping=c")
 
 
-def test_an_fmi3_fmu_in_degrees_matches_the_reference(tmp_path):
-    # tests/fmus/degrees_pendulum.py: FMI 3.0 Co-Simulation, angles in degrees, the start values
-    # as parameters of its own.
+@pytest.fixture(scope="module")
+def degrees_fmu(tmp_path_factory):
+    """tests/fmus/degrees_pendulum.py built by pythonfmu3: FMI 3.0, CS and ME, angles in degrees,
+    the start values as parameters of their own."""
     builder = pytest.importorskip("pythonfmu3.builder")
-    fmu = builder.FmuBuilder.build_FMU(SOURCE_DIR.parent / "tests" / "fmus" / "degrees_pendulum.py",
-                                       dest=tmp_path)
+    return builder.FmuBuilder.build_FMU(SOURCE_DIR.parent / "tests" / "fmus" / "degrees_pendulum.py",
+                                        dest=tmp_path_factory.mktemp("degrees"))
+
+
+@pytest.mark.parametrize("interface", ["CoSimulation", "ModelExchange"])
+def test_an_fmi3_fmu_in_degrees_matches_the_reference(degrees_fmu, interface):
     parameters = {"damping": 3.0, "mass": 25.0}
-    (theirs,) = tools.parse_tools(f"theirs={fmu}", mapping=DEGREES_MAP)
+    theirs = OtherFmu(degrees_fmu, DEGREES_MAP, interface=interface)
     run = theirs.run(PLAN, parameters=parameters, theta0=0.2, omega0=-1.0)
     expected = reference_schedule(PLAN, parameters=parameters, theta0=0.2, omega0=-1.0)
     assert max_error(run, expected) < 1e-10
     assert max_error(run, expected, "omega") < 1e-9
     assert max_error(run, expected, "alpha") < 1e-9
+
+
+def test_compare_takes_an_fmi3_fmu_by_path(degrees_fmu):
+    runs = run_tools(PLAN, ["reference", f"theirs={degrees_fmu}"], mapping=DEGREES_MAP, theta0=0.1)
+    assert max_error(runs["theirs"], runs["reference"]) < 1e-10
