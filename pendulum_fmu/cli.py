@@ -116,11 +116,11 @@ def _print_comparison(comparison) -> None:
 def cmd_compare(args) -> int:
     from .compare import compare
 
-    tools = [tool.strip() for tool in args.tools.split(",") if tool.strip()]
-    comparison = compare(_torque_signal(args), tools, output_dir=args.output_dir,
+    comparison = compare(_torque_signal(args), args.tools, output_dir=args.output_dir,
                          step_size=args.step_size, stop_time=args.stop_time, ramp=args.ramp,
                          parameters=_parameters(args.assignments), theta0=args.theta0,
-                         omega0=args.omega0, tolerance=args.tol, max_steps=args.max_steps)
+                         omega0=args.omega0, tolerance=args.tol, mapping=args.mapping,
+                         max_steps=args.max_steps)
     _print_comparison(comparison)
     for path in (comparison.trajectories, comparison.table, comparison.figure):
         print(f"wrote {path}")
@@ -229,8 +229,14 @@ def build_parser() -> argparse.ArgumentParser:
                          help="ramp the torque along the CSV's piecewise-linear signal in every "
                               "tool that can (the FMU, the reference); OpenSim cannot and says so")
     compare.add_argument("--tools", default="fmu,reference,opensim",
-                         help="comma-separated, each once: fmu, reference, opensim; the reference "
-                              "always runs as the judge (default: %(default)s)")
+                         help="comma-separated, each once: fmu, reference, opensim, mujoco, drake, "
+                              "pybullet (NAME:default for the engine's own defaults), or "
+                              "LABEL=path/to/Their.fmu for any FMI 2.0/3.0 FMU; the reference always "
+                              "runs as the judge (default: %(default)s)")
+    compare.add_argument("--map", dest="mapping", default=None, metavar="OURS=THEIRS[*FACTOR],...",
+                         help="for LABEL=FMU tools: their variable names for torque, theta, omega, "
+                              "alpha and the parameters, with a factor where they use other units, "
+                              "e.g. torque=u,theta=phi*0.0174532925 (docs/engines.md)")
     compare.add_argument("--output-dir", type=Path, required=True,
                          help="folder for trajectories.csv, differences.csv and comparison.png")
     compare.add_argument("--tol", type=_float, default=1e-9,

@@ -17,13 +17,12 @@ from pathlib import Path
 
 import numpy as np
 
-from . import results
 from .files import replacing
 from .parameters import resolve_parameters
 from .plot import plot_comparison
 from .reference import reference
-from .signal import TorqueSignal, schedule
-from .simulate import open_fmu, run_schedule
+from .signal import TorqueSchedule, TorqueSignal, schedule
+from .tools import ToolSpecError, parse_tools
 
 REFERENCE = "reference"
 TOOLS = ("fmu", REFERENCE, "opensim")
@@ -32,46 +31,14 @@ TOOLS = ("fmu", REFERENCE, "opensim")
 TORQUE_ROUNDING = 1e-9
 
 
-def _run_fmu(plan, parameters, theta0, omega0, fmu_path=None):
-    slave = open_fmu(fmu_path, parameters=parameters, theta0=theta0, omega0=omega0,
-                     start_time=float(plan.time[0]))
-    try:
-        return run_schedule(slave, plan)
-    finally:
-        slave.terminate()
-        slave.freeInstance()
-
-
-def _run_opensim(plan, parameters, theta0, omega0, fmu_path=None):
-    from .opensim_model import opensim_simulate
-
-    if np.any(plan.torque_rate):
-        raise ValueError("opensim cannot ramp: overrideActuation holds the torque over each step; "
-                         "leave opensim out of --tools, or compare held torques (no --ramp)")
-    run = opensim_simulate(plan.time, plan.torque, theta0=theta0, omega0=omega0,
-                           **resolve_parameters(parameters))
-    out = results.empty(len(plan.time))
-    for name in results.FIELDS:
-        out[name] = run[name]
-    return out
-
-
-_RUNNERS = {"fmu": _run_fmu, "opensim": _run_opensim}
-
-
-def check_tools(tools) -> list[str]:
-    """The tools as a list; unknown names, repeats and fewer than two tools are refused."""
-    tools = [str(tool).strip() for tool in tools]
-    unknown = [tool for tool in tools if tool not in TOOLS]
-    if unknown:
-        raise ValueError(f"unknown tool(s) {', '.join(unknown)}: choose from {', '.join(TOOLS)}")
-    repeated = sorted({tool for tool in tools if tools.count(tool) > 1})
-    if repeated:
-        raise ValueError(f"tool(s) {', '.join(repeated)} given more than once: name each tool once")
-    if len(tools) < 2:
-        raise ValueError(f"compare needs at least two tools, got {', '.join(tools) or 'none'}: "
-                         f"e.g. --tools fmu,{REFERENCE}")
-    return tools
+def run_tools(plan: TorqueSchedule, tools, *, parameters: dict | None = None, theta0: float = 0.0,
+              omega0: float = 0.0, fmu_path: str | Path | None = None,
+              mapping: str | None = None) -> dict[str, np.ndarray]:
+    """{tool label: result array} for the same schedule, parameters and start values; tools as
+    --tools gives them (see tools.py), mapping the --map of other FMUs. "reference" here is
+    reference_schedule: the schedule's own torques through scipy."""
+    return {tool.label: tool.run(plan, parameters=parameters, theta0=theta0, omega0=omega0)
+            for tool in parse_tools(tools, mapping=mapping, fmu_path=fmu_path)}
 
 
 def check_tolerance(tolerance: float) -> float:
@@ -160,12 +127,14 @@ class Comparison:
 def compare(torque: TorqueSignal, tools=TOOLS, *, output_dir: str | Path, step_size: float = 1e-3,
             start_time: float = 0.0, stop_time: float | None = None, ramp: bool = False,
             parameters: dict | None = None, theta0: float = 0.0, omega0: float = 0.0,
-            tolerance: float = 1e-9, title: str | None = None,
-            fmu_path: str | Path | None = None, max_steps: int | None = None) -> Comparison:
+            tolerance: float = 1e-9, title: str | None = None, fmu_path: str | Path | None = None,
+            mapping: str | None = None, max_steps: int | None = None) -> Comparison:
     """Run one signal through each tool and judge each against the reference.
 
-    The reference is always run, as the judge, whether or not `tools` names it. Writes to
-    output_dir:
+    tools: as --tools gives them (tools.py): fmu, reference, opensim, mujoco, drake, pybullet
+    (NAME:default for an engine's own defaults), LABEL=path/to/Their.fmu with mapping the --map.
+    The reference is the independent oracle reading the signal itself; it always runs, as the
+    judge, whether or not `tools` names it. Writes to output_dir:
     - trajectories.csv: every tool's torque, theta, omega, alpha;
     - differences.csv: each tool against the reference (max and RMS of theta, omega, alpha;
       max |torque received - signal|; wall time per step) and every pair of other tools;
@@ -173,21 +142,26 @@ def compare(torque: TorqueSignal, tools=TOOLS, *, output_dir: str | Path, step_s
 
     ramp=True ramps the torque over each step in every tool that can; a tool that cannot says so.
     """
-    tools = check_tools(tools)
+    parsed = parse_tools(tools, mapping=mapping, fmu_path=fmu_path)
+    if len(parsed) < 2:
+        raise ToolSpecError(f"compare needs at least two tools, got {parsed[0].label}: "
+                            f"e.g. --tools fmu,{REFERENCE}")
     tolerance = check_tolerance(tolerance)
     resolve_parameters(parameters)  # a bad parameter is refused before any tool runs
     plan = schedule(torque, start_time=start_time, stop_time=stop_time, step_size=step_size, ramp=ramp,
                     max_steps=max_steps)
+    steps = len(plan.time) - 1
     runs, seconds = {}, {}
-    for tool in [REFERENCE] + [tool for tool in tools if tool != REFERENCE]:
-        started = clock.perf_counter()
-        if tool == REFERENCE:
-            runs[tool] = reference(torque, start_time=start_time, stop_time=stop_time,
-                                   step_size=step_size, ramp=ramp, parameters=parameters,
-                                   theta0=theta0, omega0=omega0, at=plan.time)
-        else:
-            runs[tool] = _RUNNERS[tool](plan, parameters, theta0, omega0, fmu_path)
-        seconds[tool] = (clock.perf_counter() - started) / (len(plan.time) - 1)
+    started = clock.perf_counter()
+    runs[REFERENCE] = reference(torque, start_time=start_time, stop_time=stop_time, step_size=step_size,
+                                ramp=ramp, parameters=parameters, theta0=theta0, omega0=omega0,
+                                at=plan.time)
+    seconds[REFERENCE] = (clock.perf_counter() - started) / steps
+    for tool in parsed:
+        if tool.label != REFERENCE:  # the judge above takes the reference's place
+            started = clock.perf_counter()
+            runs[tool.label] = tool.run(plan, parameters=parameters, theta0=theta0, omega0=omega0)
+            seconds[tool.label] = (clock.perf_counter() - started) / steps
     judge = runs[REFERENCE]
     others = [tool for tool in runs if tool != REFERENCE]
     rows = [{"tool": tool, "against": REFERENCE, **differences(runs[tool], judge),
@@ -202,4 +176,3 @@ def compare(torque: TorqueSignal, tools=TOOLS, *, output_dir: str | Path, step_s
         figure=plot_comparison(runs, output_dir / "comparison.png",
                                title or f"Torque-driven pendulum: {', '.join(runs)}"),
     )
-

@@ -107,7 +107,8 @@ def opensim_simulate(time, torque, *, mass=40.0, length=0.5, inertia=20.0, gravi
     manager = osim.Manager(model)
     manager.setWriteToStorage(False)
     manager.setPerformAnalyses(False)
-    manager.setIntegratorAccuracy(accuracy)
+    if accuracy is not None:  # None: the Manager's own default
+        manager.setIntegratorAccuracy(accuracy)
 
     n_points = time.size
     held_torque = np.append(torque, torque[-1])

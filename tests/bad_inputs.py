@@ -73,7 +73,7 @@ CASES = [
     _case("parameters", "simulate --torque 1 --set mass", 2, "expected name=value, got 'mass'"),
     _case("compare", "compare --torque 1 --tools fmu,matlab --output-dir {files}/out", 2, "unknown tool(s) matlab"),
     _case("compare", "compare --torque 1 --tools fmu,fmu --output-dir {files}/out", 2,
-          "tool(s) fmu given more than once"),
+          "--tools names fmu twice"),
     _case("compare", "compare --torque 1 --tools fmu --output-dir {files}/out", 2,
           "compare needs at least two tools, got fmu"),
     _case("compare", "compare --torque 1 --tools fmu,reference --tol nan --output-dir {files}/out", 2,

@@ -51,7 +51,7 @@ def test_tutorial_loop_verbatim_fails_on_opensim_46():
 def test_opensim_rejects_bad_arguments(tmp_path):
     with pytest.raises(ValueError, match="one value per step"):
         opensim_simulate([0, 1, 2], [1.0])
-    with pytest.raises(ValueError, match="opensim cannot ramp"):
+    with pytest.raises(ValueError, match="opensim holds the torque over each step and cannot ramp"):
         compare(lambda t: t, ("fmu", "opensim"), output_dir=tmp_path, stop_time=0.1, step_size=0.01, ramp=True)
 
 

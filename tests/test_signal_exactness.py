@@ -176,5 +176,5 @@ def test_compare_agrees_on_the_awkward_cases(fmu, tmp_path):
 def test_compare_ramp_refuses_a_tool_that_cannot_ramp(tmp_path):
     pytest.importorskip("opensim")
     kinks = write(tmp_path / "k.csv", [(0, 0), (0.3915, 20), (1, -5)])
-    with pytest.raises(ValueError, match="opensim cannot ramp"):
+    with pytest.raises(ValueError, match="opensim holds the torque over each step and cannot ramp"):
         compare(kinks, ["fmu", "opensim"], output_dir=tmp_path, ramp=True)

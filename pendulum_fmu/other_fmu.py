@@ -1,0 +1,239 @@
+"""Any FMI 2.0 or 3.0 FMU, Co-Simulation or Model Exchange, as a compare tool (through fmpy).
+
+A map names the FMU's variable for each quantity of the comparison, with an optional unit-free
+scale factor from the FMU's value to SI:
+
+    torque=u,theta=phi*0.0174532925,omega=w*0.0174532925,alpha=der(w),mass=m,length=L
+
+reads "torque is the FMU's u; theta in rad is the FMU's phi times 0.0174532925 (phi is in
+degrees)". A quantity left out of the map is the FMU's variable of the same name when there is
+one. torque and theta are required; omega and alpha are reported as NaN when the FMU has neither.
+theta0 and omega0 name the variables that take the start values when they are not theta's and
+omega's own (a Modelica model's phi_start, say). A parameter the FMU lacks keeps the FMU's own
+value, which is refused when the comparison sets it to anything but the pendulum's default.
+
+Co-Simulation is preferred when the FMU has both. Co-Simulation steps run in a loop here (fmpy's
+simulate_fmu would apply, at a torque jump, the value from before it); Model Exchange runs through
+fmpy's simulate_fmu with CVode, which stops at every torque jump.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from fmpy import extract, read_model_description, simulate_fmu
+from fmpy.fmi2 import FMU2Slave
+from fmpy.fmi3 import FMU3Slave
+
+from .engines import check_held, check_mode, held_results
+from .parameters import default_parameters, resolve_parameters
+from .signal import TorqueSchedule
+
+OUTPUTS = ("theta", "omega", "alpha")
+REQUIRED = ("torque", "theta")
+START_VALUES = {"theta0": "theta", "omega0": "omega"}
+# accurate: the tolerance the FMU or CVode is asked for; default: what it uses when not asked.
+TOLERANCE = {"accurate": 1e-12, "default": None}
+_FACTOR = re.compile(r"^(?P<variable>.+?)\*(?P<factor>[-+0-9.eE]+)$")
+
+
+class MapError(ValueError):
+    """A --map or an FMU that does not fit it; the message says which and what to do."""
+
+
+@dataclass(frozen=True)
+class Mapped:
+    """The FMU's variable for one quantity: SI value = the FMU's value * factor."""
+
+    variable: str
+    factor: float = 1.0
+
+
+def quantities() -> tuple[str, ...]:
+    return ("torque", *OUTPUTS, *START_VALUES, *default_parameters())
+
+
+def parse_map(text: str | None) -> dict[str, Mapped]:
+    """{quantity: Mapped} from 'torque=u,theta=phi*0.0174532925,...'."""
+    mapping: dict[str, Mapped] = {}
+    for item in filter(None, (part.strip() for part in (text or "").split(","))):
+        quantity, equals, target = (part.strip() for part in item.partition("="))
+        if not equals or not quantity or not target:
+            raise MapError(f"--map item {item!r} is not QUANTITY=VARIABLE[*FACTOR]")
+        if quantity not in quantities():
+            raise MapError(f"--map: unknown quantity {quantity!r}; map any of {', '.join(quantities())}")
+        if quantity in mapping:
+            raise MapError(f"--map: {quantity} is mapped twice")
+        factor = 1.0
+        scaled = _FACTOR.match(target)
+        if scaled:
+            target, factor = scaled["variable"].strip(), float(scaled["factor"])
+            if not (math.isfinite(factor) and factor != 0):
+                raise MapError(f"--map: the factor of {quantity} must be finite and nonzero")
+        mapping[quantity] = Mapped(target, factor)
+    return mapping
+
+
+class OtherFmu:
+    """An FMU and its map, checked once; run() has the runner signature of every tool."""
+
+    def __init__(self, path: str | Path, mapping: dict[str, Mapped] | str | None = None, *,
+                 interface: str | None = None, label: str = "other"):
+        self.path, self.label = Path(path), label
+        if not self.path.is_file():
+            raise MapError(f"{label}: no FMU at {self.path}")
+        try:
+            self.description = read_model_description(str(self.path))
+        except Exception as error:
+            raise MapError(f"{label}: {self.path} is not a readable FMU: {error}") from None
+        if self.description.fmiVersion not in ("2.0", "3.0"):
+            raise MapError(f"{label}: {self.path} is FMI {self.description.fmiVersion}; "
+                           "only FMI 2.0 and 3.0 FMUs can be compared")
+        available = [name for name, present in (("CoSimulation", self.description.coSimulation),
+                                                 ("ModelExchange", self.description.modelExchange))
+                     if present]
+        self.interface = interface or available[0]
+        if self.interface not in available:
+            raise MapError(f"{label}: {self.path} has no {self.interface} interface "
+                           f"(it has {', '.join(available)})")
+        self.variables = {v.name: v for v in self.description.modelVariables}
+        given = parse_map(mapping) if isinstance(mapping, str) or mapping is None else dict(mapping)
+        self.mapping = self._complete(given)
+
+    def _complete(self, given: dict[str, Mapped]) -> dict[str, Mapped]:
+        """The map with every quantity the FMU has by name, and every named variable checked."""
+        mapping = {}
+        for quantity in quantities():
+            mapped = given.get(quantity)
+            if mapped is None and quantity in START_VALUES:
+                mapped = given.get(START_VALUES[quantity])
+            if mapped is None and quantity in self.variables:
+                mapped = Mapped(quantity)
+            if mapped is None:
+                if quantity in REQUIRED:
+                    raise MapError(f"{self.label}: {self.path.name} has no variable {quantity!r}: "
+                                   f"name it with --map {quantity}=VARIABLE")
+                continue
+            if mapped.variable not in self.variables:
+                raise MapError(f"{self.label}: {self.path.name} has no variable {mapped.variable!r} "
+                               f"(mapped to {quantity})")
+            mapping[quantity] = mapped
+        return mapping
+
+    def _start_values(self, parameters: dict, theta0: float, omega0: float) -> dict[str, float]:
+        """{FMU variable: value in the FMU's units} for the parameters and start values."""
+        values = {**resolve_parameters(parameters), "theta0": theta0, "omega0": omega0}
+        defaults = default_parameters()
+        start = {}
+        for quantity, value in values.items():
+            mapped = self.mapping.get(quantity)
+            if mapped is None:
+                if value != defaults.get(quantity, 0.0):
+                    raise MapError(f"{self.label}: {self.path.name} has no variable for {quantity} = "
+                                   f"{value:g}: map it with --map {quantity}=VARIABLE")
+                continue
+            start[mapped.variable] = value / mapped.factor
+        return start
+
+    def run(self, plan: TorqueSchedule, *, parameters: dict | None = None, theta0: float = 0.0,
+            omega0: float = 0.0, mode: str = "accurate") -> np.ndarray:
+        check_held(plan, self.label)
+        check_mode(mode, self.label)
+        start = self._start_values(parameters, theta0, omega0)
+        step = self._co_simulation if self.interface == "CoSimulation" else self._model_exchange
+        raw = step(plan, start, TOLERANCE[mode])
+        out = held_results(plan)
+        for name in OUTPUTS:
+            mapped = self.mapping.get(name)
+            out[name] = raw[name] * mapped.factor if mapped else np.nan
+        return out
+
+    def _output_variables(self) -> dict[str, str]:
+        return {name: self.mapping[name].variable for name in OUTPUTS if name in self.mapping}
+
+    def _co_simulation(self, plan, start, tolerance):
+        """Hold each step's torque, read the outputs at each communication point."""
+        fmi3 = self.description.fmiVersion == "3.0"
+        with tempfile.TemporaryDirectory(prefix="pendulum_other_fmu_") as folder:
+            extract(str(self.path), unzipdir=folder)
+            cls = FMU3Slave if fmi3 else FMU2Slave
+            slave = cls(guid=self.description.guid, unzipDirectory=folder,
+                        modelIdentifier=self.description.coSimulation.modelIdentifier,
+                        instanceName=self.label)
+            outputs = self._output_variables()
+            vr = {name: self.variables[name].valueReference for name in (*start, *outputs.values())}
+            torque = self.mapping["torque"]
+            torque_vr = [self.variables[torque.variable].valueReference]
+            output_vrs = [vr[variable] for variable in outputs.values()]
+            set_values = slave.setFloat64 if fmi3 else slave.setReal
+            get_values = slave.getFloat64 if fmi3 else slave.getReal
+            recorded = np.full((len(plan.time), len(outputs)), np.nan)
+            t0 = float(plan.time[0])
+            call = "instantiate"
+            slave.instantiate()
+            try:
+                if not fmi3:
+                    call = "fmi2SetupExperiment"
+                    slave.setupExperiment(tolerance=tolerance, startTime=t0)
+                call = "setting the parameters and start values"
+                set_values([vr[name] for name in start], list(start.values()))
+                set_values(torque_vr, [plan.torque[0] / torque.factor])
+                call = "initialization"
+                if fmi3:
+                    slave.enterInitializationMode(tolerance=tolerance, startTime=t0)
+                else:
+                    slave.enterInitializationMode()
+                slave.exitInitializationMode()
+                for k, (t, h, u) in enumerate(zip(plan.time.tolist(), plan.step_size.tolist(),
+                                                  plan.torque.tolist())):
+                    call = f"the step from t = {t:.17g}"
+                    set_values(torque_vr, [u / torque.factor])
+                    recorded[k] = get_values(output_vrs)
+                    slave.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+                recorded[-1] = get_values(output_vrs)
+                slave.terminate()
+            except Exception as error:
+                raise RuntimeError(f"{self.label}: {call} failed: {error}") from None
+            finally:
+                slave.freeInstance()
+        return {name: recorded[:, i] for i, name in enumerate(outputs)}
+
+    def _model_exchange(self, plan, start, tolerance):
+        """fmpy's CVode on the FMU's derivatives, with the torque as a table that jumps where the
+        schedule's torque changes (fmpy stops the integrator at each such time)."""
+        torque = self.mapping["torque"]
+        change = np.flatnonzero(np.diff(plan.torque)) + 1
+        # Rows in fmpy's convention: a time given twice is a jump from the first value to the second.
+        times = np.concatenate([plan.time[:1], np.repeat(plan.time[change], 2), plan.time[-1:]])
+        jumps = np.column_stack([plan.torque[change - 1], plan.torque[change]]).ravel()
+        values = np.concatenate([plan.torque[:1], jumps, plan.torque[-1:]])
+        signal = np.zeros(len(times), dtype=[("time", "f8"), (torque.variable, "f8")])
+        signal["time"], signal[torque.variable] = times, values / torque.factor
+        outputs = self._output_variables()
+        try:
+            raw = simulate_fmu(str(self.path), fmi_type="ModelExchange", solver="CVode",
+                               relative_tolerance=tolerance, start_time=float(plan.time[0]),
+                               stop_time=float(plan.time[-1]),
+                               output_interval=float(plan.step_size.min()), input=signal,
+                               output=list(outputs.values()), start_values=start)
+        except Exception as error:
+            raise RuntimeError(f"{self.label}: Model Exchange simulation failed: {error}") from None
+        # At a jump fmpy records the time twice; the row after the event is the one whose outputs
+        # see the new torque.
+        rows = np.searchsorted(raw["time"], plan.time + 1e-9 * plan.step_size.min(), side="right") - 1
+        if np.any(np.abs(raw["time"][rows] - plan.time) > 1e-9 * plan.step_size.min()):
+            raise RuntimeError(f"{self.label}: fmpy did not report every communication point")
+        return {name: raw[variable][rows] for name, variable in outputs.items()}
+
+
+def run(plan: TorqueSchedule, *, parameters: dict | None = None, theta0: float = 0.0,
+        omega0: float = 0.0, mode: str = "accurate", path: str | Path, mapping: str | None = None,
+        interface: str | None = None, label: str = "other") -> np.ndarray:
+    """The runner signature with the FMU's path and map added."""
+    return OtherFmu(path, mapping, interface=interface, label=label).run(
+        plan, parameters=parameters, theta0=theta0, omega0=omega0, mode=mode)

@@ -1,0 +1,172 @@
+"""The tools compare runs, and the parsing of --tools and --map.
+
+    --tools fmu,reference,opensim,mujoco,drake:default,pybullet,theirs=path/to/Their.fmu
+    --map torque=u,theta=phi*0.0174532925
+
+An item is a tool's name, optionally with a mode (accurate, the default, or default: what the
+engine does with its own settings), or LABEL=PATH for any other FMU, run through the --map (see
+other_fmu.py). Every tool has the same runner:
+
+    tool.run(plan, parameters=..., theta0=..., omega0=...) -> results array (results.py)
+
+A tool whose Python package is missing is refused when the list is parsed, with the pip command
+that installs it.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+import re
+from dataclasses import dataclass
+from functools import partial
+from pathlib import Path
+from typing import Callable, Sequence
+
+import numpy as np
+
+from . import results
+from .engines import MODES, check_held, check_mode
+from .parameters import resolve_parameters
+from .reference import reference_schedule
+from .signal import TorqueSchedule
+from .simulate import open_fmu, run_schedule
+
+
+class ToolSpecError(ValueError):
+    """A --tools or --map that names no runnable tool; the message says which and what to do."""
+
+
+@dataclass(frozen=True)
+class Tool:
+    """A tool as compare runs it: its label in tables and figures, and its runner."""
+
+    label: str
+    runner: Callable[..., np.ndarray]
+
+    def run(self, plan: TorqueSchedule, *, parameters: dict | None = None, theta0: float = 0.0,
+            omega0: float = 0.0) -> np.ndarray:
+        return self.runner(plan, parameters=parameters, theta0=theta0, omega0=omega0)
+
+
+def run_fmu(plan: TorqueSchedule, *, parameters: dict | None = None, theta0: float = 0.0,
+            omega0: float = 0.0, mode: str = "accurate", fmu_path: str | Path | None = None) -> np.ndarray:
+    """This project's FMU (the checkout's, or fmu_path) through fmpy; ramps are passed on."""
+    check_mode(mode, "fmu")
+    slave = open_fmu(fmu_path, parameters=parameters, theta0=theta0, omega0=omega0,
+                     start_time=float(plan.time[0]))
+    try:
+        return run_schedule(slave, plan)
+    finally:
+        slave.terminate()
+        slave.freeInstance()
+
+
+def run_reference(plan: TorqueSchedule, *, parameters: dict | None = None, theta0: float = 0.0,
+                  omega0: float = 0.0, mode: str = "accurate") -> np.ndarray:
+    check_mode(mode, "reference")
+    return reference_schedule(plan, parameters=parameters, theta0=theta0, omega0=omega0)
+
+
+# default: the Manager's own integrator (Runge-Kutta-Merson) at its own accuracy.
+OPENSIM_ACCURACY = {"accurate": 1e-12, "default": None}
+
+
+def run_opensim(plan: TorqueSchedule, *, parameters: dict | None = None, theta0: float = 0.0,
+                omega0: float = 0.0, mode: str = "accurate") -> np.ndarray:
+    from .opensim_model import opensim_simulate
+
+    check_held(plan, "opensim")
+    check_mode(mode, "opensim")
+    run = opensim_simulate(plan.time, plan.torque, theta0=theta0, omega0=omega0,
+                           accuracy=OPENSIM_ACCURACY[mode], **resolve_parameters(parameters))
+    out = results.empty(len(plan.time))
+    for name in results.FIELDS:
+        out[name] = run[name]
+    return out
+
+
+@dataclass(frozen=True)
+class Kind:
+    """A tool that --tools names: where its runner is, the package it needs, its modes."""
+
+    runner: str  # "module:function", imported only when the tool is used
+    package: str | None = None  # the module its extra installs
+    extra: str | None = None
+    modes: tuple[str, ...] = ("accurate",)
+
+    def load(self) -> Callable[..., np.ndarray]:
+        module, function = self.runner.split(":")
+        return getattr(importlib.import_module(module), function)
+
+
+KINDS = {
+    "fmu": Kind("pendulum_fmu.tools:run_fmu"),
+    "reference": Kind("pendulum_fmu.tools:run_reference"),
+    "opensim": Kind("pendulum_fmu.tools:run_opensim", "opensim", "opensim", MODES),
+    "mujoco": Kind("pendulum_fmu.engines.mujoco:run", "mujoco", "mujoco", MODES),
+    "drake": Kind("pendulum_fmu.engines.drake:run", "pydrake", "drake", MODES),
+    "pybullet": Kind("pendulum_fmu.engines.pybullet:run", "pybullet", "pybullet", MODES),
+}
+_LABEL = re.compile(r"^[A-Za-z_][A-Za-z0-9_.-]*$")
+
+
+def installed(name: str) -> bool:
+    """Whether the tool's Python package can be imported here."""
+    package = KINDS[name].package
+    return package is None or importlib.util.find_spec(package) is not None
+
+
+def _other_fmu(label: str, path: str, mapping: str | None) -> Tool:
+    from .other_fmu import OtherFmu
+
+    if not _LABEL.match(label) or label.split(":")[0] in KINDS:
+        raise ToolSpecError(f"--tools {label}={path}: the label must be a name (letters, digits, "
+                            f"_ . -) other than {', '.join(KINDS)}")
+    try:
+        return Tool(label, OtherFmu(path, mapping, label=label).run)
+    except ValueError as error:
+        raise ToolSpecError(str(error)) from None
+
+
+def _named(item: str, fmu_path: str | Path | None) -> Tool:
+    name, _, mode = item.partition(":")
+    kind = KINDS[name]
+    mode = mode or "accurate"
+    if mode not in kind.modes:
+        raise ToolSpecError(f"--tools {item}: {name} has mode{'s' if len(kind.modes) > 1 else ''} "
+                            f"{', '.join(kind.modes)}, not {mode!r}")
+    if not installed(name):
+        raise ToolSpecError(f"--tools {name}: {kind.package} is not installed; install it with: "
+                            f'pip install "pendulum-fmu[{kind.extra}]"')
+    runner = partial(kind.load(), mode=mode)
+    if name == "fmu":
+        runner = partial(runner, fmu_path=fmu_path)
+    return Tool(name if mode == "accurate" else f"{name}:{mode}", runner)
+
+
+def parse_tools(spec: str | Sequence[str], *, mapping: str | None = None,
+                fmu_path: str | Path | None = None) -> list[Tool]:
+    """The tools of a --tools list (a comma-separated string or its items), in order.
+
+    mapping is the --map for the tools given as LABEL=PATH; fmu_path the FMU that "fmu" runs.
+    """
+    items = [item.strip() for item in (spec.split(",") if isinstance(spec, str) else spec)]
+    items = [item for item in items if item]
+    if not items:
+        raise ToolSpecError("--tools is empty: name at least one of " + ", ".join(KINDS))
+    unknown = [item for item in items if "=" not in item and item.partition(":")[0] not in KINDS]
+    if unknown:
+        raise ToolSpecError(f"unknown tool(s) {', '.join(unknown)}: choose from {', '.join(KINDS)}, "
+                            "or LABEL=path/to/Their.fmu")
+    if mapping and not any("=" in item for item in items):
+        raise ToolSpecError("--map applies to FMUs given as LABEL=path/to/Their.fmu in --tools, "
+                            "and there is none")
+    tools: list[Tool] = []
+    for item in items:
+        label, equals, path = (part.strip() for part in item.partition("="))
+        tool = _other_fmu(label, path, mapping) if equals else _named(item, fmu_path)
+        if any(tool.label == other.label for other in tools):
+            raise ToolSpecError(f"--tools names {tool.label} twice")
+        tools.append(tool)
+    return tools

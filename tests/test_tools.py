@@ -1,0 +1,159 @@
+"""--tools / --map parsing, and another FMU (ours rebuilt with other names) as a tool."""
+
+import shutil
+
+import numpy as np
+import pytest
+
+from pendulum_fmu import tools
+from pendulum_fmu.build import MODEL_DESCRIPTION, SOURCE_DIR, build_fmu
+from pendulum_fmu.cli import main
+from pendulum_fmu.compare import run_tools
+from pendulum_fmu.other_fmu import MapError, Mapped, OtherFmu, parse_map
+from pendulum_fmu.reference import reference_schedule
+from pendulum_fmu.signal import schedule
+
+RENAMES = {"torque": "u", "theta": "phi", "omega": "w", "alpha": "a", "mass": "m", "length": "L",
+           "inertia": "J", "gravity": "g", "damping": "d"}
+FULL_MAP = ",".join(f"{ours}={theirs}" for ours, theirs in RENAMES.items())
+PLAN = schedule(lambda t: 50.0 if t < 0.25 else -80.0, stop_time=0.5, step_size=1e-3)
+
+
+@pytest.fixture(scope="module")
+def renamed_fmu(tmp_path_factory):
+    """The pendulum under other variable names and another model identifier, built over the same
+    plumbing from a copied model.c and modelDescription.xml."""
+    folder = tmp_path_factory.mktemp("renamed")
+    model = folder / "model"
+    model.mkdir()
+    shutil.copy2(SOURCE_DIR / "config.h", model)
+    code = (SOURCE_DIR / "model.c").read_text()
+    xml = MODEL_DESCRIPTION.read_text().replace('modelIdentifier="Pendulum"', 'modelIdentifier="Renamed"')
+    for ours, theirs in RENAMES.items():
+        code = code.replace(f"VR_{ours.upper()}", f"VR_{theirs.upper()}")
+        xml = xml.replace(f'name="{ours}"', f'name="{theirs}"')
+    (model / "model.c").write_text(code)
+    (model / "modelDescription.xml").write_text(xml)
+    return build_fmu(folder / "Renamed.fmu", model_dir=model, model_description_file=model / "modelDescription.xml")
+
+
+def max_error(run, expected, field="theta"):
+    return float(np.max(np.abs(run[field] - expected[field])))
+
+
+def test_tools_parse_in_order_with_modes():
+    pytest.importorskip("pydrake")
+    pytest.importorskip("mujoco")
+    parsed = tools.parse_tools("fmu, reference,drake:default,mujoco:accurate")
+    assert [tool.label for tool in parsed] == ["fmu", "reference", "drake:default", "mujoco"]
+
+
+@pytest.mark.parametrize("spec, message", [
+    ("fmu,matlab,simulink", "unknown tool(s) matlab, simulink"),
+    ("reference,fmu,reference", "--tools names reference twice"),
+    ("drake:fast", "drake has modes accurate, default, not 'fast'"),
+    ("fmu:default", "fmu has mode accurate, not 'default'"),
+    (" , ", "--tools is empty"),
+    ("fmu=x.fmu", "the label must be a name"),
+    ("theirs=missing.fmu", "theirs: no FMU at missing.fmu"),
+])
+def test_bad_tool_lists_are_refused_in_one_line(spec, message):
+    with pytest.raises(ValueError) as raised:
+        tools.parse_tools(spec)
+    assert message in str(raised.value) and "\n" not in str(raised.value)
+
+
+def test_a_missing_extra_names_the_pip_command(monkeypatch):
+    monkeypatch.setattr(tools, "installed", lambda name: name != "pybullet")
+    with pytest.raises(tools.ToolSpecError, match=r'pybullet is not installed; install it with: '
+                                                   r'pip install "pendulum-fmu\[pybullet\]"'):
+        tools.parse_tools("fmu,pybullet")
+
+
+def test_cli_refuses_a_duplicate_tool_in_one_line(tmp_path, capsys):
+    assert main(["compare", "--torque", "1", "--tools", "fmu,fmu", "--output-dir", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert "--tools names fmu twice" in err and err.count("\n") == 1
+
+
+def test_map_parsing():
+    assert parse_map("torque=u, theta=phi*0.0174532925,alpha=der(w)") == {
+        "torque": Mapped("u"), "theta": Mapped("phi", 0.0174532925), "alpha": Mapped("der(w)")}
+    for text, message in [("speed=w", "unknown quantity 'speed'"), ("theta", "not QUANTITY=VARIABLE"),
+                          ("theta=a,theta=b", "theta is mapped twice"), ("theta=phi*0", "finite and nonzero")]:
+        with pytest.raises(MapError, match=message):
+            parse_map(text)
+    with pytest.raises(tools.ToolSpecError, match="--map applies to FMUs"):
+        tools.parse_tools("fmu,reference", mapping="torque=u")
+
+
+@pytest.mark.parametrize("interface", ["CoSimulation", "ModelExchange"])
+def test_another_fmu_under_other_names_matches_the_reference(renamed_fmu, interface):
+    parameters = {"damping": 3.0, "length": 0.7}
+    expected = reference_schedule(PLAN, parameters=parameters, theta0=0.2, omega0=-1.0)
+    run = OtherFmu(renamed_fmu, FULL_MAP, interface=interface).run(
+        PLAN, parameters=parameters, theta0=0.2, omega0=-1.0)
+    assert max_error(run, expected) < 1e-9
+    assert max_error(run, expected, "alpha") < 1e-7
+
+
+def test_a_scale_factor_converts_both_ways(renamed_fmu):
+    # theta = phi * 0.5: the start value 0.1 sets phi to 0.2, and theta reads back half of phi,
+    # which swings as the pendulum started at 0.2.
+    half = FULL_MAP.replace("theta=phi", "theta=phi*0.5")
+    run = OtherFmu(renamed_fmu, half).run(PLAN, theta0=0.1)
+    from_double = reference_schedule(PLAN, theta0=0.2)
+    assert np.max(np.abs(run["theta"] - 0.5 * from_double["theta"])) < 1e-10
+
+
+def test_an_unmapped_quantity(renamed_fmu):
+    with pytest.raises(MapError, match="has no variable 'torque': name it with --map torque=VARIABLE"):
+        OtherFmu(renamed_fmu, "theta=phi")
+    with pytest.raises(MapError, match="has no variable 'psi' \\(mapped to theta\\)"):
+        OtherFmu(renamed_fmu, "torque=u,theta=psi")
+    partial = OtherFmu(renamed_fmu, "torque=u,theta=phi")
+    with pytest.raises(MapError, match="no variable for gravity = 0: map it with --map gravity=VARIABLE"):
+        partial.run(PLAN, parameters={"gravity": 0.0})
+    # omega and alpha unmapped: reported as NaN; the FMU's own parameters are the defaults.
+    run = partial.run(PLAN)
+    assert np.all(np.isnan(run["omega"])) and np.all(np.isnan(run["alpha"]))
+    assert max_error(run, reference_schedule(PLAN)) < 1e-9
+
+
+def test_compare_runs_another_fmu_beside_ours(renamed_fmu):
+    runs = run_tools(PLAN, ["fmu", "reference", f"theirs={renamed_fmu}"], mapping=FULL_MAP,
+                     parameters={"gravity": 3.0}, theta0=0.4)
+    assert list(runs) == ["fmu", "reference", "theirs"]
+    assert max_error(runs["theirs"], runs["fmu"]) < 1e-12
+    assert max_error(runs["theirs"], runs["reference"]) < 1e-9
+
+
+DEGREE = 0.017453292519943295
+DEGREES_MAP = (f"torque=tau,theta=phi*{DEGREE!r},omega=w*{DEGREE!r},alpha=a*{DEGREE!r},"
+               f"theta0=phi_start*{DEGREE!r},omega0=w_start*{DEGREE!r},"
+               "mass=m,length=L,inertia=J,gravity=g,damping=c")
+
+
+@pytest.fixture(scope="module")
+def degrees_fmu(tmp_path_factory):
+    """tests/fmus/degrees_pendulum.py built by pythonfmu3: FMI 3.0, CS and ME, angles in degrees,
+    the start values as parameters of their own."""
+    builder = pytest.importorskip("pythonfmu3.builder")
+    return builder.FmuBuilder.build_FMU(SOURCE_DIR.parent / "tests" / "fmus" / "degrees_pendulum.py",
+                                        dest=tmp_path_factory.mktemp("degrees"))
+
+
+@pytest.mark.parametrize("interface", ["CoSimulation", "ModelExchange"])
+def test_an_fmi3_fmu_in_degrees_matches_the_reference(degrees_fmu, interface):
+    parameters = {"damping": 3.0, "mass": 25.0}
+    theirs = OtherFmu(degrees_fmu, DEGREES_MAP, interface=interface)
+    run = theirs.run(PLAN, parameters=parameters, theta0=0.2, omega0=-1.0)
+    expected = reference_schedule(PLAN, parameters=parameters, theta0=0.2, omega0=-1.0)
+    assert max_error(run, expected) < 1e-10
+    assert max_error(run, expected, "omega") < 1e-9
+    assert max_error(run, expected, "alpha") < 1e-9
+
+
+def test_compare_takes_an_fmi3_fmu_by_path(degrees_fmu):
+    runs = run_tools(PLAN, ["reference", f"theirs={degrees_fmu}"], mapping=DEGREES_MAP, theta0=0.1)
+    assert max_error(runs["theirs"], runs["reference"]) < 1e-10
