@@ -5,11 +5,14 @@ from __future__ import annotations
 import argparse
 import importlib.util
 import sys
+import warnings
+import zipfile
 from pathlib import Path
 
 import numpy as np
 
-from .build import DEFAULT_FMU, BuildError, build_fmu
+from . import __version__
+from .build import DEFAULT_FMU, PLATFORMS, BuildError, PlatformSkipped, build_fmu
 
 TUTORIAL_TORQUE = 20.0
 
@@ -57,10 +60,37 @@ def _add_signal_arguments(parser, required=True):
                         help="parameter: mass, length, inertia, gravity, damping (repeatable)")
     parser.add_argument("--theta0", type=_float, default=0.0, help="initial angle in rad")
     parser.add_argument("--omega0", type=_float, default=0.0, help="initial rate in rad/s")
+    _add_fmu_argument(parser)
+
+
+def _add_fmu_argument(parser):
+    parser.add_argument("--fmu", type=Path, default=None,
+                        help="the FMU to run, whose own parameters and defaults apply (default: "
+                             "the packaged FMU, or dist/Pendulum.fmu in a source checkout)")
+
+
+def _platforms(text: str) -> tuple[str, ...]:
+    platforms = tuple(name.strip() for name in text.split(",") if name.strip())
+    unknown = [name for name in platforms if name not in PLATFORMS]
+    if unknown or not platforms:
+        raise argparse.ArgumentTypeError(
+            f"unknown platform(s) {', '.join(unknown) or '(none)'}: choose among {', '.join(PLATFORMS)}")
+    return platforms
 
 
 def cmd_build(args) -> int:
-    print(f"wrote {build_fmu(args.output)}")
+    path = build_fmu(args.output, platforms=args.platforms)
+    with zipfile.ZipFile(path) as fmu:
+        binaries = [name for name in fmu.namelist() if name.startswith("binaries/")]
+    print(f"wrote {path} ({', '.join(binaries)})")
+    return 0
+
+
+def cmd_cross_check(args) -> int:
+    from .cross_check import write_cross_check
+
+    for folder in write_cross_check(args.output_dir, args.fmu):
+        print(f"wrote {folder}")
     return 0
 
 
@@ -71,7 +101,7 @@ def cmd_simulate(args) -> int:
 
     run = simulate(_torque_signal(args), stop_time=args.stop_time, step_size=args.step_size,
                    ramp=args.ramp, parameters=_parameters(args.assignments), theta0=args.theta0,
-                   omega0=args.omega0, tolerance=args.tolerance)
+                   omega0=args.omega0, tolerance=args.tolerance, fmu_path=args.fmu)
     last = run[-1]
     print(f"{len(run) - 1} steps to t = {last['time']:g} s: theta = {last['theta']:.12g} rad, "
           f"omega = {last['omega']:.12g} rad/s, alpha = {last['alpha']:.12g} rad/s2; "
@@ -102,7 +132,7 @@ def cmd_compare(args) -> int:
     comparison = compare(_torque_signal(args), tools, output_dir=args.output_dir,
                          step_size=args.step_size, stop_time=args.stop_time,
                          parameters=_parameters(args.assignments), theta0=args.theta0,
-                         omega0=args.omega0, tolerance=args.tol)
+                         omega0=args.omega0, tolerance=args.tol, fmu_path=args.fmu)
     _print_comparison(comparison)
     for path in (comparison.trajectories, comparison.table, comparison.figure):
         print(f"wrote {path}")
@@ -124,7 +154,8 @@ def cmd_sweep(args) -> int:
 
     cases = sweep_grid(args.torque, args.gravity, _sweep_values(args.assignments))
     summary = run_sweep(cases, output_dir=args.output_dir, stop_time=args.stop_time,
-                        step_size=args.step_size, scheduler=args.scheduler, workers=args.workers)
+                        step_size=args.step_size, scheduler=args.scheduler, workers=args.workers,
+                        fmu_path=args.fmu)
     print(f"{summary['cases']} cases in {summary['seconds']:.1f} s")
     print(f"wrote {summary['results']}\nwrote {summary['figure']}")
     return 0
@@ -176,13 +207,28 @@ def build_parser() -> argparse.ArgumentParser:
         prog="pendulum-fmu",
         description="A torque-driven pendulum as an FMI 2.0 Co-Simulation FMU: build it, "
                     "simulate it, and compare it with scipy and OpenSim.")
+    parser.add_argument("--version", action="version", version=f"pendulum-fmu {__version__}")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     build = commands.add_parser("build", help="build the FMU (same as python build_fmu.py)",
-                                description="Build the FMU from fmu_src/ and modelDescription.xml.")
+                                description="Build the FMU from fmu_src/ and modelDescription.xml "
+                                            "(a source checkout or the unpacked sdist).")
     build.add_argument("--output", type=Path, default=DEFAULT_FMU,
                        help="where to write the FMU (default: %(default)s)")
+    build.add_argument("--platforms", type=_platforms, default=None,
+                       help=f"comma-separated, among {', '.join(PLATFORMS)} (default: every one "
+                            "whose compiler is installed; the others are skipped with a note)")
     build.set_defaults(run=cmd_build)
+
+    cross_check = commands.add_parser(
+        "cross-check", help="reference results in the FMI cross-check layout",
+        description="Write fmus/2.0/cs/<platform>/pendulum_fmu/<version>/Pendulum/ (the FMU, "
+                    "_in.csv, _ref.csv, _ref.opt, ReadMe.md) for a step-wise torque, one folder "
+                    "per platform the FMU has a binary for.")
+    cross_check.add_argument("--output-dir", type=Path, required=True,
+                             help="the cross-check repository's root")
+    _add_fmu_argument(cross_check)
+    cross_check.set_defaults(run=cmd_cross_check)
 
     simulate = commands.add_parser("simulate", help="simulate the FMU under a torque signal",
                                    description="Simulate the FMU through fmpy; the torque is held "
@@ -223,6 +269,7 @@ def build_parser() -> argparse.ArgumentParser:
                        help="folder for sweep.csv (one tidy file) and sweep.png")
     sweep.add_argument("--scheduler", help="address of a running dask.distributed scheduler")
     sweep.add_argument("--workers", type=int, default=None, help="local cluster workers (default: 2)")
+    _add_fmu_argument(sweep)
     sweep.set_defaults(run=cmd_sweep)
 
     demo = commands.add_parser("demo", help="the OpenSim tutorial end to end",
@@ -242,10 +289,21 @@ def main(argv=None) -> int:
     from .simulate import FmuError
 
     args = build_parser().parse_args(argv)
+    prefix = f"pendulum-fmu {args.command}"
+    shown = warnings.showwarning
+
+    def one_line(message, category, *where, **more):
+        if issubclass(category, PlatformSkipped):
+            print(f"{prefix}: {message}", file=sys.stderr)
+        else:
+            shown(message, category, *where, **more)
+
     try:
-        return args.run(args)
+        with warnings.catch_warnings():
+            warnings.showwarning = one_line
+            return args.run(args)
     except (ValueError, TorqueFileError, FmuError, BuildError, ImportError, OSError) as error:
-        print(f"pendulum-fmu {args.command}: error: {error}", file=sys.stderr)
+        print(f"{prefix}: error: {error}", file=sys.stderr)
         return 2
 
 

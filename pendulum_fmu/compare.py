@@ -30,7 +30,8 @@ def _run_fmu(plan, parameters, theta0, omega0, fmu_path=None):
 
 
 def _run_reference(plan, parameters, theta0, omega0, fmu_path=None):
-    return reference_schedule(plan, parameters=parameters, theta0=theta0, omega0=omega0)
+    return reference_schedule(plan, parameters=parameters, theta0=theta0, omega0=omega0,
+                              fmu_path=fmu_path)
 
 
 def _run_opensim(plan, parameters, theta0, omega0, fmu_path=None):
@@ -40,7 +41,7 @@ def _run_opensim(plan, parameters, theta0, omega0, fmu_path=None):
         raise ValueError("OpenSim's overrideActuation holds the torque over a step: compare held "
                          "torques only (no ramp)")
     run = opensim_simulate(plan.time, plan.torque, theta0=theta0, omega0=omega0,
-                           **resolve_parameters(parameters))
+                           **resolve_parameters(parameters, fmu_path))
     out = results.empty(len(plan.time))
     for name in results.FIELDS:
         out[name] = run[name]

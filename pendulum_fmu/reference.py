@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 from scipy.integrate import solve_ivp
 
@@ -11,13 +13,16 @@ from .signal import TorqueSchedule, TorqueSignal, schedule
 
 
 def reference_schedule(plan: TorqueSchedule, *, parameters: dict | None = None, theta0: float = 0.0,
-                       omega0: float = 0.0, rtol: float = 1e-12, atol: float = 1e-12) -> np.ndarray:
+                       omega0: float = 0.0, rtol: float = 1e-12, atol: float = 1e-12,
+                       fmu_path: str | Path | None = None) -> np.ndarray:
     """Integrate the equation of motion over each run of steps with the same held torque.
+
+    parameters override the defaults of the FMU at fmu_path (default: pendulum_fmu.default_fmu()).
 
     Steps are merged only where the torque does not change, so solve_ivp never integrates across
     a jump; each run reports at every communication point inside it.
     """
-    p = resolve_parameters(parameters)
+    p = resolve_parameters(parameters, fmu_path)
     inverse_inertia = 1.0 / total_inertia(p)
     gravity_moment = p["mass"] * p["gravity"] * p["length"]
     damping = p["damping"]
@@ -56,9 +61,9 @@ def reference_schedule(plan: TorqueSchedule, *, parameters: dict | None = None, 
 def reference(torque: TorqueSignal = 20.0, *, start_time: float = 0.0, stop_time: float | None = None,
               step_size: float = 1e-3, ramp: bool = False, parameters: dict | None = None,
               theta0: float = 0.0, omega0: float = 0.0, rtol: float = 1e-12,
-              atol: float = 1e-12) -> np.ndarray:
+              atol: float = 1e-12, fmu_path: str | Path | None = None) -> np.ndarray:
     """The same signal and arguments as simulate(), through scipy DOP853; same result format."""
     plan = schedule(torque, start_time=start_time, stop_time=stop_time, step_size=step_size,
                     ramp=ramp)
     return reference_schedule(plan, parameters=parameters, theta0=theta0, omega0=omega0,
-                              rtol=rtol, atol=atol)
+                              rtol=rtol, atol=atol, fmu_path=fmu_path)

@@ -1,0 +1,102 @@
+"""Reference results in the FMI cross-check layout, for other tools to compare against.
+
+    <output_dir>/fmus/2.0/cs/<platform>/pendulum_fmu/<version>/Pendulum/
+        Pendulum.fmu  Pendulum_in.csv  Pendulum_ref.csv  Pendulum_ref.opt  ReadMe.md
+
+one folder per platform the FMU carries a binary for. The input is a step-wise torque whose
+jumps lie in the middle of communication steps: every master that samples the input at the start
+of a step (and interpolates linearly between the CSV's rows) then applies the same torque, so
+the results do not depend on how it treats a jump.
+"""
+
+from __future__ import annotations
+
+import csv
+import shutil
+import zipfile
+from pathlib import Path
+
+from . import __version__, default_fmu
+from .files import replacing, replacing_path
+from .parameters import model_description
+from .simulate import simulate
+
+START_TIME, STOP_TIME, STEP_SIZE, RELATIVE_TOLERANCE = 0.0, 4.0, 1e-3, 1e-10
+# (time of the jump, torque after it in N.m); the torque before the first jump is TORQUES[0].
+INITIAL_TORQUE = 10.0
+JUMPS = ((1.0005, 20.0), (2.0005, -15.0), (3.0005, 0.0))
+OUTPUTS = ("theta", "omega")
+TOOL = "pendulum_fmu"
+
+
+def torque_at(t: float) -> float:
+    """The step-wise torque: INITIAL_TORQUE, then each jump's value from its time on."""
+    value = INITIAL_TORQUE
+    for jump_time, after in JUMPS:
+        if t >= jump_time:
+            value = after
+    return value
+
+
+def _input_rows() -> list[tuple[float, float]]:
+    rows = [(START_TIME, INITIAL_TORQUE)]
+    before = INITIAL_TORQUE
+    for jump_time, after in JUMPS:
+        rows += [(jump_time, before), (jump_time, after)]
+        before = after
+    return rows + [(STOP_TIME, before)]
+
+
+def _write_csv(path: Path, header, rows) -> None:
+    with replacing(path, newline="") as file:
+        writer = csv.writer(file)
+        writer.writerow(header)
+        writer.writerows(rows)
+
+
+def _readme(platform: str, model_name: str) -> str:
+    return f"""# {model_name}, exported by {TOOL} {__version__}
+
+A rigid pendulum driven by a torque at its pivot (FMI 2.0 Co-Simulation).
+
+- Input `{model_name}_in.csv`: the torque in N.m, {INITIAL_TORQUE:g} from t = 0, then
+  {", ".join(f"{after:g} from t = {t:g} s" for t, after in JUMPS)}. The jumps lie in the middle
+  of communication steps, so a master that samples the input at the start of each step applies
+  the same torque whatever it does at a jump.
+- Reference `{model_name}_ref.csv`: theta (rad) and omega (rad/s) at every communication point,
+  computed by {TOOL} {__version__} stepping this FMU ({platform} binary) with the options of
+  `{model_name}_ref.opt` (communication step {STEP_SIZE:g} s, relative tolerance
+  {RELATIVE_TOLERANCE:g}), all parameters at their start values.
+"""
+
+
+def write_cross_check(output_dir: str | Path, fmu_path: str | Path | None = None) -> list[Path]:
+    """Write the cross-check folders for every platform the FMU has a binary for; returns them."""
+    fmu = Path(fmu_path) if fmu_path else default_fmu()
+    description = model_description(fmu)
+    model_name = description.coSimulation.modelIdentifier
+    with zipfile.ZipFile(fmu) as archive:
+        platforms = sorted({name.split("/")[1] for name in archive.namelist()
+                            if name.startswith("binaries/") and name.count("/") == 2 and not name.endswith("/")})
+    if not platforms:
+        raise ValueError(f"{fmu} carries no binaries: a cross-check needs one to run")
+    run = simulate(torque_at, start_time=START_TIME, stop_time=STOP_TIME, step_size=STEP_SIZE,
+                   tolerance=RELATIVE_TOLERANCE, fmu_path=fmu)
+    reference_rows = [[repr(float(t)), *(repr(float(v)) for v in values)]
+                      for t, *values in zip(run["time"], *(run[name] for name in OUTPUTS))]
+    folders = []
+    for platform in platforms:
+        folder = Path(output_dir, "fmus", description.fmiVersion, "cs", platform, TOOL, __version__, model_name)
+        folder.mkdir(parents=True, exist_ok=True)
+        with replacing_path(folder / f"{model_name}.fmu") as copy:
+            shutil.copyfile(fmu, copy)
+        _write_csv(folder / f"{model_name}_in.csv", ("time", "torque"),
+                   ((repr(t), repr(u)) for t, u in _input_rows()))
+        _write_csv(folder / f"{model_name}_ref.csv", ("time", *OUTPUTS), reference_rows)
+        with replacing(folder / f"{model_name}_ref.opt") as options:
+            options.write(f"StartTime, {START_TIME!r}\nStopTime, {STOP_TIME!r}\n"
+                          f"StepSize, {STEP_SIZE!r}\nRelTol, {RELATIVE_TOLERANCE!r}\n")
+        with replacing(folder / "ReadMe.md") as readme:
+            readme.write(_readme(platform, model_name))
+        folders.append(folder)
+    return folders
