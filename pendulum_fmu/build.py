@@ -316,13 +316,13 @@ def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, *, model_dir: Path = SO
     over the same plumbing. Everything is compiled in a private temporary folder and the zip is
     renamed into place whole, so builds into the same path at the same time all succeed.
     """
+    _check_sources_present()
     if platforms is None:
         platforms = available_platforms()
     unknown = [name for name in platforms if name not in PLATFORMS]
     if unknown or not platforms:
         raise BuildError(f"unknown platform(s) {', '.join(unknown) or '(none given)'}: choose "
                          f"among {', '.join(PLATFORMS)}")
-    _check_sources_present()
     model_description = read_model_description(str(model_description_file))
     identifier = model_description.coSimulation.modelIdentifier
     with tempfile.TemporaryDirectory(prefix="pendulum_fmu_build_") as tmp:
