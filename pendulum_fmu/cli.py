@@ -173,7 +173,7 @@ def cmd_demo(args) -> int:
     if importlib.util.find_spec("opensim") is not None:
         tools.append("opensim")
     else:
-        print("OpenSim is not installed, so it is left out (pip install -e '.[opensim]')")
+        print("OpenSim is not installed, so it is left out (pip install opensim)")
     torque = TUTORIAL_TORQUE
     print(f"Tutorial case: constant torque {torque:g} N.m, 3 s in 1 ms steps; tools: {', '.join(tools)}")
     runs, agree = {}, True

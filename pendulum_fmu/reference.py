@@ -62,7 +62,8 @@ def reference(torque: TorqueSignal = 20.0, *, start_time: float = 0.0, stop_time
               step_size: float = 1e-3, ramp: bool = False, parameters: dict | None = None,
               theta0: float = 0.0, omega0: float = 0.0, rtol: float = 1e-12,
               atol: float = 1e-12, fmu_path: str | Path | None = None) -> np.ndarray:
-    """The same signal and arguments as simulate(), through scipy DOP853; same result format."""
+    """The same signal, schedule and model arguments as simulate() (rtol and atol are scipy's in
+    place of the FMU's tolerance), through scipy DOP853; same result format."""
     plan = schedule(torque, start_time=start_time, stop_time=stop_time, step_size=step_size,
                     ramp=ramp)
     return reference_schedule(plan, parameters=parameters, theta0=theta0, omega0=omega0,
