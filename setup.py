@@ -1,8 +1,7 @@
 """The wheel's build step: build_py also builds the FMU into the wheel's pendulum_fmu/data/.
 
 Everything else about the package is in pyproject.toml. The FMU is built from this source tree
-(a clone or the unpacked sdist) for every platform whose compiler is installed; the native
-stepping loop (pendulum_fmu._cs_loop) joins here as an extension when it lands.
+(a clone or the unpacked sdist) for every platform whose compiler is installed.
 """
 
 import sys
@@ -30,4 +29,5 @@ class BuildPyWithFmu(build_py):
         print(f"pendulum_fmu {__version__}: built {fmu}")
 
 
+# The native stepping loop (pendulum_fmu._cs_loop, docs/design.md) joins as ext_modules here.
 setup(cmdclass={"build_py": BuildPyWithFmu})
