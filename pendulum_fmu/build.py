@@ -90,8 +90,8 @@ def _check_sources_present() -> None:
     if not is_source_checkout():
         raise BuildError(
             f"the FMU's sources (fmu_src/, modelDescription.xml) are not beside {Path(__file__).parent}: "
-            "building needs a clone of the repository or the unpacked sdist; an installed package "
-            "uses its packaged FMU (pendulum_fmu.default_fmu())")
+            "to build, run python build_fmu.py in a clone or the unpacked sdist; an installed "
+            "package uses its packaged FMU (pendulum_fmu.default_fmu())")
 
 
 def generate_variables(model_description, out_dir: Path) -> list[Path]:

@@ -166,8 +166,10 @@ def run_sweep(cases: list[dict], *, output_dir: str | Path, stop_time: float = 3
 
     if scheduler is None:
         # Port 0 for the scheduler's HTTP server: another cluster may hold dask's usual 8787.
+        # Workers log nothing: a case that fails reaches the caller as its own one-line error,
+        # which the workers' logs would repeat with a traceback.
         cluster = LocalCluster(n_workers=workers or 2, threads_per_worker=1, processes=True,
-                               dashboard_address=":0", silence_logs=logging.WARNING)
+                               dashboard_address=":0", silence_logs=logging.CRITICAL)
     else:
         cluster = None
     results = output_dir / "sweep.csv"
