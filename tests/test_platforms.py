@@ -16,6 +16,7 @@ from fmpy import read_model_description
 import pendulum_fmu.build
 from benchmarks.builds import build_step_master
 from pendulum_fmu.build import PLATFORMS, BuildError, Platform, PlatformSkipped, build_fmu
+from pendulum_fmu.cli import main
 from pendulum_fmu.reference import reference
 
 STEPS, STEP_SIZE = 3000, 1e-3  # the tutorial case: 20 N.m, gravity on, 3 s
@@ -114,3 +115,11 @@ def test_a_platform_named_explicitly_must_build(tmp_path, monkeypatch):
     with pytest.raises(BuildError, match="apt-get install gcc-aarch64-linux-gnu"):
         build_fmu(tmp_path / "Pendulum.fmu", platforms=("linux64", "aarch64-linux"))
     assert not (tmp_path / "Pendulum.fmu").exists()
+
+
+def test_build_command_says_what_it_skipped_in_one_line(tmp_path, monkeypatch, capsys):
+    _without_compiler(monkeypatch, "aarch64-linux")
+    assert main(["build", "--output", str(tmp_path / "Pendulum.fmu")]) == 0
+    assert capsys.readouterr().err.splitlines() == [
+        "pendulum-fmu build: aarch64-linux: C compiler no-such-cross-gcc not found "
+        "(apt-get install gcc-aarch64-linux-gnu); skipped"]
