@@ -6,7 +6,6 @@ they are, never of a stale dist/Pendulum.fmu.
 
 from __future__ import annotations
 
-import shutil
 import subprocess
 import zipfile
 from dataclasses import dataclass
@@ -14,7 +13,7 @@ from pathlib import Path
 
 from fmpy import extract, read_model_description
 
-from pendulum_fmu.build import FMI_HEADERS, MINGW_COMPILER, BuildError, build_fmu, compile_linux64
+from pendulum_fmu.build import FMI_HEADERS, PLATFORMS, BuildError, build_fmu, compile_library, find_compiler
 
 HERE = Path(__file__).resolve().parent
 NULL_FMU_SOURCES = HERE / "null_fmu"
@@ -45,14 +44,14 @@ def unzipped(fmu: Path, out_dir: Path) -> BuiltFmu:
 
 
 def build_pendulum_fmu(out_dir: Path) -> BuiltFmu:
-    return unzipped(build_fmu(out_dir / "Pendulum.fmu"), out_dir)
+    return unzipped(build_fmu(out_dir / "Pendulum.fmu", platforms=("linux64",)), out_dir)
 
 
 def build_null_fmu(out_dir: Path) -> BuiltFmu:
     """Compile null_fmu/ with the pendulum's compiler flags and zip it as NullFmu.fmu."""
     work = out_dir / "null_fmu_build"
     work.mkdir(parents=True, exist_ok=True)
-    library = compile_linux64(NULL_FMU_SOURCES, work / "NullFmu.so")
+    library = compile_library(NULL_FMU_SOURCES, work / "NullFmu.so")
     fmu = out_dir / "NullFmu.fmu"
     with zipfile.ZipFile(fmu, "w", zipfile.ZIP_DEFLATED) as archive:
         archive.write(NULL_FMU_SOURCES / "modelDescription.xml", "modelDescription.xml")
@@ -62,14 +61,13 @@ def build_null_fmu(out_dir: Path) -> BuiltFmu:
 
 
 def build_step_master(out_dir: Path, platform: str = "linux64") -> Path:
-    """Compile step_master.c, the bare C master: natively, or for win64 with mingw-w64 (the
-    tests run that one under wine)."""
-    compiler = shutil.which(MINGW_COMPILER if platform == "win64" else "gcc")
-    if compiler is None:
-        raise BuildError(f"no compiler for {platform}: install gcc (and gcc-mingw-w64-x86-64 for win64)")
-    master = out_dir / ("step_master.exe" if platform == "win64" else "step_master")
-    command = [compiler, "-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", f"-I{FMI_HEADERS}",
-               str(STEP_MASTER_SOURCE), *([] if platform == "win64" else ["-ldl"]), "-o", str(master)]
+    """Compile step_master.c, the bare C master, for a platform of pendulum_fmu.build.PLATFORMS
+    with that platform's compiler (the tests run the win64 one under wine, the aarch64-linux one
+    under qemu-aarch64)."""
+    target = PLATFORMS[platform]
+    master = out_dir / f"step_master_{platform}{'.exe' if target.windows else ''}"
+    command = [*find_compiler(target), "-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", f"-I{FMI_HEADERS}",
+               str(STEP_MASTER_SOURCE), *([] if target.windows else ["-ldl"]), "-o", str(master)]
     result = subprocess.run(command, capture_output=True, text=True)
     if result.returncode != 0:
         raise BuildError(f"compiling the step master failed:\n{' '.join(command)}\n{result.stderr}")

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pendulum_fmu.build import default_fmu
+from pendulum_fmu import default_fmu
 from pendulum_fmu.reference import reference
 from pendulum_fmu.signal import schedule, write_torque_csv
 

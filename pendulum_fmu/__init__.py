@@ -1,5 +1,43 @@
 """A torque-driven pendulum as an FMI 2.0 Co-Simulation FMU, and the tools to compare it."""
 
-from .build import build_fmu, default_fmu
+# The package version's one source: pyproject.toml reads it, the FMU's generationTool carries it.
+__version__ = "0.1.0"
 
-__all__ = ["build_fmu", "default_fmu"]
+import atexit
+import contextlib
+from importlib import resources
+from pathlib import Path
+
+from .build import DEFAULT_FMU, build_fmu, fmu_is_stale, is_source_checkout
+
+__all__ = ["__version__", "build_fmu", "default_fmu"]
+
+# FMI version -> (file in a checkout's dist/, file in the installed package's data/).
+_FMU_FILES = {2: (DEFAULT_FMU, "Pendulum.fmu")}
+# Holds open the real files of packaged FMUs that importlib.resources had to extract (a zipped
+# install); a plain install hands out the files themselves.
+_extracted = contextlib.ExitStack()
+atexit.register(_extracted.close)
+
+
+def default_fmu(fmi_version: int = 2) -> Path:
+    """The FMU this package runs when none is named.
+
+    In a source checkout (a clone or an editable install): dist/Pendulum.fmu, rebuilt first when
+    any of its sources is newer. In an installed package: the FMU packaged with it. Nothing is
+    ever written into site-packages.
+    """
+    if fmi_version not in _FMU_FILES:
+        raise ValueError(f"no FMI {fmi_version} FMU: the FMI versions are {', '.join(map(str, _FMU_FILES))}")
+    checkout_fmu, packaged_name = _FMU_FILES[fmi_version]
+    if is_source_checkout():
+        if fmu_is_stale(checkout_fmu):
+            build_fmu(checkout_fmu)
+        return checkout_fmu
+    packaged = resources.files(__name__) / "data" / packaged_name
+    if not packaged.is_file():
+        raise FileNotFoundError(
+            f"pendulum_fmu {__version__} at {Path(__file__).parent} has neither its packaged "
+            f"data/{packaged_name} nor the FMU's sources beside it: reinstall it from a wheel or "
+            "the sdist (pip install pendulum-fmu), or pass the FMU's path")
+    return _extracted.enter_context(resources.as_file(packaged))

@@ -1,25 +1,37 @@
-"""Build Pendulum.fmu from fmu_src/ and modelDescription.xml.
+"""Build Pendulum.fmu from fmu_src/ and modelDescription.xml, for every platform we can compile for.
 
 The C code takes its value references, names and start values from modelDescription.xml: this
 module generates them (model_variables.h/.c), so the XML stays the single source of truth.
 fmu_src/ holds the FMI plumbing, which knows nothing of pendulums, and the pendulum's model.h and
 model.c; another model (fmu_src/pid_controller/) is built over the same plumbing by naming its
 folder and modelDescription.xml.
+
+Builds only ever run from a source tree (a clone or the sdist): an installed package carries the
+built FMU as package data instead (see pendulum_fmu.default_fmu).
 """
 
 from __future__ import annotations
 
+import functools
 import html
 import os
+import platform as host
+import re
+import shlex
 import shutil
 import subprocess
+import sys
 import tempfile
 import warnings
 import zipfile
+from dataclasses import dataclass
 from pathlib import Path
 
 import fmpy
 from fmpy import read_model_description
+
+from . import __version__
+from .files import replacing_path
 
 ROOT = Path(__file__).resolve().parent.parent
 SOURCE_DIR = ROOT / "fmu_src"
@@ -28,11 +40,46 @@ DEFAULT_FMU = ROOT / "dist" / "Pendulum.fmu"
 GENERATED_SOURCES = ("model_variables.h", "model_variables.c")
 MODEL_FILES = ("config.h", "model.c")
 PID_CONTROLLER_DIR = SOURCE_DIR / "pid_controller"
-# The FMI 2.0 headers fmpy ships, rather than a vendored copy.
+# The FMI headers fmpy ships, rather than a vendored copy.
 FMI_HEADERS = Path(fmpy.__file__).parent / "c-code"
-# Debian's gcc-mingw-w64-x86-64 cross-compiles the Windows binary.
-MINGW_COMPILER = "x86_64-w64-mingw32-gcc"
-PLATFORMS = ("linux64", "win64")
+
+
+@dataclass(frozen=True)
+class Platform:
+    """A platform an FMU can carry a binary for."""
+
+    fmi2_folder: str      # binaries/<folder> in an FMI 2.0 FMU
+    fmi3_folder: str      # binaries/<folder> in an FMI 3.0 FMU
+    cross_compiler: str   # the compiler when this is not the machine we build on
+    package: str          # the Debian package that installs cross_compiler
+    machine: str          # platform.machine() of a Linux host that builds it natively
+    suffix: str           # of the shared library
+
+    @property
+    def windows(self) -> bool:
+        return self.suffix == ".dll"
+
+    @property
+    def native(self) -> bool:
+        return not self.windows and sys.platform.startswith("linux") and host.machine() == self.machine
+
+    def compiler(self) -> list[str]:
+        """The compiler command: $CC (split as a shell would, so CC="ccache gcc" works) or gcc on
+        the machine we build on, the cross-compiler elsewhere."""
+        if self.native:
+            return shlex.split(os.environ.get("CC") or "gcc")
+        return [self.cross_compiler]
+
+    def install_hint(self) -> str:
+        return f"apt-get install {'gcc' if self.native else self.package}"
+
+
+PLATFORMS = {platform.fmi2_folder: platform for platform in (
+    Platform("linux64", "x86_64-linux", "x86_64-linux-gnu-gcc", "gcc-x86-64-linux-gnu", "x86_64", ".so"),
+    Platform("win64", "x86_64-windows", "x86_64-w64-mingw32-gcc", "gcc-mingw-w64-x86-64", "", ".dll"),
+    # The folder name fmpy and the Reference FMUs use for Linux on ARM64.
+    Platform("aarch64-linux", "aarch64-linux", "aarch64-linux-gnu-gcc", "gcc-aarch64-linux-gnu", "aarch64", ".so"),
+)}
 
 
 class BuildError(RuntimeError):
@@ -40,11 +87,11 @@ class BuildError(RuntimeError):
 
 
 def _check_sources_present() -> None:
-    if not SOURCE_DIR.is_dir() or not MODEL_DESCRIPTION.is_file():
+    if not is_source_checkout():
         raise BuildError(
-            f"FMU sources not found at {ROOT} (fmu_src/ and modelDescription.xml): build from a "
-            "clone of the repository, installed with pip install -e ."
-        )
+            f"the FMU's sources (fmu_src/, modelDescription.xml) are not beside {Path(__file__).parent}: "
+            "to build, run python build_fmu.py in a clone or the unpacked sdist; an installed "
+            "package uses its packaged FMU (pendulum_fmu.default_fmu())")
 
 
 def generate_variables(model_description, out_dir: Path) -> list[Path]:
@@ -129,41 +176,65 @@ def _assemble_sources(model_dir: Path, model_description, sources: Path) -> None
 
 
 def _compile(command: list[str], what: str) -> None:
-    result = subprocess.run(command, capture_output=True, text=True)
+    try:
+        result = subprocess.run(command, capture_output=True, text=True)
+    except OSError as error:
+        raise BuildError(f"compiling {what} failed: {shlex.join(command[:1])}: {error.strerror}") from None
     if result.returncode != 0:
-        raise BuildError(f"compiling {what} failed:\n{' '.join(command)}\n{result.stderr}")
+        raise BuildError(f"compiling {what} failed:\n{shlex.join(command)}\n{result.stderr}")
 
 
-def compile_linux64(source_dir: Path, out_file: Path, compiler: str | None = None) -> Path:
-    """Compile every C file in source_dir into a shared library exporting only fmi2* symbols."""
-    compiler = compiler or os.environ.get("CC", "gcc")
-    if shutil.which(compiler) is None:
-        raise BuildError(f"C compiler {compiler!r} not found: install gcc (apt-get install gcc)")
-    version_script = out_file.parent / "exports.map"
-    version_script.write_text("{ global: fmi2*; local: *; };\n")
-    _compile([
-        # -flto lets the integrator inline the model's right-hand side across files.
-        compiler, "-std=c99", "-O2", "-flto", "-fPIC", "-shared", "-fvisibility=hidden",
-        "-Wall", "-Wextra", "-Werror",
-        f"-I{source_dir}", f"-I{FMI_HEADERS}",
-        *sorted(str(p) for p in source_dir.glob("*.c")),
-        f"-Wl,--version-script={version_script}", "-lm",
-        "-o", str(out_file),
-    ], out_file.name)
-    return out_file
+@functools.lru_cache(maxsize=None)
+def supports_lto(compiler: tuple[str, ...], windows: bool = False) -> bool:
+    """Whether compiler links a shared library with -flto: a gcc without its LTO plug-in
+    (lto-wrapper) accepts the flag and then fails to link, so ask by trying."""
+    with tempfile.TemporaryDirectory(prefix="pendulum_fmu_lto_") as probe:
+        source = Path(probe) / "probe.c"
+        source.write_text("int probe(int x) { return x + 1; }\n")
+        command = [*compiler, "-flto", "-O2", "-shared", *([] if windows else ["-fPIC"]),
+                   str(source), "-o", str(Path(probe) / "probe.so")]
+        try:
+            return subprocess.run(command, capture_output=True).returncode == 0
+        except OSError:
+            return False
 
 
-def compile_win64(source_dir: Path, out_file: Path) -> Path:
-    """Cross-compile the Windows DLL with mingw-w64. fmi2Functions.h marks the fmi2 functions
-    __declspec(dllexport) on Windows, so they are all the DLL exports."""
-    if shutil.which(MINGW_COMPILER) is None:
-        raise BuildError(f"{MINGW_COMPILER} not found: install Debian's gcc-mingw-w64-x86-64")
-    _compile([
-        MINGW_COMPILER, "-std=c99", "-O2", "-flto", "-shared", "-Wall", "-Wextra", "-Werror",
+def find_compiler(platform: Platform) -> list[str]:
+    """The platform's compiler command, or BuildError naming the package that installs it."""
+    compiler = platform.compiler()
+    if not compiler or shutil.which(compiler[0]) is None:
+        name = shlex.join(compiler) if compiler else "CC (empty)"
+        raise BuildError(f"{platform.fmi2_folder}: C compiler {name} not found "
+                         f"({platform.install_hint()})")
+    return compiler
+
+
+def compile_library(source_dir: Path, out_file: Path, platform: str = "linux64", *,
+                    export_prefix: str = "fmi2") -> Path:
+    """Compile every C file in source_dir into the platform's shared library, exporting only the
+    functions named export_prefix* (fmi2 or fmi3).
+
+    On Windows the FMI headers mark those functions __declspec(dllexport), so they are all the DLL
+    exports; elsewhere a version script hides everything else. $CFLAGS (split as a shell would)
+    applies to the native compiler only: a cross-compiler may not take the host's flags.
+    """
+    target = PLATFORMS[platform]
+    compiler = find_compiler(target)
+    if target.windows:
         # No dependency on the mingw runtime DLLs: the FMU must load on any Windows machine.
-        "-static-libgcc", "-s", f"-I{source_dir}", f"-I{FMI_HEADERS}",
-        *sorted(str(p) for p in source_dir.glob("*.c")), "-o", str(out_file),
-    ], out_file.name)
+        linking = ["-static-libgcc", "-s"]
+    else:
+        version_script = out_file.parent / f"{out_file.stem}.exports.map"
+        version_script.write_text(f"{{ global: {export_prefix}*; local: *; }};\n")
+        linking = ["-fPIC", "-fvisibility=hidden", f"-Wl,--version-script={version_script}", "-lm"]
+    # -flto lets the integrator inline the model's right-hand side across files.
+    lto = ["-flto"] if supports_lto(tuple(compiler), target.windows) else []
+    user_flags = shlex.split(os.environ.get("CFLAGS", "")) if target.native else []
+    _compile([
+        *compiler, "-std=c99", "-O2", *lto, "-shared", "-Wall", "-Wextra", "-Werror", *user_flags,
+        f"-I{source_dir}", f"-I{FMI_HEADERS}", *sorted(str(p) for p in source_dir.glob("*.c")),
+        *linking, "-o", str(out_file),
+    ], f"{out_file.name} for {platform}")
     return out_file
 
 
@@ -205,53 +276,87 @@ where it was.</p>
 """
 
 
-def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, compiler: str | None = None, *,
-              model_dir: Path = SOURCE_DIR, model_description_file: Path = MODEL_DESCRIPTION,
-              platforms: tuple[str, ...] = ("linux64",)) -> Path:
+class PlatformSkipped(UserWarning):
+    """A platform left out of a default build because its compiler is missing."""
+
+
+def available_platforms() -> tuple[str, ...]:
+    """Every platform whose compiler is present; for each missing one, a PlatformSkipped warning
+    naming the package that installs it. The machine's own platform is never skipped."""
+    present = []
+    for name, platform in PLATFORMS.items():
+        try:
+            find_compiler(platform)
+        except BuildError as error:
+            if platform.native:
+                raise  # an FMU that cannot run where it was built is no use
+            warnings.warn(PlatformSkipped(f"{error}; skipped"), stacklevel=3)
+        else:
+            present.append(name)
+    return tuple(present)
+
+
+def _stamped_model_description(xml: Path) -> str:
+    """The model description as the FMU carries it: generationTool names this package's version."""
+    text, count = re.subn(r'generationTool="[^"]*"', f'generationTool="pendulum_fmu {__version__}"',
+                          xml.read_text(encoding="utf-8"), count=1)
+    if count != 1:
+        raise BuildError(f"{xml}: no generationTool attribute to stamp the version into")
+    return text
+
+
+def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, *, model_dir: Path = SOURCE_DIR,
+              model_description_file: Path = MODEL_DESCRIPTION,
+              platforms: tuple[str, ...] | None = None) -> Path:
     """Build an FMU (binaries/, sources/, documentation/) and return its path.
 
-    By default the pendulum for linux64; model_dir and model_description_file name another
-    model's config.h/model.c and XML to build over the same plumbing. A platform other than
-    linux64 whose cross-compiler is missing is left out with a warning.
+    platforms: FMI 2.0 folder names (see PLATFORMS); None builds every platform whose compiler is
+    present and warns (PlatformSkipped) about the others. A platform named explicitly must build.
+    model_dir and model_description_file name another model's config.h/model.c and XML to build
+    over the same plumbing. Everything is compiled in a private temporary folder and the zip is
+    renamed into place whole, so builds into the same path at the same time all succeed.
     """
-    unknown = set(platforms) - set(PLATFORMS)
-    if unknown or "linux64" not in platforms:
-        raise BuildError(f"platforms must include linux64 and be among {', '.join(PLATFORMS)}; "
-                         f"got {', '.join(platforms)}")
     _check_sources_present()
+    if platforms is None:
+        platforms = available_platforms()
+    unknown = [name for name in platforms if name not in PLATFORMS]
+    if unknown or not platforms:
+        raise BuildError(f"unknown platform(s) {', '.join(unknown) or '(none given)'}: choose "
+                         f"among {', '.join(PLATFORMS)}")
     model_description = read_model_description(str(model_description_file))
     identifier = model_description.coSimulation.modelIdentifier
-    out_file = Path(out_file)
-    out_file.parent.mkdir(parents=True, exist_ok=True)
-    with tempfile.TemporaryDirectory() as tmp:
+    with tempfile.TemporaryDirectory(prefix="pendulum_fmu_build_") as tmp:
         tmp = Path(tmp)
         sources = tmp / "sources"
         _assemble_sources(Path(model_dir), model_description, sources)
         _check_source_files(model_description, model_description_file, sources)
-        binaries = {f"binaries/linux64/{identifier}.so":
-                    compile_linux64(sources, tmp / f"{identifier}.so", compiler)}
-        if "win64" in platforms:
-            try:
-                binaries[f"binaries/win64/{identifier}.dll"] = compile_win64(sources, tmp / f"{identifier}.dll")
-            except BuildError as error:
-                warnings.warn(f"win64 left out: {error}", stacklevel=2)
-        # Write to a temporary name first so a failed build never leaves half an FMU behind.
-        partial = out_file.with_suffix(".fmu.partial")
-        with zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as fmu:
-            fmu.write(model_description_file, "modelDescription.xml")
+        binaries = {}
+        for name in platforms:
+            folder = tmp / name
+            folder.mkdir()
+            library = folder / f"{identifier}{PLATFORMS[name].suffix}"
+            binaries[f"binaries/{name}/{library.name}"] = compile_library(sources, library, name)
+        with replacing_path(out_file) as partial, zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as fmu:
+            fmu.writestr("modelDescription.xml", _stamped_model_description(Path(model_description_file)))
             for name, binary in binaries.items():
                 fmu.write(binary, name)
             for source in sorted(sources.iterdir()):
                 fmu.write(source, f"sources/{source.name}")
             fmu.writestr("documentation/index.html", documentation_html(model_description))
-        partial.replace(out_file)
-    return out_file
+    return Path(out_file)
 
 
-def build_pid_controller(out_file: str | os.PathLike, compiler: str | None = None) -> Path:
+def build_pid_controller(out_file: str | os.PathLike, *, platforms: tuple[str, ...] | None = None) -> Path:
     """The PID controller FMU that closes the loop around the pendulum in co-simulation."""
-    return build_fmu(out_file, compiler, model_dir=PID_CONTROLLER_DIR,
+    return build_fmu(out_file, model_dir=PID_CONTROLLER_DIR, platforms=platforms,
                      model_description_file=PID_CONTROLLER_DIR / "modelDescription.xml")
+
+
+def build_inputs() -> list[Path]:
+    """Every file a checkout's FMU is built from: when one is newer than the FMU, it is stale."""
+    package = Path(__file__).parent
+    return [MODEL_DESCRIPTION, Path(__file__), package / "__init__.py",
+            *(p for p in SOURCE_DIR.iterdir() if p.is_file())]
 
 
 def fmu_is_stale(fmu: Path = DEFAULT_FMU) -> bool:
@@ -259,13 +364,11 @@ def fmu_is_stale(fmu: Path = DEFAULT_FMU) -> bool:
     if not fmu.exists():
         return True
     built = fmu.stat().st_mtime
-    inputs = [MODEL_DESCRIPTION, Path(__file__), *(p for p in SOURCE_DIR.iterdir() if p.is_file())]
-    return any(p.stat().st_mtime > built for p in inputs)
+    return any(p.stat().st_mtime > built for p in build_inputs())
 
 
-def default_fmu() -> Path:
-    """The FMU built from this checkout, rebuilt first when its sources changed."""
-    _check_sources_present()
-    if fmu_is_stale(DEFAULT_FMU):
-        build_fmu(DEFAULT_FMU)
-    return DEFAULT_FMU
+def is_source_checkout() -> bool:
+    """Whether this package sits beside the FMU's sources (a clone, an editable install, the
+    sdist being built), rather than installed from a wheel."""
+    return SOURCE_DIR.is_dir() and MODEL_DESCRIPTION.is_file()
+

@@ -7,11 +7,14 @@ import importlib.util
 import signal
 import sys
 import threading
+import warnings
+import zipfile
 from pathlib import Path
 
 import numpy as np
 
-from .build import DEFAULT_FMU, BuildError, build_fmu
+from . import __version__
+from .build import DEFAULT_FMU, PLATFORMS, BuildError, PlatformSkipped, build_fmu
 
 TUTORIAL_TORQUE = 20.0
 
@@ -72,10 +75,37 @@ def _add_signal_arguments(parser, required=True):
     parser.add_argument("--omega0", type=_float, default=0.0, help="initial rate in rad/s")
     parser.add_argument("--max-steps", type=_positive_int, default=None,
                         help="refuse runs longer than this many steps (default: 10,000,000)")
+    _add_fmu_argument(parser)
+
+
+def _add_fmu_argument(parser):
+    parser.add_argument("--fmu", type=Path, default=None,
+                        help="the FMU to run, whose own parameters and defaults apply (default: "
+                             "the packaged FMU, or dist/Pendulum.fmu in a source checkout)")
+
+
+def _platforms(text: str) -> tuple[str, ...]:
+    platforms = tuple(name.strip() for name in text.split(",") if name.strip())
+    unknown = [name for name in platforms if name not in PLATFORMS]
+    if unknown or not platforms:
+        raise argparse.ArgumentTypeError(
+            f"unknown platform(s) {', '.join(unknown) or '(none)'}: choose among {', '.join(PLATFORMS)}")
+    return platforms
 
 
 def cmd_build(args) -> int:
-    print(f"wrote {build_fmu(args.output)}")
+    path = build_fmu(args.output, platforms=args.platforms)
+    with zipfile.ZipFile(path) as fmu:
+        binaries = [name for name in fmu.namelist() if name.startswith("binaries/")]
+    print(f"wrote {path} ({', '.join(binaries)})")
+    return 0
+
+
+def cmd_cross_check(args) -> int:
+    from .cross_check import write_cross_check
+
+    for folder in write_cross_check(args.output_dir, args.fmu):
+        print(f"wrote {folder}")
     return 0
 
 
@@ -87,7 +117,8 @@ def cmd_simulate(args) -> int:
 
     run = simulate(_torque_signal(args), stop_time=args.stop_time, step_size=args.step_size,
                    ramp=args.ramp, parameters=_parameters(args.assignments), theta0=args.theta0,
-                   omega0=args.omega0, tolerance=args.tolerance, max_steps=args.max_steps)
+                   omega0=args.omega0, tolerance=args.tolerance, max_steps=args.max_steps,
+                   fmu_path=args.fmu)
     last = run[-1]
     print(f"{len(run) - 1} steps to t = {last['time']:g} s: theta = {last['theta']:.12g} rad, "
           f"omega = {last['omega']:.12g} rad/s, alpha = {last['alpha']:.12g} rad/s2; "
@@ -120,7 +151,7 @@ def cmd_compare(args) -> int:
                          step_size=args.step_size, stop_time=args.stop_time, ramp=args.ramp,
                          parameters=_parameters(args.assignments), theta0=args.theta0,
                          omega0=args.omega0, tolerance=args.tol, mapping=args.mapping,
-                         max_steps=args.max_steps)
+                         max_steps=args.max_steps, fmu_path=args.fmu)
     _print_comparison(comparison)
     for path in (comparison.trajectories, comparison.table, comparison.figure):
         print(f"wrote {path}")
@@ -142,7 +173,8 @@ def cmd_sweep(args) -> int:
 
     cases = sweep_grid(args.torque, args.gravity, _sweep_values(args.assignments))
     summary = run_sweep(cases, output_dir=args.output_dir, stop_time=args.stop_time,
-                        step_size=args.step_size, scheduler=args.scheduler, workers=args.workers)
+                        step_size=args.step_size, scheduler=args.scheduler, workers=args.workers,
+                        fmu_path=args.fmu)
     print(f"{summary['cases']} cases in {summary['seconds']:.1f} s")
     print(f"wrote {summary['results']}\nwrote {summary['figure']}")
     return 0
@@ -160,7 +192,7 @@ def cmd_demo(args) -> int:
     if importlib.util.find_spec("opensim") is not None:
         tools.append("opensim")
     else:
-        print("OpenSim is not installed, so it is left out (pip install -e '.[opensim]')")
+        print("OpenSim is not installed, so it is left out (pip install opensim)")
     torque = TUTORIAL_TORQUE
     print(f"Tutorial case: constant torque {torque:g} N.m, 3 s in 1 ms steps; tools: {', '.join(tools)}")
     runs, agree = {}, True
@@ -194,15 +226,30 @@ def build_parser() -> argparse.ArgumentParser:
         prog="pendulum-fmu",
         description="A torque-driven pendulum as an FMI 2.0 Co-Simulation FMU: build it, "
                     "simulate it, and compare it with scipy and OpenSim.")
+    parser.add_argument("--version", action="version", version=f"pendulum-fmu {__version__}")
     parser.add_argument("--debug", action="store_true", default=False,
                         help="show the Python traceback of an error instead of one line")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     build = commands.add_parser("build", help="build the FMU (same as python build_fmu.py)",
-                                description="Build the FMU from fmu_src/ and modelDescription.xml.")
+                                description="Build the FMU from fmu_src/ and modelDescription.xml "
+                                            "(a source checkout or the unpacked sdist).")
     build.add_argument("--output", type=Path, default=DEFAULT_FMU,
                        help="where to write the FMU (default: %(default)s)")
+    build.add_argument("--platforms", type=_platforms, default=None,
+                       help=f"comma-separated, among {', '.join(PLATFORMS)} (default: every one "
+                            "whose compiler is installed; the others are skipped with a note)")
     build.set_defaults(run=cmd_build)
+
+    cross_check = commands.add_parser(
+        "cross-check", help="reference results in the FMI cross-check layout",
+        description="Write fmus/2.0/cs/<platform>/pendulum_fmu/<version>/Pendulum/ (the FMU, "
+                    "_in.csv, _ref.csv, _ref.opt, ReadMe.md) for a step-wise torque, one folder "
+                    "per platform the FMU has a binary for.")
+    cross_check.add_argument("--output-dir", type=Path, required=True,
+                             help="the cross-check repository's root")
+    _add_fmu_argument(cross_check)
+    cross_check.set_defaults(run=cmd_cross_check)
 
     simulate = commands.add_parser("simulate", help="simulate the FMU under a torque signal",
                                    description="Simulate the FMU through fmpy; the torque is held "
@@ -257,6 +304,7 @@ def build_parser() -> argparse.ArgumentParser:
                        help="folder for sweep.csv (one tidy file) and sweep.png")
     sweep.add_argument("--scheduler", help="address of a running dask.distributed scheduler")
     sweep.add_argument("--workers", type=int, default=None, help="local cluster workers (default: 2)")
+    _add_fmu_argument(sweep)
     sweep.set_defaults(run=cmd_sweep)
 
     demo = commands.add_parser("demo", help="the OpenSim tutorial end to end",
@@ -290,11 +338,21 @@ def main(argv=None) -> int:
 
     args = build_parser().parse_args(argv)
     command = f"pendulum-fmu {args.command}"
+    shown = warnings.showwarning
+
+    def one_line(message, category, *where, **more):
+        if issubclass(category, PlatformSkipped):
+            print(f"{command}: {message}", file=sys.stderr)
+        else:
+            shown(message, category, *where, **more)
+
     handling_sigterm = threading.current_thread() is threading.main_thread()
     if handling_sigterm:
         previous = signal.signal(signal.SIGTERM, _terminate)
     try:
-        return args.run(args)
+        with warnings.catch_warnings():
+            warnings.showwarning = one_line
+            return args.run(args)
     except KeyboardInterrupt:
         if args.debug:
             raise

@@ -147,7 +147,7 @@ def compare(torque: TorqueSignal, tools=TOOLS, *, output_dir: str | Path, step_s
         raise ToolSpecError(f"compare needs at least two tools, got {parsed[0].label}: "
                             f"e.g. --tools fmu,{REFERENCE}")
     tolerance = check_tolerance(tolerance)
-    resolve_parameters(parameters)  # a bad parameter is refused before any tool runs
+    resolve_parameters(parameters, fmu_path)  # a bad parameter is refused before any tool runs
     plan = schedule(torque, start_time=start_time, stop_time=stop_time, step_size=step_size, ramp=ramp,
                     max_steps=max_steps)
     steps = len(plan.time) - 1
@@ -155,7 +155,7 @@ def compare(torque: TorqueSignal, tools=TOOLS, *, output_dir: str | Path, step_s
     started = clock.perf_counter()
     runs[REFERENCE] = reference(torque, start_time=start_time, stop_time=stop_time, step_size=step_size,
                                 ramp=ramp, parameters=parameters, theta0=theta0, omega0=omega0,
-                                at=plan.time)
+                                at=plan.time, fmu_path=fmu_path)
     seconds[REFERENCE] = (clock.perf_counter() - started) / steps
     for tool in parsed:
         if tool.label != REFERENCE:  # the judge above takes the reference's place

@@ -1,32 +1,59 @@
-"""The FMU's parameters and their defaults, read from modelDescription.xml."""
+"""The FMU's variables, parameters and their defaults, read from that FMU's modelDescription.xml.
+
+Every function takes the FMU it is about (default: pendulum_fmu.default_fmu()), so another build
+of the pendulum brings its own parameters. Each FMU file is parsed once per modification time.
+"""
 
 from __future__ import annotations
 
 import math
 from functools import lru_cache
+from pathlib import Path
 
 from fmpy import read_model_description
 
-from .build import MODEL_DESCRIPTION
+
+@lru_cache(maxsize=32)
+def _read(path: str, modified_ns: int):
+    description = read_model_description(path)
+    return description, {v.name: v for v in description.modelVariables}
 
 
-@lru_cache(maxsize=1)
-def _variables():
-    return {v.name: v for v in read_model_description(str(MODEL_DESCRIPTION)).modelVariables}
+def _described(fmu_path: str | Path | None):
+    if fmu_path is None:
+        from . import default_fmu
+        fmu_path = default_fmu()
+    path = Path(fmu_path)
+    try:
+        modified_ns = path.stat().st_mtime_ns
+    except OSError as error:
+        raise FileNotFoundError(f"FMU {path}: {error.strerror}") from None
+    return _read(str(path.resolve()), modified_ns)
 
 
-def value_reference(name: str) -> int:
-    return _variables()[name].valueReference
+def model_description(fmu_path: str | Path | None = None):
+    """fmpy's ModelDescription of the FMU."""
+    return _described(fmu_path)[0]
 
 
-def default_parameters() -> dict[str, float]:
+def variables(fmu_path: str | Path | None = None) -> dict:
+    """{name: fmpy ModelVariable} of the FMU (shared: do not modify)."""
+    return _described(fmu_path)[1]
+
+
+def value_reference(name: str, fmu_path: str | Path | None = None) -> int:
+    return variables(fmu_path)[name].valueReference
+
+
+def default_parameters(fmu_path: str | Path | None = None) -> dict[str, float]:
     """{name: start value} of every parameter (mass, length, inertia, gravity, damping)."""
-    return {name: float(v.start) for name, v in _variables().items() if v.causality == "parameter"}
+    return {name: float(v.start) for name, v in variables(fmu_path).items() if v.causality == "parameter"}
 
 
-def resolve_parameters(overrides: dict[str, float] | None = None) -> dict[str, float]:
-    """The defaults with overrides applied; unknown names and non-finite values are refused."""
-    parameters = default_parameters()
+def resolve_parameters(overrides: dict[str, float] | None = None,
+                       fmu_path: str | Path | None = None) -> dict[str, float]:
+    """The FMU's defaults with overrides applied; unknown names and non-finite values are refused."""
+    parameters = default_parameters(fmu_path)
     for name, value in (overrides or {}).items():
         if name not in parameters:
             raise ValueError(f"unknown parameter {name!r}: the parameters are {', '.join(parameters)}")

@@ -161,8 +161,8 @@ def _holding(points: list[Fraction], values: list[float], step: Fraction) -> Cal
 
 
 def _integrate(pieces: _Pieces, at: np.ndarray, parameters: dict | None, theta0: float, omega0: float,
-               rtol: float, atol: float) -> np.ndarray:
-    p = resolve_parameters(parameters)
+               rtol: float, atol: float, fmu_path: str | Path | None) -> np.ndarray:
+    p = resolve_parameters(parameters, fmu_path)
     inverse_inertia = 1.0 / total_inertia(p)
     gravity_moment, damping = p["mass"] * p["gravity"] * p["length"], p["damping"]
 
@@ -211,12 +211,13 @@ def _integrate(pieces: _Pieces, at: np.ndarray, parameters: dict | None, theta0:
 def reference(torque=20.0, *, start_time: float = 0.0, stop_time: float | None = None,
               step_size: float = 1e-3, ramp: bool = False, parameters: dict | None = None,
               theta0: float = 0.0, omega0: float = 0.0, at: np.ndarray | None = None,
-              rtol: float = 1e-12, atol: float = 1e-12) -> np.ndarray:
+              rtol: float = 1e-12, atol: float = 1e-12, fmu_path: str | Path | None = None) -> np.ndarray:
     """The trajectory under a signal as docs/signals.md defines it, through scipy DOP853.
 
     Takes the signal and the arguments of simulate(): a constant, a callable of time, a per-step
-    array or a CSV path. at: the times to report (default: the signal's communication points).
-    Same result format as simulate().
+    array or a CSV path; parameters override the defaults of the FMU at fmu_path (default:
+    pendulum_fmu.default_fmu()). at: the times to report (default: the signal's communication
+    points). Same result format as simulate().
     """
     if not (isinstance(torque, (str, Path, list, tuple, np.ndarray, int, float)) or callable(torque)):
         raise ValueError(f"the reference takes a constant, a callable, a per-step array or a CSV path, "
@@ -228,15 +229,17 @@ def reference(torque=20.0, *, start_time: float = 0.0, stop_time: float | None =
     pieces = _signal_pieces(torque, start, None if stop_time is None else _exact(stop_time), step, ramp)
     if at is None:
         at = np.array([float(t) for t in pieces.points])
-    return _integrate(pieces, np.asarray(at, dtype=float), parameters, theta0, omega0, rtol, atol)
+    return _integrate(pieces, np.asarray(at, dtype=float), parameters, theta0, omega0, rtol, atol, fmu_path)
 
 
 def reference_schedule(plan, *, parameters: dict | None = None, theta0: float = 0.0,
-                       omega0: float = 0.0, rtol: float = 1e-12, atol: float = 1e-12) -> np.ndarray:
+                       omega0: float = 0.0, rtol: float = 1e-12, atol: float = 1e-12,
+                       fmu_path: str | Path | None = None) -> np.ndarray:
     """Integrate exactly the torques of a schedule (time, torque, torque_rate), reported at its
     communication points: the judge of a tool that was fed that schedule."""
     points = [Fraction(float(t)) for t in plan.time]
     u0, rate = plan.torque.tolist(), plan.torque_rate.tolist()
     # The schedule's points are the tools' own: no tolerance beyond rounding.
     pieces = _Pieces(points[:-1], points[-1], u0, rate, points, _holding(points, u0, Fraction(0)))
-    return _integrate(pieces, np.asarray(plan.time, dtype=float), parameters, theta0, omega0, rtol, atol)
+    return _integrate(pieces, np.asarray(plan.time, dtype=float), parameters, theta0, omega0, rtol, atol,
+                      fmu_path)

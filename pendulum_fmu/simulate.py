@@ -8,12 +8,12 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
-from fmpy import extract, read_model_description
+from fmpy import extract
 from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
 
 from . import results
-from .build import default_fmu
-from .parameters import resolve_parameters, value_reference
+from . import default_fmu
+from .parameters import model_description, resolve_parameters, value_reference
 from .signal import TorqueSignal, TorqueSchedule, schedule
 
 _STATUS = ["OK", "WARNING", "DISCARD", "ERROR", "FATAL", "PENDING"]
@@ -56,7 +56,7 @@ def _unzipped(fmu_path: Path):
     if key not in _extracted:
         folder = tempfile.TemporaryDirectory(prefix="pendulum_fmu_")
         extract(str(fmu_path), unzipdir=folder.name)
-        _extracted[key] = folder, read_model_description(folder.name)
+        _extracted[key] = folder, model_description(fmu_path)
     folder, description = _extracted[key]
     return folder.name, description
 
@@ -66,8 +66,8 @@ def open_fmu(fmu_path: str | Path | None = None, *, parameters: dict | None = No
              start_time: float = 0.0, instance_name: str = "pendulum"):
     """An initialized FMU2Slave (in step mode) and its message log.
 
-    fmu_path defaults to the FMU built from this checkout. The caller frees it with
-    slave.terminate(); slave.freeInstance().
+    fmu_path defaults to pendulum_fmu.default_fmu(); parameters and value references are that
+    FMU's own. The caller frees it with slave.terminate(); slave.freeInstance().
     """
     fmu_path = Path(fmu_path) if fmu_path else default_fmu()
     folder, description = _unzipped(fmu_path)
@@ -77,11 +77,12 @@ def open_fmu(fmu_path: str | Path | None = None, *, parameters: dict | None = No
     messages = MessageLog()
     slave.instantiate(callbacks=messages.callbacks)
     slave.messages = messages  # keeps the logger callback alive as long as the slave
-    start = {**resolve_parameters(parameters), "theta": float(theta0), "omega": float(omega0)}
+    slave.fmu_path = fmu_path  # whose value references run_schedule uses
+    start = {**resolve_parameters(parameters, fmu_path), "theta": float(theta0), "omega": float(omega0)}
     try:
         slave.setupExperiment(tolerance=tolerance, startTime=start_time)
         slave.enterInitializationMode()
-        slave.setReal([value_reference(n) for n in start], list(start.values()))
+        slave.setReal([value_reference(n, fmu_path) for n in start], list(start.values()))
         slave.exitInitializationMode()
     except Exception as error:
         slave.freeInstance()
@@ -100,9 +101,9 @@ def run_schedule(slave: FMU2Slave, plan: TorqueSchedule) -> np.ndarray:
     set_real, get_real, set_rate, do_step = (
         dll[name] for name in ("fmi2SetReal", "fmi2GetReal", "fmi2SetRealInputDerivatives", "fmi2DoStep"))
     component = ctypes.c_void_p(slave.component)
-    torque_vr = (ctypes.c_uint * 1)(value_reference("torque"))
+    torque_vr = (ctypes.c_uint * 1)(value_reference("torque", slave.fmu_path))
     # The torque is read back with the outputs: the result records what the FMU received.
-    recorded_vr = (ctypes.c_uint * 4)(*(value_reference(n) for n in ("torque", "theta", "omega", "alpha")))
+    recorded_vr = (ctypes.c_uint * 4)(*(value_reference(n, slave.fmu_path) for n in ("torque", "theta", "omega", "alpha")))
     one, four = ctypes.c_size_t(1), ctypes.c_size_t(4)
     first_order = (ctypes.c_int * 1)(1)
     no_rollback = ctypes.c_int(1)

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .build import default_fmu
+from . import default_fmu
 from .parameters import default_parameters
 from .plot import plot_cases
 from .signal import communication_points
@@ -32,8 +32,8 @@ OUTPUTS = ("time", "theta", "omega", "alpha")
 CHUNKS_PER_WORKER = 4
 
 
-def _sweepable() -> list[str]:
-    return ["torque", *default_parameters(), *START_VALUES]
+def _sweepable(fmu_path=None) -> list[str]:
+    return ["torque", *default_parameters(fmu_path), *START_VALUES]
 
 
 def _extra_names() -> list[str]:
@@ -74,7 +74,7 @@ def sweep_grid(torques, gravities=(9.81,), extra: dict | None = None) -> list[di
     return [dict(zip(axes, combination)) for combination in itertools.product(*axes.values())]
 
 
-def _check_cases(cases) -> list[str]:
+def _check_cases(cases, fmu_path=None) -> list[str]:
     """The cases' common keys, which become the CSV's case columns."""
     if not cases:
         raise ValueError("no cases to run")
@@ -86,8 +86,8 @@ def _check_cases(cases) -> list[str]:
         if list(case) != names:
             raise ValueError(f"case {number} has keys {list(case)}; every case needs {names}")
         for name, value in case.items():
-            if name not in _sweepable():
-                raise ValueError(f"cannot sweep {name!r}: choose from {', '.join(_sweepable())}")
+            if name not in _sweepable(fmu_path):
+                raise ValueError(f"cannot sweep {name!r}: choose from {', '.join(_sweepable(fmu_path))}")
             if not isinstance(value, numbers.Real) or not math.isfinite(value):
                 raise ValueError(f"case {number}: {name} = {value!r} must be a finite number")
         # A repeat would only cost time, and share the first one's line in the figure.
@@ -151,7 +151,7 @@ def run_sweep(cases: list[dict], *, output_dir: str | Path, stop_time: float = 3
     from dask.distributed import Client, LocalCluster, as_completed
 
     started = time.perf_counter()
-    names = _check_cases(cases)
+    names = _check_cases(cases, fmu_path)
     if not (isinstance(stop_time, numbers.Real) and math.isfinite(stop_time)):
         raise ValueError(f"stop time {stop_time} must be a finite number")
     communication_points(0.0, stop_time, step_size)  # refuses a bad stop time or step here, not on a worker
@@ -166,8 +166,10 @@ def run_sweep(cases: list[dict], *, output_dir: str | Path, stop_time: float = 3
 
     if scheduler is None:
         # Port 0 for the scheduler's HTTP server: another cluster may hold dask's usual 8787.
+        # Workers log nothing: a case that fails reaches the caller as its own one-line error,
+        # which the workers' logs would repeat with a traceback.
         cluster = LocalCluster(n_workers=workers or 2, threads_per_worker=1, processes=True,
-                               dashboard_address=":0", silence_logs=logging.WARNING)
+                               dashboard_address=":0", silence_logs=logging.CRITICAL)
     else:
         cluster = None
     results = output_dir / "sweep.csv"

@@ -15,7 +15,7 @@ I_TOTAL = 30.0
 def test_every_command_has_help():
     parser = build_parser()
     commands = parser._subparsers._group_actions[0].choices
-    assert set(commands) == {"build", "simulate", "compare", "sweep", "demo"}
+    assert set(commands) == {"build", "cross-check", "simulate", "compare", "sweep", "demo"}
     for name, command in commands.items():
         assert command.description, name
         for action in command._actions:
@@ -91,3 +91,11 @@ def test_sweep_command(tmp_path, capsys):
     undamped = table[(table["torque"] == 20) & (table["damping"] == 0)]
     assert np.max(np.abs(undamped["theta"] - 10 / I_TOTAL * undamped["time"] ** 2)) < 1e-12
     assert main(["sweep", "--torque", "5", "--set", "mass=heavy", "--output-dir", str(tmp_path)]) == 2
+
+
+def test_sweep_refusing_a_case_says_so_in_one_line_without_the_workers_traceback(tmp_path, capfd):
+    assert main(["sweep", "--torque", "5", "--set", "inertia=-100", "--stop-time", "0.1",
+                 "--workers", "1", "--output-dir", str(tmp_path)]) == 2
+    err = capfd.readouterr().err  # the workers' own output included: they write to this process's stderr
+    [line] = [line for line in err.splitlines() if not line.startswith("sweep [")]
+    assert line.startswith("pendulum-fmu sweep: error: case 0 (") and "inertia must be >= 0" in line

@@ -1,0 +1,116 @@
+"""The package as a user installs it: the wheel, and the sdist built on the spot, each into its own
+fresh virtual environment, used from an empty folder with no source tree in sight.
+
+`python -m build` makes the sdist and builds the wheel from it, so the wheel also shows that the
+sdist holds everything a rebuild needs. The fresh environments get their third-party packages
+(numpy, fmpy, dask, ...) from this interpreter's site-packages through a .pth line instead of a
+download, and `pip check` confirms those satisfy the wheel's requirements; pendulum_fmu itself
+is only what the artefact installs.
+"""
+
+import csv
+import os
+import subprocess
+import sys
+import sysconfig
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+from fmpy import read_model_description
+
+from pendulum_fmu import __version__
+from pendulum_fmu.reference import reference
+
+pytestmark = pytest.mark.packaging
+
+ROOT = Path(__file__).resolve().parent.parent
+# In a clean environment: no PYTHONPATH pointing back at the checkout.
+ENVIRONMENT = {name: value for name, value in os.environ.items() if name != "PYTHONPATH"}
+
+
+def _run(command, cwd=None, check=True):
+    result = subprocess.run([str(part) for part in command], cwd=cwd, env=ENVIRONMENT,
+                            capture_output=True, text=True, timeout=600)
+    if check and result.returncode != 0:
+        raise AssertionError(f"{' '.join(map(str, command))} exited {result.returncode}:\n"
+                             f"{result.stdout}\n{result.stderr}")
+    return result
+
+
+@pytest.fixture(scope="module")
+def artefacts(tmp_path_factory):
+    """{'wheel': path, 'sdist': path}, built from this checkout."""
+    out = tmp_path_factory.mktemp("dist")
+    _run([sys.executable, "-m", "build", "--outdir", out, ROOT])
+    [wheel], [sdist] = out.glob("*.whl"), out.glob("*.tar.gz")
+    return {"wheel": wheel, "sdist": sdist}
+
+
+def _files_under(folder: Path) -> set[Path]:
+    return {p for p in folder.rglob("*") if "__pycache__" not in p.parts}
+
+
+@pytest.fixture(scope="module", params=["wheel", "sdist"])
+def installed(request, artefacts, tmp_path_factory):
+    """(venv, its site-packages) with the artefact installed and nothing of the checkout."""
+    venv = tmp_path_factory.mktemp(f"venv_{request.param}")
+    _run([sys.executable, "-m", "venv", venv])
+    [site_packages] = venv.glob("lib/python*/site-packages")
+    (site_packages / "dependencies_from_the_test_environment.pth").write_text(
+        sysconfig.get_paths()["purelib"] + "\n")
+    # The sdist builds its wheel (and the FMU in it) here, in pip's isolated build environment.
+    _run([venv / "bin/python", "-m", "pip", "install", "--no-deps", "--no-cache-dir",
+          artefacts[request.param]])
+    _run([venv / "bin/python", "-m", "pip", "check"])
+    return venv, site_packages
+
+
+def _csv_columns(path: Path) -> dict[str, np.ndarray]:
+    with open(path, newline="") as file:
+        rows = list(csv.reader(file))
+    return {name.strip('"'): np.array([float(row[i]) for row in rows[1:]]) for i, name in enumerate(rows[0])}
+
+
+def test_wheel_carries_the_fmu_for_every_platform_built(artefacts):
+    with zipfile.ZipFile(artefacts["wheel"]) as wheel:
+        names = wheel.namelist()
+        assert "pendulum_fmu/data/Pendulum.fmu" in names
+        assert not any(name.startswith(("fmu_src/", "tests/", "dist/")) for name in names)
+
+
+def test_installed_package_runs_from_an_empty_folder(installed, tmp_path):
+    venv, site_packages = installed
+    package = site_packages / "pendulum_fmu"
+    before = _files_under(package)
+    python, cli = venv / "bin/python", venv / "bin/pendulum-fmu"
+
+    assert _run([cli, "--version"], cwd=tmp_path).stdout.strip() == f"pendulum-fmu {__version__}"
+    fmu = Path(_run([python, "-c", "import pendulum_fmu; print(pendulum_fmu.default_fmu())"],
+                    cwd=tmp_path).stdout.strip())
+    assert fmu == package / "data" / "Pendulum.fmu"
+    assert read_model_description(str(fmu)).generationTool == f"pendulum_fmu {__version__}"
+
+    expected = reference(20.0, stop_time=3.0, step_size=1e-3)
+    _run([cli, "simulate", "--torque", "20", "--output", "simulated.csv"], cwd=tmp_path)
+    simulated = _csv_columns(tmp_path / "simulated.csv")
+    assert np.max(np.abs(simulated["theta"] - expected["theta"])) < 1e-9
+
+    _run([python, "-m", "fmpy", "simulate", fmu, "--start-values", "torque", "20", "--stop-time", "3",
+          "--step-size", "1e-3", "--output-interval", "1e-3", "--output-file", "fmpy.csv"], cwd=tmp_path)
+    by_fmpy = _csv_columns(tmp_path / "fmpy.csv")
+    assert np.allclose(by_fmpy["time"], expected["time"], rtol=0, atol=1e-12)
+    assert np.max(np.abs(by_fmpy["theta"] - expected["theta"])) < 1e-9
+
+    _run([cli, "compare", "--torque", "20", "--tools", "fmu,reference", "--output-dir", "compared"], cwd=tmp_path)
+    _run([cli, "sweep", "--torque", "5", "10", "--stop-time", "0.5", "--workers", "1",
+          "--output-dir", "swept"], cwd=tmp_path)
+    assert (tmp_path / "swept/sweep.csv").is_file() and (tmp_path / "compared/differences.csv").is_file()
+
+    # Building needs the sources, which an installed package does not have: one line says so.
+    refused = _run([cli, "build", "--output", "P.fmu"], cwd=tmp_path, check=False)
+    assert refused.returncode == 2 and len(refused.stderr.strip().splitlines()) == 1
+    assert "run python build_fmu.py in a clone" in refused.stderr and "Traceback" not in refused.stderr
+
+    assert _files_under(package) == before  # nothing written into site-packages
