@@ -21,10 +21,13 @@ from pathlib import Path
 import fmpy
 from fmpy import read_model_description
 
+from . import fmi3
+
 ROOT = Path(__file__).resolve().parent.parent
 SOURCE_DIR = ROOT / "fmu_src"
 MODEL_DESCRIPTION = ROOT / "modelDescription.xml"
 DEFAULT_FMU = ROOT / "dist" / "Pendulum.fmu"
+DEFAULT_FMU3 = ROOT / "dist" / "Pendulum-fmi3.fmu"
 GENERATED_SOURCES = ("model_variables.h", "model_variables.c")
 MODEL_FILES = ("config.h", "model.c")
 PID_CONTROLLER_DIR = SOURCE_DIR / "pid_controller"
@@ -97,9 +100,11 @@ def _enum_name(causality: str) -> str:
     return "CALCULATED_PARAMETER" if causality == "calculatedParameter" else causality.upper()
 
 
-def _check_source_files(model_description, xml: Path, sources: Path) -> None:
+def _check_source_files(model_description, xml: Path, sources: Path, fmi_version: int = 2) -> None:
     for configuration in model_description.buildConfigurations:
         listed = set(configuration.sourceFileSets[0].sourceFiles)
+        if fmi_version == 3:
+            listed = listed - {fmi3.FMI2_ADAPTER} | {fmi3.FMI3_ADAPTER}
         present = {p.name for p in sources.glob("*.c")}
         if listed != present:
             raise BuildError(
@@ -109,19 +114,22 @@ def _check_source_files(model_description, xml: Path, sources: Path) -> None:
 
 
 def assemble_sources(sources: Path, model_dir: Path = SOURCE_DIR,
-                     model_description_file: Path = MODEL_DESCRIPTION) -> Path:
+                     model_description_file: Path = MODEL_DESCRIPTION, fmi_version: int = 2) -> Path:
     """Everything that compiles into the FMU, in one folder: what the FMU's sources/ holds, and
     what the tests' C driver and fuzzers link."""
     _check_sources_present()
-    _assemble_sources(Path(model_dir), read_model_description(str(model_description_file)), Path(sources))
+    _assemble_sources(Path(model_dir), read_model_description(str(model_description_file)), Path(sources),
+                      fmi_version)
     return Path(sources)
 
 
-def _assemble_sources(model_dir: Path, model_description, sources: Path) -> None:
-    """The plumbing from fmu_src/, the model from model_dir, the generated variables."""
+def _assemble_sources(model_dir: Path, model_description, sources: Path, fmi_version: int = 2) -> None:
+    """The plumbing from fmu_src/ (with the entry points of one FMI version), the model from
+    model_dir, the generated variables."""
     sources.mkdir()
+    left_out = {*MODEL_FILES, fmi3.adapter_left_out(fmi_version)}
     for path in SOURCE_DIR.iterdir():
-        if path.is_file() and path.name not in MODEL_FILES:
+        if path.is_file() and path.name not in left_out:
             shutil.copy2(path, sources)
     for name in MODEL_FILES:
         shutil.copy2(model_dir / name, sources)
@@ -134,13 +142,15 @@ def _compile(command: list[str], what: str) -> None:
         raise BuildError(f"compiling {what} failed:\n{' '.join(command)}\n{result.stderr}")
 
 
-def compile_linux64(source_dir: Path, out_file: Path, compiler: str | None = None) -> Path:
-    """Compile every C file in source_dir into a shared library exporting only fmi2* symbols."""
+def compile_linux64(source_dir: Path, out_file: Path, compiler: str | None = None,
+                    exported_prefix: str = "fmi2") -> Path:
+    """Compile every C file in source_dir into a shared library exporting only the
+    exported_prefix* symbols."""
     compiler = compiler or os.environ.get("CC", "gcc")
     if shutil.which(compiler) is None:
         raise BuildError(f"C compiler {compiler!r} not found: install gcc (apt-get install gcc)")
     version_script = out_file.parent / "exports.map"
-    version_script.write_text("{ global: fmi2*; local: *; };\n")
+    version_script.write_text(f"{{ global: {exported_prefix}*; local: *; }};\n")
     _compile([
         # -flto lets the integrator inline the model's right-hand side across files.
         compiler, "-std=c99", "-O2", "-flto", "-fPIC", "-shared", "-fvisibility=hidden",
@@ -154,8 +164,8 @@ def compile_linux64(source_dir: Path, out_file: Path, compiler: str | None = Non
 
 
 def compile_win64(source_dir: Path, out_file: Path) -> Path:
-    """Cross-compile the Windows DLL with mingw-w64. fmi2Functions.h marks the fmi2 functions
-    __declspec(dllexport) on Windows, so they are all the DLL exports."""
+    """Cross-compile the Windows DLL with mingw-w64. fmi2Functions.h (fmi3Functions.h) marks the
+    fmi2 (fmi3) functions __declspec(dllexport) on Windows, so they are all the DLL exports."""
     if shutil.which(MINGW_COMPILER) is None:
         raise BuildError(f"{MINGW_COMPILER} not found: install Debian's gcc-mingw-w64-x86-64")
     _compile([
@@ -207,13 +217,16 @@ where it was.</p>
 
 def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, compiler: str | None = None, *,
               model_dir: Path = SOURCE_DIR, model_description_file: Path = MODEL_DESCRIPTION,
-              platforms: tuple[str, ...] = ("linux64",)) -> Path:
+              platforms: tuple[str, ...] = ("linux64",), fmi_version: int = 2) -> Path:
     """Build an FMU (binaries/, sources/, documentation/) and return its path.
 
     By default the pendulum for linux64; model_dir and model_description_file name another
     model's config.h/model.c and XML to build over the same plumbing. A platform other than
-    linux64 whose cross-compiler is missing is left out with a warning.
+    linux64 whose cross-compiler is missing is left out with a warning. fmi_version 3 builds the
+    FMI 3.0 FMU from the same sources, its model description generated by fmi3.py.
     """
+    if fmi_version not in (2, 3):
+        raise BuildError(f"fmi_version must be 2 or 3, got {fmi_version}")
     unknown = set(platforms) - set(PLATFORMS)
     if unknown or "linux64" not in platforms:
         raise BuildError(f"platforms must include linux64 and be among {', '.join(PLATFORMS)}; "
@@ -226,19 +239,26 @@ def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, compiler: str | None = 
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         sources = tmp / "sources"
-        _assemble_sources(Path(model_dir), model_description, sources)
-        _check_source_files(model_description, model_description_file, sources)
-        binaries = {f"binaries/linux64/{identifier}.so":
-                    compile_linux64(sources, tmp / f"{identifier}.so", compiler)}
+        _assemble_sources(Path(model_dir), model_description, sources, fmi_version)
+        _check_source_files(model_description, model_description_file, sources, fmi_version)
+        if fmi_version == 3:
+            (sources / "buildDescription.xml").write_text(fmi3.build_description(model_description_file))
+        folder = {p: fmi3.platform_folder(p, fmi_version) for p in PLATFORMS}
+        binaries = {f"binaries/{folder['linux64']}/{identifier}.so":
+                    compile_linux64(sources, tmp / f"{identifier}.so", compiler, f"fmi{fmi_version}")}
         if "win64" in platforms:
             try:
-                binaries[f"binaries/win64/{identifier}.dll"] = compile_win64(sources, tmp / f"{identifier}.dll")
+                binaries[f"binaries/{folder['win64']}/{identifier}.dll"] = compile_win64(
+                    sources, tmp / f"{identifier}.dll")
             except BuildError as error:
                 warnings.warn(f"win64 left out: {error}", stacklevel=2)
         # Write to a temporary name first so a failed build never leaves half an FMU behind.
         partial = out_file.with_suffix(".fmu.partial")
         with zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as fmu:
-            fmu.write(model_description_file, "modelDescription.xml")
+            if fmi_version == 3:
+                fmu.writestr("modelDescription.xml", fmi3.model_description(model_description_file))
+            else:
+                fmu.write(model_description_file, "modelDescription.xml")
             for name, binary in binaries.items():
                 fmu.write(binary, name)
             for source in sorted(sources.iterdir()):
@@ -259,13 +279,15 @@ def fmu_is_stale(fmu: Path = DEFAULT_FMU) -> bool:
     if not fmu.exists():
         return True
     built = fmu.stat().st_mtime
-    inputs = [MODEL_DESCRIPTION, Path(__file__), *(p for p in SOURCE_DIR.iterdir() if p.is_file())]
+    inputs = [MODEL_DESCRIPTION, Path(__file__), Path(fmi3.__file__),
+              *(p for p in SOURCE_DIR.iterdir() if p.is_file())]
     return any(p.stat().st_mtime > built for p in inputs)
 
 
-def default_fmu() -> Path:
+def default_fmu(fmi_version: int = 2) -> Path:
     """The FMU built from this checkout, rebuilt first when its sources changed."""
     _check_sources_present()
-    if fmu_is_stale(DEFAULT_FMU):
-        build_fmu(DEFAULT_FMU)
-    return DEFAULT_FMU
+    path = DEFAULT_FMU3 if fmi_version == 3 else DEFAULT_FMU
+    if fmu_is_stale(path):
+        build_fmu(path, fmi_version=fmi_version)
+    return path

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .build import DEFAULT_FMU, BuildError, build_fmu
+from .build import DEFAULT_FMU, DEFAULT_FMU3, BuildError, build_fmu
 
 TUTORIAL_TORQUE = 20.0
 
@@ -60,7 +60,8 @@ def _add_signal_arguments(parser, required=True):
 
 
 def cmd_build(args) -> int:
-    print(f"wrote {build_fmu(args.output)}")
+    output = args.output or (DEFAULT_FMU3 if args.fmi_version == 3 else DEFAULT_FMU)
+    print(f"wrote {build_fmu(output, fmi_version=args.fmi_version)}")
     return 0
 
 
@@ -180,8 +181,11 @@ def build_parser() -> argparse.ArgumentParser:
 
     build = commands.add_parser("build", help="build the FMU (same as python build_fmu.py)",
                                 description="Build the FMU from fmu_src/ and modelDescription.xml.")
-    build.add_argument("--output", type=Path, default=DEFAULT_FMU,
-                       help="where to write the FMU (default: %(default)s)")
+    build.add_argument("--output", type=Path, default=None,
+                       help=f"where to write the FMU (default: {DEFAULT_FMU}, or {DEFAULT_FMU3} "
+                            "for FMI 3.0)")
+    build.add_argument("--fmi-version", type=int, choices=(2, 3), default=2,
+                       help="FMI standard of the FMU (default: %(default)s)")
     build.set_defaults(run=cmd_build)
 
     simulate = commands.add_parser("simulate", help="simulate the FMU under a torque signal",
