@@ -201,8 +201,9 @@ table{{border-collapse:collapse}}td,th{{border:1px solid #999;padding:.2em .5em}
 <p>Each <code>fmi2DoStep(t, h)</code> integrates exactly [t, t+h] with an error-controlled
 Dormand-Prince 5(4) Runge-Kutta method: internal steps end on t+h and never cross it, and the
 internal step size carries over between calls. Inputs are held over the step (zero-order
-hold) or, after <code>fmi2SetRealInputDerivatives</code> (order 1), ramp linearly from their
-values at t; a derivative holds until it is set again. The relative tolerance is
+hold) or, after <code>fmi2SetRealInputDerivatives</code> (orders 1 and 2; higher orders are
+ignored), follow their Taylor polynomial from their values at t until the derivatives are set
+again. FMI 3.0 has no input derivatives: there inputs are always held. The relative tolerance is
 <code>fmi2SetupExperiment</code>'s when defined, else 1e-10; the absolute tolerance equals it.
 A step that needs more than 100000 internal steps returns fmi2Discard and leaves the instance
 where it was.</p>
