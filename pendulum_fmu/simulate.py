@@ -26,12 +26,15 @@ class FmuError(RuntimeError):
 class MessageLog:
     """FMI callbacks whose logger keeps what the FMU says, so a failure can say why."""
 
-    def __init__(self):
+    def __init__(self, fmi_version: int = 2):
         self.lines: list[str] = []
+        if fmi_version == 3:
+            return  # log_fmi3 is the callback; no FMI 2.0 struct, so fmpy's proxy stays untouched
         self.callbacks = fmi2CallbackFunctions()
         self.callbacks.logger = fmi2CallbackLoggerTYPE(self._log)
         try:
-            # fmpy's C proxy formats printf-style arguments before they reach Python.
+            # fmpy's C proxy formats printf-style arguments before they reach Python. It keeps one
+            # logger per process: the newest FMI 2.0 MessageLog receives the messages.
             from fmpy.logging import addLoggerProxy
             addLoggerProxy(ctypes.byref(self.callbacks))
         except Exception:
@@ -77,7 +80,7 @@ def open_fmu(fmu_path: str | Path | None = None, *, parameters: dict | None = No
     fmu_path = Path(fmu_path) if fmu_path else default_fmu()
     folder, description = _unzipped(fmu_path)
     fmi_version = int(description.fmiVersion[0])
-    messages = MessageLog()
+    messages = MessageLog(fmi_version)
     arguments = dict(guid=description.guid, unzipDirectory=folder, instanceName=instance_name,
                      modelIdentifier=description.coSimulation.modelIdentifier)
     if fmi_version == 3:
