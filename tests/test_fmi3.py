@@ -251,3 +251,15 @@ def test_fmpy_command_line_validates_and_simulates(fmu3, tmp_path):
     assert np.allclose(result["time"][regular], expected["time"], atol=1e-12, rtol=0)
     # fmpy passes the description's default tolerance (1e-8) to the FMU; 1 ms steps stay exact.
     assert np.max(np.abs(result["theta"][regular] - expected["theta"])) < 1e-10
+
+
+def test_compare_and_sweep_take_the_fmi3_fmu(fmu, fmu3):
+    from pendulum_fmu.compare import run_tools
+    from pendulum_fmu.sweep import _run_chunk
+
+    plan = schedule(lambda t: 20.0 if t < 0.5 else -5.0, stop_time=1.0)
+    runs = run_tools(plan, ("fmu", "reference"), fmu_path=fmu3)
+    assert np.array_equal(runs["fmu"], run_tools(plan, ("fmu",), fmu_path=fmu)["fmu"])
+    assert np.max(np.abs(runs["fmu"]["theta"] - runs["reference"]["theta"])) < 1e-10
+    cases = [(0, {"torque": 10.0, "gravity": 0.0}), (1, {"torque": 40.0, "gravity": 9.81})]
+    assert _run_chunk(cases, str(fmu3), 1.0, 1e-3)[0] == _run_chunk(cases, str(fmu), 1.0, 1e-3)[0]
