@@ -177,7 +177,7 @@ def compile_win64(source_dir: Path, out_file: Path) -> Path:
     return out_file
 
 
-def documentation_html(model_description) -> str:
+def documentation_html(model_description, fmi_version: int = 2) -> str:
     """documentation/index.html: what the model is and every variable with its unit and meaning."""
     rows = "\n".join(
         "<tr>" + "".join(f"<td>{html.escape(str(cell))}</td>" for cell in (
@@ -196,7 +196,7 @@ table{{border-collapse:collapse}}td,th{{border:1px solid #999;padding:.2em .5em}
 <body>
 <h1>{name}</h1>
 <p>{html.escape(model_description.description or "")}</p>
-<p>FMI 2.0 {interfaces}, model identifier <code>{name}</code>.</p>
+<p>FMI {fmi_version}.0 {interfaces}, model identifier <code>{name}</code>.</p>
 <h2>Inside a communication step</h2>
 <p>Each <code>fmi2DoStep(t, h)</code> integrates exactly [t, t+h] with an error-controlled
 Dormand-Prince 5(4) Runge-Kutta method: internal steps end on t+h and never cross it, and the
@@ -264,7 +264,7 @@ def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, compiler: str | None = 
                 fmu.write(binary, name)
             for source in sorted(sources.iterdir()):
                 fmu.write(source, f"sources/{source.name}")
-            fmu.writestr("documentation/index.html", documentation_html(model_description))
+            fmu.writestr("documentation/index.html", documentation_html(model_description, fmi_version))
         partial.replace(out_file)
     return out_file
 

@@ -41,6 +41,8 @@ class Harness:
     """The FMU's library through ctypes, with a logger that keeps what the FMU says."""
 
     prefix = "fmi2"
+    state_calls = {"get": "fmi2GetFMUstate", "size": "fmi2SerializedFMUstateSize", "serialize": "fmi2SerializeFMUstate",
+                   "free": "fmi2FreeFMUstate", "deserialize": "fmi2DeSerializeFMUstate"}
 
     def __init__(self, library: Path, guid: str):
         self.lib = ctypes.CDLL(str(library))
@@ -88,6 +90,9 @@ class Harness:
         assert self.fmi2GetReal(component, refs(reference), 1, value) == OK
         return value[0]
 
+    def set(self, component, reference, value) -> int:
+        return self.fmi2SetReal(component, refs(reference), 1, reals(value))
+
     def step(self, component, time, size):
         return self.fmi2DoStep(component, ctypes.c_double(time), ctypes.c_double(size), 1)
 
@@ -105,6 +110,8 @@ class Harness3(Harness):
     """The same for an FMI 3.0 binary: fmi3 entry points, FMI 3.0's logger."""
 
     prefix = "fmi3"
+    state_calls = {"get": "fmi3GetFMUState", "size": "fmi3SerializedFMUStateSize", "serialize": "fmi3SerializeFMUState",
+                   "free": "fmi3FreeFMUState", "deserialize": "fmi3DeserializeFMUState"}
 
     def __init__(self, library: Path, token: str):
         self.lib = ctypes.CDLL(str(library))
@@ -158,6 +165,9 @@ class Harness3(Harness):
         assert self.fmi3GetFloat64(component, refs(reference), 1, value, 1) == OK
         return value[0]
 
+    def set(self, component, reference, value) -> int:
+        return self.fmi3SetFloat64(component, refs(reference), 1, reals(value), 1)
+
     def step(self, component, time, size, last_successful_time=None):
         flags = [ctypes.c_bool() for _ in range(3)]
         last = last_successful_time if last_successful_time is not None else ctypes.c_double()
@@ -175,9 +185,9 @@ class Case:
     run: Callable[[Harness], int]  # makes the bad call, returns its status; asserts what must hold after
 
 
-def _unchanged_after(harness, component, reference, bad_value, state_call=None):
+def _unchanged_after(harness, component, reference, bad_value):
     before = harness.get(component, reference)
-    status = harness.fmi2SetReal(component, refs(reference), 1, reals(bad_value))
+    status = harness.set(component, reference, bad_value)
     assert harness.get(component, reference) == before, "a refused value must leave the old one"
     return status
 
@@ -225,14 +235,14 @@ def _discarded_huge_step(h):
 
 
 def _serialized(h):
-    component = h.ready()
+    component, call = h.ready(), {name: getattr(h, function) for name, function in h.state_calls.items()}
     h.step(component, 0.0, 0.1)
     state, size = ctypes.c_void_p(), ctypes.c_size_t()
-    assert h.fmi2GetFMUstate(component, ctypes.byref(state)) == OK
-    assert h.fmi2SerializedFMUstateSize(component, state, ctypes.byref(size)) == OK
+    assert call["get"](component, ctypes.byref(state)) == OK
+    assert call["size"](component, state, ctypes.byref(size)) == OK
     blob = (ctypes.c_char * size.value)()
-    assert h.fmi2SerializeFMUstate(component, state, blob, size) == OK
-    h.fmi2FreeFMUstate(component, ctypes.byref(state))
+    assert call["serialize"](component, state, blob, size) == OK
+    call["free"](component, ctypes.byref(state))
     return component, bytearray(blob.raw)
 
 
@@ -242,7 +252,7 @@ def _deserialize(mangle):
         blob = mangle(blob)
         buffer = (ctypes.c_char * max(len(blob), 1)).from_buffer_copy(bytes(blob) or b"\0")
         state = ctypes.c_void_p()
-        status = h.fmi2DeSerializeFMUstate(component, buffer, len(blob), ctypes.byref(state))
+        status = getattr(h, h.state_calls["deserialize"])(component, buffer, len(blob), ctypes.byref(state))
         assert not state, "a refused blob must not yield a state"
         return status
     return run
@@ -389,13 +399,6 @@ CASES = [
 ]
 
 
-def _unchanged_after_fmi3(harness, component, reference, bad_value):
-    before = harness.get(component, reference)
-    status = harness.fmi3SetFloat64(component, refs(reference), 1, reals(bad_value), 1)
-    assert harness.get(component, reference) == before, "a refused value must leave the old one"
-    return status
-
-
 def _exit_with_fmi3(**values):
     def run(h):
         component = h.initializing()
@@ -420,24 +423,6 @@ def _discarded_huge_step_fmi3(h):
     return status
 
 
-def _deserialize_fmi3(mangle):
-    def run(h):
-        component = h.ready()
-        h.step(component, 0.0, 0.1)
-        state, size = ctypes.c_void_p(), ctypes.c_size_t()
-        assert h.fmi3GetFMUState(component, ctypes.byref(state)) == OK
-        assert h.fmi3SerializedFMUStateSize(component, state, ctypes.byref(size)) == OK
-        blob = (ctypes.c_char * size.value)()
-        assert h.fmi3SerializeFMUState(component, state, blob, size) == OK
-        h.fmi3FreeFMUState(component, ctypes.byref(state))
-        mangled = mangle(bytearray(blob.raw))
-        buffer = (ctypes.c_char * max(len(mangled), 1)).from_buffer_copy(bytes(mangled) or b"\0")
-        status = h.fmi3DeserializeFMUState(component, buffer, len(mangled), ctypes.byref(state))
-        assert not state, "a refused blob must not yield a state"
-        return status
-    return run
-
-
 def _ready_then(call, *arguments, kind=CO_SIMULATION):
     return lambda h: getattr(h, call)(h.ready(kind=kind), *(a() if callable(a) else a for a in arguments))
 
@@ -454,9 +439,9 @@ def _scheduled_execution(h):
 
 CASES_FMI3 = [
     Case("non-finite values", "torque = NaN after initialization", "fmi3SetFloat64", ERROR, "torque = nan refused",
-         lambda h: _unchanged_after_fmi3(h, h.ready(), TORQUE, NAN)),
+         lambda h: _unchanged_after(h, h.ready(), TORQUE, NAN)),
     Case("non-finite values", "start angle theta = -inf", "fmi3SetFloat64", ERROR, "theta = -inf refused",
-         lambda h: _unchanged_after_fmi3(h, h.initializing(), THETA, -INF)),
+         lambda h: _unchanged_after(h, h.initializing(), THETA, -INF)),
     Case("non-finite values", "time set (the independent variable)", "fmi3SetFloat64", ERROR, "cannot set time",
          lambda h: h.fmi3SetFloat64(h.ready(), refs(9), 1, reals(1.0), 1)),
     Case("physical nonsense", "mass = 0", "fmi3ExitInitializationMode", ERROR, "mass must be > 0", _exit_with_fmi3(mass=0.0)),
@@ -471,7 +456,7 @@ CASES_FMI3 = [
     Case("state machine", "fmi3EnterEventMode on a co-simulation instance (no event mode)", "fmi3EnterEventMode", ERROR,
          "not allowed in state 'step complete'", _ready_then("fmi3EnterEventMode")),
     Case("state machine", "fixed parameter mass set after initialization", "fmi3SetFloat64", ERROR,
-         "a fixed parameter cannot change after initialization", lambda h: _unchanged_after_fmi3(h, h.ready(), MASS, 1.0)),
+         "a fixed parameter cannot change after initialization", lambda h: _unchanged_after(h, h.ready(), MASS, 1.0)),
     Case("state machine", "output derivative of order 3", "fmi3GetOutputDerivatives", ERROR, "no derivative of order 3",
          _ready_then("fmi3GetOutputDerivatives", refs(THETA), 1, (ctypes.c_int * 1)(3), lambda: reals(0.0), 1)),
     Case("state machine", "directional derivative of alpha by mass", "fmi3GetDirectionalDerivative", ERROR,
@@ -528,11 +513,11 @@ CASES_FMI3 = [
     Case("fmi3Instantiate", "no logger", "fmi3InstantiateCoSimulation", ERROR, "",
          _no_instance(lambda h: h.instantiate(logger=None) is None)),
     Case("FMU state blobs", "garbage bytes", "fmi3DeserializeFMUState", ERROR, "bad magic",
-         _deserialize_fmi3(lambda blob: bytearray(b"\xde\xad\xbe\xef" * (len(blob) // 4)))),
+         _deserialize(lambda blob: bytearray(b"\xde\xad\xbe\xef" * (len(blob) // 4)))),
     Case("FMU state blobs", "truncated by one byte", "fmi3DeserializeFMUState", ERROR, "truncated, or from another build",
-         _deserialize_fmi3(lambda blob: blob[:-1])),
+         _deserialize(lambda blob: blob[:-1])),
     Case("FMU state blobs", "one payload bit flipped", "fmi3DeserializeFMUState", ERROR, "checksum mismatch",
-         _deserialize_fmi3(_flip(40))),
+         _deserialize(_flip(40))),
 ]
 
 

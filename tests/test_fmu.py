@@ -225,7 +225,11 @@ def test_directional_derivative_of_alpha_by_torque(fmu):
     assert d_alpha == pytest.approx(1.0 / total_inertia({"mass": 2.0, "length": 1.5, "inertia": 0.5}), rel=1e-15)
 
 
-def test_fmpy_simulate_command_line_with_stepwise_csv(fmu, tmp_path):
+@pytest.mark.parametrize("fixture", ["fmu", "fmu3"])
+def test_fmpy_simulate_command_line_with_stepwise_csv(request, fixture, tmp_path):
+    """FMI 2.0 and FMI 3.0 alike; fmpy passes the description's default tolerance (1e-8), and
+    1 ms steps are as exact at it."""
+    fmu = request.getfixturevalue(fixture)
     plan = schedule(lambda t: 20.0 if t < 1.0 else (-10.0 if t < 2.0 else 35.0), step_size=0.5)
     csv = write_torque_csv(tmp_path / "torque.csv", plan)
     out = tmp_path / "out.csv"
