@@ -2,6 +2,7 @@
 FMU3Model: same numbers as FMI 2.0, its own model description, states, Jacobians, Model Exchange."""
 
 import ctypes
+import re
 import shutil
 import subprocess
 import sys
@@ -82,9 +83,14 @@ def test_archive_holds_fmi3_binary_and_build_description(fmu3, tmp_path):
 
 
 @pytest.mark.skipif(shutil.which(MINGW_COMPILER) is None, reason="needs mingw-w64")
-def test_windows_binary_in_the_fmi3_folder(tmp_path):
+def test_windows_binary_in_the_fmi3_folder_exports_fmi3_only(tmp_path):
     built = build_fmu(tmp_path / "P.fmu", platforms=("linux64", "win64"), fmi_version=3)
-    assert "binaries/x86_64-windows/Pendulum.dll" in zipfile.ZipFile(built).namelist()
+    zipfile.ZipFile(built).extract("binaries/x86_64-windows/Pendulum.dll", tmp_path)
+    table = subprocess.run([MINGW_COMPILER.replace("gcc", "objdump"), "-p",
+                            str(tmp_path / "binaries/x86_64-windows/Pendulum.dll")],
+                           capture_output=True, text=True, check=True).stdout
+    exported = re.findall(r"^\s+\[\s*\d+\] (\S+)$", table.split("[Ordinal/Name Pointer] Table")[1], re.M)
+    assert "fmi3DoStep" in exported and all(name.startswith("fmi3") for name in exported), exported
 
 
 def test_build_command_writes_the_fmi3_fmu(tmp_path, capsys):
