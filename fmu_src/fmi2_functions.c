@@ -77,6 +77,11 @@
 /* fmi2Status has the core's values (and one more, fmi2Pending, which the core never returns). */
 #define STATUS(call) ((fmi2Status)(call))
 
+/* Fails to compile unless the cast in STATUS keeps every status's meaning. */
+typedef char status_values_match[(STATUS_OK == (int)fmi2OK && STATUS_WARNING == (int)fmi2Warning
+                                  && STATUS_DISCARD == (int)fmi2Discard && STATUS_ERROR == (int)fmi2Error
+                                  && STATUS_FATAL == (int)fmi2Fatal) ? 1 : -1];
+
 static void forward_to_fmi2_logger(AnyFunction master_logger, void *environment,
                                    const char *instance_name, Status status, const char *category,
                                    const char *message) {

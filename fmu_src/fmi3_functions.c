@@ -114,6 +114,11 @@
 /* fmi3Status has the core's values. */
 #define STATUS(call) ((fmi3Status)(call))
 
+/* Fails to compile unless the cast in STATUS keeps every status's meaning. */
+typedef char status_values_match[(STATUS_OK == (int)fmi3OK && STATUS_WARNING == (int)fmi3Warning
+                                  && STATUS_DISCARD == (int)fmi3Discard && STATUS_ERROR == (int)fmi3Error
+                                  && STATUS_FATAL == (int)fmi3Fatal) ? 1 : -1];
+
 #define NOT_SUPPORTED(why) return STATUS(instance_not_supported(instance, function, why))
 
 static const char NO_CLOCKS[] = "the model has no clocks";
