@@ -175,7 +175,7 @@ def cmd_demo(args) -> int:
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="pendulum-fmu",
-        description="A torque-driven pendulum as an FMI 2.0 Co-Simulation FMU: build it, "
+        description="A torque-driven pendulum as an FMI 2.0 (or 3.0) FMU: build it, "
                     "simulate it, and compare it with scipy and OpenSim.")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
