@@ -374,6 +374,7 @@ Status instance_do_step(Instance *instance, const char *function, double communi
     model_set_states(data->values, x);
     /* The inputs are where their polynomials have taken them. */
     for (size_t vr = 0; vr < N_VARIABLES; vr++) {
+        if (model_variables[vr].causality != CAUSALITY_INPUT) continue;
         data->values[vr] = input_at(data->values, &data->inputs, (int)vr, communication_step);
         data->inputs.first[vr] += communication_step * data->inputs.second[vr];
     }
