@@ -15,7 +15,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 
 class BuildPyWithFmu(build_py):
-    """build_py, then the FMU into <build_lib>/pendulum_fmu/data/Pendulum.fmu."""
+    """build_py, then the FMI 2.0 and 3.0 FMUs into <build_lib>/pendulum_fmu/data/."""
 
     def run(self):
         super().run()
@@ -25,8 +25,10 @@ class BuildPyWithFmu(build_py):
         from pendulum_fmu import __version__
         from pendulum_fmu.build import build_fmu
 
-        fmu = build_fmu(Path(self.build_lib, "pendulum_fmu", "data", "Pendulum.fmu"))
-        print(f"pendulum_fmu {__version__}: built {fmu}")
+        data = Path(self.build_lib, "pendulum_fmu", "data")
+        for name, fmi_version in (("Pendulum.fmu", 2), ("Pendulum-fmi3.fmu", 3)):
+            fmu = build_fmu(data / name, fmi_version=fmi_version)
+            print(f"pendulum_fmu {__version__}: built {fmu}")
 
 
 # The native stepping loop (pendulum_fmu._cs_loop, docs/design.md) joins as ext_modules here.

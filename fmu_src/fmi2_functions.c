@@ -3,7 +3,9 @@
    per function (FMI 2.0, tables in sections 3.2.3 and 4.2.4). */
 
 #include <stddef.h>
+#include <stdio.h>
 
+#include "fmi2Functions.h"
 #include "instance.h"
 
 #define ANY_INITIALIZED (STATE_STEP_COMPLETE | STATE_STEP_FAILED | STATE_TERMINATED \
@@ -59,16 +61,33 @@
 #define MASK_fmi2GetNominalsOfContinuousStates (STATE_INSTANTIATED | STATE_EVENT_MODE \
                                                | STATE_CONTINUOUS_TIME_MODE | STATE_TERMINATED)
 
-/* Every function with an instance starts here: NULL instance, then the state mask. */
-#define ENTER(function)                                                                \
+/* Every function with an instance starts here: NULL instance, then the state mask. Each
+   function's name travels into the core for its messages. */
+#define ENTER(name)                                                                    \
+    static const char function[] = #name;                                             \
     Instance *instance = (Instance *)c;                                                \
-    if (!instance || !instance_state_allows(instance, MASK_##function, #function))     \
+    if (!instance || !instance_state_allows(instance, MASK_##name, function))          \
         return fmi2Error;
 
 /* Array arguments may be NULL only when their length is 0. */
-#define REQUIRE_ARRAY(function, name, length)                                          \
-    if ((length) > 0 && instance_null_argument(instance, #function, #name, name))      \
+#define REQUIRE_ARRAY(name, length)                                                    \
+    if ((length) > 0 && instance_null_argument(instance, function, #name, name))       \
         return fmi2Error;
+
+/* fmi2Status has the core's values (and one more, fmi2Pending, which the core never returns). */
+#define STATUS(call) ((fmi2Status)(call))
+
+/* Fails to compile unless the cast in STATUS keeps every status's meaning. */
+typedef char status_values_match[(STATUS_OK == (int)fmi2OK && STATUS_WARNING == (int)fmi2Warning
+                                  && STATUS_DISCARD == (int)fmi2Discard && STATUS_ERROR == (int)fmi2Error
+                                  && STATUS_FATAL == (int)fmi2Fatal) ? 1 : -1];
+
+static void forward_to_fmi2_logger(AnyFunction master_logger, void *environment,
+                                   const char *instance_name, Status status, const char *category,
+                                   const char *message) {
+    ((fmi2CallbackLogger)master_logger)(environment, instance_name, (fmi2Status)status, category,
+                                        message);
+}
 
 const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
 
@@ -80,7 +99,23 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
                               fmi2Boolean loggingOn) {
     (void)fmuResourceLocation; /* the model needs no resources */
     (void)visible;
-    return instance_create(instanceName, fmuGUID, fmuType, functions, loggingOn);
+    static const char function[] = "fmi2Instantiate";
+    if (!functions) return NULL;
+    const Logger logger = {forward_to_fmi2_logger, (AnyFunction)functions->logger,
+                           functions->componentEnvironment};
+    if (fmuType != fmi2CoSimulation && fmuType != fmi2ModelExchange) {
+        char message[128];
+        snprintf(message, sizeof(message), "%s: fmuType %d is neither fmi2ModelExchange (0) nor "
+                 "fmi2CoSimulation (1)", function, (int)fmuType);
+        if (functions->logger)
+            functions->logger(functions->componentEnvironment, instanceName ? instanceName : "?",
+                              fmi2Error, "logStatusError", message);
+        return NULL;
+    }
+    return instance_create(function, instanceName, "fmuGUID", fmuGUID,
+                           fmuType == fmi2CoSimulation ? INTERFACE_CO_SIMULATION
+                                                       : INTERFACE_MODEL_EXCHANGE,
+                           &logger, loggingOn);
 }
 
 void fmi2FreeInstance(fmi2Component c) {
@@ -90,7 +125,7 @@ void fmi2FreeInstance(fmi2Component c) {
 fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories,
                                const fmi2String categories[]) {
     ENTER(fmi2SetDebugLogging)
-    return instance_set_debug_logging(instance, loggingOn, nCategories, categories);
+    return STATUS(instance_set_debug_logging(instance, function, loggingOn, nCategories, categories));
 }
 
 fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
@@ -98,7 +133,7 @@ fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fm
     (void)stopTimeDefined; /* the pendulum can run for ever */
     (void)stopTime;
     ENTER(fmi2SetupExperiment)
-    return instance_setup_experiment(instance, toleranceDefined, tolerance, startTime);
+    return STATUS(instance_setup_experiment(instance, function, toleranceDefined, tolerance, startTime));
 }
 
 fmi2Status fmi2EnterInitializationMode(fmi2Component c) {
@@ -109,7 +144,7 @@ fmi2Status fmi2EnterInitializationMode(fmi2Component c) {
 
 fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
     ENTER(fmi2ExitInitializationMode)
-    return instance_exit_initialization(instance);
+    return STATUS(instance_exit_initialization(instance, function));
 }
 
 fmi2Status fmi2Terminate(fmi2Component c) {
@@ -126,28 +161,28 @@ fmi2Status fmi2Reset(fmi2Component c) {
 
 fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[]) {
     ENTER(fmi2GetReal)
-    REQUIRE_ARRAY(fmi2GetReal, vr, nvr)
-    REQUIRE_ARRAY(fmi2GetReal, value, nvr)
-    return instance_get_real(instance, vr, nvr, value);
+    REQUIRE_ARRAY(vr, nvr)
+    REQUIRE_ARRAY(value, nvr)
+    return STATUS(instance_get_real(instance, function, vr, nvr, value));
 }
 
 fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                        const fmi2Real value[]) {
     ENTER(fmi2SetReal)
-    REQUIRE_ARRAY(fmi2SetReal, vr, nvr)
-    REQUIRE_ARRAY(fmi2SetReal, value, nvr)
-    return instance_set_real(instance, vr, nvr, value);
+    REQUIRE_ARRAY(vr, nvr)
+    REQUIRE_ARRAY(value, nvr)
+    return STATUS(instance_set_real(instance, function, vr, nvr, value));
 }
 
 /* The model has Real variables only: any Integer, Boolean or String reference is unknown. */
-#define NO_VARIABLES_OF_TYPE(function, type)                                                   \
-    fmi2Status function(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, type value) { \
-        (void)value;                                                                         \
-        ENTER(function)                                                                      \
-        REQUIRE_ARRAY(function, vr, nvr)                                                     \
-        if (nvr == 0) return fmi2OK;                                                         \
-        return instance_error(instance, #function, "vr %u: this FMU has no variables of this type", \
-                              vr[0]);                                                        \
+#define NO_VARIABLES_OF_TYPE(name, type)                                                   \
+    fmi2Status name(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, type value) { \
+        (void)value;                                                                     \
+        ENTER(name)                                                                      \
+        REQUIRE_ARRAY(vr, nvr)                                                           \
+        if (nvr == 0) return fmi2OK;                                                     \
+        return STATUS(instance_error(instance, function,                                 \
+                                     "vr %u: this FMU has no variables of this type", vr[0])); \
     }
 
 NO_VARIABLES_OF_TYPE(fmi2GetInteger, fmi2Integer *)
@@ -159,34 +194,36 @@ NO_VARIABLES_OF_TYPE(fmi2SetString, const fmi2String *)
 
 fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
     ENTER(fmi2GetFMUstate)
-    return instance_get_state(instance, FMUstate);
+    return STATUS(instance_get_state(instance, function, FMUstate));
 }
 
 fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate) {
     ENTER(fmi2SetFMUstate)
-    return instance_set_state(instance, FMUstate);
+    return STATUS(instance_set_state(instance, function, FMUstate));
 }
 
 fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
     ENTER(fmi2FreeFMUstate)
-    return instance_free_state(instance, FMUstate);
+    return STATUS(instance_free_state(instance, function, FMUstate));
 }
 
 fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, size_t *size) {
     ENTER(fmi2SerializedFMUstateSize)
-    return instance_serialized_state_size(instance, FMUstate, size);
+    return STATUS(instance_serialized_state_size(instance, function, FMUstate, size));
 }
 
 fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serializedState[],
                                  size_t size) {
     ENTER(fmi2SerializeFMUstate)
-    return instance_serialize_state(instance, FMUstate, serializedState, size);
+    return STATUS(instance_serialize_state(instance, function, FMUstate,
+                                           (unsigned char *)serializedState, size));
 }
 
 fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size,
                                    fmi2FMUstate *FMUstate) {
     ENTER(fmi2DeSerializeFMUstate)
-    return instance_deserialize_state(instance, serializedState, size, FMUstate);
+    return STATUS(instance_deserialize_state(instance, function,
+                                             (const unsigned char *)serializedState, size, FMUstate));
 }
 
 fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[],
@@ -194,37 +231,38 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReferenc
                                         size_t nKnown, const fmi2Real dvKnown[],
                                         fmi2Real dvUnknown[]) {
     ENTER(fmi2GetDirectionalDerivative)
-    REQUIRE_ARRAY(fmi2GetDirectionalDerivative, vUnknown_ref, nUnknown)
-    REQUIRE_ARRAY(fmi2GetDirectionalDerivative, dvUnknown, nUnknown)
-    REQUIRE_ARRAY(fmi2GetDirectionalDerivative, vKnown_ref, nKnown)
-    REQUIRE_ARRAY(fmi2GetDirectionalDerivative, dvKnown, nKnown)
-    return instance_directional_derivative(instance, vUnknown_ref, nUnknown, vKnown_ref, nKnown,
-                                           dvKnown, dvUnknown);
+    REQUIRE_ARRAY(vUnknown_ref, nUnknown)
+    REQUIRE_ARRAY(dvUnknown, nUnknown)
+    REQUIRE_ARRAY(vKnown_ref, nKnown)
+    REQUIRE_ARRAY(dvKnown, nKnown)
+    return STATUS(instance_directional_derivative(instance, function, vUnknown_ref, nUnknown,
+                                                  vKnown_ref, nKnown, dvKnown, dvUnknown));
 }
 
 fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                                        const fmi2Integer order[], const fmi2Real value[]) {
     ENTER(fmi2SetRealInputDerivatives)
-    REQUIRE_ARRAY(fmi2SetRealInputDerivatives, vr, nvr)
-    REQUIRE_ARRAY(fmi2SetRealInputDerivatives, order, nvr)
-    REQUIRE_ARRAY(fmi2SetRealInputDerivatives, value, nvr)
-    return instance_set_input_derivatives(instance, vr, nvr, order, value);
+    REQUIRE_ARRAY(vr, nvr)
+    REQUIRE_ARRAY(order, nvr)
+    REQUIRE_ARRAY(value, nvr)
+    return STATUS(instance_set_input_derivatives(instance, function, vr, nvr, order, value));
 }
 
 fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                                         const fmi2Integer order[], fmi2Real value[]) {
     ENTER(fmi2GetRealOutputDerivatives)
-    REQUIRE_ARRAY(fmi2GetRealOutputDerivatives, vr, nvr)
-    REQUIRE_ARRAY(fmi2GetRealOutputDerivatives, order, nvr)
-    REQUIRE_ARRAY(fmi2GetRealOutputDerivatives, value, nvr)
-    return instance_get_output_derivatives(instance, vr, nvr, order, value);
+    REQUIRE_ARRAY(vr, nvr)
+    REQUIRE_ARRAY(order, nvr)
+    REQUIRE_ARRAY(value, nvr)
+    return STATUS(instance_get_output_derivatives(instance, function, vr, nvr, order, value));
 }
 
 fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
                       fmi2Real communicationStepSize, fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
     (void)noSetFMUStatePriorToCurrentPoint; /* states are copies: nothing to release early */
     ENTER(fmi2DoStep)
-    return instance_do_step(instance, currentCommunicationPoint, communicationStepSize);
+    return STATUS(instance_do_step(instance, function, currentCommunicationPoint,
+                                   communicationStepSize));
 }
 
 fmi2Status fmi2CancelStep(fmi2Component c) {
@@ -237,14 +275,14 @@ fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *va
     ENTER(fmi2GetStatus)
     (void)s;
     (void)value;
-    return instance_error(instance, "fmi2GetStatus", "no status of this kind: steps are synchronous");
+    return STATUS(instance_error(instance, function, "no status of this kind: steps are synchronous"));
 }
 
 fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *value) {
     ENTER(fmi2GetRealStatus)
-    if (instance_null_argument(instance, "fmi2GetRealStatus", "value", value)) return fmi2Error;
+    if (instance_null_argument(instance, function, "value", value)) return fmi2Error;
     if (s != fmi2LastSuccessfulTime)
-        return instance_error(instance, "fmi2GetRealStatus", "only fmi2LastSuccessfulTime is available");
+        return STATUS(instance_error(instance, function, "only fmi2LastSuccessfulTime is available"));
     *value = instance->data.last_successful_time;
     return fmi2OK;
 }
@@ -253,14 +291,14 @@ fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Int
     ENTER(fmi2GetIntegerStatus)
     (void)s;
     (void)value;
-    return instance_error(instance, "fmi2GetIntegerStatus", "no integer status is available");
+    return STATUS(instance_error(instance, function, "no integer status is available"));
 }
 
 fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value) {
     ENTER(fmi2GetBooleanStatus)
-    if (instance_null_argument(instance, "fmi2GetBooleanStatus", "value", value)) return fmi2Error;
+    if (instance_null_argument(instance, function, "value", value)) return fmi2Error;
     if (s != fmi2Terminated)
-        return instance_error(instance, "fmi2GetBooleanStatus", "only fmi2Terminated is available");
+        return STATUS(instance_error(instance, function, "only fmi2Terminated is available"));
     *value = fmi2False; /* the pendulum never asks to stop */
     return fmi2OK;
 }
@@ -269,7 +307,7 @@ fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2Stri
     ENTER(fmi2GetStringStatus)
     (void)s;
     (void)value;
-    return instance_error(instance, "fmi2GetStringStatus", "no string status is available");
+    return STATUS(instance_error(instance, function, "no string status is available"));
 }
 
 /* Model exchange. The pendulum has no events: event mode only passes through. */
@@ -282,8 +320,7 @@ fmi2Status fmi2EnterEventMode(fmi2Component c) {
 
 fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *fmi2eventInfo) {
     ENTER(fmi2NewDiscreteStates)
-    if (instance_null_argument(instance, "fmi2NewDiscreteStates", "fmi2eventInfo", fmi2eventInfo))
-        return fmi2Error;
+    if (instance_null_argument(instance, function, "fmi2eventInfo", fmi2eventInfo)) return fmi2Error;
     fmi2eventInfo->newDiscreteStatesNeeded = fmi2False;
     fmi2eventInfo->terminateSimulation = fmi2False;
     fmi2eventInfo->nominalsOfContinuousStatesChanged = fmi2False;
@@ -303,9 +340,8 @@ fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, fmi2Boolean noSetFMUStat
                                        fmi2Boolean *enterEventMode, fmi2Boolean *terminateSimulation) {
     (void)noSetFMUStatePriorToCurrentPoint;
     ENTER(fmi2CompletedIntegratorStep)
-    if (instance_null_argument(instance, "fmi2CompletedIntegratorStep", "enterEventMode", enterEventMode) ||
-        instance_null_argument(instance, "fmi2CompletedIntegratorStep", "terminateSimulation",
-                               terminateSimulation))
+    if (instance_null_argument(instance, function, "enterEventMode", enterEventMode) ||
+        instance_null_argument(instance, function, "terminateSimulation", terminateSimulation))
         return fmi2Error;
     *enterEventMode = fmi2False;
     *terminateSimulation = fmi2False;
@@ -314,42 +350,37 @@ fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, fmi2Boolean noSetFMUStat
 
 fmi2Status fmi2SetTime(fmi2Component c, fmi2Real time) {
     ENTER(fmi2SetTime)
-    return instance_set_time(instance, time);
+    return STATUS(instance_set_time(instance, function, time));
 }
 
 fmi2Status fmi2SetContinuousStates(fmi2Component c, const fmi2Real x[], size_t nx) {
     ENTER(fmi2SetContinuousStates)
-    REQUIRE_ARRAY(fmi2SetContinuousStates, x, nx)
-    return instance_set_states(instance, x, nx);
+    REQUIRE_ARRAY(x, nx)
+    return STATUS(instance_set_states(instance, function, x, nx));
 }
 
 fmi2Status fmi2GetDerivatives(fmi2Component c, fmi2Real derivatives[], size_t nx) {
     ENTER(fmi2GetDerivatives)
-    REQUIRE_ARRAY(fmi2GetDerivatives, derivatives, nx)
-    return instance_get_derivatives(instance, derivatives, nx);
+    REQUIRE_ARRAY(derivatives, nx)
+    return STATUS(instance_get_derivatives(instance, function, derivatives, nx));
 }
 
 fmi2Status fmi2GetEventIndicators(fmi2Component c, fmi2Real eventIndicators[], size_t ni) {
     (void)eventIndicators;
     ENTER(fmi2GetEventIndicators)
     if (ni == 0) return fmi2OK;
-    return instance_error(instance, "fmi2GetEventIndicators", "ni = %lu, but the model has no "
-                          "event indicators", (unsigned long)ni);
+    return STATUS(instance_error(instance, function, "ni = %lu, but the model has no event indicators",
+                                 (unsigned long)ni));
 }
 
 fmi2Status fmi2GetContinuousStates(fmi2Component c, fmi2Real x[], size_t nx) {
     ENTER(fmi2GetContinuousStates)
-    REQUIRE_ARRAY(fmi2GetContinuousStates, x, nx)
-    return instance_get_states(instance, x, nx);
+    REQUIRE_ARRAY(x, nx)
+    return STATUS(instance_get_states(instance, function, x, nx));
 }
 
 fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, fmi2Real x_nominal[], size_t nx) {
     ENTER(fmi2GetNominalsOfContinuousStates)
-    REQUIRE_ARRAY(fmi2GetNominalsOfContinuousStates, x_nominal, nx)
-    if (nx != N_STATES)
-        return instance_error(instance, "fmi2GetNominalsOfContinuousStates",
-                              "nx = %lu, but the model has %d continuous states", (unsigned long)nx,
-                              N_STATES);
-    for (size_t i = 0; i < nx; i++) x_nominal[i] = 1.0; /* radians and radians per second */
-    return fmi2OK;
+    REQUIRE_ARRAY(x_nominal, nx)
+    return STATUS(instance_get_nominals(instance, function, x_nominal, nx));
 }

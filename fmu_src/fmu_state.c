@@ -10,7 +10,8 @@
 #include "instance.h"
 
 #define STATE_MAGIC "PNDL"
-#define STATE_FORMAT_VERSION 1u
+/* 2: inputs carry first and second derivatives. */
+#define STATE_FORMAT_VERSION 2u
 #define HEADER_SIZE 12u
 #define CHECKSUM_SIZE 8u
 #define SERIALIZED_SIZE (HEADER_SIZE + sizeof(InstanceData) + CHECKSUM_SIZE)
@@ -43,77 +44,78 @@ static const char *implausible(const InstanceData *data) {
     if (!(data->tolerance > 0 && data->tolerance < 1)) return "tolerance out of range";
     if (!(data->step_size >= 0) || !isfinite(data->step_size)) return "bad internal step size";
     for (size_t vr = 0; vr < N_VARIABLES; vr++) {
-        if (!isfinite(data->values[vr]) || !isfinite(data->input_rates[vr])) return "non-finite value";
-        if (data->input_rates[vr] != 0 && model_variables[vr].causality != CAUSALITY_INPUT)
-            return "rate on a variable that is not an input";
+        const double first = data->inputs.first[vr], second = data->inputs.second[vr];
+        if (!isfinite(data->values[vr]) || !isfinite(first) || !isfinite(second))
+            return "non-finite value";
+        if ((first != 0 || second != 0) && model_variables[vr].causality != CAUSALITY_INPUT)
+            return "derivative on a variable that is not an input";
     }
     return NULL;
 }
 
-fmi2Status instance_get_state(Instance *instance, fmi2FMUstate *state) {
-    if (instance_null_argument(instance, "fmi2GetFMUstate", "FMUstate", state)) return fmi2Error;
+Status instance_get_state(Instance *instance, const char *function, void **state) {
+    if (instance_null_argument(instance, function, "FMUstate", state)) return STATUS_ERROR;
     /* The master may hand back a state it got before: overwrite it in place. */
     InstanceData *copy = *state ? (InstanceData *)*state : malloc(sizeof(InstanceData));
-    if (!copy) return instance_error(instance, "fmi2GetFMUstate", "out of memory");
+    if (!copy) return instance_error(instance, function, "out of memory");
     *copy = instance->data;
     *state = copy;
-    return fmi2OK;
+    return STATUS_OK;
 }
 
-fmi2Status instance_set_state(Instance *instance, fmi2FMUstate state) {
-    if (instance_null_argument(instance, "fmi2SetFMUstate", "FMUstate", state)) return fmi2Error;
+Status instance_set_state(Instance *instance, const char *function, const void *state) {
+    if (instance_null_argument(instance, function, "FMUstate", state)) return STATUS_ERROR;
     const InstanceData *data = state;
-    const int own_states = instance->type == fmi2CoSimulation ? CO_SIMULATION_STATES
-                                                                : MODEL_EXCHANGE_STATES;
+    const int own_states = instance->type == INTERFACE_CO_SIMULATION ? CO_SIMULATION_STATES
+                                                                       : MODEL_EXCHANGE_STATES;
     if (!(data->machine_state & own_states))
-        return instance_error(instance, "fmi2SetFMUstate",
+        return instance_error(instance, function,
                               "the state comes from an instance of the other FMI interface");
     instance->data = *data;
     instance_data_changed(instance);
-    return fmi2OK;
+    return STATUS_OK;
 }
 
-fmi2Status instance_free_state(Instance *instance, fmi2FMUstate *state) {
-    if (instance_null_argument(instance, "fmi2FreeFMUstate", "FMUstate", state)) return fmi2Error;
+Status instance_free_state(Instance *instance, const char *function, void **state) {
+    if (instance_null_argument(instance, function, "FMUstate", state)) return STATUS_ERROR;
     free(*state);
     *state = NULL;
-    return fmi2OK;
+    return STATUS_OK;
 }
 
-fmi2Status instance_serialized_state_size(Instance *instance, fmi2FMUstate state, size_t *size) {
-    if (instance_null_argument(instance, "fmi2SerializedFMUstateSize", "FMUstate", state) ||
-        instance_null_argument(instance, "fmi2SerializedFMUstateSize", "size", size))
-        return fmi2Error;
+Status instance_serialized_state_size(Instance *instance, const char *function, const void *state,
+                                      size_t *size) {
+    if (instance_null_argument(instance, function, "FMUstate", state) ||
+        instance_null_argument(instance, function, "size", size))
+        return STATUS_ERROR;
     *size = SERIALIZED_SIZE;
-    return fmi2OK;
+    return STATUS_OK;
 }
 
-fmi2Status instance_serialize_state(Instance *instance, fmi2FMUstate state, fmi2Byte bytes[],
-                                    size_t size) {
-    const char *function = "fmi2SerializeFMUstate";
+Status instance_serialize_state(Instance *instance, const char *function, const void *state,
+                                unsigned char bytes[], size_t size) {
     if (instance_null_argument(instance, function, "FMUstate", state) ||
         instance_null_argument(instance, function, "serializedState", bytes))
-        return fmi2Error;
+        return STATUS_ERROR;
     if (size < SERIALIZED_SIZE)
         return instance_error(instance, function, "size %lu is too small: %lu bytes needed",
                               (unsigned long)size, (unsigned long)SERIALIZED_SIZE);
-    unsigned char *out = (unsigned char *)bytes;
+    unsigned char *out = bytes;
     memcpy(out, STATE_MAGIC, 4);
     put_u32(out + 4, STATE_FORMAT_VERSION);
     put_u32(out + 8, (uint32_t)sizeof(InstanceData));
     memcpy(out + HEADER_SIZE, state, sizeof(InstanceData));
     const uint64_t checksum = fnv1a(out, HEADER_SIZE + sizeof(InstanceData));
     memcpy(out + HEADER_SIZE + sizeof(InstanceData), &checksum, CHECKSUM_SIZE);
-    return fmi2OK;
+    return STATUS_OK;
 }
 
-fmi2Status instance_deserialize_state(Instance *instance, const fmi2Byte bytes[], size_t size,
-                                      fmi2FMUstate *state) {
-    const char *function = "fmi2DeSerializeFMUstate";
+Status instance_deserialize_state(Instance *instance, const char *function,
+                                  const unsigned char bytes[], size_t size, void **state) {
     if (instance_null_argument(instance, function, "serializedState", bytes) ||
         instance_null_argument(instance, function, "FMUstate", state))
-        return fmi2Error;
-    const unsigned char *in = (const unsigned char *)bytes;
+        return STATUS_ERROR;
+    const unsigned char *in = bytes;
     if (size < HEADER_SIZE || memcmp(in, STATE_MAGIC, 4) != 0)
         return instance_error(instance, function, "not a serialized state of this FMU (bad magic)");
     if (get_u32(in + 4) != STATE_FORMAT_VERSION)
@@ -138,5 +140,5 @@ fmi2Status instance_deserialize_state(Instance *instance, const fmi2Byte bytes[]
     if (!copy) return instance_error(instance, function, "out of memory");
     *copy = data;
     *state = copy;
-    return fmi2OK;
+    return STATUS_OK;
 }

@@ -14,7 +14,7 @@ static const char *const category_names[] = {"logStatusWarning", "logStatusDisca
                                              "logStatusError", "logAll"};
 #define N_CATEGORIES (sizeof(category_names) / sizeof(category_names[0]))
 
-void instance_log(const Instance *instance, fmi2Status status, LogCategory category,
+void instance_log(const Instance *instance, Status status, LogCategory category,
                   const char *format, ...) {
     char message[512];
     va_list args;
@@ -29,17 +29,22 @@ void instance_log(const Instance *instance, fmi2Status status, LogCategory categ
        drop the arguments; so no '%' from a master's strings may reach a master that formats it. */
     for (char *c = message; *c; c++)
         if (*c == '%') *c = '#';
-    instance->logger(instance->environment, instance->name, status, category_names[index], message);
+    instance->logger.forward(instance->logger.master_logger, instance->logger.environment,
+                             instance->name, status, category_names[index], message);
 }
 
-fmi2Status instance_error(const Instance *instance, const char *function, const char *format, ...) {
+Status instance_error(const Instance *instance, const char *function, const char *format, ...) {
     char message[448];
     va_list args;
     va_start(args, format);
     vsnprintf(message, sizeof(message), format, args);
     va_end(args);
-    instance_log(instance, fmi2Error, LOG_STATUS_ERROR, "%s: %s", function, message);
-    return fmi2Error;
+    instance_log(instance, STATUS_ERROR, LOG_STATUS_ERROR, "%s: %s", function, message);
+    return STATUS_ERROR;
+}
+
+Status instance_not_supported(const Instance *instance, const char *function, const char *why) {
+    return instance_error(instance, function, "not supported: %s", why);
 }
 
 static const char *state_name(int state) {
@@ -69,31 +74,27 @@ int instance_null_argument(const Instance *instance, const char *function, const
     return 1;
 }
 
-Instance *instance_create(fmi2String name, fmi2String guid, fmi2Type type,
-                          const fmi2CallbackFunctions *callbacks, fmi2Boolean logging_on) {
-    /* Without a logger there is nobody to tell why we refuse: FMI 2.0 requires one. */
-    if (!callbacks || !callbacks->logger) return NULL;
+Instance *instance_create(const char *function, const char *name, const char *token_argument,
+                          const char *token, InterfaceType type, const Logger *logger, int logging_on) {
+    /* Without a logger there is nobody to tell why we refuse: both standards require one. */
+    if (!logger || !logger->master_logger) return NULL;
     Instance probe;
     memset(&probe, 0, sizeof(probe));
-    probe.logger = callbacks->logger;
-    probe.environment = callbacks->componentEnvironment;
+    probe.logger = *logger;
     snprintf(probe.name, sizeof(probe.name), "%s", name ? name : "?");
 
     if (!name || !name[0])
-        return instance_error(&probe, "fmi2Instantiate", "instanceName must be a non-empty string"), NULL;
-    if (!guid || strcmp(guid, MODEL_GUID) != 0)
-        return instance_error(&probe, "fmi2Instantiate",
-                              "fmuGUID %s does not match this FMU's %s (was modelDescription.xml "
-                              "taken from another FMU?)", guid ? guid : "NULL", MODEL_GUID), NULL;
-    if (type != fmi2CoSimulation && type != fmi2ModelExchange)
-        return instance_error(&probe, "fmi2Instantiate",
-                              "fmuType %d is neither fmi2ModelExchange (0) nor fmi2CoSimulation (1)",
-                              (int)type), NULL;
+        return instance_error(&probe, function, "instanceName must be a non-empty string"), NULL;
+    if (!token || strcmp(token, MODEL_GUID) != 0)
+        return instance_error(&probe, function,
+                              "%s %s does not match this FMU's %s (was the model description "
+                              "taken from another FMU?)", token_argument, token ? token : "NULL",
+                              MODEL_GUID), NULL;
     probe.type = type;
 
     Instance *instance = calloc(1, sizeof(Instance));
     if (!instance)
-        return instance_error(&probe, "fmi2Instantiate", "out of memory"), NULL;
+        return instance_error(&probe, function, "out of memory"), NULL;
     *instance = probe;
     instance->log_categories = logging_on ? (LOG_STATUS_WARNING | LOG_STATUS_DISCARD
                                              | LOG_STATUS_ERROR | LOG_ALL) : 0;
@@ -119,62 +120,67 @@ void instance_data_changed(Instance *instance) {
     instance->outputs_stale = 1;
 }
 
-fmi2Status instance_set_debug_logging(Instance *instance, fmi2Boolean logging_on,
-                                      size_t n_categories, const fmi2String categories[]) {
+Status instance_set_debug_logging(Instance *instance, const char *function, int logging_on,
+                                  size_t n_categories, const char *const categories[]) {
     int bits = 0;
     if (n_categories == 0) {
         bits = LOG_STATUS_WARNING | LOG_STATUS_DISCARD | LOG_STATUS_ERROR | LOG_ALL;
     } else {
-        if (instance_null_argument(instance, "fmi2SetDebugLogging", "categories", categories))
-            return fmi2Error;
+        if (instance_null_argument(instance, function, "categories", categories))
+            return STATUS_ERROR;
         for (size_t i = 0; i < n_categories; i++) {
             size_t c = 0;
             while (c < N_CATEGORIES && !(categories[i] && strcmp(categories[i], category_names[c]) == 0)) c++;
             if (c == N_CATEGORIES)
-                return instance_error(instance, "fmi2SetDebugLogging", "unknown log category %s",
+                return instance_error(instance, function, "unknown log category %s",
                                       categories[i] ? categories[i] : "NULL");
             bits |= 1 << c;
         }
     }
     instance->log_categories = logging_on ? (instance->log_categories | bits)
                                           : (instance->log_categories & ~bits);
-    return fmi2OK;
+    return STATUS_OK;
 }
 
-fmi2Status instance_setup_experiment(Instance *instance, fmi2Boolean tolerance_defined,
-                                     fmi2Real tolerance, fmi2Real start_time) {
+Status instance_setup_experiment(Instance *instance, const char *function, int tolerance_defined,
+                                 double tolerance, double start_time) {
     if (!isfinite(start_time))
-        return instance_error(instance, "fmi2SetupExperiment", "startTime must be finite");
+        return instance_error(instance, function, "startTime must be finite");
     if (tolerance_defined) {
         if (!(tolerance > 0 && tolerance < 1))
-            return instance_error(instance, "fmi2SetupExperiment",
-                                  "tolerance %g must be in (0, 1)", tolerance);
+            return instance_error(instance, function, "tolerance %g must be in (0, 1)", tolerance);
         instance->data.tolerance = tolerance;
     }
     instance->data.time = start_time;
     instance->data.last_successful_time = start_time;
-    return fmi2OK;
+    return STATUS_OK;
 }
 
-fmi2Status instance_exit_initialization(Instance *instance) {
+Status instance_exit_initialization(Instance *instance, const char *function) {
     const char *problem = model_invalid_parameters(instance->data.values);
-    if (problem) return instance_error(instance, "fmi2ExitInitializationMode", "%s", problem);
+    if (problem) return instance_error(instance, function, "%s", problem);
     for (size_t vr = 0; vr < N_VARIABLES; vr++) {
         if (!isfinite(instance->data.values[vr]))
-            return instance_error(instance, "fmi2ExitInitializationMode", "%s is not finite",
-                                  model_variables[vr].name);
+            return instance_error(instance, function, "%s is not finite", model_variables[vr].name);
     }
     instance_data_changed(instance);
     instance->data.machine_state =
-        instance->type == fmi2CoSimulation ? STATE_STEP_COMPLETE : STATE_EVENT_MODE;
-    return fmi2OK;
+        instance->type == INTERFACE_CO_SIMULATION ? STATE_STEP_COMPLETE : STATE_EVENT_MODE;
+    return STATUS_OK;
 }
 
-static const char *unknown_reference(fmi2ValueReference vr) {
-    return vr < N_VARIABLES ? NULL : "is not a value reference of this FMU";
+int instance_known_references(const Instance *instance, const char *function,
+                              const unsigned int vr[], size_t nvr) {
+    for (size_t i = 0; i < nvr; i++) {
+        if (vr[i] >= N_VARIABLES) {
+            instance_error(instance, function, "vr %u is not a value reference of this FMU", vr[i]);
+            return 0;
+        }
+    }
+    return 1;
 }
 
-/* Why a variable may not be set in this state, or NULL when it may (FMI 2.0, section 3.2.3). */
+/* Why a variable may not be set in this state, or NULL when it may (FMI 2.0 section 3.2.3, FMI 3.0 section 2.2.4). */
 static const char *why_not_settable(const VariableInfo *variable, int state) {
     const int input = variable->causality == CAUSALITY_INPUT;
     const int exact = variable->initial == INITIAL_EXACT;
@@ -195,18 +201,17 @@ static const char *why_not_settable(const VariableInfo *variable, int state) {
     }
 }
 
-fmi2Status instance_set_real(Instance *instance, const fmi2ValueReference vr[], size_t nvr,
-                             const fmi2Real value[]) {
+Status instance_set_real(Instance *instance, const char *function, const unsigned int vr[],
+                         size_t nvr, const double value[]) {
     /* All checked before any is set, so a refused call changes nothing. */
+    if (!instance_known_references(instance, function, vr, nvr)) return STATUS_ERROR;
     for (size_t i = 0; i < nvr; i++) {
-        const char *problem = unknown_reference(vr[i]);
-        if (problem) return instance_error(instance, "fmi2SetReal", "vr %u %s", vr[i], problem);
         const VariableInfo *variable = &model_variables[vr[i]];
-        problem = why_not_settable(variable, instance->data.machine_state);
-        if (problem) return instance_error(instance, "fmi2SetReal", "cannot set %s: %s",
-                                           variable->name, problem);
+        const char *problem = why_not_settable(variable, instance->data.machine_state);
+        if (problem) return instance_error(instance, function, "cannot set %s: %s", variable->name,
+                                           problem);
         if (!isfinite(value[i]))
-            return instance_error(instance, "fmi2SetReal",
+            return instance_error(instance, function,
                                   "%s = %g refused: values must be finite; %s keeps %.17g",
                                   variable->name, value[i], variable->name,
                                   instance->data.values[vr[i]]);
@@ -218,15 +223,12 @@ fmi2Status instance_set_real(Instance *instance, const fmi2ValueReference vr[], 
     }
     if (parameters_changed) model_coefficients(instance->data.values, &instance->coefficients);
     if (nvr > 0) instance->outputs_stale = 1;
-    return fmi2OK;
+    return STATUS_OK;
 }
 
-fmi2Status instance_get_real(Instance *instance, const fmi2ValueReference vr[], size_t nvr,
-                             fmi2Real value[]) {
-    for (size_t i = 0; i < nvr; i++) {
-        if (unknown_reference(vr[i]))
-            return instance_error(instance, "fmi2GetReal", "vr %u %s", vr[i], unknown_reference(vr[i]));
-    }
+Status instance_get_real(Instance *instance, const char *function, const unsigned int vr[],
+                         size_t nvr, double value[]) {
+    if (!instance_known_references(instance, function, vr, nvr)) return STATUS_ERROR;
     for (size_t i = 0; i < nvr; i++) {
         /* Calculated outputs are brought up to date only when one is asked for. */
         if (instance->outputs_stale && model_variables[vr[i]].initial == INITIAL_CALCULATED) {
@@ -235,83 +237,118 @@ fmi2Status instance_get_real(Instance *instance, const fmi2ValueReference vr[], 
         }
         value[i] = instance->data.values[vr[i]];
     }
-    return fmi2OK;
+    return STATUS_OK;
 }
 
-fmi2Status instance_set_input_derivatives(Instance *instance, const fmi2ValueReference vr[],
-                                          size_t nvr, const fmi2Integer order[],
-                                          const fmi2Real value[]) {
-    const char *function = "fmi2SetRealInputDerivatives";
-    if (instance->type != fmi2CoSimulation)
+Status instance_set_input_derivatives(Instance *instance, const char *function,
+                                      const unsigned int vr[], size_t nvr, const int order[],
+                                      const double value[]) {
+    if (instance->type != INTERFACE_CO_SIMULATION)
         return instance_error(instance, function, "input derivatives are for co-simulation only");
+    if (!instance_known_references(instance, function, vr, nvr)) return STATUS_ERROR;
     for (size_t i = 0; i < nvr; i++) {
-        if (unknown_reference(vr[i]))
-            return instance_error(instance, function, "vr %u %s", vr[i], unknown_reference(vr[i]));
         const VariableInfo *variable = &model_variables[vr[i]];
         if (variable->causality != CAUSALITY_INPUT)
             return instance_error(instance, function, "%s is not an input", variable->name);
-        if (order[i] != 1)
-            return instance_error(instance, function,
-                                  "order %d for %s: only first derivatives (a linear ramp over the "
-                                  "step) are supported", (int)order[i], variable->name);
+        if (order[i] < 1)
+            return instance_error(instance, function, "order %d for %s: orders start at 1",
+                                  order[i], variable->name);
         if (!isfinite(value[i]))
             return instance_error(instance, function, "derivative of %s = %g refused: must be finite",
                                   variable->name, value[i]);
     }
-    for (size_t i = 0; i < nvr; i++) instance->data.input_rates[vr[i]] = value[i];
-    return fmi2OK;
-}
-
-fmi2Status instance_get_output_derivatives(Instance *instance, const fmi2ValueReference vr[],
-                                           size_t nvr, const fmi2Integer order[], fmi2Real value[]) {
+    Status status = STATUS_OK;
     for (size_t i = 0; i < nvr; i++) {
-        if (unknown_reference(vr[i]) ||
-            !model_output_derivative(&instance->coefficients, instance->data.values,
-                                     instance->data.input_rates, vr[i], order[i], &value[i]))
-            return instance_error(instance, "fmi2GetRealOutputDerivatives",
-                                  "no derivative of order %d for vr %u (outputs theta, omega, alpha; "
-                                  "orders 1 and 2)", (int)order[i], vr[i]);
+        if (order[i] == 1) {
+            instance->data.inputs.first[vr[i]] = value[i];
+        } else if (order[i] == 2) {
+            instance->data.inputs.second[vr[i]] = value[i];
+        } else if (!instance->ignored_orders_logged) {
+            /* An extrapolating master sends every order up to maxOutputDerivativeOrder of the
+               FMU it connects; a quadratic over one step is all the accuracy the integrator
+               can use, so the rest is ignored rather than refused. */
+            instance->ignored_orders_logged = 1;
+            instance_log(instance, STATUS_WARNING, LOG_STATUS_WARNING,
+                         "%s: order %d for %s ignored: inputs follow their first and second "
+                         "derivatives only (logged once per instance)", function, order[i],
+                         model_variables[vr[i]].name);
+            status = STATUS_WARNING;
+        }
     }
-    return fmi2OK;
+    return status;
 }
 
-fmi2Status instance_directional_derivative(Instance *instance, const fmi2ValueReference unknown[],
-                                           size_t n_unknown, const fmi2ValueReference known[],
-                                           size_t n_known, const fmi2Real known_delta[],
-                                           fmi2Real unknown_delta[]) {
+Status instance_get_output_derivatives(Instance *instance, const char *function,
+                                       const unsigned int vr[], size_t nvr, const int order[],
+                                       double value[]) {
+    for (size_t i = 0; i < nvr; i++) {
+        if (vr[i] >= N_VARIABLES ||
+            !model_output_derivative(&instance->coefficients, instance->data.values,
+                                     &instance->data.inputs, vr[i], order[i], &value[i]))
+            return instance_error(instance, function,
+                                  "no derivative of order %d for vr %u (outputs theta, omega, alpha; "
+                                  "orders 1 and 2)", order[i], vr[i]);
+    }
+    return STATUS_OK;
+}
+
+/* d unknown / d known, or 0 after logging why there is none. */
+static int partial(Instance *instance, const char *function, unsigned int unknown,
+                   unsigned int known, double *value) {
+    if (unknown < N_VARIABLES && known < N_VARIABLES &&
+        model_partial_derivative(&instance->coefficients, instance->data.values, unknown, known, value))
+        return 1;
+    instance_error(instance, function, "no partial derivative of vr %u with respect to vr %u",
+                   unknown, known);
+    return 0;
+}
+
+Status instance_directional_derivative(Instance *instance, const char *function,
+                                       const unsigned int unknown[], size_t n_unknown,
+                                       const unsigned int known[], size_t n_known,
+                                       const double known_delta[], double unknown_delta[]) {
     for (size_t i = 0; i < n_unknown; i++) {
-        double sum = 0.0;
+        double sum = 0.0, value;
         for (size_t j = 0; j < n_known; j++) {
-            double partial;
-            if (unknown_reference(unknown[i]) || unknown_reference(known[j]) ||
-                !model_partial_derivative(&instance->coefficients, instance->data.values,
-                                          unknown[i], known[j], &partial))
-                return instance_error(instance, "fmi2GetDirectionalDerivative",
-                                      "no partial derivative of vr %u with respect to vr %u",
-                                      unknown[i], known[j]);
-            sum += partial * known_delta[j];
+            if (!partial(instance, function, unknown[i], known[j], &value)) return STATUS_ERROR;
+            sum += value * known_delta[j];
         }
         unknown_delta[i] = sum;
     }
-    return fmi2OK;
+    return STATUS_OK;
+}
+
+Status instance_adjoint_derivative(Instance *instance, const char *function,
+                                   const unsigned int unknown[], size_t n_unknown,
+                                   const unsigned int known[], size_t n_known,
+                                   const double unknown_seed[], double known_sensitivity[]) {
+    for (size_t j = 0; j < n_known; j++) {
+        double sum = 0.0, value;
+        for (size_t i = 0; i < n_unknown; i++) {
+            if (!partial(instance, function, unknown[i], known[j], &value)) return STATUS_ERROR;
+            sum += unknown_seed[i] * value;
+        }
+        known_sensitivity[j] = sum;
+    }
+    return STATUS_OK;
 }
 
 static void derivatives(const void *context, double offset, const double x[N_STATES],
                         double dx[N_STATES]) {
     const Instance *instance = context;
-    model_derivatives(&instance->coefficients, instance->data.values, instance->data.input_rates,
+    model_derivatives(&instance->coefficients, instance->data.values, &instance->data.inputs,
                       offset, x, dx);
 }
 
-fmi2Status instance_do_step(Instance *instance, fmi2Real communication_point,
-                            fmi2Real communication_step) {
+Status instance_do_step(Instance *instance, const char *function, double communication_point,
+                        double communication_step) {
     InstanceData *data = &instance->data;
     if (!(communication_step > 0) || !isfinite(communication_step))
-        return instance_error(instance, "fmi2DoStep",
+        return instance_error(instance, function,
                               "communicationStepSize %g must be positive and finite",
                               communication_step);
     if (!(fabs(communication_point - data->time) <= TIME_MATCH_TOLERANCE * fmax(1.0, fabs(data->time))))
-        return instance_error(instance, "fmi2DoStep",
+        return instance_error(instance, function,
                               "currentCommunicationPoint %.17g is not where the instance stands "
                               "(%.17g)", communication_point, data->time);
 
@@ -324,63 +361,72 @@ fmi2Status instance_do_step(Instance *instance, fmi2Real communication_point,
                                                  MAX_INTERNAL_STEPS, &step_size, &steps);
     if (result != DOPRI5_OK) {
         data->machine_state = STATE_STEP_FAILED;
-        instance_log(instance, fmi2Discard, LOG_STATUS_DISCARD,
-                     "fmi2DoStep: step from t = %.17g of size %g discarded after %ld internal steps: "
-                     "%s at tolerance %g; the instance stays at t = %.17g (roll back with "
-                     "fmi2SetFMUstate or take smaller steps)",
-                     communication_point, communication_step, steps,
+        instance_log(instance, STATUS_DISCARD, LOG_STATUS_DISCARD,
+                     "%s: step from t = %.17g of size %g discarded after %ld internal steps: "
+                     "%s at tolerance %g; the instance stays at t = %.17g (restore an FMU state "
+                     "or take smaller steps)",
+                     function, communication_point, communication_step, steps,
                      result == DOPRI5_STEP_BUDGET_EXHAUSTED ? "step budget exhausted"
                                                             : "step size underflow",
                      data->tolerance, data->time);
-        return fmi2Discard;
+        return STATUS_DISCARD;
     }
     model_set_states(data->values, x);
-    /* A ramped input is where the ramp has taken it. */
-    for (size_t vr = 0; vr < N_VARIABLES; vr++)
-        data->values[vr] += data->input_rates[vr] * communication_step;
+    /* The inputs are where their polynomials have taken them. */
+    for (size_t vr = 0; vr < N_VARIABLES; vr++) {
+        if (model_variables[vr].causality != CAUSALITY_INPUT) continue;
+        data->values[vr] = input_at(data->values, &data->inputs, (int)vr, communication_step);
+        data->inputs.first[vr] += communication_step * data->inputs.second[vr];
+    }
     data->step_size = step_size;
     data->time = communication_point + communication_step;
     data->last_successful_time = data->time;
     instance->outputs_stale = 1;
-    return fmi2OK;
+    return STATUS_OK;
 }
 
 static int wrong_state_count(const Instance *instance, const char *function, size_t nx) {
     if (nx == N_STATES) return 0;
-    instance_error(instance, function, "nx = %lu, but the model has %d continuous states "
-                   "(theta, omega)", (unsigned long)nx, N_STATES);
+    instance_error(instance, function, "nx = %lu, but the model has %d continuous states",
+                   (unsigned long)nx, N_STATES);
     return 1;
 }
 
-fmi2Status instance_set_time(Instance *instance, fmi2Real time) {
-    if (!isfinite(time)) return instance_error(instance, "fmi2SetTime", "time must be finite");
+Status instance_set_time(Instance *instance, const char *function, double time) {
+    if (!isfinite(time)) return instance_error(instance, function, "time must be finite");
     instance->data.time = time;
-    return fmi2OK;
+    return STATUS_OK;
 }
 
-fmi2Status instance_set_states(Instance *instance, const fmi2Real x[], size_t nx) {
-    if (wrong_state_count(instance, "fmi2SetContinuousStates", nx)) return fmi2Error;
+Status instance_set_states(Instance *instance, const char *function, const double x[], size_t nx) {
+    if (wrong_state_count(instance, function, nx)) return STATUS_ERROR;
     for (size_t i = 0; i < nx; i++) {
         if (!isfinite(x[i]))
-            return instance_error(instance, "fmi2SetContinuousStates",
-                                  "x[%lu] = %g refused: states must be finite", (unsigned long)i, x[i]);
+            return instance_error(instance, function, "x[%lu] = %g refused: states must be finite",
+                                  (unsigned long)i, x[i]);
     }
     model_set_states(instance->data.values, x);
     instance->outputs_stale = 1;
-    return fmi2OK;
+    return STATUS_OK;
 }
 
-fmi2Status instance_get_states(Instance *instance, fmi2Real x[], size_t nx) {
-    if (wrong_state_count(instance, "fmi2GetContinuousStates", nx)) return fmi2Error;
+Status instance_get_states(Instance *instance, const char *function, double x[], size_t nx) {
+    if (wrong_state_count(instance, function, nx)) return STATUS_ERROR;
     model_get_states(instance->data.values, x);
-    return fmi2OK;
+    return STATUS_OK;
 }
 
-fmi2Status instance_get_derivatives(Instance *instance, fmi2Real dx[], size_t nx) {
-    if (wrong_state_count(instance, "fmi2GetDerivatives", nx)) return fmi2Error;
+Status instance_get_derivatives(Instance *instance, const char *function, double dx[], size_t nx) {
+    if (wrong_state_count(instance, function, nx)) return STATUS_ERROR;
     double x[N_STATES];
     model_get_states(instance->data.values, x);
-    model_derivatives(&instance->coefficients, instance->data.values, instance->data.input_rates,
-                      0.0, x, dx);
-    return fmi2OK;
+    model_derivatives(&instance->coefficients, instance->data.values, &instance->data.inputs, 0.0,
+                      x, dx);
+    return STATUS_OK;
+}
+
+Status instance_get_nominals(Instance *instance, const char *function, double nominals[], size_t nx) {
+    if (wrong_state_count(instance, function, nx)) return STATUS_ERROR;
+    for (size_t i = 0; i < nx; i++) nominals[i] = 1.0; /* the states are of order one in SI */
+    return STATUS_OK;
 }

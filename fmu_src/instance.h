@@ -1,15 +1,32 @@
 #ifndef INSTANCE_H
 #define INSTANCE_H
 
-/* An FMU instance and the checks every FMI call goes through. Nothing here knows what the
-   variables mean: that is model.c's business. */
+/* An FMU instance and the checks every call goes through, for either FMI standard: nothing here
+   includes an FMI header or knows what the variables mean. The adapters (fmi2_functions.c,
+   fmi3_functions.c) translate their standard's types to these and name the function that was
+   called, so every message speaks the master's language. */
 
+#include <stddef.h>
 #include <stdint.h>
 
-#include "fmi2Functions.h"
 #include "model.h"
 
-/* The FMI 2.0 states, as bits so that each function's allowed states are a mask. Co-simulation
+/* Same order and values as fmi2Status and fmi3Status, so an adapter converts by a cast. */
+typedef enum {
+    STATUS_OK,
+    STATUS_WARNING,
+    STATUS_DISCARD,
+    STATUS_ERROR,
+    STATUS_FATAL
+} Status;
+
+typedef enum {
+    INTERFACE_MODEL_EXCHANGE,
+    INTERFACE_CO_SIMULATION
+} InterfaceType;
+
+/* The machine states of both standards, as bits so that each function's allowed states are a
+   mask. STEP_COMPLETE is FMI 3.0's step mode and STEP_FAILED its step discarded. Co-simulation
    instances never reach the model-exchange states and vice versa, so the masks also keep each
    interface's functions to its own instances. */
 typedef enum {
@@ -28,9 +45,20 @@ typedef enum {
                                | STATE_CONTINUOUS_TIME_MODE | STATE_TERMINATED)
 
 #define DEFAULT_TOLERANCE 1e-10
-/* Internal steps one fmi2DoStep may try before it gives up with fmi2Discard. */
+/* Internal steps one communication step may try before it gives up with a discard. */
 #define MAX_INTERNAL_STEPS 100000L
 #define MAX_INSTANCE_NAME 128
+
+/* The master's logger as an adapter hands it over: its function, cast to a generic function
+   pointer, and forward, the adapter's function that casts it back and calls it. */
+typedef void (*AnyFunction)(void);
+typedef void (*LogForwarder)(AnyFunction master_logger, void *environment, const char *instance_name,
+                             Status status, const char *category, const char *message);
+typedef struct {
+    LogForwarder forward;
+    AnyFunction master_logger;
+    void *environment;
+} Logger;
 
 /* Everything that says where an instance stands. An FMU state is a copy of it and a serialized
    FMU state is its bytes, so a rollback restores results bit for bit. */
@@ -41,7 +69,7 @@ typedef struct {
     double tolerance;
     double step_size;                    /* the internal step carried between communication steps */
     double values[N_VARIABLES];          /* indexed by value reference */
-    double input_rates[N_VARIABLES];     /* first derivatives from fmi2SetRealInputDerivatives */
+    InputDerivatives inputs;             /* the inputs' derivatives at `time` */
 } InstanceData;
 
 typedef enum {
@@ -56,65 +84,85 @@ typedef struct {
     /* Derived from data: recomputed whenever data changes outside a step. */
     ModelCoefficients coefficients;
     int outputs_stale;
-    fmi2Type type;                       /* co-simulation or model exchange, fixed at instantiation */
-    fmi2CallbackLogger logger;
-    fmi2ComponentEnvironment environment;
+    int ignored_orders_logged;           /* the one message about input derivatives of order > 2 */
+    InterfaceType type;                  /* fixed at instantiation */
+    Logger logger;
     int log_categories;                  /* LogCategory bits switched on by the master */
     char name[MAX_INSTANCE_NAME];
 } Instance;
 
-Instance *instance_create(fmi2String name, fmi2String guid, fmi2Type type,
-                          const fmi2CallbackFunctions *callbacks, fmi2Boolean logging_on);
+/* Every function below takes `function`, the name of the FMI function the master called, for
+   its messages. */
+
+/* NULL (after logging why, when there is a logger) unless the arguments make an instance. */
+Instance *instance_create(const char *function, const char *name, const char *token_argument,
+                          const char *token, InterfaceType type, const Logger *logger, int logging_on);
 void instance_free(Instance *instance);
 void instance_reset(Instance *instance);
 
 /* Logs through the master's logger: status messages always, debug messages (category LOG_ALL)
    only when the master switched them on. */
-void instance_log(const Instance *instance, fmi2Status status, LogCategory category,
+void instance_log(const Instance *instance, Status status, LogCategory category,
                   const char *format, ...);
-fmi2Status instance_error(const Instance *instance, const char *function, const char *format, ...);
+Status instance_error(const Instance *instance, const char *function, const char *format, ...);
 
 /* 1 when the instance's machine state is in mask, else logs an illegal call sequence. */
 int instance_state_allows(const Instance *instance, int mask, const char *function);
 int instance_null_argument(const Instance *instance, const char *function, const char *argument,
                            const void *pointer);
+/* An error for a function the FMU does not support, saying why. */
+Status instance_not_supported(const Instance *instance, const char *function, const char *why);
+/* 1 when the value references are all variables of this FMU, else logs which is not. */
+int instance_known_references(const Instance *instance, const char *function,
+                              const unsigned int vr[], size_t nvr);
 
-fmi2Status instance_set_debug_logging(Instance *instance, fmi2Boolean logging_on,
-                                      size_t n_categories, const fmi2String categories[]);
-fmi2Status instance_setup_experiment(Instance *instance, fmi2Boolean tolerance_defined,
-                                     fmi2Real tolerance, fmi2Real start_time);
-fmi2Status instance_exit_initialization(Instance *instance);
-fmi2Status instance_get_real(Instance *instance, const fmi2ValueReference vr[], size_t nvr,
-                             fmi2Real value[]);
-fmi2Status instance_set_real(Instance *instance, const fmi2ValueReference vr[], size_t nvr,
-                             const fmi2Real value[]);
-fmi2Status instance_set_input_derivatives(Instance *instance, const fmi2ValueReference vr[],
-                                          size_t nvr, const fmi2Integer order[],
-                                          const fmi2Real value[]);
-fmi2Status instance_get_output_derivatives(Instance *instance, const fmi2ValueReference vr[],
-                                           size_t nvr, const fmi2Integer order[], fmi2Real value[]);
-fmi2Status instance_directional_derivative(Instance *instance, const fmi2ValueReference unknown[],
-                                           size_t n_unknown, const fmi2ValueReference known[],
-                                           size_t n_known, const fmi2Real known_delta[],
-                                           fmi2Real unknown_delta[]);
-fmi2Status instance_do_step(Instance *instance, fmi2Real communication_point,
-                            fmi2Real communication_step);
+Status instance_set_debug_logging(Instance *instance, const char *function, int logging_on,
+                                  size_t n_categories, const char *const categories[]);
+Status instance_setup_experiment(Instance *instance, const char *function, int tolerance_defined,
+                                 double tolerance, double start_time);
+Status instance_exit_initialization(Instance *instance, const char *function);
+Status instance_get_real(Instance *instance, const char *function, const unsigned int vr[],
+                         size_t nvr, double value[]);
+Status instance_set_real(Instance *instance, const char *function, const unsigned int vr[],
+                         size_t nvr, const double value[]);
+/* Orders 1 and 2 shape the inputs over the next steps; higher orders are ignored (one message
+   per instance). */
+Status instance_set_input_derivatives(Instance *instance, const char *function,
+                                      const unsigned int vr[], size_t nvr, const int order[],
+                                      const double value[]);
+Status instance_get_output_derivatives(Instance *instance, const char *function,
+                                       const unsigned int vr[], size_t nvr, const int order[],
+                                       double value[]);
+/* unknown_delta = J * known_delta, J[i][j] = d unknown[i] / d known[j]. */
+Status instance_directional_derivative(Instance *instance, const char *function,
+                                       const unsigned int unknown[], size_t n_unknown,
+                                       const unsigned int known[], size_t n_known,
+                                       const double known_delta[], double unknown_delta[]);
+/* known_sensitivity = J^T * unknown_seed, the same J. */
+Status instance_adjoint_derivative(Instance *instance, const char *function,
+                                   const unsigned int unknown[], size_t n_unknown,
+                                   const unsigned int known[], size_t n_known,
+                                   const double unknown_seed[], double known_sensitivity[]);
+Status instance_do_step(Instance *instance, const char *function, double communication_point,
+                        double communication_step);
 
 /* Model exchange: the continuous states and their derivatives. */
-fmi2Status instance_set_time(Instance *instance, fmi2Real time);
-fmi2Status instance_set_states(Instance *instance, const fmi2Real x[], size_t nx);
-fmi2Status instance_get_states(Instance *instance, fmi2Real x[], size_t nx);
-fmi2Status instance_get_derivatives(Instance *instance, fmi2Real dx[], size_t nx);
+Status instance_set_time(Instance *instance, const char *function, double time);
+Status instance_set_states(Instance *instance, const char *function, const double x[], size_t nx);
+Status instance_get_states(Instance *instance, const char *function, double x[], size_t nx);
+Status instance_get_derivatives(Instance *instance, const char *function, double dx[], size_t nx);
+Status instance_get_nominals(Instance *instance, const char *function, double nominals[], size_t nx);
 
-/* FMU states (fmu_state.c). */
-fmi2Status instance_get_state(Instance *instance, fmi2FMUstate *state);
-fmi2Status instance_set_state(Instance *instance, fmi2FMUstate state);
-fmi2Status instance_free_state(Instance *instance, fmi2FMUstate *state);
-fmi2Status instance_serialized_state_size(Instance *instance, fmi2FMUstate state, size_t *size);
-fmi2Status instance_serialize_state(Instance *instance, fmi2FMUstate state, fmi2Byte bytes[],
-                                    size_t size);
-fmi2Status instance_deserialize_state(Instance *instance, const fmi2Byte bytes[], size_t size,
-                                      fmi2FMUstate *state);
+/* FMU states (fmu_state.c): opaque to the adapters, which pass their fmi*FMUstate through. */
+Status instance_get_state(Instance *instance, const char *function, void **state);
+Status instance_set_state(Instance *instance, const char *function, const void *state);
+Status instance_free_state(Instance *instance, const char *function, void **state);
+Status instance_serialized_state_size(Instance *instance, const char *function, const void *state,
+                                      size_t *size);
+Status instance_serialize_state(Instance *instance, const char *function, const void *state,
+                                unsigned char bytes[], size_t size);
+Status instance_deserialize_state(Instance *instance, const char *function,
+                                  const unsigned char bytes[], size_t size, void **state);
 /* Recomputes what is derived from data after data was replaced wholesale. */
 void instance_data_changed(Instance *instance);
 

@@ -43,9 +43,9 @@ static double acceleration(const ModelCoefficients *k, double theta, double omeg
 }
 
 void model_derivatives(const ModelCoefficients *coefficients, const double values[N_VARIABLES],
-                       const double input_rates[N_VARIABLES], double offset,
+                       const InputDerivatives *inputs, double offset,
                        const double x[N_STATES], double dx[N_STATES]) {
-    const double torque = values[VR_TORQUE] + offset * input_rates[VR_TORQUE];
+    const double torque = input_at(values, inputs, VR_TORQUE, offset);
     dx[0] = x[1];
     dx[1] = acceleration(coefficients, x[0], x[1], torque);
 }
@@ -55,14 +55,14 @@ void model_update_outputs(const ModelCoefficients *coefficients, double values[N
 }
 
 int model_output_derivative(const ModelCoefficients *k, const double values[N_VARIABLES],
-                            const double input_rates[N_VARIABLES], unsigned int vr, int order,
+                            const InputDerivatives *inputs, unsigned int vr, int order,
                             double *derivative) {
     const double theta = values[VR_THETA], omega = values[VR_OMEGA];
     const double alpha = acceleration(k, theta, omega, values[VR_TORQUE]);
-    /* The torque ramps linearly over a step, so its second derivative is zero. */
-    const double jerk = (input_rates[VR_TORQUE] - k->gravity_moment * cos(theta) * omega
+    const double jerk = (inputs->first[VR_TORQUE] - k->gravity_moment * cos(theta) * omega
                          - k->damping * alpha) * k->inverse_inertia;
-    const double snap = (k->gravity_moment * (sin(theta) * omega * omega - cos(theta) * alpha)
+    const double snap = (inputs->second[VR_TORQUE]
+                         + k->gravity_moment * (sin(theta) * omega * omega - cos(theta) * alpha)
                          - k->damping * jerk) * k->inverse_inertia;
     /* theta, omega, alpha are successive derivatives: the order-th derivative of the output
        at position p in that chain is the entry at p + order. */

@@ -8,6 +8,20 @@
 #include "config.h"
 #include "model_variables.h"
 
+/* What a master said of how its inputs move over a step: first and second time derivatives at
+   the step's start (FMI 2.0's input derivatives; all zero holds the inputs). */
+#define MAX_INPUT_DERIVATIVE_ORDER 2
+typedef struct {
+    double first[N_VARIABLES];
+    double second[N_VARIABLES];
+} InputDerivatives;
+
+/* Input vr `offset` seconds into a step: its Taylor polynomial from the step's start. */
+static inline double input_at(const double values[N_VARIABLES], const InputDerivatives *derivatives,
+                              int vr, double offset) {
+    return values[vr] + offset * (derivatives->first[vr] + 0.5 * offset * derivatives->second[vr]);
+}
+
 /* NULL when the parameters make sense, else what is wrong with them. */
 const char *model_invalid_parameters(const double values[N_VARIABLES]);
 
@@ -16,10 +30,9 @@ void model_coefficients(const double values[N_VARIABLES], ModelCoefficients *coe
 void model_get_states(const double values[N_VARIABLES], double x[N_STATES]);
 void model_set_states(double values[N_VARIABLES], const double x[N_STATES]);
 
-/* dx/dt at `offset` seconds into a communication step: each input starts at values[] and
-   ramps with input_rates[] (zero rates hold it), as fmi2SetRealInputDerivatives asks. */
+/* dx/dt at `offset` seconds into a communication step, the inputs at input_at(offset). */
 void model_derivatives(const ModelCoefficients *coefficients, const double values[N_VARIABLES],
-                       const double input_rates[N_VARIABLES], double offset,
+                       const InputDerivatives *inputs, double offset,
                        const double x[N_STATES], double dx[N_STATES]);
 
 /* Brings the calculated outputs in values[] up to date with the states and inputs. */
@@ -27,7 +40,7 @@ void model_update_outputs(const ModelCoefficients *coefficients, double values[N
 
 /* The order-th time derivative of an output; returns 0 when vr or order is not supported. */
 int model_output_derivative(const ModelCoefficients *coefficients, const double values[N_VARIABLES],
-                            const double input_rates[N_VARIABLES], unsigned int vr, int order,
+                            const InputDerivatives *inputs, unsigned int vr, int order,
                             double *derivative);
 
 /* d(unknown)/d(known) for unknown an output or state derivative and known an input or state;

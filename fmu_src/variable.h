@@ -1,7 +1,7 @@
 #ifndef VARIABLE_H
 #define VARIABLE_H
 
-/* What the FMI plumbing must know of a variable to police fmi2SetReal. The table of these is
+/* What the FMI plumbing must know of a variable to police the setters. The table of these is
    generated from modelDescription.xml by the build, so the C code cannot drift from the XML. */
 
 typedef enum {

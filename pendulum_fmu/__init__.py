@@ -8,12 +8,12 @@ import contextlib
 from importlib import resources
 from pathlib import Path
 
-from .build import DEFAULT_FMU, build_fmu, fmu_is_stale, is_source_checkout
+from .build import DEFAULT_FMU, DEFAULT_FMU3, build_fmu, fmu_is_stale, is_source_checkout
 
 __all__ = ["__version__", "build_fmu", "default_fmu"]
 
 # FMI version -> (file in a checkout's dist/, file in the installed package's data/).
-_FMU_FILES = {2: (DEFAULT_FMU, "Pendulum.fmu")}
+_FMU_FILES = {2: (DEFAULT_FMU, "Pendulum.fmu"), 3: (DEFAULT_FMU3, "Pendulum-fmi3.fmu")}
 # Holds open the real files of packaged FMUs that importlib.resources had to extract (a zipped
 # install); a plain install hands out the files themselves.
 _extracted = contextlib.ExitStack()
@@ -32,7 +32,7 @@ def default_fmu(fmi_version: int = 2) -> Path:
     checkout_fmu, packaged_name = _FMU_FILES[fmi_version]
     if is_source_checkout():
         if fmu_is_stale(checkout_fmu):
-            build_fmu(checkout_fmu)
+            build_fmu(checkout_fmu, fmi_version=fmi_version)
         return checkout_fmu
     packaged = resources.files(__name__) / "data" / packaged_name
     if not packaged.is_file():

@@ -30,13 +30,15 @@ from pathlib import Path
 import fmpy
 from fmpy import read_model_description
 
-from . import __version__
+from . import __version__, fmi3
 from .files import replacing_path
 
 ROOT = Path(__file__).resolve().parent.parent
 SOURCE_DIR = ROOT / "fmu_src"
 MODEL_DESCRIPTION = ROOT / "modelDescription.xml"
 DEFAULT_FMU = ROOT / "dist" / "Pendulum.fmu"
+DEFAULT_FMU3 = ROOT / "dist" / "Pendulum-fmi3.fmu"
+FMI_VERSIONS = (2, 3)
 GENERATED_SOURCES = ("model_variables.h", "model_variables.c")
 MODEL_FILES = ("config.h", "model.c")
 PID_CONTROLLER_DIR = SOURCE_DIR / "pid_controller"
@@ -144,9 +146,11 @@ def _enum_name(causality: str) -> str:
     return "CALCULATED_PARAMETER" if causality == "calculatedParameter" else causality.upper()
 
 
-def _check_source_files(model_description, xml: Path, sources: Path) -> None:
+def _check_source_files(model_description, xml: Path, sources: Path, fmi_version: int = 2) -> None:
     for configuration in model_description.buildConfigurations:
         listed = set(configuration.sourceFileSets[0].sourceFiles)
+        if fmi_version == 3:
+            listed = listed - {fmi3.FMI2_ADAPTER} | {fmi3.FMI3_ADAPTER}
         present = {p.name for p in sources.glob("*.c")}
         if listed != present:
             raise BuildError(
@@ -156,19 +160,22 @@ def _check_source_files(model_description, xml: Path, sources: Path) -> None:
 
 
 def assemble_sources(sources: Path, model_dir: Path = SOURCE_DIR,
-                     model_description_file: Path = MODEL_DESCRIPTION) -> Path:
+                     model_description_file: Path = MODEL_DESCRIPTION, fmi_version: int = 2) -> Path:
     """Everything that compiles into the FMU, in one folder: what the FMU's sources/ holds, and
     what the tests' C driver and fuzzers link."""
     _check_sources_present()
-    _assemble_sources(Path(model_dir), read_model_description(str(model_description_file)), Path(sources))
+    _assemble_sources(Path(model_dir), read_model_description(str(model_description_file)), Path(sources),
+                      fmi_version)
     return Path(sources)
 
 
-def _assemble_sources(model_dir: Path, model_description, sources: Path) -> None:
-    """The plumbing from fmu_src/, the model from model_dir, the generated variables."""
+def _assemble_sources(model_dir: Path, model_description, sources: Path, fmi_version: int = 2) -> None:
+    """The plumbing from fmu_src/ (with the entry points of one FMI version), the model from
+    model_dir, the generated variables."""
     sources.mkdir()
+    left_out = {*MODEL_FILES, fmi3.adapter_left_out(fmi_version)}
     for path in SOURCE_DIR.iterdir():
-        if path.is_file() and path.name not in MODEL_FILES:
+        if path.is_file() and path.name not in left_out:
             shutil.copy2(path, sources)
     for name in MODEL_FILES:
         shutil.copy2(model_dir / name, sources)
@@ -238,7 +245,7 @@ def compile_library(source_dir: Path, out_file: Path, platform: str = "linux64",
     return out_file
 
 
-def documentation_html(model_description) -> str:
+def documentation_html(model_description, fmi_version: int = 2) -> str:
     """documentation/index.html: what the model is and every variable with its unit and meaning."""
     rows = "\n".join(
         "<tr>" + "".join(f"<td>{html.escape(str(cell))}</td>" for cell in (
@@ -257,13 +264,14 @@ table{{border-collapse:collapse}}td,th{{border:1px solid #999;padding:.2em .5em}
 <body>
 <h1>{name}</h1>
 <p>{html.escape(model_description.description or "")}</p>
-<p>FMI 2.0 {interfaces}, model identifier <code>{name}</code>.</p>
+<p>FMI {fmi_version}.0 {interfaces}, model identifier <code>{name}</code>.</p>
 <h2>Inside a communication step</h2>
-<p>Each <code>fmi2DoStep(t, h)</code> integrates exactly [t, t+h] with an error-controlled
+<p>Each <code>fmi{fmi_version}DoStep(t, h)</code> integrates exactly [t, t+h] with an error-controlled
 Dormand-Prince 5(4) Runge-Kutta method: internal steps end on t+h and never cross it, and the
 internal step size carries over between calls. Inputs are held over the step (zero-order
-hold) or, after <code>fmi2SetRealInputDerivatives</code> (order 1), ramp linearly from their
-values at t; a derivative holds until it is set again. The relative tolerance is
+hold) or, after <code>fmi2SetRealInputDerivatives</code> (orders 1 and 2; higher orders are
+ignored), follow their Taylor polynomial from their values at t until the derivatives are set
+again. FMI 3.0 has no input derivatives: there inputs are always held. The relative tolerance is
 <code>fmi2SetupExperiment</code>'s when defined, else 1e-10; the absolute tolerance equals it.
 A step that needs more than 100000 internal steps returns fmi2Discard and leaves the instance
 where it was.</p>
@@ -296,10 +304,12 @@ def available_platforms() -> tuple[str, ...]:
     return tuple(present)
 
 
-def _stamped_model_description(xml: Path) -> str:
-    """The model description as the FMU carries it: generationTool names this package's version."""
+def _stamped_model_description(xml: Path, fmi_version: int = 2) -> str:
+    """The model description as the FMU carries it (for FMI 3.0 generated from the FMI 2.0 one):
+    generationTool names this package's version."""
+    text = xml.read_text(encoding="utf-8") if fmi_version == 2 else fmi3.model_description(xml)
     text, count = re.subn(r'generationTool="[^"]*"', f'generationTool="pendulum_fmu {__version__}"',
-                          xml.read_text(encoding="utf-8"), count=1)
+                          text, count=1)
     if count != 1:
         raise BuildError(f"{xml}: no generationTool attribute to stamp the version into")
     return text
@@ -307,8 +317,12 @@ def _stamped_model_description(xml: Path) -> str:
 
 def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, *, model_dir: Path = SOURCE_DIR,
               model_description_file: Path = MODEL_DESCRIPTION,
-              platforms: tuple[str, ...] | None = None) -> Path:
+              platforms: tuple[str, ...] | None = None, fmi_version: int = 2) -> Path:
     """Build an FMU (binaries/, sources/, documentation/) and return its path.
+
+    fmi_version 3 builds the FMI 3.0 FMU from the same sources: its model description and
+    sources/buildDescription.xml are generated from the FMI 2.0 one by fmi3.py, its binaries go
+    into the FMI 3.0 platform folders and export only fmi3* functions.
 
     platforms: FMI 2.0 folder names (see PLATFORMS); None builds every platform whose compiler is
     present and warns (PlatformSkipped) about the others. A platform named explicitly must build.
@@ -317,6 +331,8 @@ def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, *, model_dir: Path = SO
     renamed into place whole, so builds into the same path at the same time all succeed.
     """
     _check_sources_present()
+    if fmi_version not in FMI_VERSIONS:
+        raise BuildError(f"FMI version {fmi_version}: choose among {', '.join(map(str, FMI_VERSIONS))}")
     if platforms is None:
         platforms = available_platforms()
     unknown = [name for name in platforms if name not in PLATFORMS]
@@ -328,21 +344,26 @@ def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, *, model_dir: Path = SO
     with tempfile.TemporaryDirectory(prefix="pendulum_fmu_build_") as tmp:
         tmp = Path(tmp)
         sources = tmp / "sources"
-        _assemble_sources(Path(model_dir), model_description, sources)
-        _check_source_files(model_description, model_description_file, sources)
+        _assemble_sources(Path(model_dir), model_description, sources, fmi_version)
+        _check_source_files(model_description, model_description_file, sources, fmi_version)
+        if fmi_version == 3:
+            (sources / "buildDescription.xml").write_text(fmi3.build_description(model_description_file))
         binaries = {}
         for name in platforms:
             folder = tmp / name
             folder.mkdir()
             library = folder / f"{identifier}{PLATFORMS[name].suffix}"
-            binaries[f"binaries/{name}/{library.name}"] = compile_library(sources, library, name)
+            platform_folder = name if fmi_version == 2 else PLATFORMS[name].fmi3_folder
+            binaries[f"binaries/{platform_folder}/{library.name}"] = compile_library(
+                sources, library, name, export_prefix=f"fmi{fmi_version}")
         with replacing_path(out_file) as partial, zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as fmu:
-            fmu.writestr("modelDescription.xml", _stamped_model_description(Path(model_description_file)))
+            fmu.writestr("modelDescription.xml",
+                         _stamped_model_description(Path(model_description_file), fmi_version))
             for name, binary in binaries.items():
                 fmu.write(binary, name)
             for source in sorted(sources.iterdir()):
                 fmu.write(source, f"sources/{source.name}")
-            fmu.writestr("documentation/index.html", documentation_html(model_description))
+            fmu.writestr("documentation/index.html", documentation_html(model_description, fmi_version))
     return Path(out_file)
 
 
@@ -355,7 +376,7 @@ def build_pid_controller(out_file: str | os.PathLike, *, platforms: tuple[str, .
 def build_inputs() -> list[Path]:
     """Every file a checkout's FMU is built from: when one is newer than the FMU, it is stale."""
     package = Path(__file__).parent
-    return [MODEL_DESCRIPTION, Path(__file__), package / "__init__.py",
+    return [MODEL_DESCRIPTION, Path(__file__), package / "__init__.py", Path(fmi3.__file__),
             *(p for p in SOURCE_DIR.iterdir() if p.is_file())]
 
 

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__
-from .build import DEFAULT_FMU, PLATFORMS, BuildError, PlatformSkipped, build_fmu
+from .build import DEFAULT_FMU, DEFAULT_FMU3, PLATFORMS, BuildError, PlatformSkipped, build_fmu
 
 TUTORIAL_TORQUE = 20.0
 
@@ -94,7 +94,8 @@ def _platforms(text: str) -> tuple[str, ...]:
 
 
 def cmd_build(args) -> int:
-    path = build_fmu(args.output, platforms=args.platforms)
+    output = args.output or (DEFAULT_FMU3 if args.fmi_version == 3 else DEFAULT_FMU)
+    path = build_fmu(output, platforms=args.platforms, fmi_version=args.fmi_version)
     with zipfile.ZipFile(path) as fmu:
         binaries = [name for name in fmu.namelist() if name.startswith("binaries/")]
     print(f"wrote {path} ({', '.join(binaries)})")
@@ -224,7 +225,7 @@ def cmd_demo(args) -> int:
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="pendulum-fmu",
-        description="A torque-driven pendulum as an FMI 2.0 Co-Simulation FMU: build it, "
+        description="A torque-driven pendulum as an FMI 2.0 (or 3.0) FMU: build it, "
                     "simulate it, and compare it with scipy and OpenSim.")
     parser.add_argument("--version", action="version", version=f"pendulum-fmu {__version__}")
     parser.add_argument("--debug", action="store_true", default=False,
@@ -234,8 +235,11 @@ def build_parser() -> argparse.ArgumentParser:
     build = commands.add_parser("build", help="build the FMU (same as python build_fmu.py)",
                                 description="Build the FMU from fmu_src/ and modelDescription.xml "
                                             "(a source checkout or the unpacked sdist).")
-    build.add_argument("--output", type=Path, default=DEFAULT_FMU,
-                       help="where to write the FMU (default: %(default)s)")
+    build.add_argument("--output", type=Path, default=None,
+                       help=f"where to write the FMU (default: {DEFAULT_FMU}, or {DEFAULT_FMU3} "
+                            "for FMI 3.0)")
+    build.add_argument("--fmi-version", type=int, choices=(2, 3), default=2,
+                       help="FMI standard of the FMU (default: %(default)s)")
     build.add_argument("--platforms", type=_platforms, default=None,
                        help=f"comma-separated, among {', '.join(PLATFORMS)} (default: every one "
                             "whose compiler is installed; the others are skipped with a note)")

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 from fmpy import extract
 from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
+from fmpy.fmi3 import FMU3Slave
 
 from . import results
 from . import default_fmu
@@ -26,18 +27,25 @@ class FmuError(RuntimeError):
 class MessageLog:
     """FMI callbacks whose logger keeps what the FMU says, so a failure can say why."""
 
-    def __init__(self):
+    def __init__(self, fmi_version: int = 2):
         self.lines: list[str] = []
+        if fmi_version == 3:
+            return  # log_fmi3 is the callback; no FMI 2.0 struct, so fmpy's proxy stays untouched
         self.callbacks = fmi2CallbackFunctions()
         self.callbacks.logger = fmi2CallbackLoggerTYPE(self._log)
         try:
-            # fmpy's C proxy formats printf-style arguments before they reach Python.
+            # fmpy's C proxy formats printf-style arguments before they reach Python. It keeps one
+            # logger per process: the newest FMI 2.0 MessageLog receives the messages.
             from fmpy.logging import addLoggerProxy
             addLoggerProxy(ctypes.byref(self.callbacks))
         except Exception:
             pass
 
     def _log(self, environment, instance_name, status, category, message):
+        self.log_fmi3(environment, status, category, message)
+
+    def log_fmi3(self, environment, status, category, message):
+        """FMI 3.0's logger, which has no instance name."""
         self.lines.append(f"[{_STATUS[status] if 0 <= status < 6 else status}] "
                           f"{message.decode('utf-8', 'replace')}")
 
@@ -64,25 +72,37 @@ def _unzipped(fmu_path: Path):
 def open_fmu(fmu_path: str | Path | None = None, *, parameters: dict | None = None,
              theta0: float = 0.0, omega0: float = 0.0, tolerance: float | None = None,
              start_time: float = 0.0, instance_name: str = "pendulum"):
-    """An initialized FMU2Slave (in step mode) and its message log.
+    """An initialized FMU2Slave or FMU3Slave (in step mode, the FMI version read from the FMU's
+    model description; slave.fmi_version says which) with its message log as slave.messages.
 
-    fmu_path defaults to pendulum_fmu.default_fmu(); parameters and value references are that
+    fmu_path defaults to pendulum_fmu.default_fmu() (FMI 2.0); parameters and value references are that
     FMU's own. The caller frees it with slave.terminate(); slave.freeInstance().
     """
     fmu_path = Path(fmu_path) if fmu_path else default_fmu()
     folder, description = _unzipped(fmu_path)
-    slave = FMU2Slave(guid=description.guid, unzipDirectory=folder,
-                      modelIdentifier=description.coSimulation.modelIdentifier,
-                      instanceName=instance_name)
-    messages = MessageLog()
-    slave.instantiate(callbacks=messages.callbacks)
+    fmi_version = int(description.fmiVersion[0])
+    messages = MessageLog(fmi_version)
+    arguments = dict(guid=description.guid, unzipDirectory=folder, instanceName=instance_name,
+                     modelIdentifier=description.coSimulation.modelIdentifier)
+    if fmi_version == 3:
+        slave = FMU3Slave(**arguments)
+        slave.instantiate(logMessage=messages.log_fmi3)
+    else:
+        slave = FMU2Slave(**arguments)
+        slave.instantiate(callbacks=messages.callbacks)
+    slave.fmi_version = fmi_version
     slave.messages = messages  # keeps the logger callback alive as long as the slave
     slave.fmu_path = fmu_path  # whose value references run_schedule uses
     start = {**resolve_parameters(parameters, fmu_path), "theta": float(theta0), "omega": float(omega0)}
+    references = [value_reference(n, fmu_path) for n in start]
     try:
-        slave.setupExperiment(tolerance=tolerance, startTime=start_time)
-        slave.enterInitializationMode()
-        slave.setReal([value_reference(n, fmu_path) for n in start], list(start.values()))
+        if fmi_version == 3:
+            slave.enterInitializationMode(tolerance=tolerance, startTime=start_time)
+            slave.setFloat64(references, list(start.values()))
+        else:
+            slave.setupExperiment(tolerance=tolerance, startTime=start_time)
+            slave.enterInitializationMode()
+            slave.setReal(references, list(start.values()))
         slave.exitInitializationMode()
     except Exception as error:
         slave.freeInstance()
@@ -90,52 +110,64 @@ def open_fmu(fmu_path: str | Path | None = None, *, parameters: dict | None = No
     return slave
 
 
-def run_schedule(slave: FMU2Slave, plan: TorqueSchedule) -> np.ndarray:
-    """Feed a schedule to an initialized slave; returns the result array (see results.py).
+def run_schedule(slave: FMU2Slave | FMU3Slave, plan: TorqueSchedule) -> np.ndarray:
+    """Feed a schedule to an initialized slave (from open_fmu); returns the result array (see
+    results.py).
 
     The FMI functions are bound once from the library fmpy loaded, without fmpy's argtypes (with
     them ctypes converts every argument on every call), and every argument is a ctypes object
     allocated before the loop, so a step costs little more than the FMU's own work.
     """
-    dll, messages = slave.dll, slave.messages
-    set_real, get_real, set_rate, do_step = (
-        dll[name] for name in ("fmi2SetReal", "fmi2GetReal", "fmi2SetRealInputDerivatives", "fmi2DoStep"))
+    dll, messages, fmi3 = slave.dll, slave.messages, slave.fmi_version == 3
+    ramped = bool(np.any(plan.torque_rate))
+    if fmi3 and ramped:
+        raise ValueError("FMI 3.0 has no input derivatives, so an FMI 3.0 FMU cannot ramp the "
+                         "torque: hold it over each step (no --ramp), or use the FMI 2.0 FMU")
+    names = (("fmi3SetFloat64", "fmi3GetFloat64", None, "fmi3DoStep") if fmi3 else
+             ("fmi2SetReal", "fmi2GetReal", "fmi2SetRealInputDerivatives", "fmi2DoStep"))
+    set_real, get_real, set_rate, do_step = (dll[name] if name else None for name in names)
     component = ctypes.c_void_p(slave.component)
     torque_vr = (ctypes.c_uint * 1)(value_reference("torque", slave.fmu_path))
     # The torque is read back with the outputs: the result records what the FMU received.
-    recorded_vr = (ctypes.c_uint * 4)(*(value_reference(n, slave.fmu_path) for n in ("torque", "theta", "omega", "alpha")))
+    recorded_vr = (ctypes.c_uint * 4)(*(value_reference(n, slave.fmu_path)
+                                        for n in ("torque", "theta", "omega", "alpha")))
     one, four = ctypes.c_size_t(1), ctypes.c_size_t(4)
     first_order = (ctypes.c_int * 1)(1)
     no_rollback = ctypes.c_int(1)
     torque, rate, recorded = (ctypes.c_double * 1)(), (ctypes.c_double * 1)(), (ctypes.c_double * 4)()
     recorded_bytes = memoryview(recorded).cast("B")
     time, step = ctypes.c_double(), ctypes.c_double()
-    ramped = bool(np.any(plan.torque_rate))
+    # FMI 3.0 getters and setters also take the number of values, and fmi3DoStep reports back.
+    torque_arguments = (component, torque_vr, one, torque) + ((one,) if fmi3 else ())
+    get_recorded = (component, recorded_vr, four, recorded) + ((four,) if fmi3 else ())
+    step_report = ((ctypes.byref(ctypes.c_bool()), ctypes.byref(ctypes.c_bool()),
+                    ctypes.byref(ctypes.c_bool()), ctypes.byref(ctypes.c_double())) if fmi3 else ())
+    step_arguments = (component, time, step, ctypes.c_bool(True) if fmi3 else no_rollback) + step_report
 
     rows = array.array("d")  # 32 bytes a step, not a Python list of floats
     for t, h, u, r in zip(plan.time.tolist(), plan.step_size.tolist(), plan.torque.tolist(),
                           plan.torque_rate.tolist()):
         torque[0] = u
-        status = set_real(component, torque_vr, one, torque)
+        status = set_real(*torque_arguments)
         if status > 1:
-            raise messages.error(status, f"fmi2SetReal at t = {t:.17g}")
+            raise messages.error(status, f"{names[0]} at t = {t:.17g}")
         if ramped:
             rate[0] = r
             status = set_rate(component, torque_vr, one, first_order, rate)
             if status > 1:
                 raise messages.error(status, f"fmi2SetRealInputDerivatives at t = {t:.17g}")
-        status = get_real(component, recorded_vr, four, recorded)
+        status = get_real(*get_recorded)
         if status > 1:
-            raise messages.error(status, f"fmi2GetReal at t = {t:.17g}")
+            raise messages.error(status, f"{names[1]} at t = {t:.17g}")
         rows.frombytes(recorded_bytes)
         time.value, step.value = t, h
-        status = do_step(component, time, step, no_rollback)
+        status = do_step(*step_arguments)
         if status > 1:
-            raise messages.error(status, f"fmi2DoStep at t = {t:.17g}")
+            raise messages.error(status, f"{names[3]} at t = {t:.17g}")
     # After a ramp the FMU's torque is where the ramp ended.
-    status = get_real(component, recorded_vr, four, recorded)
+    status = get_real(*get_recorded)
     if status > 1:
-        raise messages.error(status, "fmi2GetReal at the end")
+        raise messages.error(status, f"{names[1]} at the end")
     rows.frombytes(recorded_bytes)
 
     out = results.empty(len(plan.time))

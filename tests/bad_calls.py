@@ -14,11 +14,17 @@ from pathlib import Path
 from typing import Callable
 
 from fmpy.fmi2 import fmi2CallbackFunctions
+from fmpy.fmi3 import fmi3LogMessageCallback
 
 from pendulum_fmu.simulate import MessageLog
 
 OK, WARNING, DISCARD, ERROR = 0, 1, 2, 3
 STATUS_NAMES = ["fmi2OK", "fmi2Warning", "fmi2Discard", "fmi2Error", "fmi2Fatal", "fmi2Pending"]
+
+
+def status_name(call: str, status: int) -> str:
+    """fmi2Error, fmi3Error, ...: the status in the standard of the call."""
+    return call[:4] + STATUS_NAMES[status][4:]
 CO_SIMULATION, MODEL_EXCHANGE = 1, 0
 TORQUE, THETA, OMEGA, ALPHA, MASS, LENGTH, INERTIA, GRAVITY, DAMPING = range(9)
 
@@ -33,6 +39,10 @@ def refs(*references):
 
 class Harness:
     """The FMU's library through ctypes, with a logger that keeps what the FMU says."""
+
+    prefix = "fmi2"
+    state_calls = {"get": "fmi2GetFMUstate", "size": "fmi2SerializedFMUstateSize", "serialize": "fmi2SerializeFMUstate",
+                   "free": "fmi2FreeFMUstate", "deserialize": "fmi2DeSerializeFMUstate"}
 
     def __init__(self, library: Path, guid: str):
         self.lib = ctypes.CDLL(str(library))
@@ -80,6 +90,9 @@ class Harness:
         assert self.fmi2GetReal(component, refs(reference), 1, value) == OK
         return value[0]
 
+    def set(self, component, reference, value) -> int:
+        return self.fmi2SetReal(component, refs(reference), 1, reals(value))
+
     def step(self, component, time, size):
         return self.fmi2DoStep(component, ctypes.c_double(time), ctypes.c_double(size), 1)
 
@@ -88,8 +101,78 @@ class Harness:
 
     def close(self):
         for component in self.live:
-            self.lib.fmi2FreeInstance(ctypes.c_void_p(component))
+            getattr(self.lib, f"{self.prefix}FreeInstance")(ctypes.c_void_p(component))
         self.live.clear()
+
+
+
+class Harness3(Harness):
+    """The same for an FMI 3.0 binary: fmi3 entry points, FMI 3.0's logger."""
+
+    prefix = "fmi3"
+    state_calls = {"get": "fmi3GetFMUState", "size": "fmi3SerializedFMUStateSize", "serialize": "fmi3SerializeFMUState",
+                   "free": "fmi3FreeFMUState", "deserialize": "fmi3DeserializeFMUState"}
+
+    def __init__(self, library: Path, token: str):
+        self.lib = ctypes.CDLL(str(library))
+        for name in ("fmi3InstantiateCoSimulation", "fmi3InstantiateModelExchange"):
+            getattr(self.lib, name).restype = ctypes.c_void_p
+        self.guid = token.encode()
+        self.log = MessageLog(fmi_version=3)
+        self.logger = fmi3LogMessageCallback(self.log.log_fmi3)
+        self.live = []
+
+    def __getattr__(self, name):
+        """The library's function, with Python numbers passed as ctypes would not guess them: an
+        int as a 64-bit word (every integer argument, size_t or bool, takes a full register or
+        stack slot in the x86-64 and AArch64 calling conventions), a float as a double."""
+        function = getattr(self.lib, name)
+
+        def call(*arguments):
+            return function(*(ctypes.c_size_t(a) if isinstance(a, int) else
+                              ctypes.c_double(a) if isinstance(a, float) else a for a in arguments))
+        return call
+
+    def instantiate(self, name=b"robust", kind=CO_SIMULATION, guid=None, logger="default"):
+        logger = self.logger if logger == "default" else logger
+        token = self.guid if guid is None else guid
+        if kind == CO_SIMULATION:
+            component = self.lib.fmi3InstantiateCoSimulation(name, token, b"", False, False, False, False,
+                                                             None, ctypes.c_size_t(0), None, logger, None)
+        else:
+            component = self.lib.fmi3InstantiateModelExchange(name, token, b"", False, False, None, logger)
+        if component:
+            self.live.append(component)
+        return ctypes.c_void_p(component) if component else None
+
+    def initializing(self):
+        component = self.instantiate()
+        assert self.fmi3EnterInitializationMode(component, False, ctypes.c_double(0), ctypes.c_double(0),
+                                                False, ctypes.c_double(0)) == OK
+        return component
+
+    def ready(self, kind=CO_SIMULATION, **parameters):
+        component = self.instantiate(kind=kind)
+        for name, value in parameters.items():
+            assert self.fmi3SetFloat64(component, refs(globals()[name.upper()]), 1, reals(value), 1) == OK
+        assert self.fmi3EnterInitializationMode(component, False, ctypes.c_double(0), ctypes.c_double(0),
+                                                False, ctypes.c_double(0)) == OK
+        assert self.fmi3ExitInitializationMode(component) == OK
+        return component
+
+    def get(self, component, reference) -> float:
+        value = reals(0.0)
+        assert self.fmi3GetFloat64(component, refs(reference), 1, value, 1) == OK
+        return value[0]
+
+    def set(self, component, reference, value) -> int:
+        return self.fmi3SetFloat64(component, refs(reference), 1, reals(value), 1)
+
+    def step(self, component, time, size, last_successful_time=None):
+        flags = [ctypes.c_bool() for _ in range(3)]
+        last = last_successful_time if last_successful_time is not None else ctypes.c_double()
+        return self.fmi3DoStep(component, ctypes.c_double(time), ctypes.c_double(size), True,
+                               *map(ctypes.byref, flags), ctypes.byref(last))
 
 
 @dataclass(frozen=True)
@@ -102,9 +185,9 @@ class Case:
     run: Callable[[Harness], int]  # makes the bad call, returns its status; asserts what must hold after
 
 
-def _unchanged_after(harness, component, reference, bad_value, state_call=None):
+def _unchanged_after(harness, component, reference, bad_value):
     before = harness.get(component, reference)
-    status = harness.fmi2SetReal(component, refs(reference), 1, reals(bad_value))
+    status = harness.set(component, reference, bad_value)
     assert harness.get(component, reference) == before, "a refused value must leave the old one"
     return status
 
@@ -152,14 +235,14 @@ def _discarded_huge_step(h):
 
 
 def _serialized(h):
-    component = h.ready()
+    component, call = h.ready(), {name: getattr(h, function) for name, function in h.state_calls.items()}
     h.step(component, 0.0, 0.1)
     state, size = ctypes.c_void_p(), ctypes.c_size_t()
-    assert h.fmi2GetFMUstate(component, ctypes.byref(state)) == OK
-    assert h.fmi2SerializedFMUstateSize(component, state, ctypes.byref(size)) == OK
+    assert call["get"](component, ctypes.byref(state)) == OK
+    assert call["size"](component, state, ctypes.byref(size)) == OK
     blob = (ctypes.c_char * size.value)()
-    assert h.fmi2SerializeFMUstate(component, state, blob, size) == OK
-    h.fmi2FreeFMUstate(component, ctypes.byref(state))
+    assert call["serialize"](component, state, blob, size) == OK
+    call["free"](component, ctypes.byref(state))
     return component, bytearray(blob.raw)
 
 
@@ -169,7 +252,7 @@ def _deserialize(mangle):
         blob = mangle(blob)
         buffer = (ctypes.c_char * max(len(blob), 1)).from_buffer_copy(bytes(blob) or b"\0")
         state = ctypes.c_void_p()
-        status = h.fmi2DeSerializeFMUstate(component, buffer, len(blob), ctypes.byref(state))
+        status = getattr(h, h.state_calls["deserialize"])(component, buffer, len(blob), ctypes.byref(state))
         assert not state, "a refused blob must not yield a state"
         return status
     return run
@@ -316,6 +399,128 @@ CASES = [
 ]
 
 
+def _exit_with_fmi3(**values):
+    def run(h):
+        component = h.initializing()
+        references = [globals()[name.upper()] for name in values]
+        assert h.fmi3SetFloat64(component, refs(*references), len(values), reals(*values.values()), len(values)) == OK
+        status = h.fmi3ExitInitializationMode(component)
+        assert h.fmi3SetFloat64(component, refs(MASS), 1, reals(40.0), 1) == OK
+        assert h.fmi3ExitInitializationMode(component) == OK
+        return status
+    return run
+
+
+def _discarded_huge_step_fmi3(h):
+    component = h.ready()
+    assert h.fmi3SetFloat64(component, refs(TORQUE), 1, reals(20.0), 1) == OK
+    assert h.step(component, 0.0, 0.5) == OK
+    theta, last = h.get(component, THETA), ctypes.c_double()
+    status = h.step(component, 0.5, 1e9, last)
+    assert last.value == 0.5, "fmi3DoStep reports lastSuccessfulTime"
+    assert h.get(component, THETA) == theta, "a discarded step must leave the instance where it was"
+    assert h.step(component, 0.5, 1e-3) == ERROR, "step discarded: no more steps without a rollback"
+    return status
+
+
+def _ready_then(call, *arguments, kind=CO_SIMULATION):
+    return lambda h: getattr(h, call)(h.ready(kind=kind), *(a() if callable(a) else a for a in arguments))
+
+
+def _flags(n):
+    return [ctypes.byref(ctypes.c_bool()) for _ in range(n)]
+
+
+def _scheduled_execution(h):
+    component = h.lib.fmi3InstantiateScheduledExecution(b"x", h.guid, b"", False, False, None, h.logger,
+                                                        None, None, None)
+    return 0 if not component else 3
+
+
+CASES_FMI3 = [
+    Case("non-finite values", "torque = NaN after initialization", "fmi3SetFloat64", ERROR, "torque = nan refused",
+         lambda h: _unchanged_after(h, h.ready(), TORQUE, NAN)),
+    Case("non-finite values", "start angle theta = -inf", "fmi3SetFloat64", ERROR, "theta = -inf refused",
+         lambda h: _unchanged_after(h, h.initializing(), THETA, -INF)),
+    Case("non-finite values", "time set (the independent variable)", "fmi3SetFloat64", ERROR, "cannot set time",
+         lambda h: h.fmi3SetFloat64(h.ready(), refs(9), 1, reals(1.0), 1)),
+    Case("physical nonsense", "mass = 0", "fmi3ExitInitializationMode", ERROR, "mass must be > 0", _exit_with_fmi3(mass=0.0)),
+    Case("state machine", "fmi3DoStep before initialization", "fmi3DoStep", ERROR, "not allowed in state 'instantiated'",
+         lambda h: h.step(h.instantiate(), 0.0, 0.001)),
+    Case("state machine", "fmi3DoStep after fmi3Terminate", "fmi3DoStep", ERROR, "not allowed in state 'terminated'",
+         lambda h: (lambda c: (h.fmi3Terminate(c), h.step(c, 0.0, 0.001))[-1])(h.ready())),
+    Case("state machine", "fmi3DoStep on a model-exchange instance", "fmi3DoStep", ERROR, "not allowed in state 'event mode'",
+         lambda h: h.step(h.ready(kind=MODEL_EXCHANGE), 0.0, 0.001)),
+    Case("state machine", "model-exchange call on a co-simulation instance", "fmi3SetContinuousStates", ERROR,
+         "not allowed in state 'step complete'", _ready_then("fmi3SetContinuousStates", lambda: reals(0.0, 0.0), 2)),
+    Case("state machine", "fmi3EnterEventMode on a co-simulation instance (no event mode)", "fmi3EnterEventMode", ERROR,
+         "not allowed in state 'step complete'", _ready_then("fmi3EnterEventMode")),
+    Case("state machine", "fixed parameter mass set after initialization", "fmi3SetFloat64", ERROR,
+         "a fixed parameter cannot change after initialization", lambda h: _unchanged_after(h, h.ready(), MASS, 1.0)),
+    Case("state machine", "output derivative of order 3", "fmi3GetOutputDerivatives", ERROR, "no derivative of order 3",
+         _ready_then("fmi3GetOutputDerivatives", refs(THETA), 1, (ctypes.c_int * 1)(3), lambda: reals(0.0), 1)),
+    Case("state machine", "directional derivative of alpha by mass", "fmi3GetDirectionalDerivative", ERROR,
+         "no partial derivative of vr 3 with respect to vr 4",
+         _ready_then("fmi3GetDirectionalDerivative", refs(ALPHA), 1, refs(MASS), 1, lambda: reals(1.0), 1,
+                     lambda: reals(0.0), 1)),
+    Case("state machine", "an Int32 variable read", "fmi3GetInt32", ERROR, "this FMU has no variables of this type",
+         _ready_then("fmi3GetInt32", refs(0), 1, lambda: (ctypes.c_int32 * 1)(), 1)),
+    Case("counts", "nValues = 2 for one value reference", "fmi3SetFloat64", ERROR, "nValues = 2, expected 1",
+         _ready_then("fmi3SetFloat64", refs(TORQUE), 1, lambda: reals(1.0, 2.0), 2)),
+    Case("counts", "adjoint with nSensitivity = nUnknowns instead of nKnowns", "fmi3GetAdjointDerivative", ERROR,
+         "nSensitivity = 1, expected 3",
+         _ready_then("fmi3GetAdjointDerivative", refs(ALPHA), 1, refs(TORQUE, THETA, OMEGA), 3, lambda: reals(1.0), 1,
+                     lambda: reals(0.0), 1)),
+    Case("not supported", "configuration mode", "fmi3EnterConfigurationMode", ERROR,
+         "not supported: the model has no structural parameters", _ready_then("fmi3EnterConfigurationMode")),
+    Case("not supported", "a clock read", "fmi3GetClock", ERROR, "not supported: the model has no clocks",
+         _ready_then("fmi3GetClock", refs(0), 1, lambda: (ctypes.c_bool * 1)())),
+    Case("not supported", "an interval set", "fmi3SetIntervalDecimal", ERROR, "not supported: the model has no clocks",
+         _ready_then("fmi3SetIntervalDecimal", refs(0), 1, lambda: reals(1.0))),
+    Case("not supported", "fmi3EnterStepMode (co-simulation has no event mode)", "fmi3EnterStepMode", ERROR,
+         "not supported: co-simulation has no event mode", _ready_then("fmi3EnterStepMode")),
+    Case("not supported", "per-element dependencies", "fmi3GetNumberOfVariableDependencies", ERROR,
+         "providesPerElementDependencies is false",
+         _ready_then("fmi3GetNumberOfVariableDependencies", ALPHA, lambda: ctypes.byref(ctypes.c_size_t()))),
+    Case("not supported", "a model partition activated", "fmi3ActivateModelPartition", ERROR,
+         "not supported: the model has no clocks to schedule", _ready_then("fmi3ActivateModelPartition", 0, ctypes.c_double(0))),
+    Case("not supported", "scheduled execution", "fmi3InstantiateScheduledExecution", ERROR,
+         "not supported: the model has no clocks", _scheduled_execution),
+    Case("fmi3DoStep", "step size 0", "fmi3DoStep", ERROR, "must be positive and finite", lambda h: h.step(h.ready(), 0.0, 0.0)),
+    Case("fmi3DoStep", "currentCommunicationPoint 0.5 where the instance stands at 0", "fmi3DoStep", ERROR,
+         "is not where the instance stands", lambda h: h.step(h.ready(), 0.5, 0.001)),
+    Case("fmi3DoStep", "a step of 1e9 s: more than the 100000 internal steps allowed", "fmi3DoStep", DISCARD,
+         "step budget exhausted", _discarded_huge_step_fmi3),
+    Case("NULL and counts", "NULL instance", "fmi3DoStep", ERROR, "",
+         lambda h: h.fmi3DoStep(None, ctypes.c_double(0), ctypes.c_double(0.001), True, *_flags(3),
+                                ctypes.byref(ctypes.c_double()))),
+    Case("NULL and counts", "valueReferences = NULL with nValueReferences = 1", "fmi3GetFloat64", ERROR,
+         "argument valueReferences must not be NULL", _ready_then("fmi3GetFloat64", None, 1, lambda: reals(0.0), 1)),
+    Case("NULL and counts", "lastSuccessfulTime = NULL", "fmi3DoStep", ERROR, "argument lastSuccessfulTime must not be NULL",
+         lambda h: h.fmi3DoStep(h.ready(), ctypes.c_double(0), ctypes.c_double(0.001), True, *_flags(3), None)),
+    Case("NULL and counts", "NULL flags", "fmi3UpdateDiscreteStates", ERROR,
+         "argument discreteStatesNeedUpdate must not be NULL",
+         _ready_then("fmi3UpdateDiscreteStates", None, *_flags(4), lambda: ctypes.byref(ctypes.c_double()),
+                     kind=MODEL_EXCHANGE)),
+    Case("NULL and counts", "NULL FMU state pointer", "fmi3GetFMUState", ERROR, "argument FMUstate must not be NULL",
+         _ready_then("fmi3GetFMUState", None)),
+    Case("fmi3Instantiate", "a token from another FMU", "fmi3InstantiateCoSimulation", ERROR,
+         "instantiationToken {00000000-0000-0000-0000-000000000000} does not match",
+         _no_instance(lambda h: h.instantiate(guid=b"{00000000-0000-0000-0000-000000000000}") is None)),
+    Case("fmi3Instantiate", "empty instance name", "fmi3InstantiateModelExchange", ERROR,
+         "instanceName must be a non-empty string",
+         _no_instance(lambda h: h.instantiate(name=b"", kind=MODEL_EXCHANGE) is None)),
+    Case("fmi3Instantiate", "no logger", "fmi3InstantiateCoSimulation", ERROR, "",
+         _no_instance(lambda h: h.instantiate(logger=None) is None)),
+    Case("FMU state blobs", "garbage bytes", "fmi3DeserializeFMUState", ERROR, "bad magic",
+         _deserialize(lambda blob: bytearray(b"\xde\xad\xbe\xef" * (len(blob) // 4)))),
+    Case("FMU state blobs", "truncated by one byte", "fmi3DeserializeFMUState", ERROR, "truncated, or from another build",
+         _deserialize(lambda blob: blob[:-1])),
+    Case("FMU state blobs", "one payload bit flipped", "fmi3DeserializeFMUState", ERROR, "checksum mismatch",
+         _deserialize(_flip(40))),
+]
+
+
 def run_case(harness: Harness, case: Case) -> tuple[int, str]:
     """(status, what the FMU logged for the call)."""
     harness.messages.clear()
@@ -325,23 +530,31 @@ def run_case(harness: Harness, case: Case) -> tuple[int, str]:
     return status, message
 
 
-def markdown(rows: list[tuple[Case, int, str]]) -> str:
+def _table(rows: list[tuple[Case, int, str]]) -> list[str]:
+    lines = ["| group | bad input | call | answer | message logged through the master's logger |",
+             "|---|---|---|---|---|"]
+    for case, status, message in rows:
+        shown = message.replace("|", "\\|") if message else "(no instance, so nothing to log to)" \
+            if "Instantiate" in case.call or case.call.endswith("DoStep") else ""
+        answer = "NULL" if "Instantiate" in case.call else status_name(case.call, status)
+        lines.append(f"| {case.group} | {case.bad_input} | `{case.call}` | {answer} | {shown} |")
+    return lines
+
+
+def markdown(rows: list[tuple[Case, int, str]], rows_fmi3: list[tuple[Case, int, str]]) -> str:
     lines = ["# What the FMU answers to bad calls", "",
              "Generated by `python tests/bad_calls.py docs/robustness.md` from the cases that "
              "`tests/test_robustness.py` asserts; do not edit by hand. Each call goes to the binary through "
              "ctypes. After every refused call the instance keeps its last good state and can go on.", "",
-             "| group | bad input | call | answer | message logged through the master's logger |",
-             "|---|---|---|---|---|"]
-    for case, status, message in rows:
-        shown = message.replace("|", "\\|") if message else "(no instance, so nothing to log to)" \
-            if case.call in ("fmi2Instantiate", "fmi2DoStep") else ""
-        answer = "NULL" if case.call == "fmi2Instantiate" else STATUS_NAMES[status]
-        lines.append(f"| {case.group} | {case.bad_input} | `{case.call}` | {answer} | {shown} |")
+             "## FMI 2.0 (`Pendulum.fmu`)", "", *_table(rows), "",
+             "## FMI 3.0 (`Pendulum-fmi3.fmu`)", "",
+             "The same core answers through the FMI 3.0 entry points; what FMI 3.0 adds that the pendulum "
+             "has no use for answers `fmi3Error` with the reason.", "", *_table(rows_fmi3)]
     return "\n".join(lines) + "\n"
 
 
 def main(argv=None):
-    """Build the FMU, run every case, write the markdown table."""
+    """Build both FMUs, run every case, write the markdown tables."""
     import tempfile
     import zipfile
 
@@ -351,13 +564,17 @@ def main(argv=None):
 
     out = Path((argv or sys.argv[1:] or ["docs/robustness.md"])[0])
     with tempfile.TemporaryDirectory() as tmp:
-        fmu = build_fmu(Path(tmp) / "Pendulum.fmu")
-        zipfile.ZipFile(fmu).extractall(tmp)
-        harness = Harness(Path(tmp) / "binaries/linux64/Pendulum.so", read_model_description(str(fmu)).guid)
-        rows = [(case, *run_case(harness, case)) for case in CASES]
+        tables = []
+        for version, harness_type, folder, cases in ((2, Harness, "linux64", CASES),
+                                                      (3, Harness3, "x86_64-linux", CASES_FMI3)):
+            fmu = build_fmu(Path(tmp) / f"Pendulum{version}.fmu", fmi_version=version)
+            zipfile.ZipFile(fmu).extractall(Path(tmp) / str(version))
+            harness = harness_type(Path(tmp) / str(version) / f"binaries/{folder}/Pendulum.so",
+                                   read_model_description(str(fmu)).guid)
+            tables.append([(case, *run_case(harness, case)) for case in cases])
     out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(markdown(rows))
-    print(f"wrote {out}: {len(rows)} cases")
+    out.write_text(markdown(*tables))
+    print(f"wrote {out}: {sum(map(len, tables))} cases")
 
 
 if __name__ == "__main__":

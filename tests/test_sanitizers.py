@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from pendulum_fmu.build import FMI_HEADERS, assemble_sources
+from pendulum_fmu.build import FMI_HEADERS, SOURCE_DIR, assemble_sources
 
 DRIVER = Path(__file__).resolve().parent / "c" / "driver.c"
 pytestmark = pytest.mark.skipif(shutil.which("gcc") is None, reason="needs gcc")
@@ -28,6 +28,7 @@ def _compile(sources, out, flags):
 def drivers(tmp_path_factory):
     work = tmp_path_factory.mktemp("driver")
     sources = assemble_sources(work / "sources")
+    shutil.copy2(SOURCE_DIR / "fmi3_functions.c", sources)  # both adapters over one core
     return {"asan": _compile(sources, work / "driver_asan",
                              ["-O1", "-fno-omit-frame-pointer", "-fsanitize=address,undefined",
                               "-fno-sanitize-recover=all"]),
@@ -40,8 +41,8 @@ def _run(command, **kwargs):
     return result.stdout
 
 
-@pytest.mark.parametrize("case", [["bad-calls"], ["instances", "1000"], ["threads", "8"],
-                                  ["energy", "100000"], ["churn", "20000"]])
+@pytest.mark.parametrize("case", [["bad-calls"], ["bad-calls-fmi3"], ["instances", "1000"], ["threads", "8"],
+                                  ["energy", "100000"], ["churn", "20000"], ["churn-fmi3", "20000"]])
 def test_under_address_and_undefined_behavior_sanitizers(drivers, case):
     environment = {**os.environ, "ASAN_OPTIONS": "detect_leaks=1:abort_on_error=0",
                    "UBSAN_OPTIONS": "print_stacktrace=1"}
@@ -50,7 +51,8 @@ def test_under_address_and_undefined_behavior_sanitizers(drivers, case):
 
 
 @pytest.mark.skipif(shutil.which("valgrind") is None, reason="needs valgrind")
-@pytest.mark.parametrize("case", [["bad-calls"], ["instances", "100"], ["threads", "8"], ["churn", "2000"]])
+@pytest.mark.parametrize("case", [["bad-calls"], ["bad-calls-fmi3"], ["instances", "100"], ["threads", "8"],
+                                  ["churn", "2000"], ["churn-fmi3", "2000"]])
 def test_under_valgrind_memcheck(drivers, case):
     _run(["valgrind", "-q", "--leak-check=full", "--errors-for-leak-kinds=all", "--error-exitcode=1",
           str(drivers["plain"]), *case])

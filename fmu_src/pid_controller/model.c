@@ -32,10 +32,10 @@ void model_set_states(double values[N_VARIABLES], const double x[N_STATES]) {
 }
 
 void model_derivatives(const ModelCoefficients *coefficients, const double values[N_VARIABLES],
-                       const double input_rates[N_VARIABLES], double offset,
+                       const InputDerivatives *inputs, double offset,
                        const double x[N_STATES], double dx[N_STATES]) {
     (void)x;
-    dx[0] = coefficients->setpoint - (values[VR_THETA] + offset * input_rates[VR_THETA]);
+    dx[0] = coefficients->setpoint - input_at(values, inputs, VR_THETA, offset);
 }
 
 void model_update_outputs(const ModelCoefficients *k, double values[N_VARIABLES]) {
@@ -45,9 +45,9 @@ void model_update_outputs(const ModelCoefficients *k, double values[N_VARIABLES]
 }
 
 int model_output_derivative(const ModelCoefficients *coefficients, const double values[N_VARIABLES],
-                            const double input_rates[N_VARIABLES], unsigned int vr, int order,
+                            const InputDerivatives *inputs, unsigned int vr, int order,
                             double *derivative) {
-    (void)coefficients, (void)values, (void)input_rates, (void)vr, (void)order, (void)derivative;
+    (void)coefficients, (void)values, (void)inputs, (void)vr, (void)order, (void)derivative;
     return 0;
 }
 

@@ -1,7 +1,10 @@
 /* Drives the FMU's sources, linked in, through the bad calls and loads a master can inflict,
    so AddressSanitizer, UndefinedBehaviorSanitizer and valgrind watch every access.
 
-   usage: driver bad-calls | instances N | threads N | energy STEPS | churn N [MAX_GROWTH_KIB]
+   Both adapters are linked in, so the FMI 3.0 entry points get the same treatment.
+
+   usage: driver bad-calls | bad-calls-fmi3 | instances N | threads N | energy STEPS
+                 | churn N [MAX_GROWTH_KIB] | churn-fmi3 N
    Prints one line of figures per case; exits non-zero on the first failed expectation. */
 
 #include <math.h>
@@ -13,6 +16,7 @@
 #include <unistd.h>
 
 #include "fmi2Functions.h"
+#include "fmi3Functions.h"
 #include "model_variables.h"
 
 static int messages_logged;
@@ -24,6 +28,12 @@ static void logger(fmi2ComponentEnvironment environment, fmi2String instance_nam
 }
 
 static const fmi2CallbackFunctions callbacks = {logger, NULL, NULL, NULL, NULL};
+
+static void logger3(fmi3InstanceEnvironment environment, fmi3Status status, fmi3String category,
+                    fmi3String message) {
+    (void)environment, (void)status, (void)category, (void)message;
+    __atomic_add_fetch(&messages_logged, 1, __ATOMIC_RELAXED);
+}
 
 #define EXPECT(condition)                                                                    \
     do {                                                                                     \
@@ -54,6 +64,36 @@ static double run(fmi2Component c, double torque, long steps) {
     }
     EXPECT(fmi2GetReal(c, &theta_vr, 1, &theta) == fmi2OK);
     return theta;
+}
+
+/* 1 when the deserializer of one standard refuses the bytes and yields no state. */
+typedef int (*Refuses)(void *instance, const unsigned char *bytes, size_t size);
+
+static int deserialize_fmi2(void *instance, const unsigned char *bytes, size_t size) {
+    fmi2FMUstate state = NULL;
+    return fmi2DeSerializeFMUstate(instance, (const fmi2Byte *)bytes, size, &state) == fmi2Error && !state;
+}
+
+static int deserialize_fmi3(void *instance, const unsigned char *bytes, size_t size) {
+    fmi3FMUState state = NULL;
+    return fmi3DeserializeFMUState(instance, bytes, size, &state) == fmi3Error && !state;
+}
+
+/* Every truncation and every single-byte corruption of a serialized state must be refused;
+   returns how many were. */
+static int refuse_every_damaged_copy(void *instance, unsigned char *blob, size_t size, Refuses refuses) {
+    for (size_t length = 0; length < size; length++) {
+        unsigned char *truncated = malloc(length ? length : 1); /* exactly length bytes: ASan sees any overread */
+        memcpy(truncated, blob, length);
+        EXPECT(refuses(instance, truncated, length));
+        free(truncated);
+    }
+    for (size_t i = 0; i < size; i++) {
+        blob[i] ^= 0x5a;
+        EXPECT(refuses(instance, blob, size));
+        blob[i] ^= 0x5a;
+    }
+    return (int)(2 * size);
 }
 
 static void bad_calls(void) {
@@ -104,18 +144,7 @@ static void bad_calls(void) {
     fmi2Byte *blob = malloc(size);
     EXPECT(fmi2SerializeFMUstate(c, state, blob, size) == fmi2OK);
     REFUSED(fmi2SerializeFMUstate(c, state, blob, size - 1));
-    for (size_t length = 0; length < size; length++) {
-        fmi2Byte *truncated = malloc(length ? length : 1); /* exactly length bytes: ASan sees any overread */
-        memcpy(truncated, blob, length);
-        REFUSED(fmi2DeSerializeFMUstate(c, truncated, length, &restored));
-        free(truncated);
-    }
-    for (size_t i = 0; i < size; i++) {
-        blob[i] ^= 0x5a;
-        REFUSED(fmi2DeSerializeFMUstate(c, blob, size, &restored));
-        blob[i] ^= 0x5a;
-    }
-    EXPECT(restored == NULL);
+    refused += refuse_every_damaged_copy(c, (unsigned char *)blob, size, deserialize_fmi2);
     EXPECT(fmi2DeSerializeFMUstate(c, blob, size, &restored) == fmi2OK);
     EXPECT(fmi2SetFMUstate(c, restored) == fmi2OK);
     EXPECT(fmi2FreeFMUstate(c, &restored) == fmi2OK && restored == NULL);
@@ -126,6 +155,103 @@ static void bad_calls(void) {
     printf("bad-calls: %d refused calls, %d messages logged, %zu truncations and %zu corruptions of a "
            "%zu-byte state refused\n", refused, messages_logged, size, size, size);
 #undef REFUSED
+}
+
+static fmi3Instance ready3(const char *name, int co_simulation) {
+    fmi3Instance c = co_simulation
+        ? fmi3InstantiateCoSimulation(name, MODEL_GUID, "", fmi3False, fmi3False, fmi3False, fmi3False, NULL, 0,
+                                      NULL, logger3, NULL)
+        : fmi3InstantiateModelExchange(name, MODEL_GUID, "", fmi3False, fmi3False, NULL, logger3);
+    EXPECT(c != NULL);
+    EXPECT(fmi3EnterInitializationMode(c, fmi3False, 0, 0, fmi3False, 0) == fmi3OK);
+    EXPECT(fmi3ExitInitializationMode(c) == fmi3OK);
+    return c;
+}
+
+/* The FMI 3.0 entry points: refused calls, every truncation and single-byte corruption of a
+   serialized state, and the same numbers as FMI 2.0 for the same held torque. */
+static void bad_calls_fmi3(void) {
+    const fmi3ValueReference theta = VR_THETA, mass = VR_MASS, torque_vr = VR_TORQUE, time_vr = N_VARIABLES;
+    double value = NAN, one = 1.0, x[2] = {0, 0};
+    fmi3Boolean event, terminate, early;
+    fmi3Float64 last;
+    int refused = 0;
+#define REFUSED(call) do { EXPECT((call) == fmi3Error); refused++; } while (0)
+    EXPECT(fmi3InstantiateCoSimulation("x", MODEL_GUID, "", 0, 0, 0, 0, NULL, 0, NULL, NULL, NULL) == NULL);
+    EXPECT(fmi3InstantiateModelExchange(NULL, MODEL_GUID, "", 0, 0, NULL, logger3) == NULL);
+    EXPECT(fmi3InstantiateModelExchange("x", "{wrong}", "", 0, 0, NULL, logger3) == NULL);
+    EXPECT(fmi3InstantiateScheduledExecution("x", MODEL_GUID, "", 0, 0, NULL, logger3, NULL, NULL, NULL) == NULL);
+    fmi3FreeInstance(NULL);
+    REFUSED(fmi3DoStep(NULL, 0, 1e-3, fmi3True, &event, &terminate, &early, &last));
+
+    fmi3Instance c = fmi3InstantiateCoSimulation("bad", MODEL_GUID, "", 0, 0, 0, 0, NULL, 0, NULL, logger3, NULL);
+    REFUSED(fmi3DoStep(c, 0, 1e-3, fmi3True, &event, &terminate, &early, &last));
+    REFUSED(fmi3SetFloat64(c, &theta, 1, &value, 1));        /* NaN start value */
+    REFUSED(fmi3SetFloat64(c, &theta, 1, &one, 2));          /* nValues */
+    REFUSED(fmi3SetFloat64(c, NULL, 1, &one, 1));
+    REFUSED(fmi3SetFloat64(c, &time_vr, 1, &one, 1));
+    EXPECT(fmi3EnterInitializationMode(c, fmi3False, 0, 0, fmi3False, 0) == fmi3OK);
+    EXPECT(fmi3ExitInitializationMode(c) == fmi3OK);
+    REFUSED(fmi3SetFloat64(c, &mass, 1, &one, 1));           /* fixed after initialization */
+    REFUSED(fmi3DoStep(c, 0, -1, fmi3True, &event, &terminate, &early, &last));
+    REFUSED(fmi3DoStep(c, 0, 1e-3, fmi3True, NULL, &terminate, &early, &last));
+    REFUSED(fmi3GetFMUState(c, NULL));
+    REFUSED(fmi3SetFMUState(c, NULL));
+    REFUSED(fmi3GetDirectionalDerivative(c, &theta, 1, &mass, 1, &one, 1, &value, 1));
+    REFUSED(fmi3GetAdjointDerivative(c, &theta, 1, &theta, 1, &one, 1, NULL, 1));
+    REFUSED(fmi3SetContinuousStates(c, x, 2));
+    REFUSED(fmi3EnterConfigurationMode(c));
+    REFUSED(fmi3GetClock(c, &theta, 1, NULL));
+    REFUSED(fmi3EnterStepMode(c));
+    REFUSED(fmi3UpdateDiscreteStates(c, NULL, NULL, NULL, NULL, NULL, NULL));
+
+    fmi3FMUState state = NULL, restored = NULL;
+    size_t size = 0;
+    EXPECT(fmi3DoStep(c, 0, 1e-3, fmi3True, &event, &terminate, &early, &last) == fmi3OK && last == 1e-3);
+    EXPECT(fmi3GetFMUState(c, &state) == fmi3OK);
+    EXPECT(fmi3SerializedFMUStateSize(c, state, &size) == fmi3OK);
+    fmi3Byte *blob = malloc(size);
+    EXPECT(fmi3SerializeFMUState(c, state, blob, size) == fmi3OK);
+    refused += refuse_every_damaged_copy(c, blob, size, deserialize_fmi3);
+    EXPECT(fmi3DeserializeFMUState(c, blob, size, &restored) == fmi3OK);
+    EXPECT(fmi3SetFMUState(c, restored) == fmi3OK);
+    EXPECT(fmi3FreeFMUState(c, &restored) == fmi3OK && restored == NULL);
+    EXPECT(fmi3FreeFMUState(c, &state) == fmi3OK);
+    free(blob);
+    fmi3FreeInstance(c);
+
+    /* The same held torque gives FMI 2.0's numbers to the last bit. */
+    fmi3Instance three = ready3("fmi3", 1);
+    fmi2Component two = ready("fmi2", 0.0);
+    const double torque = 20.0;
+    double theta3, theta2;
+    for (long k = 0; k < 3000; k++) {
+        EXPECT(fmi3SetFloat64(three, &torque_vr, 1, &torque, 1) == fmi3OK);
+        EXPECT(fmi3DoStep(three, k * 1e-3, 1e-3, fmi3True, &event, &terminate, &early, &last) == fmi3OK);
+    }
+    EXPECT(fmi3GetFloat64(three, &theta, 1, &theta3, 1) == fmi3OK);
+    theta2 = run(two, torque, 3000);
+    EXPECT(theta3 == theta2);
+    fmi3FreeInstance(three);
+    fmi2FreeInstance(two);
+    printf("bad-calls-fmi3: %d refused calls, %zu truncations and %zu corruptions of a %zu-byte state "
+           "refused, theta(3 s) equal to FMI 2.0's\n", refused, size, size, size);
+#undef REFUSED
+}
+
+static void churn_fmi3(long n) {
+    for (long i = 0; i < n; i++) {
+        fmi3Instance c = ready3("churn", i % 2);
+        fmi3FMUState state = NULL;
+        if (i % 2) {
+            fmi3Boolean event, terminate, early;
+            fmi3Float64 last;
+            EXPECT(fmi3DoStep(c, 0, 1e-3, fmi3True, &event, &terminate, &early, &last) == fmi3OK);
+        }
+        EXPECT(fmi3GetFMUState(c, &state) == fmi3OK && fmi3FreeFMUState(c, &state) == fmi3OK);
+        fmi3FreeInstance(c);
+    }
+    printf("churn-fmi3: %ld instantiate/free cycles of both interfaces\n", n);
 }
 
 static void instances(long n) {
@@ -255,12 +381,14 @@ static void churn(long n, long max_growth_kib) {
 
 int main(int argc, char **argv) {
     if (argc < 2) {
-        fprintf(stderr, "usage: %s bad-calls | instances N | threads N | energy STEPS | churn N [MAX_GROWTH_KIB]\n",
-                argv[0]);
+        fprintf(stderr, "usage: %s bad-calls | bad-calls-fmi3 | instances N | threads N | energy STEPS "
+                "| churn N [MAX_GROWTH_KIB] | churn-fmi3 N\n", argv[0]);
         return 2;
     }
     const long n = argc > 2 ? atol(argv[2]) : 0;
     if (!strcmp(argv[1], "bad-calls")) bad_calls();
+    else if (!strcmp(argv[1], "bad-calls-fmi3")) bad_calls_fmi3();
+    else if (!strcmp(argv[1], "churn-fmi3")) churn_fmi3(n);
     else if (!strcmp(argv[1], "instances")) instances(n);
     else if (!strcmp(argv[1], "threads")) threads((int)n);
     else if (!strcmp(argv[1], "energy")) energy(n);

@@ -1,13 +1,16 @@
-/* libFuzzer harness for fmi2DeSerializeFMUstate. The first byte picks what the rest is:
+/* libFuzzer harness for fmi2DeSerializeFMUstate and fmi3DeserializeFMUState. The first byte's
+   lowest bit picks what the rest is:
    0: raw bytes as the blob;
    1: a valid blob with the bytes XORed over its payload and the checksum then repaired, so the
-      plausibility checks behind the checksum, and stepping from what passes them, get fuzzed. */
+      plausibility checks behind the checksum, and stepping from what passes them, get fuzzed;
+   and its next bit the standard whose entry points take it. */
 
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "fmi2Functions.h"
+#include "fmi3Functions.h"
 #include "model_variables.h"
 
 static void logger(fmi2ComponentEnvironment e, fmi2String n, fmi2Status s, fmi2String c, fmi2String m, ...) {
@@ -15,7 +18,13 @@ static void logger(fmi2ComponentEnvironment e, fmi2String n, fmi2Status s, fmi2S
 }
 
 static const fmi2CallbackFunctions callbacks = {logger, NULL, NULL, NULL, NULL};
+
+static void logger3(fmi3InstanceEnvironment e, fmi3Status s, fmi3String c, fmi3String m) {
+    (void)e, (void)s, (void)c, (void)m;
+}
+
 static fmi2Component instance;
+static fmi3Instance instance3;
 static fmi2Byte *valid;
 static size_t valid_size;
 
@@ -38,6 +47,26 @@ static void setup(void) {
     valid = malloc(valid_size);
     fmi2SerializeFMUstate(instance, state, valid, valid_size);
     fmi2FreeFMUstate(instance, &state);
+    instance3 = fmi3InstantiateCoSimulation("fuzz3", MODEL_GUID, "", fmi3False, fmi3False, fmi3False, fmi3False,
+                                            NULL, 0, NULL, logger3, NULL);
+    fmi3EnterInitializationMode(instance3, fmi3False, 0, 0, fmi3False, 0);
+    fmi3ExitInitializationMode(instance3);
+}
+
+/* The FMI 3.0 path of the same checks: whatever passes must be safe to restore and step from. */
+static void deserialize_fmi3(const fmi3Byte *blob, size_t blob_size) {
+    fmi3FMUState state = NULL;
+    if (fmi3DeserializeFMUState(instance3, blob, blob_size, &state) != fmi3OK) return;
+    const fmi3ValueReference time_vr = N_VARIABLES; /* the independent variable */
+    fmi3Boolean event, terminate, early;
+    double time, last;
+    fmi3SetFMUState(instance3, state);
+    if (fmi3GetFloat64(instance3, &time_vr, 1, &time, 1) == fmi3OK)
+        fmi3DoStep(instance3, time, 1e-3, fmi3True, &event, &terminate, &early, &last);
+    fmi3FreeFMUState(instance3, &state);
+    fmi3Reset(instance3);
+    fmi3EnterInitializationMode(instance3, fmi3False, 0, 0, fmi3False, 0);
+    fmi3ExitInitializationMode(instance3);
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
@@ -58,7 +87,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
         memcpy(blob + valid_size - 8, &checksum, 8);
     }
     fmi2FMUstate state = NULL;
-    if (fmi2DeSerializeFMUstate(instance, blob, blob_size, &state) == fmi2OK) {
+    if (data[0] & 2) {
+        deserialize_fmi3((const fmi3Byte *)blob, blob_size);
+    } else if (fmi2DeSerializeFMUstate(instance, blob, blob_size, &state) == fmi2OK) {
         /* Whatever passes must be safe to restore and step from. */
         const fmi2ValueReference theta = VR_THETA;
         double value, time;
