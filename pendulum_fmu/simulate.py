@@ -10,7 +10,7 @@ import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
 
-from . import results
+from . import cs_loop, results
 from .build import default_fmu
 from .parameters import resolve_parameters, value_reference
 from .signal import TorqueSignal, TorqueSchedule, schedule
@@ -76,6 +76,19 @@ def open_fmu(fmu_path: str | Path | None = None, *, parameters: dict | None = No
     messages = MessageLog()
     slave.instantiate(callbacks=messages.callbacks)
     slave.messages = messages  # keeps the logger callback alive as long as the slave
+    try:
+        initialize(slave, parameters=parameters, theta0=theta0, omega0=omega0,
+                   tolerance=tolerance, start_time=start_time)
+    except BaseException:
+        slave.freeInstance()
+        raise
+    return slave
+
+
+def initialize(slave: FMU2Slave, *, parameters: dict | None = None, theta0: float = 0.0,
+               omega0: float = 0.0, tolerance: float | None = None, start_time: float = 0.0) -> None:
+    """Set the parameters and start values of an instantiated (or reset) slave with a
+    MessageLog as slave.messages, and leave it in step mode; FmuError says why the FMU refused."""
     start = {**resolve_parameters(parameters), "theta": float(theta0), "omega": float(omega0)}
     try:
         slave.setupExperiment(tolerance=tolerance, startTime=start_time)
@@ -83,13 +96,40 @@ def open_fmu(fmu_path: str | Path | None = None, *, parameters: dict | None = No
         slave.setReal([value_reference(n) for n in start], list(start.values()))
         slave.exitInitializationMode()
     except Exception as error:
-        slave.freeInstance()
-        raise FmuError(f"initialization failed: {'; '.join(messages.lines) or error}") from None
-    return slave
+        raise FmuError(f"initialization failed: {'; '.join(slave.messages.lines) or error}") from None
 
 
 def run_schedule(slave: FMU2Slave, plan: TorqueSchedule) -> np.ndarray:
     """Feed a schedule to an initialized slave; returns the result array (see results.py).
+
+    One call into the native loop (cs_loop.py) when it was compiled, else the Python loop below,
+    the readable reference; the two give the same numbers bit for bit.
+    """
+    if not cs_loop.available():
+        return run_schedule_python(slave, plan)
+    torque_vr = np.array([value_reference("torque")], np.uint32)
+    output_vr = np.array([value_reference(n) for n in ("theta", "omega", "alpha")], np.uint32)
+    outputs, final_torque = np.empty((len(plan.time), 3)), np.empty(1)
+    ramped = bool(np.any(plan.torque_rate))
+    cs_loop.run(slave, torque_vr, output_vr, plan.time, np.ascontiguousarray(plan.torque)[:, None],
+                np.ascontiguousarray(plan.torque_rate)[:, None] if ramped else None, outputs,
+                final_torque)
+    return _result(plan, outputs, final_torque[0])
+
+
+def _result(plan: TorqueSchedule, outputs: np.ndarray, final_torque: float) -> np.ndarray:
+    """The result array of a schedule from theta, omega, alpha at every point (columns)."""
+    out = results.empty(len(plan.time))
+    out["time"] = plan.time
+    out["torque"][:-1] = plan.torque
+    out["torque"][-1] = final_torque
+    for name, column in zip(("theta", "omega", "alpha"), outputs.T):
+        out[name] = column
+    return out
+
+
+def run_schedule_python(slave: FMU2Slave, plan: TorqueSchedule) -> np.ndarray:
+    """run_schedule in Python: the reference the native loop is checked against.
 
     The FMI functions are bound once from the library fmpy loaded, without fmpy's argtypes (with
     them ctypes converts every argument on every call), and every argument is a ctypes object
@@ -134,14 +174,7 @@ def run_schedule(slave: FMU2Slave, plan: TorqueSchedule) -> np.ndarray:
     if status > 1:
         raise messages.error(status, "fmi2GetReal at the end")
     recorded.append(outputs[:])
-
-    out = results.empty(len(plan.time))
-    out["time"] = plan.time
-    out["torque"][:-1] = plan.torque
-    out["torque"][-1] = torque[0]
-    for name, column in zip(("theta", "omega", "alpha"), np.array(recorded).T):
-        out[name] = column
-    return out
+    return _result(plan, np.array(recorded), torque[0])
 
 
 def simulate(torque: TorqueSignal = 20.0, *, start_time: float = 0.0, stop_time: float | None = None,
