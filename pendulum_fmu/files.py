@@ -11,6 +11,7 @@ from __future__ import annotations
 import contextlib
 import os
 import tempfile
+import uuid
 from pathlib import Path
 
 
@@ -63,4 +64,30 @@ def replacing_path(path: str | os.PathLike):
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(temporary)
+        raise
+
+
+@contextlib.contextmanager
+def replacing_on(filesystem, path: str):
+    """replacing(path, "wb") on any fsspec file system, for outputs given as URLs.
+
+    The local file system goes through replacing. Elsewhere the content is written to a unique
+    temporary name beside path and moved into place (an object store's upload appears whole;
+    the move makes that hold for the other file systems too).
+    """
+    from fsspec.implementations.local import LocalFileSystem
+
+    if isinstance(filesystem, LocalFileSystem):
+        with replacing(path, "wb") as file:
+            yield file
+        return
+    parent, _, name = path.rpartition("/")
+    temporary = f"{parent}/.{name}.{uuid.uuid4().hex}.partial"
+    try:
+        with filesystem.open(temporary, "wb") as file:
+            yield file
+        filesystem.mv(temporary, path)
+    except BaseException:
+        with contextlib.suppress(FileNotFoundError):
+            filesystem.rm(temporary)
         raise
