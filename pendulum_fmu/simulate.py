@@ -3,7 +3,10 @@
 from __future__ import annotations
 
 import ctypes
+import itertools
 import tempfile
+import threading
+import weakref
 from pathlib import Path
 
 import numpy as np
@@ -22,13 +25,32 @@ class FmuError(RuntimeError):
     """An FMI call failed; the message carries what the FMU logged."""
 
 
+def _log_to_instance(environment, instance_name, status, category, message):
+    log = _logs.get(environment)
+    if log is not None:
+        log.lines.append(f"[{_STATUS[status] if 0 <= status < 6 else status}] "
+                         f"{message.decode('utf-8', 'replace')}")
+
+
+# One logger for every instance, never freed, which hands each message to its instance's log by
+# the componentEnvironment the instance was given: fmpy's formatting proxy keeps the last logger
+# it was given in one global, so a logger per instance would be called for another instance's
+# messages, or after it was freed (a crash when instances live in several threads).
+_LOGGER = fmi2CallbackLoggerTYPE(_log_to_instance)
+_logs: weakref.WeakValueDictionary[int, MessageLog] = weakref.WeakValueDictionary()
+_log_keys = itertools.count(1)
+
+
 class MessageLog:
     """FMI callbacks whose logger keeps what the FMU says, so a failure can say why."""
 
     def __init__(self):
         self.lines: list[str] = []
         self.callbacks = fmi2CallbackFunctions()
-        self.callbacks.logger = fmi2CallbackLoggerTYPE(self._log)
+        self.callbacks.logger = _LOGGER
+        key = next(_log_keys)
+        self.callbacks.componentEnvironment = key
+        _logs[key] = self
         try:
             # fmpy's C proxy formats printf-style arguments before they reach Python.
             from fmpy.logging import addLoggerProxy
@@ -36,27 +58,25 @@ class MessageLog:
         except Exception:
             pass
 
-    def _log(self, environment, instance_name, status, category, message):
-        self.lines.append(f"[{_STATUS[status] if 0 <= status < 6 else status}] "
-                          f"{message.decode('utf-8', 'replace')}")
-
     def error(self, status: int, call: str) -> FmuError:
         detail = "; ".join(self.lines[-3:]) or "no message"
         return FmuError(f"{call} returned {_STATUS[status]}: {detail}")
 
 
 _extracted: dict[tuple[str, int], tuple[tempfile.TemporaryDirectory, object]] = {}
+_extracting = threading.Lock()  # threads of one dask worker share the cache
 
 
 def _unzipped(fmu_path: Path):
     """(folder, model description) of an FMU file, extracted and parsed once per process; the
     folder is removed at exit."""
     key = (str(fmu_path.resolve()), fmu_path.stat().st_mtime_ns)
-    if key not in _extracted:
-        folder = tempfile.TemporaryDirectory(prefix="pendulum_fmu_")
-        extract(str(fmu_path), unzipdir=folder.name)
-        _extracted[key] = folder, read_model_description(folder.name)
-    folder, description = _extracted[key]
+    with _extracting:
+        if key not in _extracted:
+            folder = tempfile.TemporaryDirectory(prefix="pendulum_fmu_")
+            extract(str(fmu_path), unzipdir=folder.name)
+            _extracted[key] = folder, read_model_description(folder.name)
+        folder, description = _extracted[key]
     return folder.name, description
 
 

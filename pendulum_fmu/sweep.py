@@ -29,6 +29,7 @@ import logging
 import math
 import numbers
 import os
+import queue
 import sys
 import tempfile
 import threading
@@ -361,7 +362,7 @@ def _client(scheduler: str | None, workers: int | None, connect_timeout: float):
     if scheduler is None:
         # Port 0 for the scheduler's HTTP server: another cluster may hold dask's usual 8787.
         with LocalCluster(n_workers=workers or 2, threads_per_worker=1, processes=True,
-                          dashboard_address=":0", silence_logs=logging.WARNING) as cluster, \
+                          dashboard_address=":0", silence_logs=logging.CRITICAL) as cluster, \
                 Client(cluster) as client:
             yield client
         return
@@ -505,14 +506,19 @@ def run_sweep(cases, *, output_dir: str | os.PathLike, stop_time: float = 3.0,
     try:
         if pending:
             with _client(scheduler, workers, connect_timeout) as client:
-                from dask.distributed import as_completed
-
                 futures = [client.submit(_run_chunk, index, index * chunk_cases,
                                          _columns(cases, names, index * chunk_cases,
                                                   min(len(cases), (index + 1) * chunk_cases)),
                                          study, pure=False) for index in pending]
+                # Done callbacks rather than as_completed: on Ctrl-C no waiting coroutine is left
+                # to fail, with a traceback, when the cluster closes.
+                finished_futures = queue.SimpleQueue()
+                for future in futures:
+                    future.add_done_callback(finished_futures.put)
                 failed = 0
-                for future, (_, count, chunk_failed, chunk_bytes) in as_completed(futures, with_results=True):
+                for _ in futures:
+                    future = finished_futures.get()
+                    _, count, chunk_failed, chunk_bytes = future.result()
                     finished, failed, written = finished + count, failed + chunk_failed, written + chunk_bytes
                     future.release()
                     bar.show(finished, failed)
