@@ -32,7 +32,7 @@ EFFICIENCY_TARGET = 0.85
 FIGURE_TARGET = 5.0  # s for 100,000 cases
 
 
-def _free_port() -> int:
+def free_port() -> int:
     with socket.socket() as probe:
         probe.bind(("127.0.0.1", 0))
         return probe.getsockname()[1]
@@ -44,7 +44,7 @@ def dask_processes(workers: int):
     own process on localhost, started as a user starts them on a cluster; stopped on exit."""
     from dask.distributed import Client
 
-    port = _free_port()
+    port = free_port()
     address = f"tcp://127.0.0.1:{port}"
     quiet = dict(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     processes = [subprocess.Popen([sys.executable, "-m", "dask", "scheduler", "--host", "127.0.0.1",
@@ -88,6 +88,7 @@ def measure_client(address: str, cases: int, stop_time: float, fmu: str, output_
     client_cpu = cpu() - before
     print(json.dumps({"seconds": summary["seconds"], "cpu": client_cpu, "figure": summary["figure_seconds"],
                       "bytes": summary["bytes"], "failed": summary["failed"],
+                      "worker_cpu": summary["worker_cpu_seconds"],
                       "peak_rss": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024}))
 
 
@@ -126,6 +127,9 @@ def scale_rows(fmu: BuiltFmu, quick: bool) -> list[Row]:
                 f">= {RATE_TARGET} per worker", per_worker >= RATE_TARGET),
             Row(PART, f"{label}: parallel efficiency", f"{efficiency:.0%}",
                 f">= {EFFICIENCY_TARGET:.0%}" if workers > 1 else "", efficiency >= EFFICIENCY_TARGET if workers > 1 else None),
+            Row(PART, f"{label}: worker CPU per case (stepping and writing)",
+                f"{result['worker_cpu'] / cases * 1e3:.2f} ms, so at most {cases / result['worker_cpu']:.0f} "
+                "cases/s per core", f">= {RATE_TARGET} cases/s", cases / result["worker_cpu"] >= RATE_TARGET),
             Row(PART, f"{label}: client CPU per case (whole run, figure included)",
                 f"{per_case_cpu * 1e6:.0f} µs"),
             Row(PART, f"{label}: client peak memory", f"{result['peak_rss'] / 1e6:.0f} MB"),

@@ -183,13 +183,13 @@ class _Runner:
         self.torque = np.array([value_reference("torque")], np.uint32)
         self.outputs = np.array([value_reference(name) for name in OUTPUTS], np.uint32)
 
-    def run(self, case: dict[str, float], time: np.ndarray, torque: np.ndarray,
+    def run(self, case: dict[str, float], points: np.ndarray, torque: np.ndarray,
             outputs: np.ndarray) -> None:
-        """theta, omega and alpha of one case at every point of time into outputs (points x 3);
+        """theta, omega and alpha of one case at every communication point into outputs (points x 3);
         torque is a scratch buffer (steps x 1). FmuError when the FMU refuses the case."""
         start = dict(parameters={k: v for k, v in case.items() if k not in ("torque", *START_VALUES)},
                      theta0=case.get("theta0", 0.0), omega0=case.get("omega0", 0.0),
-                     start_time=float(time[0]))
+                     start_time=float(points[0]))
         try:
             if self.slave is None:
                 self.slave = open_fmu(self.fmu, **start)
@@ -199,9 +199,9 @@ class _Runner:
                 initialize(self.slave, **start)
             torque[:] = case["torque"]
             if cs_loop.available():
-                cs_loop.run(self.slave, self.torque, self.outputs, time, torque, None, outputs)
+                cs_loop.run(self.slave, self.torque, self.outputs, points, torque, None, outputs)
             else:
-                plan = TorqueSchedule(time=time, torque=torque[:, 0], torque_rate=np.zeros(len(torque)))
+                plan = TorqueSchedule(time=points, torque=torque[:, 0], torque_rate=np.zeros(len(torque)))
                 run = run_schedule_python(self.slave, plan)
                 outputs[:] = np.column_stack([run[name] for name in OUTPUTS])
         except BaseException:
@@ -260,17 +260,18 @@ def _run_chunk(index: int, first: int, values: dict[str, np.ndarray], study: _St
     """Simulate a chunk of cases on a worker and write its parts.
 
     values: the chunk's cases, one array per name; first: the number of its first case.
-    Returns (index, cases, failed, bytes written).
+    Returns (index, cases, failed, bytes written, CPU seconds of this thread).
     """
-    time = communication_points(0.0, study.stop_time, study.step_size)
+    cpu = time.thread_time()
+    points = communication_points(0.0, study.stop_time, study.step_size)
     count = len(next(iter(values.values())))
-    recorded = np.empty((count, len(time), len(OUTPUTS)))
-    torque = np.empty((len(time) - 1, 1))
+    recorded = np.empty((count, len(points), len(OUTPUTS)))
+    torque = np.empty((len(points) - 1, 1))
     messages = [""] * count
     runner = _runner(study.fmu)
     for i in range(count):
         try:
-            runner.run({name: float(column[i]) for name, column in values.items()}, time, torque,
+            runner.run({name: float(column[i]) for name, column in values.items()}, points, torque,
                        recorded[i])
         except FmuError as error:
             messages[i] = str(error)
@@ -279,10 +280,10 @@ def _run_chunk(index: int, first: int, values: dict[str, np.ndarray], study: _St
     numbers = first + np.arange(count)
     written = 0
     if study.outputs:
-        keep = kept_points(len(time), study.stride)
+        keep = kept_points(len(points), study.stride)
         kept = recorded[ok][:, keep]
         written += _write_table(study, "trajectories", index, {
-            "case": np.repeat(numbers[ok], len(keep)), "time": np.tile(time[keep], int(ok.sum())),
+            "case": np.repeat(numbers[ok], len(keep)), "time": np.tile(points[keep], int(ok.sum())),
             **{name: kept[:, :, OUTPUTS.index(name)].ravel() for name in study.outputs}},
             split=study.outputs)
     final = recorded[:, -1]
@@ -290,7 +291,7 @@ def _run_chunk(index: int, first: int, values: dict[str, np.ndarray], study: _St
     written += _write_table(study, "cases", index, {
         "case": numbers, **values, **dict(zip(SUMMARIES, summaries)),
         "status": np.where(ok, "ok", "failed").tolist(), "message": messages})
-    return index, count, count - int(ok.sum()), written
+    return index, count, count - int(ok.sum()), written, time.thread_time() - cpu
 
 
 def _sha256(data: bytes) -> str:
@@ -465,7 +466,8 @@ def run_sweep(cases, *, output_dir: str | os.PathLike, stop_time: float = 3.0,
     `if __name__ == "__main__":` guard). progress: a progress line on stderr.
     Returns {'output_dir', 'trajectories', 'cases_table', 'figure': paths or URLs; 'cases',
     'failed': counts; 'chunks', 'chunks_run'; 'bytes': written by this run; 'seconds' in all,
-    'figure_seconds' of them reading the cases table and drawing}.
+    'figure_seconds' of them reading the cases table and drawing; 'worker_cpu_seconds' the
+    workers spent on this run's chunks}.
     """
     import fsspec
 
@@ -504,7 +506,7 @@ def run_sweep(cases, *, output_dir: str | os.PathLike, stop_time: float = 3.0,
     pending = [index for index in chunks if index not in done]
     finished = sum(min(chunk_cases, len(cases) - i * chunk_cases) for i in done)
     bar = _Progress(len(cases), progress)
-    written = 0
+    written, worker_cpu = 0, 0.0
     try:
         if pending:
             with _client(scheduler, workers, connect_timeout) as client:
@@ -520,8 +522,9 @@ def run_sweep(cases, *, output_dir: str | os.PathLike, stop_time: float = 3.0,
                 failed = 0
                 for _ in futures:
                     future = finished_futures.get()
-                    _, count, chunk_failed, chunk_bytes = future.result()
+                    _, count, chunk_failed, chunk_bytes, chunk_cpu = future.result()
                     finished, failed, written = finished + count, failed + chunk_failed, written + chunk_bytes
+                    worker_cpu += chunk_cpu
                     future.release()
                     bar.show(finished, failed)
     finally:
@@ -541,4 +544,5 @@ def run_sweep(cases, *, output_dir: str | os.PathLike, stop_time: float = 3.0,
             "cases_table": where("cases"), "figure": where("sweep.png"),
             "cases": len(cases), "failed": failed,
             "chunks": len(chunks), "chunks_run": len(pending), "bytes": written,
-            "seconds": drawn - started, "figure_seconds": drawn - drawing}
+            "seconds": drawn - started, "figure_seconds": drawn - drawing,
+            "worker_cpu_seconds": worker_cpu}

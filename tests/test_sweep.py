@@ -11,7 +11,6 @@ import subprocess
 import sys
 import threading
 import time
-from pathlib import Path
 
 import numpy as np
 import psutil
@@ -19,6 +18,8 @@ import pyarrow.csv
 import pyarrow.dataset as ds
 import pytest
 from dask.distributed import Client, LocalCluster
+
+import benchmarks.scale
 
 from pendulum_fmu import cs_loop, simulate
 from pendulum_fmu.build import default_fmu
@@ -251,34 +252,11 @@ def test_many_cases_draw_quantile_bands(tmp_path, threads_scheduler):
 
 # --- a cluster of separate processes, as on a real cluster ---------------------------------
 
-def _free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
-
-
 @pytest.fixture
 def dask_processes():
     """`dask scheduler` and two `dask worker`s on localhost, each its own process."""
-    address = f"tcp://127.0.0.1:{_free_port()}"
-    common = ["--no-dashboard"]
-    processes = [subprocess.Popen([sys.executable, "-m", "dask", "scheduler", "--host", "127.0.0.1",
-                                   "--port", address.rsplit(":", 1)[1], *common],
-                                  stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
-    try:
-        for _ in range(2):
-            processes.append(subprocess.Popen(
-                [sys.executable, "-m", "dask", "worker", address, "--host", "127.0.0.1",
-                 "--nworkers", "1", "--nthreads", "1", *common],
-                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
-        with Client(address, timeout=60) as client:
-            client.wait_for_workers(2, timeout=60)
+    with benchmarks.scale.dask_processes(2) as address:
         yield address
-    finally:
-        for process in reversed(processes):
-            process.terminate()
-        for process in processes:
-            process.wait(timeout=30)
 
 
 def test_a_study_on_a_scheduler_and_workers_started_as_processes(tmp_path, dask_processes, fmu, capsys):
@@ -297,7 +275,7 @@ def test_a_study_on_a_scheduler_and_workers_started_as_processes(tmp_path, dask_
 
 
 def test_an_unreachable_or_wrong_scheduler_is_one_line_within_the_timeout(tmp_path, capsys):
-    closed = f"tcp://127.0.0.1:{_free_port()}"
+    closed = f"tcp://127.0.0.1:{benchmarks.scale.free_port()}"
     with socket.socket() as impostor:  # answers, but not as a dask scheduler
         impostor.bind(("127.0.0.1", 0))
         impostor.listen()
