@@ -50,36 +50,46 @@ def _address(array: np.ndarray | None, shape: tuple[int, ...], dtype, what: str)
     return array.ctypes.data
 
 
-def run(slave, input_references: np.ndarray, output_references: np.ndarray, time: np.ndarray,
-        inputs: np.ndarray, input_rates: np.ndarray | None, outputs: np.ndarray,
-        final_inputs: np.ndarray | None = None) -> None:
-    """Step an initialized fmpy FMU2Slave through the communication points `time` (N + 1).
-
-    inputs, input_rates: (N, inputs) values and first derivatives of the inputs over each step
-    (input_rates None: held, fmi2SetRealInputDerivatives is not called). outputs: (N + 1,
-    outputs), filled with the outputs at every point, read after the step's inputs were set.
-    final_inputs: (inputs,) the inputs read back after the last step. References are uint32
-    arrays. A failing call raises the error of slave.messages (simulate.MessageLog), with the
-    FMU's messages and the time of the failing step.
+class Stepper:
+    """The native loop bound to an initialized fmpy FMU2Slave, its input and output value
+    references (uint32 arrays) and the communication points `time` (N + 1); run() steps it
+    through them. Binding once keeps a case's Python cost to a few microseconds; the slave may
+    be reset and initialized again between runs.
     """
-    steps = len(time) - 1
-    n_in, n_out = len(input_references), len(output_references)
-    dll = slave.dll
-    functions = [ctypes.cast(dll[name], ctypes.c_void_p) for name in _FMI_FUNCTIONS]
-    failed_step, failed_call = ctypes.c_size_t(), ctypes.c_int()
-    first_order = None if input_rates is None else np.ones(n_in, np.int32)  # fmi2Integer is int
-    status = _library()(
-        *functions, slave.component,
-        _address(input_references, (n_in,), np.uint32, "input_references"), n_in,
-        _address(output_references, (n_out,), np.uint32, "output_references"), n_out,
-        steps, _address(time, (steps + 1,), np.float64, "time"),
-        _address(inputs, (steps, n_in), np.float64, "inputs"),
-        _address(first_order, (n_in,), np.int32, "input orders"),
-        _address(input_rates, (steps, n_in), np.float64, "input_rates"),
-        _address(outputs, (steps + 1, n_out), np.float64, "outputs"),
-        _address(final_inputs, (n_in,), np.float64, "final_inputs"),
-        ctypes.byref(failed_step), ctypes.byref(failed_call))
-    if status > 1:
-        call = _CALLS[failed_call.value]
-        where = "at the end" if failed_call.value >= 4 else f"at t = {time[failed_step.value]:.17g}"
-        raise slave.messages.error(status, f"{call} {where}")
+
+    def __init__(self, slave, input_references: np.ndarray, output_references: np.ndarray,
+                 time: np.ndarray):
+        self.steps, self.inputs, self.outputs = len(time) - 1, len(input_references), len(output_references)
+        self.time, self.messages = time, slave.messages
+        self._references = input_references, output_references  # kept alive for the addresses
+        functions = [ctypes.cast(slave.dll[name], ctypes.c_void_p) for name in _FMI_FUNCTIONS]
+        self._first_order = np.ones(self.inputs, np.int32)  # fmi2Integer is int
+        self._failed_step, self._failed_call = ctypes.c_size_t(), ctypes.c_int()
+        self._bound = (
+            *functions, slave.component,
+            _address(input_references, (self.inputs,), np.uint32, "input_references"), self.inputs,
+            _address(output_references, (self.outputs,), np.uint32, "output_references"), self.outputs,
+            self.steps, _address(time, (self.steps + 1,), np.float64, "time"))
+        self._reports = ctypes.byref(self._failed_step), ctypes.byref(self._failed_call)
+
+    def run(self, inputs: np.ndarray, input_rates: np.ndarray | None, outputs: np.ndarray,
+            final_inputs: np.ndarray | None = None) -> None:
+        """inputs, input_rates: (N, inputs) values and first derivatives of the inputs over each
+        step (input_rates None: held, fmi2SetRealInputDerivatives is not called). outputs:
+        (N + 1, outputs), filled with the outputs at every point, read after the step's inputs
+        were set. final_inputs: (inputs,) the inputs read back after the last step. A failing
+        call raises the slave's MessageLog error, with the FMU's messages and the time of the
+        failing step.
+        """
+        status = _library()(
+            *self._bound,
+            _address(inputs, (self.steps, self.inputs), np.float64, "inputs"),
+            None if input_rates is None else self._first_order.ctypes.data,
+            _address(input_rates, (self.steps, self.inputs), np.float64, "input_rates"),
+            _address(outputs, (self.steps + 1, self.outputs), np.float64, "outputs"),
+            _address(final_inputs, (self.inputs,), np.float64, "final_inputs"),
+            *self._reports)
+        if status > 1:
+            call = self._failed_call.value
+            where = "at the end" if call >= 4 else f"at t = {self.time[self._failed_step.value]:.17g}"
+            raise self.messages.error(status, f"{_CALLS[call]} {where}")

@@ -131,9 +131,9 @@ def run_schedule(slave: FMU2Slave, plan: TorqueSchedule) -> np.ndarray:
     output_vr = np.array([value_reference(n) for n in ("theta", "omega", "alpha")], np.uint32)
     outputs, final_torque = np.empty((len(plan.time), 3)), np.empty(1)
     ramped = bool(np.any(plan.torque_rate))
-    cs_loop.run(slave, torque_vr, output_vr, plan.time, np.ascontiguousarray(plan.torque)[:, None],
-                np.ascontiguousarray(plan.torque_rate)[:, None] if ramped else None, outputs,
-                final_torque)
+    cs_loop.Stepper(slave, torque_vr, output_vr, plan.time).run(
+        np.ascontiguousarray(plan.torque)[:, None],
+        np.ascontiguousarray(plan.torque_rate)[:, None] if ramped else None, outputs, final_torque)
     return _result(plan, outputs, final_torque[0])
 
 

@@ -179,7 +179,7 @@ class _Runner:
     times what a reset and initialization cost."""
 
     def __init__(self, fmu: str):
-        self.fmu, self.slave = fmu, None
+        self.fmu, self.slave, self.stepper = fmu, None, None
         self.torque = np.array([value_reference("torque")], np.uint32)
         self.outputs = np.array([value_reference(name) for name in OUTPUTS], np.uint32)
 
@@ -199,7 +199,9 @@ class _Runner:
                 initialize(self.slave, **start)
             torque[:] = case["torque"]
             if cs_loop.available():
-                cs_loop.run(self.slave, self.torque, self.outputs, points, torque, None, outputs)
+                if self.stepper is None or self.stepper.time is not points:
+                    self.stepper = cs_loop.Stepper(self.slave, self.torque, self.outputs, points)
+                self.stepper.run(torque, None, outputs)
             else:
                 plan = TorqueSchedule(time=points, torque=torque[:, 0], torque_rate=np.zeros(len(torque)))
                 run = run_schedule_python(self.slave, plan)
@@ -212,7 +214,7 @@ class _Runner:
     def close(self) -> None:
         if self.slave is not None:
             self.slave.freeInstance()
-            self.slave = None
+            self.slave = self.stepper = None
 
 
 _runners = threading.local()
@@ -281,7 +283,9 @@ def _run_chunk(index: int, first: int, values: dict[str, np.ndarray], study: _St
     written = 0
     if study.outputs:
         keep = kept_points(len(points), study.stride)
-        kept = recorded[ok][:, keep]
+        kept = recorded if ok.all() else recorded[ok]  # copies only what is left out
+        if len(keep) < len(points):
+            kept = kept[:, keep]
         written += _write_table(study, "trajectories", index, {
             "case": np.repeat(numbers[ok], len(keep)), "time": np.tile(points[keep], int(ok.sum())),
             **{name: kept[:, :, OUTPUTS.index(name)].ravel() for name in study.outputs}},

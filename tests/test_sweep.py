@@ -93,8 +93,8 @@ def test_native_loop_reports_the_failing_step(fmu):
         plan = schedule(1.0, stop_time=0.01, step_size=1e-3)
         wrong = plan.time + 0.5  # fmi2DoStep refuses a step from where the instance is not
         with pytest.raises(simulate.FmuError, match=r"fmi2DoStep at t = 0.5 returned ERROR: .*not where"):
-            cs_loop.run(slave, np.array([0], np.uint32), np.array([1, 2, 3], np.uint32), wrong,
-                        plan.torque[:, None].copy(), None, np.empty((len(wrong), 3)))
+            stepper = cs_loop.Stepper(slave, np.array([0], np.uint32), np.array([1, 2, 3], np.uint32), wrong)
+            stepper.run(plan.torque[:, None].copy(), None, np.empty((len(wrong), 3)))
     finally:
         slave.freeInstance()
 
