@@ -165,8 +165,10 @@ def cmd_sweep(args) -> int:
     finally:
         for name, handler in previous.items():
             signal.signal(name, handler)
-    print(f"{summary['cases']} cases in {summary['seconds']:.1f} s ({summary['chunks_run']} of "
-          f"{summary['chunks']} chunks run, the others were written before)")
+    resumed = summary["chunks_run"] < summary["chunks"]
+    print(f"{summary['cases']} cases in {summary['seconds']:.1f} s"
+          + (f" ({summary['chunks_run']} of {summary['chunks']} chunks run; the others were "
+             "written by an earlier run)" if resumed else ""))
     if summary["failed"]:
         print(f"{summary['failed']} cases failed: their status and message are in the cases table")
     for key in ("trajectories", "cases_table", "figure"):

@@ -497,7 +497,7 @@ def run_sweep(cases, *, output_dir: str | os.PathLike, stop_time: float = 3.0,
         raise ValueError("workers sizes the local cluster; with a scheduler the cluster has its own")
     if workers is not None and (not isinstance(workers, numbers.Integral) or workers < 1):
         raise ValueError(f"workers must be a positive integer, got {workers!r}")
-    if not (isinstance(connect_timeout, numbers.Real) and connect_timeout > 0):
+    if not (isinstance(connect_timeout, numbers.Real) and 0 < connect_timeout < math.inf):
         raise ValueError(f"connect timeout {connect_timeout} must be a positive number of seconds")
     filesystem, root = fsspec.core.url_to_fs(str(output_dir))
     url = str(output_dir)
