@@ -274,6 +274,32 @@ def test_a_study_on_a_scheduler_and_workers_started_as_processes(tmp_path, dask_
         assert list(client.run(lambda: len(simulate._extracted)).values()) == [1, 1]
 
 
+def test_a_chunk_whose_worker_dies_is_run_again(tmp_path, dask_processes):
+    cases = sweep_grid(list(np.linspace(1.0, 40.0, 256)), [9.81])  # 64 chunks of 4 cases
+    summary = {}
+    study = threading.Thread(target=lambda: summary.update(run_sweep(
+        cases, output_dir=tmp_path, stop_time=10.0, outputs=[], scheduler=dask_processes,
+        progress=False)))
+    study.start()
+    deadline = time.monotonic() + 120
+    while not list(tmp_path.glob("cases/part-*")):
+        assert study.is_alive() and time.monotonic() < deadline
+        time.sleep(0.01)
+    # The process a `dask worker` (its nanny) started to run tasks, killed as a lost node would be,
+    # while chunks are still queued, so it holds one.
+    nannies = [p for p in psutil.Process().children() if "worker" in p.cmdline()]
+    victim = next(c for c in nannies[0].children() if "spawn_main" in " ".join(c.cmdline()))
+    victim.kill()
+    assert len(list(tmp_path.glob("cases/part-*"))) < 60
+    study.join(timeout=300)
+    assert not victim.is_running()
+    assert summary["cases"] == 256 and summary["failed"] == 0
+    table = _table(tmp_path / "cases")
+    assert table["case"].tolist() == list(range(256)) and set(table["status"]) == {"ok"}
+    assert table["final_theta"][255] == simulate.simulate(40.0, stop_time=10.0)["theta"][-1]
+    assert not list(tmp_path.glob("**/.*"))
+
+
 def test_an_unreachable_or_wrong_scheduler_is_one_line_within_the_timeout(tmp_path, capsys):
     closed = f"tcp://127.0.0.1:{benchmarks.scale.free_port()}"
     with socket.socket() as impostor:  # answers, but not as a dask scheduler
