@@ -56,6 +56,8 @@ SUMMARIES = ("final_theta", "final_omega", "final_alpha", "max_abs_theta")
 # chunk's files stay tens of megabytes and a lost worker loses little.
 TARGET_CHUNKS = 64
 MAX_CHUNK_CASES = 256
+# And a chunk's recordings (every point of every case, before thinning) stay this small.
+MAX_CHUNK_BYTES = 64_000_000
 # Up to this many cases the figure draws every trajectory; above, quantile bands of the summaries.
 LINES_UP_TO = 20
 
@@ -231,7 +233,7 @@ def _runner(fmu: str) -> _Runner:
     return current[1]
 
 
-def kept_points(points: int, stride: int) -> np.ndarray:
+def _kept_points(points: int, stride: int) -> np.ndarray:
     """Indices of the communication points written: every stride-th, and the last."""
     return np.unique(np.append(np.arange(0, points, stride), points - 1))
 
@@ -282,8 +284,8 @@ def _run_chunk(index: int, first: int, values: dict[str, np.ndarray], study: _St
     numbers = first + np.arange(count)
     written = 0
     if study.outputs:
-        keep = kept_points(len(points), study.stride)
-        kept = recorded if ok.all() else recorded[ok]  # copies only what is left out
+        keep = _kept_points(len(points), study.stride)
+        kept = recorded if ok.all() else recorded[ok]  # a copy only when a case failed
         if len(keep) < len(points):
             kept = kept[:, keep]
         written += _write_table(study, "trajectories", index, {
@@ -333,7 +335,8 @@ def _temporaries() -> tuple[str, ...]:
     return (".*.partial", "trajectories/.*.partial", "cases/.*.partial")
 
 
-def _prepare(study: _Study, definition: dict, resume: bool, count: int, output_dir) -> int:
+def _prepare(study: _Study, definition: dict, resume: bool, count: int, points: int,
+             output_dir) -> int:
     """Write study.json (or check it, on resume); returns the cases per chunk."""
     fs, manifest = study.filesystem, f"{study.root}/study.json"
     if resume and fs.exists(manifest):
@@ -347,7 +350,8 @@ def _prepare(study: _Study, definition: dict, resume: bool, count: int, output_d
         return previous["chunk_cases"]
     # A new study replaces whatever study was there.
     _remove(study, ("study.json", "sweep.png", "trajectories/part-*", "cases/part-*"))
-    chunk_cases = min(MAX_CHUNK_CASES, max(1, math.ceil(count / TARGET_CHUNKS)))
+    fitting = MAX_CHUNK_BYTES // (points * len(OUTPUTS) * 8)
+    chunk_cases = max(1, min(MAX_CHUNK_CASES, fitting, math.ceil(count / TARGET_CHUNKS)))
     with replacing_on(fs, manifest) as file:
         file.write(json.dumps({"study": definition, "chunk_cases": chunk_cases}, indent=1).encode())
     return chunk_cases
@@ -479,7 +483,7 @@ def run_sweep(cases, *, output_dir: str | os.PathLike, stop_time: float = 3.0,
     names = _check_cases(cases)
     if not (isinstance(stop_time, numbers.Real) and math.isfinite(stop_time)):
         raise ValueError(f"stop time {stop_time} must be a finite number")
-    communication_points(0.0, stop_time, step_size)  # refuses a bad stop time or step here
+    points = len(communication_points(0.0, stop_time, step_size))  # refuses a bad stop or step here
     outputs = tuple(outputs)
     for name in outputs:
         if name not in OUTPUTS or outputs.count(name) > 1:
@@ -504,7 +508,7 @@ def run_sweep(cases, *, output_dir: str | os.PathLike, stop_time: float = 3.0,
     study = _Study(fmu=str(Path(fmu_path).resolve() if fmu_path else default_fmu()),
                    filesystem=filesystem, root=root.rstrip("/"), stop_time=float(stop_time),
                    step_size=float(step_size), outputs=outputs, stride=stride, format=format)
-    chunk_cases = _prepare(study, _definition(cases, names, study), resume, len(cases), url)
+    chunk_cases = _prepare(study, _definition(cases, names, study), resume, len(cases), points, url)
     chunks = range(math.ceil(len(cases) / chunk_cases))
     done = _done_chunks(study)
     pending = [index for index in chunks if index not in done]
