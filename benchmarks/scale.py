@@ -92,6 +92,30 @@ def measure_client(address: str, cases: int, stop_time: float, fmu: str, output_
                       "peak_rss": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024}))
 
 
+def simulate_repeatedly(fmu: str, cases: int) -> None:
+    """Run in a control process: `cases` 3-second cases through simulate(), no dask, no files."""
+    from pendulum_fmu.simulate import simulate
+
+    for case in range(cases):
+        simulate(5.0 + case % 30, stop_time=3.0, fmu_path=fmu)
+
+
+def _control_speedup(fmu: BuiltFmu, processes: int, cases: int = 200) -> float:
+    """How many times one process's rate N plain processes reach together: what the machine
+    gives at that moment, the ceiling for N workers."""
+    import time
+
+    code = f"from benchmarks.scale import simulate_repeatedly; simulate_repeatedly({str(fmu.path)!r}, {cases})"
+    seconds = {}
+    for count in (1, processes):
+        started = time.perf_counter()
+        running = [subprocess.Popen([sys.executable, "-c", code], cwd=REPOSITORY) for _ in range(count)]
+        if any(process.wait() for process in running):
+            raise RuntimeError("a control process failed")
+        seconds[count] = time.perf_counter() - started
+    return processes * seconds[1] / seconds[processes]
+
+
 def _study(address: str, cases: int, stop_time: float, fmu: BuiltFmu) -> dict:
     with tempfile.TemporaryDirectory(prefix="pendulum-scale-") as out:
         code = (f"from benchmarks.scale import measure_client; measure_client({address!r}, {cases}, "
@@ -128,6 +152,9 @@ def scale_rows(fmu: BuiltFmu, quick: bool) -> list[Row]:
                 f">= {RATE_TARGET} per worker", per_worker >= RATE_TARGET),
             Row(PART, f"{label}: parallel efficiency", f"{efficiency:.0%}",
                 f">= {EFFICIENCY_TARGET:.0%}" if workers > 1 else "", efficiency >= EFFICIENCY_TARGET if workers > 1 else None),
+            *([Row(PART, f"control: {workers} plain processes running simulate() (no dask, no files), "
+                   "speed-up over one", f"{_control_speedup(fmu, workers):.2f} of {workers}")]
+              if workers > 1 else []),
             Row(PART, f"{label}: worker CPU per case (stepping and writing)",
                 f"{worker_cpu[workers] * 1e3:.2f} ms, so at most {1 / worker_cpu[workers]:.0f} cases/s "
                 "per core", f">= {RATE_TARGET} cases/s", 1 / worker_cpu[workers] >= RATE_TARGET),
