@@ -158,8 +158,9 @@ def scale_rows(fmu: BuiltFmu, quick: bool) -> list[Row]:
             Row(PART, f"{label}: worker CPU per case (stepping and writing)",
                 f"{worker_cpu[workers] * 1e3:.2f} ms, so at most {1 / worker_cpu[workers]:.0f} cases/s "
                 "per core", f">= {RATE_TARGET} cases/s", 1 / worker_cpu[workers] >= RATE_TARGET),
-            Row(PART, f"{label}: worker CPU per case at 1 worker / at {workers} (work added by "
-                "workers: none at 100 %)", f"{worker_cpu[1] / worker_cpu[workers]:.0%}"),
+            *([Row(PART, f"{label}: worker CPU per case at 1 worker / at {workers} (work added by "
+                   "workers: none at 100 %)", f"{worker_cpu[1] / worker_cpu[workers]:.0%}")]
+              if workers > 1 else []),
             Row(PART, f"{label}: client CPU per case (whole run, figure included)",
                 f"{per_case_cpu * 1e6:.0f} µs"),
             Row(PART, f"{label}: client peak memory", f"{result['peak_rss'] / 1e6:.0f} MB"),
