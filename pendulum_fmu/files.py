@@ -83,11 +83,14 @@ def replacing_on(filesystem, path: str):
         return
     parent, _, name = path.rpartition("/")
     temporary = f"{parent}/.{name}.{uuid.uuid4().hex}.partial"
-    try:
+    with contextlib.ExitStack() as on_failure:
+        on_failure.callback(_remove_if_there, filesystem, temporary)
         with filesystem.open(temporary, "wb") as file:
             yield file
         filesystem.mv(temporary, path)
-    except BaseException:
-        with contextlib.suppress(FileNotFoundError):
-            filesystem.rm(temporary)
-        raise
+        on_failure.pop_all()  # moved into place: nothing to remove
+
+
+def _remove_if_there(filesystem, path: str) -> None:
+    with contextlib.suppress(FileNotFoundError):
+        filesystem.rm(path)

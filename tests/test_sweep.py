@@ -227,6 +227,21 @@ def test_output_to_fsspec_memory(threads_scheduler):
     assert not [path for path in filesystem.find("/study") if "/." in path]
 
 
+def test_a_failed_write_to_a_url_leaves_neither_file_nor_temporary():
+    import fsspec
+
+    from pendulum_fmu.files import replacing_on
+
+    filesystem = fsspec.filesystem("memory")
+    with replacing_on(filesystem, "/writes/kept.bin") as file:
+        file.write(b"whole")
+    with pytest.raises(RuntimeError), replacing_on(filesystem, "/writes/lost.bin") as file:
+        file.write(b"half")
+        raise RuntimeError("interrupted")
+    assert filesystem.find("/writes") == ["/writes/kept.bin"]
+    assert filesystem.cat("/writes/kept.bin") == b"whole"
+
+
 def test_band_quantiles_are_numpys_per_value():
     from pendulum_fmu.plot import BAND_LEVELS, _quantiles
 
