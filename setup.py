@@ -1,17 +1,23 @@
-"""The wheel's build step: build_py also builds the FMU into the wheel's pendulum_fmu/data/.
+"""The wheel's build steps; everything else about the package is in pyproject.toml.
 
-Everything else about the package is in pyproject.toml. The FMU is built from this source tree
-(a clone or the unpacked sdist) for every platform whose compiler is installed.
+- build_py also builds the FMI 2.0 and 3.0 FMUs into the wheel's pendulum_fmu/data/, from this
+  source tree (a clone or the unpacked sdist), for every platform whose compiler is installed.
+- The native co-simulation loop, pendulum_fmu/_cs_loop.c, is built as a shared library. It is
+  plain C loaded with ctypes (pendulum_fmu/cs_loop.py), not a CPython module, so it exports its
+  own function rather than a PyInit_ one. The FMI headers are fmpy's (a build requirement).
 """
 
 import sys
 from pathlib import Path
 
-from setuptools import setup
+from setuptools import Extension, setup
+from setuptools.command.build_ext import build_ext
 from setuptools.command.build_py import build_py
 
 # This tree's pendulum_fmu (not an installed one) knows where the sources are.
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from pendulum_fmu.build import FMI_HEADERS  # noqa: E402
 
 
 class BuildPyWithFmu(build_py):
@@ -31,5 +37,13 @@ class BuildPyWithFmu(build_py):
             print(f"pendulum_fmu {__version__}: built {fmu}")
 
 
-# The native stepping loop (pendulum_fmu._cs_loop, docs/design.md) joins as ext_modules here.
-setup(cmdclass={"build_py": BuildPyWithFmu})
+class BuildCLibrary(build_ext):
+    def get_export_symbols(self, extension):
+        return extension.export_symbols
+
+
+setup(
+    ext_modules=[Extension("pendulum_fmu._cs_loop", sources=["pendulum_fmu/_cs_loop.c"],
+                           include_dirs=[str(FMI_HEADERS)], export_symbols=["cs_loop_run"])],
+    cmdclass={"build_py": BuildPyWithFmu, "build_ext": BuildCLibrary},
+)

@@ -1,5 +1,6 @@
-"""Part 4: our Python master, pendulum_fmu.simulate, against fmpy's FMU2Slave wrappers making
-the same FMI calls, on the same FMU, with the same results."""
+"""Part 4: our Python master loop (run_schedule_python, simulate()'s reference path) against
+fmpy's FMU2Slave wrappers making the same FMI calls, and the native loop (cs_loop, what
+simulate() runs when it is built) making them from C; same FMU, same results bit for bit."""
 
 from __future__ import annotations
 
@@ -9,7 +10,8 @@ from fmpy.fmi2 import FMU2Slave
 from pendulum_fmu import results
 from pendulum_fmu.parameters import value_reference
 from pendulum_fmu.signal import TorqueSchedule, schedule
-from pendulum_fmu.simulate import open_fmu, run_schedule
+from pendulum_fmu import cs_loop
+from pendulum_fmu.simulate import open_fmu, run_schedule, run_schedule_python
 
 from . import tutorial
 from .builds import BuiltFmu
@@ -58,18 +60,25 @@ def python_loop_rows(fmu: BuiltFmu, repetitions: int) -> list[Row]:
             return seconds
         return run
 
-    seconds = interleaved({"ours": contender("ours", run_schedule),
-                           "fmpy": contender("fmpy", fmpy_schedule_loop)}, repetitions)
+    contenders = {"ours": contender("ours", run_schedule_python),
+                  "fmpy": contender("fmpy", fmpy_schedule_loop)}
+    if cs_loop.available():
+        contenders["native"] = contender("native", run_schedule)
+    seconds = interleaved(contenders, repetitions)
     # Same FMU, same calls, same order: anything but bit-for-bit equality is a bug.
-    assert np.array_equal(theta["ours"], theta["fmpy"]), "run_schedule and fmpy differ in theta"
+    for name in theta:
+        assert np.array_equal(theta["ours"], theta[name]), f"run_schedule_python and {name} differ in theta"
     ours_step = median(seconds["ours"]) / tutorial.STEPS
     fmpy_step = median(seconds["fmpy"]) / tutorial.STEPS
     ours_over_fmpy = ours_step / fmpy_step
     return [
-        Row(PART, f"simulate()'s loop, run_schedule (setReal, getReal x3, doStep), {tutorial.STEPS} "
+        Row(PART, f"the Python loop, run_schedule_python (setReal, getReal x3, doStep), {tutorial.STEPS} "
                   f"x 1 ms, median of {repetitions}", f"{microseconds(ours_step)}/step"),
         Row(PART, "fmpy FMU2Slave wrappers making the same calls", f"{microseconds(fmpy_step)}/step"),
-        Row(PART, "simulate() / fmpy", ratio(ours_over_fmpy), f"<= {TARGET_RATIO:.2f}",
+        Row(PART, "Python loop / fmpy", ratio(ours_over_fmpy), f"<= {TARGET_RATIO:.2f}",
             ours_over_fmpy <= TARGET_RATIO),
         Row(PART, "theta arrays identical (asserted)", "yes"),
-    ]
+    ] + ([Row(PART, "native loop (cs_loop: the same calls from C, one call per run)",
+              f"{microseconds(median(seconds['native']) / tutorial.STEPS)}/step"),
+          Row(PART, "native / Python loop", ratio(median(seconds["native"]) / median(seconds["ours"])))]
+         if "native" in seconds else [])

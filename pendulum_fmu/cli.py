@@ -169,15 +169,60 @@ def _sweep_values(assignments) -> dict[str, list[float]]:
     return values
 
 
+class _Stopped(BaseException):
+    """SIGINT or SIGTERM during a sweep (a BaseException, so no `except Exception` swallows it)."""
+
+    def __init__(self, signal_number: int):
+        super().__init__(signal_number)
+        self.signal_number = signal_number
+
+
+def _stop_on_signals():
+    """Make SIGINT and SIGTERM raise _Stopped once; further ones are ignored so the cleanup that
+    follows (closing the cluster, removing temporaries) runs to its end. Returns the old handlers."""
+    import signal
+
+    def stop(number, frame):
+        for name in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(name, signal.SIG_IGN)
+        raise _Stopped(number)
+
+    return {name: signal.signal(name, stop) for name in (signal.SIGINT, signal.SIGTERM)}
+
+
+def _sweep_outputs(text: str) -> tuple[str, ...]:
+    return () if text.strip() == "none" else tuple(name.strip() for name in text.split(","))
+
+
 def cmd_sweep(args) -> int:
+    import signal
+
     from .sweep import run_sweep, sweep_grid
 
     cases = sweep_grid(args.torque, args.gravity, _sweep_values(args.assignments))
-    summary = run_sweep(cases, output_dir=args.output_dir, stop_time=args.stop_time,
-                        step_size=args.step_size, scheduler=args.scheduler, workers=args.workers,
-                        fmu_path=args.fmu)
-    print(f"{summary['cases']} cases in {summary['seconds']:.1f} s")
-    print(f"wrote {summary['results']}\nwrote {summary['figure']}")
+    previous = _stop_on_signals()
+    try:
+        summary = run_sweep(cases, output_dir=args.output_dir, stop_time=args.stop_time,
+                            step_size=args.step_size, outputs=_sweep_outputs(args.outputs),
+                            output_interval=args.output_interval, format=args.format,
+                            resume=args.resume, scheduler=args.scheduler, workers=args.workers,
+                            connect_timeout=args.connect_timeout, fmu_path=args.fmu)
+    except _Stopped as stopped:
+        what = "interrupted" if stopped.signal_number == signal.SIGINT else "terminated"
+        print(f"pendulum-fmu sweep: {what}; the chunks that finished are kept in {args.output_dir}: "
+              "run the same command with --resume to run the rest", file=sys.stderr)
+        return 128 + stopped.signal_number
+    finally:
+        for name, handler in previous.items():
+            signal.signal(name, handler)
+    resumed = summary["chunks_run"] < summary["chunks"]
+    print(f"{summary['cases']} cases in {summary['seconds']:.1f} s"
+          + (f" ({summary['chunks_run']} of {summary['chunks']} chunks run; the others were "
+             "written by an earlier run)" if resumed else ""))
+    if summary["failed"]:
+        print(f"{summary['failed']} cases failed: their status and message are in the cases table")
+    for key in ("trajectories", "cases_table", "figure"):
+        print(f"wrote {summary[key]}")
     return 0
 
 
@@ -217,7 +262,7 @@ def cmd_demo(args) -> int:
     print("\nParameter study: torque 5, 10, 20, 40 N.m with gravity, on a local dask cluster")
     summary = run_sweep(sweep_grid([5.0, 10.0, 20.0, 40.0], [9.81]), output_dir=out / "parameter_study",
                         workers=args.workers)
-    print(f"{summary['cases']} cases in {summary['seconds']:.1f} s\nwrote {summary['results']}\n"
+    print(f"{summary['cases']} cases in {summary['seconds']:.1f} s\nwrote {summary['cases_table']}\n"
           f"wrote {summary['figure']}")
     return 0 if agree else 1
 
@@ -304,9 +349,23 @@ def build_parser() -> argparse.ArgumentParser:
                        metavar="NAME=V1,V2", help="more values of a parameter or theta0/omega0")
     sweep.add_argument("--stop-time", type=_float, default=3.0, help="default: %(default)s s")
     sweep.add_argument("--step-size", type=_float, default=1e-3, help="default: %(default)s s")
-    sweep.add_argument("--output-dir", type=Path, required=True,
-                       help="folder for sweep.csv (one tidy file) and sweep.png")
+    sweep.add_argument("--output-dir", required=True,
+                       help="local folder or fsspec URL (s3://..., a shared file system) every "
+                            "worker can write to: trajectories/ and cases/ (a file per chunk), "
+                            "sweep.png")
+    sweep.add_argument("--outputs", default="theta,omega,alpha",
+                       help="outputs the trajectories keep, comma-separated, or none for only "
+                            "the cases table (default: %(default)s)")
+    sweep.add_argument("--output-interval", type=_float, default=None,
+                       help="keep a point every so many s, a whole number of steps (default: "
+                            "every step)")
+    sweep.add_argument("--format", choices=("parquet", "csv"), default="parquet",
+                       help="file format of the tables (default: %(default)s; csv for small studies)")
+    sweep.add_argument("--resume", action="store_true",
+                       help="run only the chunks a previous run of the same study did not write")
     sweep.add_argument("--scheduler", help="address of a running dask.distributed scheduler")
+    sweep.add_argument("--connect-timeout", type=_float, default=10.0,
+                       help="seconds to wait for --scheduler to answer (default: %(default)s)")
     sweep.add_argument("--workers", type=int, default=None, help="local cluster workers (default: 2)")
     _add_fmu_argument(sweep)
     sweep.set_defaults(run=cmd_sweep)
@@ -383,5 +442,15 @@ def main(argv=None) -> int:
             signal.signal(signal.SIGTERM, previous)
 
 
+def run() -> None:
+    """The pendulum-fmu program: main() with the process's exit code. Once main() returned, every
+    file is in place, so a Ctrl-C or SIGTERM while the interpreter shuts down is ignored rather
+    than shown as a traceback."""
+    code = main()
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    sys.exit(code)
+
+
 if __name__ == "__main__":
-    sys.exit(main())
+    run()

@@ -11,6 +11,7 @@ from __future__ import annotations
 import contextlib
 import os
 import tempfile
+import uuid
 from pathlib import Path
 
 
@@ -68,3 +69,32 @@ def replacing_path(path: str | os.PathLike):
         with contextlib.suppress(FileNotFoundError):
             os.unlink(temporary)
         raise
+
+
+@contextlib.contextmanager
+def replacing_on(filesystem, path: str):
+    """replacing(path, "wb") on any fsspec file system, for outputs given as URLs.
+
+    The local file system goes through replacing. Elsewhere the content is written to a unique
+    temporary name beside path and moved into place (an object store's upload appears whole;
+    the move makes that hold for the other file systems too).
+    """
+    from fsspec.implementations.local import LocalFileSystem
+
+    if isinstance(filesystem, LocalFileSystem):
+        with replacing(path, "wb") as file:
+            yield file
+        return
+    parent, _, name = path.rpartition("/")
+    temporary = f"{parent}/.{name}.{uuid.uuid4().hex}.partial"
+    with contextlib.ExitStack() as on_failure:
+        on_failure.callback(_remove_if_there, filesystem, temporary)
+        with filesystem.open(temporary, "wb") as file:
+            yield file
+        filesystem.mv(temporary, path)
+        on_failure.pop_all()  # moved into place: nothing to remove
+
+
+def _remove_if_there(filesystem, path: str) -> None:
+    with contextlib.suppress(FileNotFoundError):
+        filesystem.rm(path)

@@ -4,7 +4,10 @@ from __future__ import annotations
 
 import array
 import ctypes
+import itertools
 import tempfile
+import threading
+import weakref
 from pathlib import Path
 
 import numpy as np
@@ -12,40 +15,58 @@ from fmpy import extract
 from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
 from fmpy.fmi3 import FMU3Slave
 
-from . import results
-from . import default_fmu
+from . import cs_loop, default_fmu, results
 from .parameters import model_description, resolve_parameters, value_reference
 from .signal import TorqueSignal, TorqueSchedule, schedule
 
 _STATUS = ["OK", "WARNING", "DISCARD", "ERROR", "FATAL", "PENDING"]
+# What a result records at every communication point, read back from the FMU after the step's
+# input was set: the torque it received, and the outputs.
+RECORDED = ("torque", "theta", "omega", "alpha")
 
 
 class FmuError(RuntimeError):
     """An FMI call failed; the message carries what the FMU logged."""
 
 
+def _log_to_instance(environment, instance_name, status, category, message):
+    log = _logs.get(environment)
+    if log is not None:
+        log.log_fmi3(environment, status, category, message)
+
+
+# One FMI 2.0 logger for every instance, never freed, which hands each message to its instance's
+# log by the componentEnvironment the instance was given: fmpy's formatting proxy keeps the last
+# logger it was given in one global, so a logger per instance would be called for another
+# instance's messages, or after it was freed (a crash when instances live in several threads).
+_LOGGER = fmi2CallbackLoggerTYPE(_log_to_instance)
+_logs: weakref.WeakValueDictionary[int, MessageLog] = weakref.WeakValueDictionary()
+_log_keys = itertools.count(1)
+
+
 class MessageLog:
-    """FMI callbacks whose logger keeps what the FMU says, so a failure can say why."""
+    """FMI callbacks whose logger keeps what the FMU says, so a failure can say why.
+
+    FMI 2.0: `callbacks` for fmi2Instantiate. FMI 3.0: `log_fmi3` is the logMessage callback (it
+    has no instance name), and fmpy's FMI 2.0 proxy is left alone."""
 
     def __init__(self, fmi_version: int = 2):
         self.lines: list[str] = []
         if fmi_version == 3:
-            return  # log_fmi3 is the callback; no FMI 2.0 struct, so fmpy's proxy stays untouched
+            return
         self.callbacks = fmi2CallbackFunctions()
-        self.callbacks.logger = fmi2CallbackLoggerTYPE(self._log)
+        self.callbacks.logger = _LOGGER
+        key = next(_log_keys)
+        self.callbacks.componentEnvironment = key
+        _logs[key] = self
         try:
-            # fmpy's C proxy formats printf-style arguments before they reach Python. It keeps one
-            # logger per process: the newest FMI 2.0 MessageLog receives the messages.
+            # fmpy's C proxy formats printf-style arguments before they reach Python.
             from fmpy.logging import addLoggerProxy
             addLoggerProxy(ctypes.byref(self.callbacks))
         except Exception:
             pass
 
-    def _log(self, environment, instance_name, status, category, message):
-        self.log_fmi3(environment, status, category, message)
-
     def log_fmi3(self, environment, status, category, message):
-        """FMI 3.0's logger, which has no instance name."""
         self.lines.append(f"[{_STATUS[status] if 0 <= status < 6 else status}] "
                           f"{message.decode('utf-8', 'replace')}")
 
@@ -55,17 +76,19 @@ class MessageLog:
 
 
 _extracted: dict[tuple[str, int], tuple[tempfile.TemporaryDirectory, object]] = {}
+_extracting = threading.Lock()  # threads of one dask worker share the cache
 
 
 def _unzipped(fmu_path: Path):
     """(folder, model description) of an FMU file, extracted and parsed once per process; the
     folder is removed at exit."""
     key = (str(fmu_path.resolve()), fmu_path.stat().st_mtime_ns)
-    if key not in _extracted:
-        folder = tempfile.TemporaryDirectory(prefix="pendulum_fmu_")
-        extract(str(fmu_path), unzipdir=folder.name)
-        _extracted[key] = folder, model_description(fmu_path)
-    folder, description = _extracted[key]
+    with _extracting:
+        if key not in _extracted:
+            folder = tempfile.TemporaryDirectory(prefix="pendulum_fmu_")
+            extract(str(fmu_path), unzipdir=folder.name)
+            _extracted[key] = folder, model_description(fmu_path)
+        folder, description = _extracted[key]
     return folder.name, description
 
 
@@ -75,8 +98,8 @@ def open_fmu(fmu_path: str | Path | None = None, *, parameters: dict | None = No
     """An initialized FMU2Slave or FMU3Slave (in step mode, the FMI version read from the FMU's
     model description; slave.fmi_version says which) with its message log as slave.messages.
 
-    fmu_path defaults to pendulum_fmu.default_fmu() (FMI 2.0); parameters and value references are that
-    FMU's own. The caller frees it with slave.terminate(); slave.freeInstance().
+    fmu_path defaults to pendulum_fmu.default_fmu() (FMI 2.0); parameters and value references
+    are that FMU's own. The caller frees it with slave.terminate(); slave.freeInstance().
     """
     fmu_path = Path(fmu_path) if fmu_path else default_fmu()
     folder, description = _unzipped(fmu_path)
@@ -92,11 +115,24 @@ def open_fmu(fmu_path: str | Path | None = None, *, parameters: dict | None = No
         slave.instantiate(callbacks=messages.callbacks)
     slave.fmi_version = fmi_version
     slave.messages = messages  # keeps the logger callback alive as long as the slave
-    slave.fmu_path = fmu_path  # whose value references run_schedule uses
-    start = {**resolve_parameters(parameters, fmu_path), "theta": float(theta0), "omega": float(omega0)}
-    references = [value_reference(n, fmu_path) for n in start]
+    slave.fmu_path = fmu_path  # whose parameters and value references apply
     try:
-        if fmi_version == 3:
+        initialize(slave, parameters=parameters, theta0=theta0, omega0=omega0,
+                   tolerance=tolerance, start_time=start_time)
+    except BaseException:
+        slave.freeInstance()
+        raise
+    return slave
+
+
+def initialize(slave: FMU2Slave | FMU3Slave, *, parameters: dict | None = None, theta0: float = 0.0,
+               omega0: float = 0.0, tolerance: float | None = None, start_time: float = 0.0) -> None:
+    """Set the parameters and start values of an instantiated (or reset) slave from open_fmu and
+    leave it in step mode; FmuError says why the FMU refused."""
+    start = {**resolve_parameters(parameters, slave.fmu_path), "theta": float(theta0), "omega": float(omega0)}
+    references = [value_reference(n, slave.fmu_path) for n in start]
+    try:
+        if slave.fmi_version == 3:
             slave.enterInitializationMode(tolerance=tolerance, startTime=start_time)
             slave.setFloat64(references, list(start.values()))
         else:
@@ -105,14 +141,40 @@ def open_fmu(fmu_path: str | Path | None = None, *, parameters: dict | None = No
             slave.setReal(references, list(start.values()))
         slave.exitInitializationMode()
     except Exception as error:
-        slave.freeInstance()
-        raise FmuError(f"initialization failed: {'; '.join(messages.lines) or error}") from None
-    return slave
+        raise FmuError(f"initialization failed: {'; '.join(slave.messages.lines) or error}") from None
 
 
 def run_schedule(slave: FMU2Slave | FMU3Slave, plan: TorqueSchedule) -> np.ndarray:
     """Feed a schedule to an initialized slave (from open_fmu); returns the result array (see
     results.py).
+
+    One call into the native loop (cs_loop.py) when it was compiled and the FMU is FMI 2.0, else
+    the Python loop, the readable reference; the two give the same numbers bit for bit.
+    """
+    if not cs_loop.available() or slave.fmi_version != 2:
+        return run_schedule_python(slave, plan)
+    torque_vr = np.array([value_reference("torque", slave.fmu_path)], np.uint32)
+    recorded_vr = np.array([value_reference(n, slave.fmu_path) for n in RECORDED], np.uint32)
+    recorded = np.empty((len(plan.time), len(RECORDED)))
+    ramped = bool(np.any(plan.torque_rate))
+    cs_loop.Stepper(slave, torque_vr, recorded_vr, plan.time).run(
+        np.ascontiguousarray(plan.torque)[:, None],
+        np.ascontiguousarray(plan.torque_rate)[:, None] if ramped else None, recorded)
+    return _result(plan, recorded)
+
+
+def _result(plan: TorqueSchedule, recorded: np.ndarray) -> np.ndarray:
+    """The result array of a schedule from the RECORDED columns at every point."""
+    out = results.empty(len(plan.time))
+    out["time"] = plan.time
+    for name, column in zip(RECORDED, recorded.T):
+        out[name] = column
+    return out
+
+
+def run_schedule_python(slave: FMU2Slave | FMU3Slave, plan: TorqueSchedule) -> np.ndarray:
+    """run_schedule in Python: the reference the native loop is checked against, and the loop for
+    FMI 3.0.
 
     The FMI functions are bound once from the library fmpy loaded, without fmpy's argtypes (with
     them ctypes converts every argument on every call), and every argument is a ctypes object
@@ -128,9 +190,7 @@ def run_schedule(slave: FMU2Slave | FMU3Slave, plan: TorqueSchedule) -> np.ndarr
     set_real, get_real, set_rate, do_step = (dll[name] if name else None for name in names)
     component = ctypes.c_void_p(slave.component)
     torque_vr = (ctypes.c_uint * 1)(value_reference("torque", slave.fmu_path))
-    # The torque is read back with the outputs: the result records what the FMU received.
-    recorded_vr = (ctypes.c_uint * 4)(*(value_reference(n, slave.fmu_path)
-                                        for n in ("torque", "theta", "omega", "alpha")))
+    recorded_vr = (ctypes.c_uint * 4)(*(value_reference(n, slave.fmu_path) for n in RECORDED))
     one, four = ctypes.c_size_t(1), ctypes.c_size_t(4)
     first_order = (ctypes.c_int * 1)(1)
     no_rollback = ctypes.c_int(1)
@@ -170,11 +230,7 @@ def run_schedule(slave: FMU2Slave | FMU3Slave, plan: TorqueSchedule) -> np.ndarr
         raise messages.error(status, f"{names[1]} at the end")
     rows.frombytes(recorded_bytes)
 
-    out = results.empty(len(plan.time))
-    out["time"] = plan.time
-    for name, column in zip(("torque", "theta", "omega", "alpha"), np.frombuffer(rows).reshape(-1, 4).T):
-        out[name] = column
-    return out
+    return _result(plan, np.frombuffer(rows).reshape(-1, len(RECORDED)))
 
 
 def simulate(torque: TorqueSignal = 20.0, *, start_time: float = 0.0, stop_time: float | None = None,

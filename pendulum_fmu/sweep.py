@@ -1,35 +1,65 @@
-"""Parameter studies: a grid of cases run on dask.distributed.
+"""Parameter studies on dask.distributed: workers simulate chunks of cases and write them.
 
-A local cluster by default; with a scheduler address, an existing cluster, which is how a study
-grows past one machine (every worker needs this package installed and the FMU path readable).
-Cases go out in chunks, so a task amortizes its scheduling over several simulations, and each
-worker formats its chunk's CSV rows: printing floats exactly costs over half as much as
-simulating them, so the client only concatenates.
+A study goes to an output directory, a local path or any fsspec URL every worker can write to
+(a shared file system, s3://, gs://, ...):
+
+    study.json                        what the study is (cases, times, outputs, chunking)
+    trajectories/part-000000.parquet  per chunk: case, time and the chosen outputs at each kept
+                                      communication point
+    cases/part-000000.parquet         per chunk, one row per case: case, its values, final_theta,
+                                      final_omega, final_alpha, max_abs_theta, status ("ok" or
+                                      "failed") and message (why the FMU refused the case)
+    sweep.png                         the figure
+
+The worker that ran a chunk writes its two files, trajectories first, so a chunk is done when its
+cases part exists; --resume runs the chunks that are not. The client submits chunks, shows
+progress and draws the figure from the cases table: it never holds a trajectory, so its memory
+and its work per case stay small however large the study. A worker steps each case in the native
+loop (cs_loop.py) through one FMU instance that it resets between cases. With format "csv" the
+same files are CSV. One line of pandas, pyarrow, dask or DuckDB reads either table, e.g.
+pandas.read_parquet("out/trajectories").
 """
 
 from __future__ import annotations
 
-import itertools
+import contextlib
+import hashlib
+import json
 import logging
 import math
 import numbers
+import os
+import queue
 import sys
+import tempfile
+import threading
 import time
+from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from . import cs_loop
 from . import default_fmu
-from .parameters import default_parameters
-from .plot import plot_cases
-from .signal import communication_points
-from .simulate import FmuError, simulate
+from .files import replacing_on
+from .parameters import default_parameters, value_reference
+from .signal import TorqueSchedule, communication_points
+from .simulate import FmuError, initialize, open_fmu, run_schedule_python
 
 START_VALUES = ("theta0", "omega0")
-OUTPUTS = ("time", "theta", "omega", "alpha")
-# Enough chunks per worker to even out the load and show progress, few enough that per-task
-# overhead stays small next to the simulations.
-CHUNKS_PER_WORKER = 4
+OUTPUTS = ("theta", "omega", "alpha")
+FORMATS = ("parquet", "csv")
+SUMMARIES = ("final_theta", "final_omega", "final_alpha", "max_abs_theta")
+# A study is cut into about this many chunks, so that up to 16 workers each get several (the
+# load evens out and progress shows), but no chunk holds more than MAX_CHUNK_CASES cases, so a
+# chunk's files stay tens of megabytes and a lost worker loses little.
+TARGET_CHUNKS = 64
+MAX_CHUNK_CASES = 256
+# And a chunk's recordings (every point of every case, before thinning) stay this small.
+MAX_CHUNK_BYTES = 64_000_000
+# Up to this many cases the figure draws every trajectory; above, quantile bands of the summaries.
+LINES_UP_TO = 20
 
 
 def _sweepable(fmu_path=None) -> list[str]:
@@ -40,7 +70,7 @@ def _extra_names() -> list[str]:
     return [name for name in _sweepable() if name not in ("torque", "gravity")]
 
 
-def _values(name: str, values) -> list[float]:
+def _values(name: str, values) -> np.ndarray:
     try:
         array = np.asarray(values, dtype=float)
     except (TypeError, ValueError):
@@ -53,11 +83,36 @@ def _values(name: str, values) -> list[float]:
         raise ValueError(f"{name} values must be finite, got {array[~np.isfinite(array)][0]}")
     if len(np.unique(array)) < array.size:
         raise ValueError(f"{name} values repeat: {values!r}")
-    return array.tolist()
+    return array
 
 
-def sweep_grid(torques, gravities=(9.81,), extra: dict | None = None) -> list[dict]:
-    """Every combination of the torques, gravities and extra values as a list of cases.
+class Grid(Sequence):
+    """Every combination of the axes' values as a sequence of cases ({name: value} dicts), in
+    itertools.product order, computed when asked: a grid of a million cases costs its axes."""
+
+    def __init__(self, axes: dict[str, np.ndarray]):
+        self.axes = axes
+        self._shape = tuple(len(values) for values in axes.values())
+
+    def __len__(self) -> int:
+        return math.prod(self._shape)
+
+    def __getitem__(self, index):
+        if isinstance(index, slice):
+            return [self[i] for i in range(*index.indices(len(self)))]
+        number = index + len(self) if index < 0 else index
+        if not 0 <= number < len(self):
+            raise IndexError(f"case {index} of a grid of {len(self)}")
+        return {name: float(column[0]) for name, column in self.columns(number, number + 1).items()}
+
+    def columns(self, start: int, stop: int) -> dict[str, np.ndarray]:
+        """The values of cases start..stop-1, one array per name."""
+        positions = np.unravel_index(np.arange(start, stop), self._shape)
+        return {name: values[p] for (name, values), p in zip(self.axes.items(), positions)}
+
+
+def sweep_grid(torques, gravities=(9.81,), extra: dict | None = None) -> Grid:
+    """Every combination of the torques, gravities and extra values as a sequence of cases.
 
     extra: {name: [values, ...]} for the parameters mass, length, inertia, damping and the start
     values theta0, omega0. A case is a dict {'torque': .., 'gravity': .., <extra names>: ..}.
@@ -70,12 +125,13 @@ def sweep_grid(torques, gravities=(9.81,), extra: dict | None = None) -> list[di
         if name not in _extra_names():
             raise ValueError(f"cannot sweep {name!r}: extra takes {', '.join(_extra_names())}")
     axes = {"torque": torques, "gravity": gravities, **extra}
-    axes = {name: _values(name, values) for name, values in axes.items()}
-    return [dict(zip(axes, combination)) for combination in itertools.product(*axes.values())]
+    return Grid({name: _values(name, values) for name, values in axes.items()})
 
 
 def _check_cases(cases, fmu_path=None) -> list[str]:
-    """The cases' common keys, which become the CSV's case columns."""
+    """The cases' common keys, which become the cases table's value columns."""
+    if isinstance(cases, Grid):
+        return list(cases.axes)  # checked when the grid was made
     if not cases:
         raise ValueError("no cases to run")
     names = list(cases[0])
@@ -97,114 +153,404 @@ def _check_cases(cases, fmu_path=None) -> list[str]:
     return names
 
 
-def _label(case: dict) -> str:
-    return ", ".join(f"{name} = {value:g}" for name, value in case.items())
+def _columns(cases, names: list[str], start: int, stop: int) -> dict[str, np.ndarray]:
+    if isinstance(cases, Grid):
+        return cases.columns(start, stop)
+    return {name: np.array([case[name] for case in cases[start:stop]], float) for name in names}
 
 
-def _run_chunk(numbered_cases: list[tuple[int, dict]], fmu_path: str, stop_time: float,
-               step_size: float) -> tuple[str, np.ndarray, np.ndarray]:
-    """Simulate a chunk of cases on a worker.
+@dataclass(frozen=True)
+class _Study:
+    """What every chunk of a study shares; shipped to the workers with each chunk."""
 
-    Returns the chunk's CSV rows, the common time points and theta and omega of each case
-    (shape cases x 2 x points) for the figure.
-    """
-    text, curves, row_templates = [], [], None
-    for number, case in numbered_cases:
-        parameters = {k: v for k, v in case.items() if k != "torque" and k not in START_VALUES}
+    fmu: str
+    filesystem: object  # fsspec
+    root: str
+    stop_time: float
+    step_size: float
+    outputs: tuple[str, ...]
+    stride: int  # keep every stride-th communication point (and the last)
+    format: str
+
+    def part(self, table: str, index: int) -> str:
+        return f"{self.root}/{table}/part-{index:06d}.{self.format}"
+
+
+class _Runner:
+    """A worker thread's FMU instance, reset between cases: instantiating costs about a hundred
+    times what a reset and initialization cost."""
+
+    def __init__(self, fmu: str):
+        self.fmu, self.slave, self.stepper = fmu, None, None
+        self.torque = np.array([value_reference("torque", fmu)], np.uint32)
+        self.outputs = np.array([value_reference(name, fmu) for name in OUTPUTS], np.uint32)
+
+    def run(self, case: dict[str, float], points: np.ndarray, torque: np.ndarray,
+            outputs: np.ndarray) -> None:
+        """theta, omega and alpha of one case at every communication point into outputs (points x 3);
+        torque is a scratch buffer (steps x 1). FmuError when the FMU refuses the case."""
+        start = dict(parameters={k: v for k, v in case.items() if k not in ("torque", *START_VALUES)},
+                     theta0=case.get("theta0", 0.0), omega0=case.get("omega0", 0.0),
+                     start_time=float(points[0]))
         try:
-            run = simulate(case["torque"], parameters=parameters, theta0=case.get("theta0", 0.0),
-                           omega0=case.get("omega0", 0.0), stop_time=stop_time,
-                           step_size=step_size, fmu_path=fmu_path)
-        except FmuError as error:
-            raise FmuError(f"case {number} ({_label(case)}): {error}") from None
-        if row_templates is None:
-            # Every case shares the time points, so they are printed once per chunk.
-            row_templates = [f"{t!r},%.17g,%.17g,%.17g\n" for t in run["time"].tolist()]
-        # One %-formatting of the whole case, done in C; 17 digits read back as the same double.
-        prefix = ",".join([str(number), *(repr(float(v)) for v in case.values())]) + ","
-        values = np.column_stack([run["theta"], run["omega"], run["alpha"]]).ravel().tolist()
-        text.append((prefix + prefix.join(row_templates)) % tuple(values))
-        curves.append((run["theta"], run["omega"]))
-    return "".join(text), run["time"], np.array(curves)
+            if self.slave is None:
+                self.slave = open_fmu(self.fmu, **start)
+            else:
+                self.slave.messages.lines.clear()
+                self.slave.reset()
+                initialize(self.slave, **start)
+            torque[:] = case["torque"]
+            if cs_loop.available() and self.slave.fmi_version == 2:
+                if self.stepper is None or self.stepper.time is not points:
+                    self.stepper = cs_loop.Stepper(self.slave, self.torque, self.outputs, points)
+                self.stepper.run(torque, None, outputs)
+            else:
+                plan = TorqueSchedule(time=points, torque=torque[:, 0], torque_rate=np.zeros(len(torque)))
+                run = run_schedule_python(self.slave, plan)
+                outputs[:] = np.column_stack([run[name] for name in OUTPUTS])
+        except BaseException:
+            # After a refusal the instance is in an error state: the next case starts afresh.
+            self.close()
+            raise
+
+    def close(self) -> None:
+        if self.slave is not None:
+            self.slave.freeInstance()
+            self.slave = self.stepper = None
 
 
-def _show_progress(done: int, total: int, seconds: float) -> None:
-    # On a terminal the line redraws in place; in a log, a line per finished chunk.
-    end = "\r" if sys.stderr.isatty() and done < total else "\n"
-    bar = "#" * (30 * done // total)
-    print(f"sweep [{bar:<30}] {done}/{total} cases, {seconds:.1f} s", end=end, file=sys.stderr,
-          flush=True)
+_runners = threading.local()
 
 
-def run_sweep(cases: list[dict], *, output_dir: str | Path, stop_time: float = 3.0,
-              step_size: float = 1e-3, scheduler: str | None = None, workers: int | None = None,
-              progress: bool = True, fmu_path: str | Path | None = None) -> dict:
-    """Run every case on dask; write output_dir/sweep.csv and output_dir/sweep.png.
+def _runner(fmu: str) -> _Runner:
+    """This thread's runner for the FMU file (a new one when the file changed)."""
+    key = (fmu, os.stat(fmu).st_mtime_ns)
+    current = getattr(_runners, "runner", None)
+    if current is None or current[0] != key:
+        if current is not None:
+            current[1].close()
+        current = _runners.runner = key, _Runner(fmu)
+    return current[1]
 
-    sweep.csv is tidy: columns case, the case's keys (torque, gravity, ...), time, theta, omega,
-    alpha, one row per case and communication point. scheduler: the address of a running
-    dask.distributed scheduler; without one a local cluster of `workers` processes (default 2)
-    runs for this call (its workers are spawned, so a script calling this needs the
-    `if __name__ == "__main__":` guard). progress: a progress line on stderr.
-    Returns {'results': csv path, 'figure': png path, 'cases': count, 'seconds': wall time}.
+
+def _kept_points(points: int, stride: int) -> np.ndarray:
+    """Indices of the communication points written: every stride-th, and the last."""
+    return np.unique(np.append(np.arange(0, points, stride), points - 1))
+
+
+def _write_table(study: _Study, name: str, index: int, columns: dict, split: tuple = ()) -> int:
+    """Write one part of a table; returns its size in bytes. split: float columns stored
+    byte-stream-split (smooth trajectories compress to about two thirds with it)."""
+    import pyarrow as pa
+
+    table = pa.table(columns)
+    with replacing_on(study.filesystem, study.part(name, index)) as file:
+        if study.format == "parquet":
+            import pyarrow.parquet as pq
+
+            # Dictionaries only where values repeat: on the outputs they cost more than the
+            # simulation and gain nothing.
+            pq.write_table(table, file, compression="zstd", compression_level=1,
+                           use_dictionary=[c for c in table.column_names if c not in split],
+                           column_encoding={c: "BYTE_STREAM_SPLIT" for c in split})
+        else:
+            import pyarrow.csv
+
+            pyarrow.csv.write_csv(table, file)  # shortest round-trip digits: reads back exact
+        return file.tell()
+
+
+def _run_chunk(index: int, first: int, values: dict[str, np.ndarray], study: _Study) -> tuple:
+    """Simulate a chunk of cases on a worker and write its parts.
+
+    values: the chunk's cases, one array per name; first: the number of its first case.
+    Returns (index, cases, failed, bytes written, CPU seconds of this thread).
     """
-    from dask.distributed import Client, LocalCluster, as_completed
+    cpu = time.thread_time()
+    points = communication_points(0.0, study.stop_time, study.step_size)
+    count = len(next(iter(values.values())))
+    recorded = np.empty((count, len(points), len(OUTPUTS)))
+    torque = np.empty((len(points) - 1, 1))
+    messages = [""] * count
+    runner = _runner(study.fmu)
+    for i in range(count):
+        try:
+            runner.run({name: float(column[i]) for name, column in values.items()}, points, torque,
+                       recorded[i])
+        except FmuError as error:
+            messages[i] = str(error)
+            recorded[i] = np.nan
+    ok = np.array([not message for message in messages], bool)
+    numbers = first + np.arange(count)
+    written = 0
+    if study.outputs:
+        keep = _kept_points(len(points), study.stride)
+        kept = recorded if ok.all() else recorded[ok]  # a copy only when a case failed
+        if len(keep) < len(points):
+            kept = kept[:, keep]
+        written += _write_table(study, "trajectories", index, {
+            "case": np.repeat(numbers[ok], len(keep)), "time": np.tile(points[keep], int(ok.sum())),
+            **{name: kept[:, :, OUTPUTS.index(name)].ravel() for name in study.outputs}},
+            split=study.outputs)
+    final = recorded[:, -1]
+    summaries = [*final.T, np.max(np.abs(recorded[:, :, 0]), axis=1)]
+    written += _write_table(study, "cases", index, {
+        "case": numbers, **values, **dict(zip(SUMMARIES, summaries)),
+        "status": np.where(ok, "ok", "failed").tolist(), "message": messages})
+    return index, count, count - int(ok.sum()), written, time.thread_time() - cpu
+
+
+def _sha256(data: bytes) -> str:
+    return hashlib.sha256(data).hexdigest()
+
+
+def _definition(cases, names, study: _Study) -> dict:
+    """What makes two runs the same study, for --resume."""
+    if isinstance(cases, Grid):
+        values = {name: axis.tolist() for name, axis in cases.axes.items()}
+    else:
+        values = _sha256(np.stack(list(_columns(cases, names, 0, len(cases)).values())).tobytes())
+    with open(study.fmu, "rb") as file:
+        fmu = _sha256(file.read())
+    return {"names": names, "cases": len(cases), "values": values, "stop_time": study.stop_time,
+            "step_size": study.step_size, "outputs": list(study.outputs), "stride": study.stride,
+            "format": study.format, "fmu_sha256": fmu}
+
+
+def _done_chunks(study: _Study) -> set[int]:
+    pattern = f"{study.root}/cases/part-*.{study.format}"
+    return {int(Path(path).stem.split("-")[1]) for path in study.filesystem.glob(pattern)}
+
+
+def _remove(study: _Study, patterns) -> None:
+    fs = study.filesystem
+    for pattern in patterns:
+        for path in fs.glob(f"{study.root}/{pattern}"):
+            with contextlib.suppress(FileNotFoundError):
+                fs.rm(path)
+
+
+def _temporaries() -> tuple[str, ...]:
+    """Where an interrupted writer (a killed worker) leaves a temporary (see files.py)."""
+    return (".*.partial", "trajectories/.*.partial", "cases/.*.partial")
+
+
+def _prepare(study: _Study, definition: dict, resume: bool, count: int, points: int,
+             output_dir) -> int:
+    """Write study.json (or check it, on resume); returns the cases per chunk."""
+    fs, manifest = study.filesystem, f"{study.root}/study.json"
+    if resume and fs.exists(manifest):
+        with fs.open(manifest, "r") as file:
+            previous = json.load(file)
+        differences = [key for key in definition if previous["study"].get(key) != definition[key]]
+        if differences:
+            raise ValueError(
+                f"{output_dir} holds a different study ({', '.join(differences)} differ); leave "
+                "out --resume to replace it, or choose another output directory")
+        return previous["chunk_cases"]
+    # A new study replaces whatever study was there.
+    _remove(study, ("study.json", "sweep.png", "trajectories/part-*", "cases/part-*"))
+    fitting = MAX_CHUNK_BYTES // (points * len(OUTPUTS) * 8)
+    chunk_cases = max(1, min(MAX_CHUNK_CASES, fitting, math.ceil(count / TARGET_CHUNKS)))
+    with replacing_on(fs, manifest) as file:
+        file.write(json.dumps({"study": definition, "chunk_cases": chunk_cases}, indent=1).encode())
+    return chunk_cases
+
+
+class SchedulerUnreachable(ConnectionError):
+    """The dask scheduler did not answer; the message names the address."""
+
+
+@contextlib.contextmanager
+def _client(scheduler: str | None, workers: int | None, connect_timeout: float):
+    """A dask client: on a local cluster of `workers` processes started (and closed) here, or on
+    the scheduler at an address, refused within connect_timeout when it does not answer."""
+    from dask.distributed import Client, LocalCluster
+
+    if scheduler is None:
+        # Port 0 for the scheduler's HTTP server: another cluster may hold dask's usual 8787.
+        with LocalCluster(n_workers=workers or 2, threads_per_worker=1, processes=True,
+                          dashboard_address=":0", silence_logs=logging.CRITICAL) as cluster, \
+                Client(cluster) as client:
+            yield client
+        return
+    try:
+        # A port that answers but is no dask scheduler would otherwise be waited on for ever, or
+        # have its bytes read as a message length.
+        client = Client(scheduler, timeout=connect_timeout)
+    except Exception as error:
+        reason = str(error).splitlines()[0] if str(error) else type(error).__name__
+        raise SchedulerUnreachable(
+            f"no dask scheduler answered at {scheduler} within {connect_timeout:g} s ({reason}); "
+            "check the address (start one with `dask scheduler`), raise --connect-timeout, or "
+            "leave out --scheduler for a local cluster") from None
+    with client:
+        yield client
+
+
+class _Progress:
+    """A bar redrawn in place on a terminal; elsewhere (a log) a plain line every few seconds."""
+
+    def __init__(self, total: int, enabled: bool):
+        self.total, self.enabled, self.tty = total, enabled, sys.stderr.isatty()
+        self.started = self.shown = time.perf_counter()
+
+    def show(self, done: int, failed: int) -> None:
+        now = time.perf_counter()
+        if not self.enabled or (done < self.total and now - self.shown < (0.2 if self.tty else 5.0)):
+            return
+        self.shown = now
+        counts = f"{done}/{self.total} cases, {failed} failed, {now - self.started:.1f} s"
+        if self.tty:
+            bar = "#" * (30 * done // self.total)
+            end = "\n" if done == self.total else ""
+            print(f"\rsweep [{bar:<30}] {counts}", end=end, file=sys.stderr, flush=True)
+        else:
+            print(f"sweep: {counts}", file=sys.stderr, flush=True)
+
+
+def _read_cases(study: _Study, names: list[str]):
+    """The cases table's values and summaries, as a pyarrow table."""
+    import pyarrow as pa
+    import pyarrow.dataset as ds
+
+    types = {"case": pa.int64(), **{n: pa.float64() for n in (*names, *SUMMARIES)},
+             "status": pa.string(), "message": pa.string()}
+    if study.format == "csv":
+        import pyarrow.csv
+
+        file_format = ds.CsvFileFormat(convert_options=pyarrow.csv.ConvertOptions(column_types=types))
+    else:
+        file_format = "parquet"
+    dataset = ds.dataset(f"{study.root}/cases", format=file_format, schema=pa.schema(types),
+                         filesystem=study.filesystem)
+    return dataset.to_table(columns=["case", *names, "max_abs_theta", "final_theta", "status"])
+
+
+def _draw(study: _Study, cases_table, names: list[str], target: str) -> None:
+    """sweep.png: every trajectory when there are few, else quantile bands of the summaries."""
+    import pyarrow.dataset as ds
+
+    from .plot import plot_case_bands, plot_cases  # here: workers never draw, nor import matplotlib
+
+    title = f"Parameter study: {cases_table.num_rows} cases of the torque-driven pendulum"
+    with tempfile.TemporaryDirectory(prefix="pendulum_fmu_sweep_") as scratch:
+        figure = Path(scratch) / "sweep.png"
+        if cases_table.num_rows <= LINES_UP_TO and {"theta", "omega"} <= set(study.outputs):
+            trajectories = ds.dataset(f"{study.root}/trajectories", format=study.format,
+                                      filesystem=study.filesystem).to_table()
+            case_column = trajectories["case"].to_numpy()
+            runs = {}
+            for row in cases_table.to_pylist():
+                if row["status"] == "ok":
+                    rows = case_column == row["case"]
+                    label = ", ".join(f"{name} = {row[name]:g}" for name in names)
+                    runs[label] = {k: trajectories[k].to_numpy()[rows] for k in ("time", "theta", "omega")}
+            plot_cases(runs, figure, title)
+        else:
+            plot_case_bands({name: cases_table[name].to_numpy() for name in names},
+                            {"max |theta| in rad": cases_table["max_abs_theta"].to_numpy(),
+                             "final theta in rad": cases_table["final_theta"].to_numpy()},
+                            figure, title)
+        with replacing_on(study.filesystem, target) as file:
+            file.write(figure.read_bytes())
+
+
+def run_sweep(cases, *, output_dir: str | os.PathLike, stop_time: float = 3.0,
+              step_size: float = 1e-3, outputs=OUTPUTS, output_interval: float | None = None,
+              format: str = "parquet", resume: bool = False, scheduler: str | None = None,
+              workers: int | None = None, connect_timeout: float = 10.0, progress: bool = True,
+              fmu_path: str | Path | None = None) -> dict:
+    """Run every case on dask; the workers write the study into output_dir (see the module doc).
+
+    cases: sweep_grid(...) or a list of {'torque': .., <parameter or start value>: ..} dicts.
+    output_dir: a local path or an fsspec URL that every worker can write to. outputs: which of
+    theta, omega, alpha the trajectories keep (none: only the cases table); output_interval: keep
+    a point every so many seconds (a whole number of steps; default every step). resume: run
+    only the chunks a previous run of the same study into output_dir did not finish.
+    scheduler: the address of a running dask.distributed scheduler, which must answer within
+    connect_timeout seconds; without one a local cluster of `workers` processes (default 2) runs
+    for this call (its workers are spawned, so a script calling this needs the
+    `if __name__ == "__main__":` guard). progress: a progress line on stderr.
+    Returns {'output_dir', 'trajectories', 'cases_table', 'figure': paths or URLs; 'cases',
+    'failed': counts; 'chunks', 'chunks_run'; 'bytes': written by this run; 'seconds' in all,
+    'figure_seconds' of them reading the cases table and drawing; 'worker_cpu_seconds' the
+    workers spent on this run's chunks}.
+    """
+    import fsspec
 
     started = time.perf_counter()
     names = _check_cases(cases, fmu_path)
     if not (isinstance(stop_time, numbers.Real) and math.isfinite(stop_time)):
         raise ValueError(f"stop time {stop_time} must be a finite number")
-    communication_points(0.0, stop_time, step_size)  # refuses a bad stop time or step here, not on a worker
+    points = len(communication_points(0.0, stop_time, step_size))  # refuses a bad stop or step here
+    outputs = tuple(outputs)
+    for name in outputs:
+        if name not in OUTPUTS or outputs.count(name) > 1:
+            raise ValueError(f"outputs {', '.join(outputs)}: choose each at most once among "
+                             f"{', '.join(OUTPUTS)}")
+    stride = 1
+    if output_interval is not None:
+        stride = round(output_interval / step_size) if math.isfinite(output_interval) else 0
+        if stride < 1 or abs(stride * step_size - output_interval) > 1e-9 * output_interval:
+            raise ValueError(f"output interval {output_interval} s must be a whole number of steps "
+                             f"of {step_size} s")
+    if format not in FORMATS:
+        raise ValueError(f"format {format!r}: choose {' or '.join(FORMATS)}")
     if scheduler is not None and workers is not None:
         raise ValueError("workers sizes the local cluster; with a scheduler the cluster has its own")
     if workers is not None and (not isinstance(workers, numbers.Integral) or workers < 1):
         raise ValueError(f"workers must be a positive integer, got {workers!r}")
-    output_dir = Path(output_dir)
-    output_dir.mkdir(parents=True, exist_ok=True)
-    # Built here once: workers only read it, each extracting it once per process.
-    fmu = str(Path(fmu_path).resolve() if fmu_path else default_fmu())
-
-    if scheduler is None:
-        # Port 0 for the scheduler's HTTP server: another cluster may hold dask's usual 8787.
-        # Workers log nothing: a case that fails reaches the caller as its own one-line error,
-        # which the workers' logs would repeat with a traceback.
-        cluster = LocalCluster(n_workers=workers or 2, threads_per_worker=1, processes=True,
-                               dashboard_address=":0", silence_logs=logging.CRITICAL)
-    else:
-        cluster = None
-    results = output_dir / "sweep.csv"
-    partial = results.with_suffix(".csv.partial")  # so a failed run leaves no half table
+    if not (isinstance(connect_timeout, numbers.Real) and 0 < connect_timeout < math.inf):
+        raise ValueError(f"connect timeout {connect_timeout} must be a positive number of seconds")
+    filesystem, root = fsspec.core.url_to_fs(str(output_dir))
+    url = str(output_dir)
+    study = _Study(fmu=str(Path(fmu_path).resolve() if fmu_path else default_fmu()),
+                   filesystem=filesystem, root=root.rstrip("/"), stop_time=float(stop_time),
+                   step_size=float(step_size), outputs=outputs, stride=stride, format=format)
+    chunk_cases = _prepare(study, _definition(cases, names, study), resume, len(cases), points, url)
+    chunks = range(math.ceil(len(cases) / chunk_cases))
+    done = _done_chunks(study)
+    pending = [index for index in chunks if index not in done]
+    finished = sum(min(chunk_cases, len(cases) - i * chunk_cases) for i in done)
+    bar = _Progress(len(cases), progress)
+    written, worker_cpu = 0, 0.0
     try:
-        with Client(cluster if cluster is not None else scheduler) as client, open(partial, "w") as file:
-            slots = max(sum(client.nthreads().values()), 1)
-            size = math.ceil(len(cases) / (slots * CHUNKS_PER_WORKER))
-            numbered = list(enumerate(cases))
-            chunks = [numbered[i:i + size] for i in range(0, len(numbered), size)]
-            futures = client.map(_run_chunk, chunks, fmu_path=fmu, stop_time=stop_time,
-                                 step_size=step_size, pure=False)
-            position = {future.key: i for i, future in enumerate(futures)}
-            file.write(",".join(["case", *names, *OUTPUTS]) + "\n")
-            texts, curves, written, done = {}, [None] * len(chunks), 0, 0
-            for future, (text, times, chunk_curves) in as_completed(futures, with_results=True):
-                index = position[future.key]
-                texts[index], curves[index] = text, chunk_curves
-                # Rows go out in case order as soon as the chunks before them are in, so the
-                # text, the bulk of the results, never piles up in the client.
-                while written in texts:
-                    file.write(texts.pop(written))
-                    written += 1
-                done += len(chunks[index])
-                if progress:
-                    _show_progress(done, len(cases), time.perf_counter() - started)
-        partial.replace(results)
+        if pending:
+            with _client(scheduler, workers, connect_timeout) as client:
+                futures = [client.submit(_run_chunk, index, index * chunk_cases,
+                                         _columns(cases, names, index * chunk_cases,
+                                                  min(len(cases), (index + 1) * chunk_cases)),
+                                         study, pure=False) for index in pending]
+                # Done callbacks rather than as_completed: on Ctrl-C no waiting coroutine is left
+                # to fail, with a traceback, when the cluster closes.
+                finished_futures = queue.SimpleQueue()
+                for future in futures:
+                    future.add_done_callback(finished_futures.put)
+                failed = 0
+                for _ in futures:
+                    future = finished_futures.get()
+                    _, count, chunk_failed, chunk_bytes, chunk_cpu = future.result()
+                    finished, failed, written = finished + count, failed + chunk_failed, written + chunk_bytes
+                    worker_cpu += chunk_cpu
+                    future.release()
+                    bar.show(finished, failed)
     finally:
-        partial.unlink(missing_ok=True)
-        if cluster is not None:
-            cluster.close()
+        # A worker killed mid-write (Ctrl-C reaches the whole process group) leaves its temporary.
+        _remove(study, _temporaries())
+    drawing = time.perf_counter()
+    table = _read_cases(study, names)
+    _draw(study, table, names, f"{study.root}/sweep.png")
+    drawn = time.perf_counter()
+    failed = int(np.sum(table["status"].to_numpy(zero_copy_only=False) == "failed"))
+    from fsspec.implementations.local import LocalFileSystem
 
-    runs = {_label(case): {"time": times, "theta": theta, "omega": omega}
-            for case, (theta, omega) in zip(cases, np.concatenate(curves))}
-    figure = plot_cases(runs, output_dir / "sweep.png",
-                        f"Parameter study: {len(cases)} cases of the torque-driven pendulum")
-    return {"results": results, "figure": figure, "cases": len(cases),
-            "seconds": time.perf_counter() - started}
+    # Paths on the local file system, URLs elsewhere.
+    where = (Path(study.root).joinpath if isinstance(filesystem, LocalFileSystem)
+             else f"{url.rstrip('/')}/".__add__)
+    return {"output_dir": where(""), "trajectories": where("trajectories"),
+            "cases_table": where("cases"), "figure": where("sweep.png"),
+            "cases": len(cases), "failed": failed,
+            "chunks": len(chunks), "chunks_run": len(pending), "bytes": written,
+            "seconds": drawn - started, "figure_seconds": drawn - drawing,
+            "worker_cpu_seconds": worker_cpu}

@@ -38,8 +38,8 @@ def test_gravity_overlay(tmp_path):
 def test_parameter_study(tmp_path):
     table = load("parameter_study").run(torques=(5.0, 40.0), stop_time=0.5, output_dir=tmp_path)
     for torque in (5.0, 40.0):
-        rows = table[table["torque"] == torque]
-        assert np.max(np.abs(rows["theta"] - reference(torque, stop_time=0.5)["theta"])) < 1e-10
+        theta = table["theta"][table["torque"] == torque]
+        assert np.max(np.abs(theta - reference(torque, stop_time=0.5)["theta"])) < 1e-10
 
 
 def test_closed_loop_pd_settles_and_follows_the_applied_torques():

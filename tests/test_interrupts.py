@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 OLD = "the file from before\n"
-STEPS = 400_000  # a few seconds on a loaded 2-core machine, writing included
+STEPS = 1_000_000  # several seconds even on a fast machine: writing 1e6 rows takes the most
 
 
 def start(arguments, folder):

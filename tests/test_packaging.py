@@ -106,7 +106,8 @@ def test_installed_package_runs_from_an_empty_folder(installed, tmp_path):
     _run([cli, "compare", "--torque", "20", "--tools", "fmu,reference", "--output-dir", "compared"], cwd=tmp_path)
     _run([cli, "sweep", "--torque", "5", "10", "--stop-time", "0.5", "--workers", "1",
           "--output-dir", "swept"], cwd=tmp_path)
-    assert (tmp_path / "swept/sweep.csv").is_file() and (tmp_path / "compared/differences.csv").is_file()
+    assert (tmp_path / "swept/sweep.png").is_file() and (tmp_path / "compared/differences.csv").is_file()
+    assert any((tmp_path / "swept/cases").glob("*.parquet"))
 
     # Building needs the sources, which an installed package does not have: one line says so.
     refused = _run([cli, "build", "--output", "P.fmu"], cwd=tmp_path, check=False)

@@ -1,0 +1,95 @@
+"""The native co-simulation loop (`_cs_loop.c`), loaded with ctypes when it was compiled.
+
+It drives any FMI 2.0 co-simulation instance that fmpy instantiated, through the FMU's own
+exported fmi2SetReal, fmi2SetRealInputDerivatives, fmi2GetReal and fmi2DoStep, for a whole
+schedule in one call, writing into the caller's numpy buffers. `pip install` (or
+`python setup.py build_ext --inplace` in a checkout) compiles it; without it `available()` is
+False and callers use the Python loop in simulate.py, which gives the same numbers bit for bit.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import importlib.machinery
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+# The call that failed, by the index _cs_loop.c reports.
+_CALLS = ("fmi2SetReal", "fmi2SetRealInputDerivatives", "fmi2GetReal", "fmi2DoStep",
+          "fmi2GetReal of the inputs", "fmi2GetReal")
+_FMI_FUNCTIONS = ("fmi2SetReal", "fmi2SetRealInputDerivatives", "fmi2GetReal", "fmi2DoStep")
+
+
+@lru_cache(maxsize=1)
+def _library():
+    """The compiled loop's run function, or None when it was not built."""
+    here = Path(__file__).resolve().parent
+    for suffix in importlib.machinery.EXTENSION_SUFFIXES:
+        path = here / f"_cs_loop{suffix}"
+        if path.is_file():
+            run = ctypes.CDLL(str(path)).cs_loop_run
+            pointer, size = ctypes.c_void_p, ctypes.c_size_t
+            run.argtypes = [pointer] * 5 + [pointer, size, pointer, size, size] + [pointer] * 8
+            run.restype = ctypes.c_int
+            return run
+    return None
+
+
+def available() -> bool:
+    return _library() is not None
+
+
+def _address(array: np.ndarray | None, shape: tuple[int, ...], dtype, what: str) -> int | None:
+    if array is None:
+        return None
+    if array.shape != shape or array.dtype != dtype or not array.flags.c_contiguous:
+        raise ValueError(f"{what} must be a C-contiguous {np.dtype(dtype)} array of shape {shape}, "
+                         f"got {array.dtype} {array.shape}")
+    return array.ctypes.data
+
+
+class Stepper:
+    """The native loop bound to an initialized fmpy FMU2Slave, its input and output value
+    references (uint32 arrays) and the communication points `time` (N + 1); run() steps it
+    through them. Binding once keeps a case's Python cost to a few microseconds; the slave may
+    be reset and initialized again between runs.
+    """
+
+    def __init__(self, slave, input_references: np.ndarray, output_references: np.ndarray,
+                 time: np.ndarray):
+        self.steps, self.inputs, self.outputs = len(time) - 1, len(input_references), len(output_references)
+        self.time, self.messages = time, slave.messages
+        self._references = input_references, output_references  # kept alive for the addresses
+        functions = [ctypes.cast(slave.dll[name], ctypes.c_void_p) for name in _FMI_FUNCTIONS]
+        self._first_order = np.ones(self.inputs, np.int32)  # fmi2Integer is int
+        self._failed_step, self._failed_call = ctypes.c_size_t(), ctypes.c_int()
+        self._bound = (
+            *functions, slave.component,
+            _address(input_references, (self.inputs,), np.uint32, "input_references"), self.inputs,
+            _address(output_references, (self.outputs,), np.uint32, "output_references"), self.outputs,
+            self.steps, _address(time, (self.steps + 1,), np.float64, "time"))
+        self._reports = ctypes.byref(self._failed_step), ctypes.byref(self._failed_call)
+
+    def run(self, inputs: np.ndarray, input_rates: np.ndarray | None, outputs: np.ndarray,
+            final_inputs: np.ndarray | None = None) -> None:
+        """inputs, input_rates: (N, inputs) values and first derivatives of the inputs over each
+        step (input_rates None: held, fmi2SetRealInputDerivatives is not called). outputs:
+        (N + 1, outputs), filled with the outputs at every point, read after the step's inputs
+        were set. final_inputs: (inputs,) the inputs read back after the last step. A failing
+        call raises the slave's MessageLog error, with the FMU's messages and the time of the
+        failing step.
+        """
+        status = _library()(
+            *self._bound,
+            _address(inputs, (self.steps, self.inputs), np.float64, "inputs"),
+            None if input_rates is None else self._first_order.ctypes.data,
+            _address(input_rates, (self.steps, self.inputs), np.float64, "input_rates"),
+            _address(outputs, (self.steps + 1, self.outputs), np.float64, "outputs"),
+            _address(final_inputs, (self.inputs,), np.float64, "final_inputs"),
+            *self._reports)
+        if status > 1:
+            call = self._failed_call.value
+            where = "at the end" if call >= 4 else f"at t = {self.time[self._failed_step.value]:.17g}"
+            raise self.messages.error(status, f"{_CALLS[call]} {where}")
