@@ -16,7 +16,7 @@ from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
 from fmpy.fmi3 import FMU3Slave
 
 from . import cs_loop, default_fmu, results
-from .parameters import model_description, resolve_parameters, value_reference
+from .parameters import merged_parameters, model_description, resolve_parameters, value_reference
 from .signal import TorqueSignal, TorqueSchedule, schedule
 
 _STATUS = ["OK", "WARNING", "DISCARD", "ERROR", "FATAL", "PENDING"]
@@ -129,7 +129,8 @@ def initialize(slave: FMU2Slave | FMU3Slave, *, parameters: dict | None = None, 
                omega0: float = 0.0, tolerance: float | None = None, start_time: float = 0.0) -> None:
     """Set the parameters and start values of an instantiated (or reset) slave from open_fmu and
     leave it in step mode; FmuError says why the FMU refused."""
-    start = {**resolve_parameters(parameters, slave.fmu_path), "theta": float(theta0), "omega": float(omega0)}
+    # The FMU checks the parameters itself, here as everywhere (parameters.resolve_parameters).
+    start = {**merged_parameters(parameters, slave.fmu_path), "theta": float(theta0), "omega": float(omega0)}
     references = [value_reference(n, slave.fmu_path) for n in start]
     try:
         if slave.fmi_version == 3:
@@ -250,6 +251,7 @@ def simulate(torque: TorqueSignal = 20.0, *, start_time: float = 0.0, stop_time:
     """
     plan = schedule(torque, start_time=start_time, stop_time=stop_time, step_size=step_size,
                     ramp=ramp, max_steps=max_steps)
+    resolve_parameters(parameters, fmu_path)  # refused with the same words as every other tool
     slave = open_fmu(fmu_path, parameters=parameters, theta0=theta0, omega0=omega0,
                      tolerance=tolerance, start_time=float(plan.time[0]))
     try:

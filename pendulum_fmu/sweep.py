@@ -508,36 +508,36 @@ def run_sweep(cases, *, output_dir: str | os.PathLike, stop_time: float = 3.0,
     study = _Study(fmu=str(Path(fmu_path).resolve() if fmu_path else default_fmu()),
                    filesystem=filesystem, root=root.rstrip("/"), stop_time=float(stop_time),
                    step_size=float(step_size), outputs=outputs, stride=stride, format=format)
-    chunk_cases = _prepare(study, _definition(cases, names, study), resume, len(cases), points, url)
-    chunks = range(math.ceil(len(cases) / chunk_cases))
-    done = _done_chunks(study)
-    pending = [index for index in chunks if index not in done]
-    finished = sum(min(chunk_cases, len(cases) - i * chunk_cases) for i in done)
     bar = _Progress(len(cases), progress)
     written, worker_cpu = 0, 0.0
-    try:
-        if pending:
-            with _client(scheduler, workers, connect_timeout) as client:
-                futures = [client.submit(_run_chunk, index, index * chunk_cases,
-                                         _columns(cases, names, index * chunk_cases,
-                                                  min(len(cases), (index + 1) * chunk_cases)),
-                                         study, pure=False) for index in pending]
-                # Done callbacks rather than as_completed: on Ctrl-C no waiting coroutine is left
-                # to fail, with a traceback, when the cluster closes.
-                finished_futures = queue.SimpleQueue()
-                for future in futures:
-                    future.add_done_callback(finished_futures.put)
-                failed = 0
-                for _ in futures:
-                    future = finished_futures.get()
-                    _, count, chunk_failed, chunk_bytes, chunk_cpu = future.result()
-                    finished, failed, written = finished + count, failed + chunk_failed, written + chunk_bytes
-                    worker_cpu += chunk_cpu
-                    future.release()
-                    bar.show(finished, failed)
-    finally:
-        # A worker killed mid-write (Ctrl-C reaches the whole process group) leaves its temporary.
-        _remove(study, _temporaries())
+    # Connected first, so that a scheduler that does not answer leaves the output untouched.
+    with _client(scheduler, workers, connect_timeout) as client:
+        chunk_cases = _prepare(study, _definition(cases, names, study), resume, len(cases), points, url)
+        chunks = range(math.ceil(len(cases) / chunk_cases))
+        done = _done_chunks(study)
+        pending = [index for index in chunks if index not in done]
+        finished = sum(min(chunk_cases, len(cases) - i * chunk_cases) for i in done)
+        try:
+            futures = [client.submit(_run_chunk, index, index * chunk_cases,
+                                     _columns(cases, names, index * chunk_cases,
+                                              min(len(cases), (index + 1) * chunk_cases)),
+                                     study, pure=False) for index in pending]
+            # Done callbacks rather than as_completed: on Ctrl-C no waiting coroutine is left to
+            # fail, with a traceback, when the cluster closes.
+            finished_futures = queue.SimpleQueue()
+            for future in futures:
+                future.add_done_callback(finished_futures.put)
+            failed = 0
+            for _ in futures:
+                future = finished_futures.get()
+                _, count, chunk_failed, chunk_bytes, chunk_cpu = future.result()
+                finished, failed, written = finished + count, failed + chunk_failed, written + chunk_bytes
+                worker_cpu += chunk_cpu
+                future.release()
+                bar.show(finished, failed)
+        finally:
+            # A worker killed mid-write (Ctrl-C reaches the whole process group) leaves its temporary.
+            _remove(study, _temporaries())
     drawing = time.perf_counter()
     table = _read_cases(study, names)
     _draw(study, table, names, f"{study.root}/sweep.png")

@@ -53,6 +53,7 @@ def run_fmu(plan: TorqueSchedule, *, parameters: dict | None = None, theta0: flo
             omega0: float = 0.0, mode: str = "accurate", fmu_path: str | Path | None = None) -> np.ndarray:
     """This project's FMU (the checkout's, or fmu_path) through fmpy; ramps are passed on."""
     check_mode(mode, "fmu")
+    resolve_parameters(parameters, fmu_path)  # refused with the same words as every other tool
     slave = open_fmu(fmu_path, parameters=parameters, theta0=theta0, omega0=omega0,
                      start_time=float(plan.time[0]))
     try:

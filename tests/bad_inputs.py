@@ -80,6 +80,12 @@ CASES = [
           "the tolerance nan must be a positive finite number"),
     _case("compare", "compare --torque 1 --tools fmu,reference --tol -1 --output-dir {files}/out", 2,
           "the tolerance -1.0 must be a positive finite number"),
+    _case("fmu", "simulate --torque 1 --fmu {files}/absent.fmu", 2, "FMU {files}/absent.fmu: No such file or directory"),
+    _case("sweep", "sweep --torque 5 --scheduler tcp://127.0.0.1:9 --connect-timeout 1 --output-dir {files}/out", 2,
+          "no dask scheduler answered at tcp://127.0.0.1:9 within 1 s"),
+    _case("sweep", "sweep --torque 5 --set mass=heavy --output-dir {files}/out", 2,
+          "--set mass=heavy: expected comma-separated numbers"),
+    _case("sweep", "sweep --torque 5 --stop-time inf --output-dir {files}/out", 2, "stop time inf must be a finite number"),
     _case("output", "simulate --torque 1 --stop-time 0.01 --output {files}/bad_number.csv/out.csv", 2,
           "bad_number.csv is a file, not a folder; choose another output path"),
 ]
