@@ -61,7 +61,9 @@ def installed(request, artefacts, tmp_path_factory):
     (site_packages / "dependencies_from_the_test_environment.pth").write_text(
         sysconfig.get_paths()["purelib"] + "\n")
     # The sdist builds its wheel (and the FMU in it) here, in pip's isolated build environment.
-    _run([venv / "bin/python", "-m", "pip", "install", "--no-deps", "--no-cache-dir",
+    # --ignore-installed: the test environment on the .pth path may hold this package itself
+    # (a non-editable install), which pip would otherwise take as already satisfied.
+    _run([venv / "bin/python", "-m", "pip", "install", "--no-deps", "--ignore-installed", "--no-cache-dir",
           artefacts[request.param]])
     _run([venv / "bin/python", "-m", "pip", "check"])
     return venv, site_packages
