@@ -44,15 +44,9 @@ def replacing(path: str | os.PathLike, mode: str = "w", **open_arguments):
 
     with replacing("out.csv", newline="") as file: ...
     """
-    descriptor, temporary = _temporary_beside(Path(path), ".partial")
-    try:
-        with os.fdopen(descriptor, mode, **open_arguments) as file:
-            yield file
-        os.replace(temporary, path)
-    except BaseException:
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(temporary)
-        raise
+    # The file closes before replacing_path renames it.
+    with replacing_path(path) as temporary, open(temporary, mode, **open_arguments) as file:
+        yield file
 
 
 @contextlib.contextmanager
