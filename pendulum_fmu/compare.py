@@ -63,11 +63,12 @@ COLUMNS = ("tool", "against", "theta_max", "theta_rms", "omega_max", "omega_rms"
 
 
 def format_table(rows: list[dict]) -> str:
-    lines = [f"{'tool':<12} {'against':<12} {'max|dtheta| rad':>15} {'rms dtheta':>10} "
+    width = max([12, *(len(row["tool"]) + 1 for row in rows), *(len(row["against"]) + 1 for row in rows)])
+    lines = [f"{'tool':<{width}} {'against':<{width}} {'max|dtheta| rad':>15} {'rms dtheta':>10} "
              f"{'max|domega| rad/s':>17} {'max|dalpha|':>11} {'max|dtorque| N.m':>16} {'s/step':>8}"]
     for row in rows:
         per_step = row.get("seconds_per_step")
-        lines.append(f"{row['tool']:<12} {row['against']:<12} {row['theta_max']:>15.3e} "
+        lines.append(f"{row['tool']:<{width}} {row['against']:<{width}} {row['theta_max']:>15.3e} "
                      f"{row['theta_rms']:>10.2e} {row['omega_max']:>17.3e} {row['alpha_max']:>11.2e} "
                      f"{row['torque_max']:>16.2e} {'' if per_step is None else f'{per_step:8.1e}':>8}")
     return "\n".join(lines)
