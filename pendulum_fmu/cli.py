@@ -170,7 +170,8 @@ def _sweep_values(assignments) -> dict[str, list[float]]:
 
 
 class _Stopped(BaseException):
-    """SIGINT or SIGTERM during a sweep (a BaseException, so no `except Exception` swallows it)."""
+    """SIGINT or SIGTERM, raised where the program is, so that every file being written is
+    cleaned up on the way out (a BaseException, so no `except Exception` swallows it)."""
 
     def __init__(self, signal_number: int):
         super().__init__(signal_number)
@@ -180,7 +181,6 @@ class _Stopped(BaseException):
 def _stop_on_signals():
     """Make SIGINT and SIGTERM raise _Stopped once; further ones are ignored so the cleanup that
     follows (closing the cluster, removing temporaries) runs to its end. Returns the old handlers."""
-    import signal
 
     def stop(number, frame):
         for name in (signal.SIGINT, signal.SIGTERM):
@@ -195,12 +195,9 @@ def _sweep_outputs(text: str) -> tuple[str, ...]:
 
 
 def cmd_sweep(args) -> int:
-    import signal
-
     from .sweep import run_sweep, sweep_grid
 
     cases = sweep_grid(args.torque, args.gravity, _sweep_values(args.assignments))
-    previous = _stop_on_signals()
     try:
         summary = run_sweep(cases, output_dir=args.output_dir, stop_time=args.stop_time,
                             step_size=args.step_size, outputs=_sweep_outputs(args.outputs),
@@ -212,9 +209,6 @@ def cmd_sweep(args) -> int:
         print(f"pendulum-fmu sweep: {what}; the chunks that finished are kept in {args.output_dir}: "
               "run the same command with --resume to run the rest", file=sys.stderr)
         return 128 + stopped.signal_number
-    finally:
-        for name, handler in previous.items():
-            signal.signal(name, handler)
     resumed = summary["chunks_run"] < summary["chunks"]
     print(f"{summary['cases']} cases in {summary['seconds']:.1f} s"
           + (f" ({summary['chunks_run']} of {summary['chunks']} chunks run; the others were "
@@ -386,15 +380,6 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-class Terminated(BaseException):
-    """SIGTERM, raised where the program is, so that every file being written is cleaned up on
-    the way out as it is for Ctrl-C."""
-
-
-def _terminate(signum, frame):
-    raise Terminated()
-
-
 def main(argv=None) -> int:
     from .signal import TorqueFileError
     from .simulate import FmuError
@@ -409,23 +394,19 @@ def main(argv=None) -> int:
         else:
             shown(message, category, *where, **more)
 
-    handling_sigterm = threading.current_thread() is threading.main_thread()
-    if handling_sigterm:
-        previous = signal.signal(signal.SIGTERM, _terminate)
+    # Signal handlers can only be set from the main thread; elsewhere Ctrl-C stays Python's.
+    previous = _stop_on_signals() if threading.current_thread() is threading.main_thread() else {}
     try:
         with warnings.catch_warnings():
             warnings.showwarning = one_line
             return args.run(args)
-    except KeyboardInterrupt:
+    except (_Stopped, KeyboardInterrupt) as stopped:
         if args.debug:
             raise
-        print(f"{command}: interrupted; no output file was left half written", file=sys.stderr)
-        return 130
-    except Terminated:
-        if args.debug:
-            raise
-        print(f"{command}: terminated; no output file was left half written", file=sys.stderr)
-        return 143
+        number = getattr(stopped, "signal_number", signal.SIGINT)
+        what = "interrupted" if number == signal.SIGINT else "terminated"
+        print(f"{command}: {what}; no output file was left half written", file=sys.stderr)
+        return 128 + number
     except (ValueError, TorqueFileError, FmuError, BuildError, ImportError, OSError) as error:
         if args.debug:
             raise
@@ -438,8 +419,8 @@ def main(argv=None) -> int:
               "for the traceback, and report it)", file=sys.stderr)
         return 3
     finally:
-        if handling_sigterm:
-            signal.signal(signal.SIGTERM, previous)
+        for number, handler in previous.items():
+            signal.signal(number, handler)
 
 
 def run() -> None:
