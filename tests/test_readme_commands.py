@@ -174,3 +174,14 @@ def test_readme_command_runs_as_written(readme, command, copies):
     assert result.returncode == 0, (
         f"{readme}: `{command}` exited {result.returncode} after {elapsed:.0f} s\n"
         f"--- stdout (end)\n{result.stdout[-3000:]}\n--- stderr (end)\n{result.stderr[-3000:]}")
+
+
+def test_ci_runs_the_readme_test_command_after_the_readme_system_packages():
+    readme = commands_in((ROOT / "README.md").read_text(encoding="utf-8"))
+    ci = (ROOT / ".ci" / "run").read_text(encoding="utf-8")
+    test_command = [command for command in readme if command.endswith("&& .venv/bin/pytest")]
+    assert len(test_command) == 1 and test_command[0] in ci.splitlines(), \
+        f"the README's test command {test_command} is not a line of .ci/run"
+    readme_packages = [command.split()[3:] for command in readme if command.startswith("sudo apt-get install ")]
+    ci_packages = re.search(r"apt-get install -y -qq ([^>]+)>", ci.replace("\\\n", " ")).group(1).split()
+    assert len(readme_packages) == 1 and sorted(readme_packages[0]) == sorted(ci_packages)
