@@ -68,7 +68,7 @@ def commands_in(text: str) -> list[str]:
         elif language is not None:
             fence = language
         elif line.startswith("    ") and (indented or previous_blank):
-            found.append(line[4:].rstrip())
+            found.append(line.strip())
         elif line.startswith("|"):
             cells = [cell.strip() for cell in re.split(r"(?<!\\)\|", line.strip())[1:-1]]
             if table_column is None and "command" in cells:
