@@ -95,3 +95,13 @@ def test_sweep_command(tmp_path, capsys):
     time, theta = np.array(table["time"])[rows], np.array(table["theta"])[rows]
     assert np.max(np.abs(theta - 10 / I_TOTAL * time**2)) < 1e-12
     assert main(["sweep", "--torque", "5", "--set", "mass=heavy", "--output-dir", str(tmp_path)]) == 2
+
+
+def test_sweep_with_a_refused_case_runs_the_rest_and_exits_1(tmp_path, capsys):
+    import pyarrow.parquet as pq
+
+    assert main(["sweep", "--torque", "5", "--set", "mass=0,40", "--stop-time", "0.1", "--workers", "1",
+                 "--output-dir", str(tmp_path)]) == 1
+    assert "1 of 2 cases failed" in capsys.readouterr().err
+    cases = pq.read_table(tmp_path / "cases").to_pydict()
+    assert sorted(zip(cases["mass"], cases["status"])) == [(0.0, "failed"), (40.0, "ok")]
