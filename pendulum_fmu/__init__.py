@@ -8,12 +8,12 @@ import contextlib
 from importlib import resources
 from pathlib import Path
 
-from .build import DEFAULT_FMU, DEFAULT_FMU3, build_fmu, fmu_is_stale, is_source_checkout
+# Nothing heavy is imported here (build.py brings fmpy): the command line sets its signal
+# handlers before it imports anything that takes a noticeable time (cli.run).
+__all__ = ["__version__", "default_fmu"]
 
-__all__ = ["__version__", "build_fmu", "default_fmu"]
-
-# FMI version -> (file in a checkout's dist/, file in the installed package's data/).
-_FMU_FILES = {2: (DEFAULT_FMU, "Pendulum.fmu"), 3: (DEFAULT_FMU3, "Pendulum-fmi3.fmu")}
+# FMI version -> the FMU's file name, in a checkout's dist/ and in the installed package's data/.
+_FMU_FILES = {2: "Pendulum.fmu", 3: "Pendulum-fmi3.fmu"}
 # Holds open the real files of packaged FMUs that importlib.resources had to extract (a zipped
 # install); a plain install hands out the files themselves.
 _extracted = contextlib.ExitStack()
@@ -27,9 +27,12 @@ def default_fmu(fmi_version: int = 2) -> Path:
     any of its sources is newer. In an installed package: the FMU packaged with it. Nothing is
     ever written into site-packages.
     """
+    from .build import DEFAULT_FMU, build_fmu, fmu_is_stale, is_source_checkout
+
     if fmi_version not in _FMU_FILES:
         raise ValueError(f"no FMI {fmi_version} FMU: the FMI versions are {', '.join(map(str, _FMU_FILES))}")
-    checkout_fmu, packaged_name = _FMU_FILES[fmi_version]
+    packaged_name = _FMU_FILES[fmi_version]
+    checkout_fmu = DEFAULT_FMU.parent / packaged_name
     if is_source_checkout():
         if fmu_is_stale(checkout_fmu):
             build_fmu(checkout_fmu, fmi_version=fmi_version)
@@ -41,3 +44,4 @@ def default_fmu(fmi_version: int = 2) -> Path:
             f"data/{packaged_name} nor the FMU's sources beside it: reinstall it from a wheel or "
             "the sdist (pip install pendulum-fmu), or pass the FMU's path")
     return _extracted.enter_context(resources.as_file(packaged))
+

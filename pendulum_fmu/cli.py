@@ -426,15 +426,7 @@ def main(argv=None) -> int:
             signal.signal(number, handler)
 
 
-def run() -> None:
-    """The pendulum-fmu program: main() with the process's exit code. Once main() returned, every
-    file is in place, so a Ctrl-C or SIGTERM while the interpreter shuts down is ignored rather
-    than shown as a traceback."""
-    code = main()
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_IGN)
-    sys.exit(code)
-
-
 if __name__ == "__main__":
+    from .entry import run
+
     run()

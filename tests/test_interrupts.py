@@ -61,3 +61,18 @@ def test_compare_outputs_survive_ctrl_c(tmp_path):
     assert process.returncode in (0, 130), stderr
     for path in out.iterdir() if out.exists() else ():
         assert ".partial" not in path.name
+
+
+@pytest.mark.parametrize("delay", [0.05, 0.1, 0.2, 0.4, 0.8])
+def test_ctrl_c_while_the_program_starts_is_one_line_too(tmp_path, delay):
+    # The installed program sets its handlers before it imports numpy, fmpy or dask.
+    program = os.path.join(os.path.dirname(sys.executable), "pendulum-fmu")
+    process = subprocess.Popen([program, "simulate", "--torque", "1", "--stop-time", "0.5",
+                                "--output", str(tmp_path / "out.csv")],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(delay)
+    process.send_signal(signal.SIGINT)
+    _, stderr = process.communicate(timeout=120)
+    assert "Traceback" not in stderr and len(stderr.strip().splitlines()) <= 1, stderr
+    assert process.returncode in (0, 130)
+    assert [p.name for p in tmp_path.iterdir()] in ([], ["out.csv"])

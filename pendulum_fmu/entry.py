@@ -1,0 +1,30 @@
+"""The pendulum-fmu program.
+
+Signals are handled from its first line, before the imports that take a noticeable time (numpy,
+fmpy, dask), so that a Ctrl-C or SIGTERM at any moment ends in one line: while starting, here;
+while a command runs, by cli.main, which cleans up what the command was writing.
+"""
+
+import os
+import signal
+import sys
+
+_WHAT = {signal.SIGINT: "interrupted", signal.SIGTERM: "terminated"}
+
+
+def _while_starting(number, frame):
+    # No command has started, so nothing is being written: leave at once.
+    os.write(2, f"pendulum-fmu: {_WHAT[number]} while starting; nothing was written\n".encode())
+    os._exit(128 + number)
+
+
+def run() -> None:
+    for number in _WHAT:
+        signal.signal(number, _while_starting)
+    from .cli import main  # sets the command's own handlers while it runs
+
+    code = main()
+    # Every file is in place: a signal while the interpreter shuts down changes nothing.
+    for number in _WHAT:
+        signal.signal(number, signal.SIG_IGN)
+    sys.exit(code)
