@@ -3,7 +3,7 @@
 It drives any FMI 2.0 co-simulation instance that fmpy instantiated, through the FMU's own
 exported fmi2SetReal, fmi2SetRealInputDerivatives, fmi2GetReal and fmi2DoStep, for a whole
 schedule in one call, writing into the caller's numpy buffers. `pip install` (or
-`python setup.py build_ext --inplace` in a checkout) compiles it; without it `available()` is
+`pip install -e .` in a checkout) compiles it; without it `available()` is
 False and callers use the Python loop in simulate.py, which gives the same numbers bit for bit.
 """
 

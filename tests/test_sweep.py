@@ -62,7 +62,7 @@ def _built_fmu(fmu, monkeypatch):
 # --- the native loop ------------------------------------------------------------------------
 
 def test_the_native_loop_is_built():
-    assert cs_loop.available(), "build it: pip install -e . or python setup.py build_ext --inplace"
+    assert cs_loop.available(), "build it: pip install -e ."
 
 
 @pytest.mark.parametrize("ramp", [False, True])
