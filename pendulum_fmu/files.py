@@ -15,6 +15,11 @@ import uuid
 from pathlib import Path
 
 
+# Every temporary a writer here leaves if it is killed (SIGKILL, a lost worker) matches this, so
+# that whoever owns the folder can sweep them up.
+TEMPORARY_GLOB = ".*.partial*"
+
+
 def _read_umask() -> int:
     mask = os.umask(0o022)
     os.umask(mask)

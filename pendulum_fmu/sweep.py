@@ -42,7 +42,7 @@ import numpy as np
 
 from . import cs_loop
 from . import default_fmu
-from .files import replacing_on
+from .files import TEMPORARY_GLOB, replacing_on
 from .parameters import default_parameters, value_reference
 from .signal import TorqueSchedule, communication_points
 from .simulate import FmuError, initialize, open_fmu, run_schedule_python
@@ -332,7 +332,7 @@ def _remove(study: _Study, patterns) -> None:
 
 def _temporaries() -> tuple[str, ...]:
     """Where an interrupted writer (a killed worker) leaves a temporary (see files.py)."""
-    return (".*.partial", "trajectories/.*.partial", "cases/.*.partial")
+    return (TEMPORARY_GLOB, f"trajectories/{TEMPORARY_GLOB}", f"cases/{TEMPORARY_GLOB}")
 
 
 def _prepare(study: _Study, definition: dict, resume: bool, count: int, points: int,
