@@ -3,30 +3,31 @@
 # The package version's one source: pyproject.toml reads it, the FMU's generationTool carries it.
 __version__ = "0.1.0"
 
-import atexit
-import contextlib
-from importlib import resources
-from pathlib import Path
-
-# Nothing heavy is imported here (build.py brings fmpy): the command line sets its signal
-# handlers before it imports anything that takes a noticeable time (cli.run).
+# Nothing is imported here at import time, not even the standard library's importlib.resources:
+# the program (pendulum_fmu.entry) sets its signal handlers as soon as this package is loaded,
+# before anything that takes a noticeable time.
 __all__ = ["__version__", "default_fmu"]
 
 # FMI version -> the FMU's file name, in a checkout's dist/ and in the installed package's data/.
 _FMU_FILES = {2: "Pendulum.fmu", 3: "Pendulum-fmi3.fmu"}
 # Holds open the real files of packaged FMUs that importlib.resources had to extract (a zipped
-# install); a plain install hands out the files themselves.
-_extracted = contextlib.ExitStack()
-atexit.register(_extracted.close)
+# install); a plain install hands out the files themselves. Made on first use.
+_extracted = None
 
 
-def default_fmu(fmi_version: int = 2) -> Path:
+def default_fmu(fmi_version: int = 2):
     """The FMU this package runs when none is named.
 
     In a source checkout (a clone or an editable install): dist/Pendulum.fmu, rebuilt first when
     any of its sources is newer. In an installed package: the FMU packaged with it. Nothing is
     ever written into site-packages.
     """
+    global _extracted
+    import atexit
+    import contextlib
+    from importlib import resources
+    from pathlib import Path
+
     from .build import DEFAULT_FMU, build_fmu, fmu_is_stale, is_source_checkout
 
     if fmi_version not in _FMU_FILES:
@@ -41,7 +42,10 @@ def default_fmu(fmi_version: int = 2) -> Path:
     if not packaged.is_file():
         raise FileNotFoundError(
             f"pendulum_fmu {__version__} at {Path(__file__).parent} has neither its packaged "
-            f"data/{packaged_name} nor the FMU's sources beside it: reinstall it from a wheel or "
-            "the sdist (pip install pendulum-fmu), or pass the FMU's path")
+            f"data/{packaged_name} nor the FMU's sources beside it: reinstall it from its wheel or "
+            "sdist, or pass the FMU's path")
+    if _extracted is None:
+        _extracted = contextlib.ExitStack()
+        atexit.register(_extracted.close)
     return _extracted.enter_context(resources.as_file(packaged))
 
