@@ -294,6 +294,11 @@ def communication_points(start_time: float, stop_time: float, step_size: float,
     steps = step_count(start_time, stop_time, step_size, max_steps)
     grid = start_time + step_size * np.arange(steps + 1, dtype=float)
     grid[-1] = stop_time if abs(grid[-1] - stop_time) > event_tolerance(stop_time, step_size) else grid[-1]
+    return _with_events(grid, events, step_size)
+
+
+def _with_events(grid: np.ndarray, events: np.ndarray | None, step_size: float) -> np.ndarray:
+    """The grid plus the events inside it that are not within event_tolerance of a grid point."""
     if events is None or not len(events):
         return grid
     events = np.unique(events[(events > grid[0]) & (events < grid[-1])])
@@ -342,8 +347,7 @@ def schedule(torque: TorqueSignal, *, start_time: float = 0.0, stop_time: float 
                              "give a stop time")
         grid = communication_points(start_time, stop, step_size, max_steps=max_steps)
         table = torque.snapped(grid, step_size)
-        time = communication_points(start_time, stop, step_size, table.time if ramp else table.jumps(),
-                                    max_steps=max_steps)
+        time = _with_events(grid, table.time if ramp else table.jumps(), step_size)
         start_values = table.value_after(time[:-1])
         end_values = table.value_before(time[1:])
     else:

@@ -251,6 +251,14 @@ def simulate(torque: TorqueSignal = 20.0, *, start_time: float = 0.0, stop_time:
     """
     plan = schedule(torque, start_time=start_time, stop_time=stop_time, step_size=step_size,
                     ramp=ramp, max_steps=max_steps)
+    return simulate_plan(plan, parameters=parameters, theta0=theta0, omega0=omega0,
+                         tolerance=tolerance, fmu_path=fmu_path)
+
+
+def simulate_plan(plan: TorqueSchedule, *, parameters: dict | None = None, theta0: float = 0.0,
+                  omega0: float = 0.0, tolerance: float | None = None,
+                  fmu_path: str | Path | None = None) -> np.ndarray:
+    """A schedule through a fresh instance of the FMU, freed afterwards (see simulate)."""
     resolve_parameters(parameters, fmu_path)  # refused with the same words as every other tool
     slave = open_fmu(fmu_path, parameters=parameters, theta0=theta0, omega0=omega0,
                      tolerance=tolerance, start_time=float(plan.time[0]))

@@ -30,7 +30,7 @@ from .engines import MODES, check_held, check_mode
 from .parameters import resolve_parameters
 from .reference import reference_schedule
 from .signal import TorqueSchedule
-from .simulate import open_fmu, run_schedule
+from .simulate import simulate_plan
 
 
 class ToolSpecError(ValueError):
@@ -53,14 +53,7 @@ def run_fmu(plan: TorqueSchedule, *, parameters: dict | None = None, theta0: flo
             omega0: float = 0.0, mode: str = "accurate", fmu_path: str | Path | None = None) -> np.ndarray:
     """This project's FMU (the checkout's, or fmu_path) through fmpy; ramps are passed on."""
     check_mode(mode, "fmu")
-    resolve_parameters(parameters, fmu_path)  # refused with the same words as every other tool
-    slave = open_fmu(fmu_path, parameters=parameters, theta0=theta0, omega0=omega0,
-                     start_time=float(plan.time[0]))
-    try:
-        return run_schedule(slave, plan)
-    finally:
-        slave.terminate()
-        slave.freeInstance()
+    return simulate_plan(plan, parameters=parameters, theta0=theta0, omega0=omega0, fmu_path=fmu_path)
 
 
 def run_reference(plan: TorqueSchedule, *, parameters: dict | None = None, theta0: float = 0.0,

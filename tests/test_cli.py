@@ -5,7 +5,6 @@ import sys
 
 import numpy as np
 import pyarrow.parquet as pq
-import pytest
 
 from pendulum_fmu.cli import build_parser, main
 from pendulum_fmu.reference import reference

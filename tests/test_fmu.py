@@ -9,7 +9,7 @@ import pytest
 from fmpy import read_model_description
 from fmpy.validation import validate_fmu
 
-from pendulum_fmu.parameters import default_parameters, total_inertia, value_reference
+from pendulum_fmu.parameters import default_parameters, total_inertia
 from pendulum_fmu.reference import reference
 from pendulum_fmu.signal import schedule
 from pendulum_fmu.simulate import FmuError, open_fmu, run_schedule, simulate
