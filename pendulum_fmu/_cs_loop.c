@@ -1,14 +1,17 @@
-/* A generic FMI 2.0 co-simulation loop: one call runs a whole schedule through the FMU's own
-   exported fmi2SetReal, fmi2SetRealInputDerivatives, fmi2GetReal and fmi2DoStep.
+/* A generic FMI 2.0 co-simulation loop: one call runs a whole case through the FMU's own exported
+   FMI functions: optionally a restart (fmi2Reset and initialization with new start values), then
+   every communication step (fmi2SetReal, fmi2SetRealInputDerivatives, fmi2GetReal, fmi2DoStep).
 
    Plain C99, not a CPython module: Python loads it with ctypes and passes the addresses of the
    functions of the FMU library fmpy already loaded, the instance, and numpy buffers. Nothing is
-   allocated here, so the cost of a step is the FMU's own work plus four indirect calls.
+   allocated here, so the cost of a step is the FMU's own work plus four indirect calls, and the
+   cost of a restart is the FMU's own.
 
-   The call sequence is the one of the Python loop in pendulum_fmu/simulate.py (the readable
-   reference), so the two give bit-identical results: per step k, set the inputs, set their
-   first derivatives (when rates are given), read the outputs, step from time[k] by
-   time[k+1] - time[k]; after the last step read the inputs and the outputs once more. */
+   The call sequence is the one of the Python code in pendulum_fmu/simulate.py (initialize and
+   the loop of run_schedule_python, the readable reference), so the two give bit-identical
+   results: per step k, set the inputs, set their first derivatives (when rates are given), read
+   the outputs, step from time[k] by time[k+1] - time[k]; after the last step read the inputs
+   and the outputs once more. */
 
 #include <stddef.h>
 
@@ -20,12 +23,30 @@
 #define CS_LOOP_EXPORT __attribute__((visibility("default")))
 #endif
 
+/* The FMU's functions, in this order (cs_loop.py passes them as an array of addresses). */
+typedef struct {
+    fmi2ResetTYPE *reset;
+    fmi2SetupExperimentTYPE *setup_experiment;
+    fmi2EnterInitializationModeTYPE *enter_initialization_mode;
+    fmi2ExitInitializationModeTYPE *exit_initialization_mode;
+    fmi2SetRealTYPE *set_real;
+    fmi2SetRealInputDerivativesTYPE *set_real_input_derivatives;
+    fmi2GetRealTYPE *get_real;
+    fmi2DoStepTYPE *do_step;
+} CsFunctions;
+
 /* Which call failed, as reported through *failed_call. */
 enum { CALL_SET_REAL = 0, CALL_SET_RATE = 1, CALL_GET_REAL = 2, CALL_DO_STEP = 3,
-       CALL_GET_INPUTS_AT_END = 4, CALL_GET_OUTPUTS_AT_END = 5 };
+       CALL_GET_INPUTS_AT_END = 4, CALL_GET_OUTPUTS_AT_END = 5, CALL_RESET = 6,
+       CALL_SETUP_EXPERIMENT = 7, CALL_ENTER_INITIALIZATION_MODE = 8, CALL_SET_START_VALUES = 9,
+       CALL_EXIT_INITIALIZATION_MODE = 10 };
 
-/* Runs n_steps communication steps.
+/* Runs one case.
 
+   start_values[i]                   when not NULL, the instance is first reset and initialized
+                                     again, with start_references[i] set to start_values[i] in
+                                     initialization mode, at start time time[0] (no tolerance,
+                                     no stop time); when NULL it must be initialized already
    time[0..n_steps]                  communication points
    inputs[k*n_inputs + i]            input i over step k (the value at the step's start)
    input_rates[k*n_inputs + i]       its derivative of order input_orders[i] (1 for a ramp) over
@@ -36,11 +57,12 @@ enum { CALL_SET_REAL = 0, CALL_SET_RATE = 1, CALL_GET_REAL = 2, CALL_DO_STEP = 3
    final_inputs[i]                   the inputs read back after the last step (may be NULL)
 
    Returns fmi2OK or fmi2Warning when every call succeeded (a warning is the worst status seen),
-   else the failing call's status, with *failed_step = k (n_steps for the reads at the end) and
-   *failed_call one of the CALL_ values; the outputs before the failure are filled in. */
+   else the failing call's status, with *failed_step = k (0 for the restart, n_steps for the
+   reads at the end) and *failed_call one of the CALL_ values; the outputs before the failure
+   are filled in. */
 CS_LOOP_EXPORT int cs_loop_run(
-    fmi2SetRealTYPE *set_real, fmi2SetRealInputDerivativesTYPE *set_real_input_derivatives,
-    fmi2GetRealTYPE *get_real, fmi2DoStepTYPE *do_step, fmi2Component component,
+    const CsFunctions *fmi, fmi2Component component,
+    const fmi2ValueReference *start_references, size_t n_start, const double *start_values,
     const fmi2ValueReference *input_references, size_t n_inputs,
     const fmi2ValueReference *output_references, size_t n_outputs,
     size_t n_steps, const double *time, const double *inputs,
@@ -49,7 +71,7 @@ CS_LOOP_EXPORT int cs_loop_run(
     size_t *failed_step, int *failed_call)
 {
     fmi2Status worst = fmi2OK, status;
-    size_t k;
+    size_t k = 0;
 
 #define CHECK(call_expression, which)                                                   \
     do {                                                                                \
@@ -58,23 +80,33 @@ CS_LOOP_EXPORT int cs_loop_run(
         if (status > worst) worst = status;                                             \
     } while (0)
 
+    if (start_values != NULL) {
+        CHECK(fmi->reset(component), CALL_RESET);
+        CHECK(fmi->setup_experiment(component, fmi2False, 0.0, time[0], fmi2False, 0.0),
+              CALL_SETUP_EXPERIMENT);
+        CHECK(fmi->enter_initialization_mode(component), CALL_ENTER_INITIALIZATION_MODE);
+        if (n_start)
+            CHECK(fmi->set_real(component, start_references, n_start, start_values),
+                  CALL_SET_START_VALUES);
+        CHECK(fmi->exit_initialization_mode(component), CALL_EXIT_INITIALIZATION_MODE);
+    }
     for (k = 0; k < n_steps; k++) {
         if (n_inputs) {
-            CHECK(set_real(component, input_references, n_inputs, inputs + k * n_inputs),
+            CHECK(fmi->set_real(component, input_references, n_inputs, inputs + k * n_inputs),
                   CALL_SET_REAL);
             if (input_rates != NULL)
-                CHECK(set_real_input_derivatives(component, input_references, n_inputs,
-                                                 input_orders, input_rates + k * n_inputs),
+                CHECK(fmi->set_real_input_derivatives(component, input_references, n_inputs,
+                                                      input_orders, input_rates + k * n_inputs),
                       CALL_SET_RATE);
         }
-        CHECK(get_real(component, output_references, n_outputs, outputs + k * n_outputs),
+        CHECK(fmi->get_real(component, output_references, n_outputs, outputs + k * n_outputs),
               CALL_GET_REAL);
-        CHECK(do_step(component, time[k], time[k + 1] - time[k], fmi2True), CALL_DO_STEP);
+        CHECK(fmi->do_step(component, time[k], time[k + 1] - time[k], fmi2True), CALL_DO_STEP);
     }
     if (final_inputs != NULL && n_inputs)
-        CHECK(get_real(component, input_references, n_inputs, final_inputs),
+        CHECK(fmi->get_real(component, input_references, n_inputs, final_inputs),
               CALL_GET_INPUTS_AT_END);
-    CHECK(get_real(component, output_references, n_outputs, outputs + k * n_outputs),
+    CHECK(fmi->get_real(component, output_references, n_outputs, outputs + k * n_outputs),
           CALL_GET_OUTPUTS_AT_END);
 #undef CHECK
     return (int)worst;

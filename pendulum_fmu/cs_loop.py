@@ -1,8 +1,10 @@
 """The native co-simulation loop (`_cs_loop.c`), loaded with ctypes when it was compiled.
 
 It drives any FMI 2.0 co-simulation instance that fmpy instantiated, through the FMU's own
-exported fmi2SetReal, fmi2SetRealInputDerivatives, fmi2GetReal and fmi2DoStep, for a whole
-schedule in one call, writing into the caller's numpy buffers. `pip install` (or
+exported FMI functions, for a whole case in one call: optionally a restart (fmi2Reset and
+initialization with new start values, as simulate.initialize does), then every step of a
+schedule (fmi2SetReal, fmi2SetRealInputDerivatives, fmi2GetReal, fmi2DoStep), writing into the
+caller's numpy buffers. `pip install` (or
 `pip install -e .` in a checkout) compiles it; without it `available()` is
 False and callers use the Python loop in simulate.py, which gives the same numbers bit for bit.
 """
@@ -16,10 +18,16 @@ from pathlib import Path
 
 import numpy as np
 
-# The call that failed, by the index _cs_loop.c reports.
+# The call that failed, by the index _cs_loop.c reports; from RESTART on, the restart's.
 _CALLS = ("fmi2SetReal", "fmi2SetRealInputDerivatives", "fmi2GetReal", "fmi2DoStep",
-          "fmi2GetReal of the inputs", "fmi2GetReal")
-_FMI_FUNCTIONS = ("fmi2SetReal", "fmi2SetRealInputDerivatives", "fmi2GetReal", "fmi2DoStep")
+          "fmi2GetReal of the inputs", "fmi2GetReal", "fmi2Reset", "fmi2SetupExperiment",
+          "fmi2EnterInitializationMode", "fmi2SetReal of the start values",
+          "fmi2ExitInitializationMode")
+_RESTART = 6
+# In the order of CsFunctions in _cs_loop.c.
+_FMI_FUNCTIONS = ("fmi2Reset", "fmi2SetupExperiment", "fmi2EnterInitializationMode",
+                  "fmi2ExitInitializationMode", "fmi2SetReal", "fmi2SetRealInputDerivatives",
+                  "fmi2GetReal", "fmi2DoStep")
 
 
 @lru_cache(maxsize=1)
@@ -31,7 +39,8 @@ def _library():
         if path.is_file():
             run = ctypes.CDLL(str(path)).cs_loop_run
             pointer, size = ctypes.c_void_p, ctypes.c_size_t
-            run.argtypes = [pointer] * 5 + [pointer, size, pointer, size, size] + [pointer] * 8
+            run.argtypes = ([pointer] * 3 + [size] + [pointer] * 2 + [size, pointer, size, size]
+                            + [pointer] * 8)
             run.restype = ctypes.c_int
             return run
     return None
@@ -51,38 +60,52 @@ def _address(array: np.ndarray | None, shape: tuple[int, ...], dtype, what: str)
 
 
 class Stepper:
-    """The native loop bound to an initialized fmpy FMU2Slave, its input and output value
-    references (uint32 arrays) and the communication points `time` (N + 1); run() steps it
-    through them. Binding once keeps a case's Python cost to a few microseconds; the slave may
-    be reset and initialized again between runs.
+    """The native loop bound to an fmpy FMU2Slave, its input and output value references (uint32
+    arrays), the communication points `time` (N + 1) and the value references of the start values
+    a restart sets (start_references); run() steps it through them. Binding once keeps a case's
+    Python cost to a few microseconds.
     """
 
     def __init__(self, slave, input_references: np.ndarray, output_references: np.ndarray,
-                 time: np.ndarray):
+                 time: np.ndarray, start_references: np.ndarray | None = None):
         self.steps, self.inputs, self.outputs = len(time) - 1, len(input_references), len(output_references)
         self.time, self.messages = time, slave.messages
-        self._references = input_references, output_references  # kept alive for the addresses
-        functions = [ctypes.cast(slave.dll[name], ctypes.c_void_p) for name in _FMI_FUNCTIONS]
+        if start_references is None:
+            start_references = np.empty(0, np.uint32)
+        self.starts = len(start_references)
+        # Kept alive for the addresses.
+        self._references = input_references, output_references, start_references
+        self._functions = (ctypes.c_void_p * len(_FMI_FUNCTIONS))(
+            *[ctypes.cast(slave.dll[name], ctypes.c_void_p) for name in _FMI_FUNCTIONS])
         self._first_order = np.ones(self.inputs, np.int32)  # fmi2Integer is int
         self._failed_step, self._failed_call = ctypes.c_size_t(), ctypes.c_int()
-        self._bound = (
-            *functions, slave.component,
+        self._fmu = (ctypes.addressof(self._functions), slave.component)
+        self._schedule = (
             _address(input_references, (self.inputs,), np.uint32, "input_references"), self.inputs,
             _address(output_references, (self.outputs,), np.uint32, "output_references"), self.outputs,
             self.steps, _address(time, (self.steps + 1,), np.float64, "time"))
+        self._start_references = (_address(start_references, (self.starts,), np.uint32,
+                                           "start_references"), self.starts)
         self._reports = ctypes.byref(self._failed_step), ctypes.byref(self._failed_call)
 
     def run(self, inputs: np.ndarray, input_rates: np.ndarray | None, outputs: np.ndarray,
-            final_inputs: np.ndarray | None = None) -> None:
+            final_inputs: np.ndarray | None = None, start_values: np.ndarray | None = None) -> None:
         """inputs, input_rates: (N, inputs) values and first derivatives of the inputs over each
-        step (input_rates None: held, fmi2SetRealInputDerivatives is not called). outputs:
+        step (input_rates None: held, fmi2SetRealInputDerivatives is not called; inputs None
+        when there are no inputs). outputs:
         (N + 1, outputs), filled with the outputs at every point, read after the step's inputs
-        were set. final_inputs: (inputs,) the inputs read back after the last step. A failing
-        call raises the slave's MessageLog error, with the FMU's messages and the time of the
-        failing step.
+        were set. final_inputs: (inputs,) the inputs read back after the last step.
+        start_values: (start_references,) restart the instance first (reset, and initialize at
+        time[0] with these start values), or None when it is initialized already. A failing call
+        raises the slave's MessageLog error, with the FMU's messages and the time of the failing
+        step, or FmuError("initialization failed: ...") as simulate.initialize does.
         """
+        if inputs is None and self.inputs:
+            raise ValueError(f"inputs must be given: the stepper has {self.inputs}")
         status = _library()(
-            *self._bound,
+            *self._fmu, *self._start_references,
+            _address(start_values, (self.starts,), np.float64, "start_values"),
+            *self._schedule,
             _address(inputs, (self.steps, self.inputs), np.float64, "inputs"),
             None if input_rates is None else self._first_order.ctypes.data,
             _address(input_rates, (self.steps, self.inputs), np.float64, "input_rates"),
@@ -91,5 +114,7 @@ class Stepper:
             *self._reports)
         if status > 1:
             call = self._failed_call.value
+            if call >= _RESTART:
+                raise self.messages.initialization_error(f"{_CALLS[call]} failed")
             where = "at the end" if call >= 4 else f"at t = {self.time[self._failed_step.value]:.17g}"
             raise self.messages.error(status, f"{_CALLS[call]} {where}")

@@ -31,12 +31,11 @@ from fmpy.fmi2 import FMU2Slave
 from fmpy.fmi3 import FMU3Slave
 
 from .engines import check_held, check_mode, held_results
-from .parameters import default_parameters, resolve_parameters
+from .parameters import START_VALUES, default_parameters, resolve_parameters
 from .signal import TorqueSchedule
 
 OUTPUTS = ("theta", "omega", "alpha")
 REQUIRED = ("torque", "theta")
-START_VALUES = {"theta0": "theta", "omega0": "omega"}
 # accurate: the tolerance the FMU or CVode is asked for; default: what it uses when not asked.
 TOLERANCE = {"accurate": 1e-12, "default": None}
 _FACTOR = re.compile(r"^(?P<variable>.+?)\*(?P<factor>[-+0-9.eE]+)$")

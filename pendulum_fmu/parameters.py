@@ -12,6 +12,9 @@ from pathlib import Path
 
 from fmpy import read_model_description
 
+# The start values a user gives, and the FMU's variables they start.
+START_VALUES = {"theta0": "theta", "omega0": "omega"}
+
 
 @lru_cache(maxsize=32)
 def _read(path: str, modified_ns: int):

@@ -74,6 +74,9 @@ class MessageLog:
         detail = "; ".join(self.lines[-3:]) or "no message"
         return FmuError(f"{call} returned {_STATUS[status]}: {detail}")
 
+    def initialization_error(self, reason: str) -> FmuError:
+        return FmuError(f"initialization failed: {'; '.join(self.lines) or reason}")
+
 
 _extracted: dict[tuple[str, int], tuple[tempfile.TemporaryDirectory, object]] = {}
 _extracting = threading.Lock()  # threads of one dask worker share the cache
@@ -142,7 +145,7 @@ def initialize(slave: FMU2Slave | FMU3Slave, *, parameters: dict | None = None, 
             slave.setReal(references, list(start.values()))
         slave.exitInitializationMode()
     except Exception as error:
-        raise FmuError(f"initialization failed: {'; '.join(slave.messages.lines) or error}") from None
+        raise slave.messages.initialization_error(str(error)) from None
 
 
 def run_schedule(slave: FMU2Slave | FMU3Slave, plan: TorqueSchedule) -> np.ndarray:

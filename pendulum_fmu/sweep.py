@@ -43,11 +43,10 @@ import numpy as np
 from . import cs_loop
 from . import default_fmu
 from .files import TEMPORARY_GLOB, replacing_on
-from .parameters import default_parameters, value_reference
+from .parameters import START_VALUES, default_parameters, value_reference
 from .signal import TorqueSchedule, communication_points
 from .simulate import FmuError, initialize, open_fmu, run_schedule_python
 
-START_VALUES = ("theta0", "omega0")
 OUTPUTS = ("theta", "omega", "alpha")
 FORMATS = ("parquet", "csv")
 SUMMARIES = ("final_theta", "final_omega", "final_alpha", "max_abs_theta")
@@ -177,41 +176,53 @@ class _Study:
 
 
 class _Runner:
-    """A worker thread's FMU instance, reset between cases: instantiating costs about a hundred
-    times what a reset and initialization cost."""
+    """A worker thread's FMU instance, restarted (reset and initialized again) between cases:
+    instantiating costs about a hundred times what a restart costs.
+
+    A case is the start values of a restart: the parameters, theta and omega, and the torque,
+    which then stays as it was set, so the native loop sets no input per step."""
 
     def __init__(self, fmu: str):
         self.fmu, self.slave, self.stepper = fmu, None, None
-        self.torque = np.array([value_reference("torque", fmu)], np.uint32)
+        self.defaults = {**default_parameters(fmu), "theta": 0.0, "omega": 0.0, "torque": 0.0}
+        self.start_references = np.array([value_reference(n, fmu) for n in self.defaults], np.uint32)
         self.outputs = np.array([value_reference(name, fmu) for name in OUTPUTS], np.uint32)
 
-    def run(self, case: dict[str, float], points: np.ndarray, torque: np.ndarray,
-            outputs: np.ndarray) -> None:
-        """theta, omega and alpha of one case at every communication point into outputs (points x 3);
-        torque is a scratch buffer (steps x 1). FmuError when the FMU refuses the case."""
-        start = dict(parameters={k: v for k, v in case.items() if k not in ("torque", *START_VALUES)},
-                     theta0=case.get("theta0", 0.0), omega0=case.get("omega0", 0.0),
-                     start_time=float(points[0]))
+    def start_values(self, values: dict[str, np.ndarray], count: int) -> np.ndarray:
+        """(count, start values) of the cases given as {name: column}, the defaults elsewhere."""
+        given = {START_VALUES.get(name, name): column for name, column in values.items()}
+        return np.column_stack([np.broadcast_to(given.get(name, default), count)
+                                for name, default in self.defaults.items()]).astype(float)
+
+    def run(self, start_values: np.ndarray, points: np.ndarray, outputs: np.ndarray) -> None:
+        """theta, omega and alpha of one case (its row of start_values) at every communication
+        point into outputs (points x 3). FmuError when the FMU refuses the case."""
         try:
             if self.slave is None:
-                self.slave = open_fmu(self.fmu, **start)
-            else:
-                self.slave.messages.lines.clear()
-                self.slave.reset()
-                initialize(self.slave, **start)
-            torque[:] = case["torque"]
+                self.slave = open_fmu(self.fmu, start_time=float(points[0]))
+            self.slave.messages.lines.clear()
             if cs_loop.available() and self.slave.fmi_version == 2:
                 if self.stepper is None or self.stepper.time is not points:
-                    self.stepper = cs_loop.Stepper(self.slave, self.torque, self.outputs, points)
-                self.stepper.run(torque, None, outputs)
+                    self.stepper = cs_loop.Stepper(self.slave, np.empty(0, np.uint32), self.outputs,
+                                                   points, self.start_references)
+                self.stepper.run(None, None, outputs, start_values=start_values)
             else:
-                plan = TorqueSchedule(time=points, torque=torque[:, 0], torque_rate=np.zeros(len(torque)))
-                run = run_schedule_python(self.slave, plan)
-                outputs[:] = np.column_stack([run[name] for name in OUTPUTS])
+                self._run_python(dict(zip(self.defaults, start_values.tolist())), points, outputs)
         except BaseException:
             # After a refusal the instance is in an error state: the next case starts afresh.
             self.close()
             raise
+
+    def _run_python(self, start: dict[str, float], points: np.ndarray, outputs: np.ndarray) -> None:
+        """The same case through fmpy's calls: FMI 3.0 FMUs, or no native loop."""
+        torque, theta0, omega0 = start.pop("torque"), start.pop("theta"), start.pop("omega")
+        self.slave.reset()
+        initialize(self.slave, parameters=start, theta0=theta0, omega0=omega0,
+                   start_time=float(points[0]))
+        plan = TorqueSchedule(time=points, torque=np.full(len(points) - 1, torque),
+                              torque_rate=np.zeros(len(points) - 1))
+        run = run_schedule_python(self.slave, plan)
+        outputs[:] = np.column_stack([run[name] for name in OUTPUTS])
 
     def close(self) -> None:
         if self.slave is not None:
@@ -240,17 +251,21 @@ def _kept_points(points: int, stride: int) -> np.ndarray:
 
 def _write_table(study: _Study, name: str, index: int, columns: dict, split: tuple = ()) -> int:
     """Write one part of a table; returns its size in bytes. split: float columns stored
-    byte-stream-split (smooth trajectories compress to about two thirds with it)."""
+    byte-stream-split, as smooth series compress best."""
     import pyarrow as pa
 
-    table = pa.table(columns)
+    arrays = {column: pa.array(values) for column, values in columns.items()}
+    # Not nullable (no value is ever missing): the writer then has no definition levels to write.
+    table = pa.table(list(arrays.values()), schema=pa.schema(
+        [pa.field(column, array.type, nullable=False) for column, array in arrays.items()]))
     with replacing_on(study.filesystem, study.part(name, index)) as file:
         if study.format == "parquet":
             import pyarrow.parquet as pq
 
-            # Dictionaries only where values repeat: on the outputs they cost more than the
-            # simulation and gain nothing.
-            pq.write_table(table, file, compression="zstd", compression_level=1,
+            # Measured on trajectories (benchmarks/scale.py): LZ4 after byte-stream-split is as
+            # small as zstd level 1 (57 kB for a 3-s case) and writes in a quarter of the time;
+            # dictionaries only where values repeat within a column (case numbers, status).
+            pq.write_table(table, file, compression="lz4",
                            use_dictionary=[c for c in table.column_names if c not in split],
                            column_encoding={c: "BYTE_STREAM_SPLIT" for c in split})
         else:
@@ -270,13 +285,12 @@ def _run_chunk(index: int, first: int, values: dict[str, np.ndarray], study: _St
     points = communication_points(0.0, study.stop_time, study.step_size)
     count = len(next(iter(values.values())))
     recorded = np.empty((count, len(points), len(OUTPUTS)))
-    torque = np.empty((len(points) - 1, 1))
     messages = [""] * count
     runner = _runner(study.fmu)
+    start_values = runner.start_values(values, count)
     for i in range(count):
         try:
-            runner.run({name: float(column[i]) for name, column in values.items()}, points, torque,
-                       recorded[i])
+            runner.run(start_values[i], points, recorded[i])
         except FmuError as error:
             messages[i] = str(error)
             recorded[i] = np.nan
@@ -291,7 +305,7 @@ def _run_chunk(index: int, first: int, values: dict[str, np.ndarray], study: _St
         written += _write_table(study, "trajectories", index, {
             "case": np.repeat(numbers[ok], len(keep)), "time": np.tile(points[keep], int(ok.sum())),
             **{name: kept[:, :, OUTPUTS.index(name)].ravel() for name in study.outputs}},
-            split=study.outputs)
+            split=("time", *study.outputs))
     final = recorded[:, -1]
     summaries = [*final.T, np.max(np.abs(recorded[:, :, 0]), axis=1)]
     written += _write_table(study, "cases", index, {
