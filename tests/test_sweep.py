@@ -24,6 +24,7 @@ import benchmarks.scale
 from pendulum_fmu import cs_loop, simulate
 from pendulum_fmu import default_fmu
 from pendulum_fmu.cli import main
+from pendulum_fmu.parameters import value_reference
 from pendulum_fmu.reference import reference, reference_schedule
 from pendulum_fmu.signal import TorqueTable, schedule
 from pendulum_fmu.sweep import OUTPUTS, run_sweep, sweep_grid
@@ -95,6 +96,32 @@ def test_native_loop_reports_the_failing_step(fmu):
         with pytest.raises(simulate.FmuError, match=r"fmi2DoStep at t = 0.5 returned ERROR: .*not where"):
             stepper = cs_loop.Stepper(slave, np.array([0], np.uint32), np.array([1, 2, 3], np.uint32), wrong)
             stepper.run(plan.torque[:, None].copy(), None, np.empty((len(wrong), 3)))
+    finally:
+        slave.freeInstance()
+
+
+def test_native_restart_matches_a_fresh_instance_bit_for_bit(fmu):
+    """A restart in C (fmi2Reset, initialization with new start values, the torque among them)
+    gives what a new instance initialized in Python and fed the torque every step gives."""
+    plan = schedule(12.0, stop_time=0.2, step_size=1e-3)
+    names = ("mass", "damping", "theta", "torque")
+    references = np.array([value_reference(n, fmu) for n in names], np.uint32)
+    outputs = np.array([value_reference(n, fmu) for n in OUTPUTS], np.uint32)
+    slave = simulate.open_fmu(fmu)  # initialized with the defaults, then restarted twice
+    try:
+        stepper = cs_loop.Stepper(slave, np.empty(0, np.uint32), outputs, plan.time, references)
+        for mass in (30.0, 55.0):
+            restarted = np.empty((len(plan.time), 3))
+            stepper.run(None, None, restarted, start_values=np.array([mass, 2.0, 0.4, 12.0]))
+            fresh = simulate.open_fmu(fmu, parameters={"mass": mass, "damping": 2.0}, theta0=0.4)
+            try:
+                expected = simulate.run_schedule_python(fresh, plan)
+            finally:
+                fresh.freeInstance()
+            for column, name in enumerate(OUTPUTS):
+                assert np.array_equal(restarted[:, column], expected[name]), (mass, name)
+        with pytest.raises(simulate.FmuError, match="initialization failed: .*mass must be > 0"):
+            stepper.run(None, None, restarted, start_values=np.array([-1.0, 0.0, 0.0, 0.0]))
     finally:
         slave.freeInstance()
 
