@@ -279,7 +279,7 @@ def _run_chunk(index: int, first: int, values: dict[str, np.ndarray], study: _St
     """Simulate a chunk of cases on a worker and write its parts.
 
     values: the chunk's cases, one array per name; first: the number of its first case.
-    Returns (index, cases, failed, bytes written, CPU seconds of this thread).
+    Returns (index, cases, failed, bytes written, CPU seconds of this thread, of which stepping).
     """
     cpu = time.thread_time()
     points = communication_points(0.0, study.stop_time, study.step_size)
@@ -288,12 +288,14 @@ def _run_chunk(index: int, first: int, values: dict[str, np.ndarray], study: _St
     messages = [""] * count
     runner = _runner(study.fmu)
     start_values = runner.start_values(values, count)
+    stepping = time.thread_time()
     for i in range(count):
         try:
             runner.run(start_values[i], points, recorded[i])
         except FmuError as error:
             messages[i] = str(error)
             recorded[i] = np.nan
+    stepping = time.thread_time() - stepping
     ok = np.array([not message for message in messages], bool)
     numbers = first + np.arange(count)
     written = 0
@@ -311,7 +313,7 @@ def _run_chunk(index: int, first: int, values: dict[str, np.ndarray], study: _St
     written += _write_table(study, "cases", index, {
         "case": numbers, **values, **dict(zip(SUMMARIES, summaries)),
         "status": np.where(ok, "ok", "failed").tolist(), "message": messages})
-    return index, count, count - int(ok.sum()), written, time.thread_time() - cpu
+    return index, count, count - int(ok.sum()), written, time.thread_time() - cpu, stepping
 
 
 def _sha256(data: bytes) -> str:
@@ -489,7 +491,7 @@ def run_sweep(cases, *, output_dir: str | os.PathLike, stop_time: float = 3.0,
     Returns {'output_dir', 'trajectories', 'cases_table', 'figure': paths or URLs; 'cases',
     'failed': counts; 'chunks', 'chunks_run'; 'bytes': written by this run; 'seconds' in all,
     'figure_seconds' of them reading the cases table and drawing; 'worker_cpu_seconds' the
-    workers spent on this run's chunks}.
+    workers spent on this run's chunks, 'worker_stepping_seconds' of them running the cases}.
     """
     import fsspec
 
@@ -523,7 +525,7 @@ def run_sweep(cases, *, output_dir: str | os.PathLike, stop_time: float = 3.0,
                    filesystem=filesystem, root=root.rstrip("/"), stop_time=float(stop_time),
                    step_size=float(step_size), outputs=outputs, stride=stride, format=format)
     bar = _Progress(len(cases), progress)
-    written, worker_cpu = 0, 0.0
+    written, worker_cpu, worker_stepping = 0, 0.0, 0.0
     # Connected first, so that a scheduler that does not answer leaves the output untouched.
     with _client(scheduler, workers, connect_timeout) as client:
         chunk_cases = _prepare(study, _definition(cases, names, study), resume, len(cases), points, url)
@@ -544,9 +546,9 @@ def run_sweep(cases, *, output_dir: str | os.PathLike, stop_time: float = 3.0,
             failed = 0
             for _ in futures:
                 future = finished_futures.get()
-                _, count, chunk_failed, chunk_bytes, chunk_cpu = future.result()
+                _, count, chunk_failed, chunk_bytes, chunk_cpu, chunk_stepping = future.result()
                 finished, failed, written = finished + count, failed + chunk_failed, written + chunk_bytes
-                worker_cpu += chunk_cpu
+                worker_cpu, worker_stepping = worker_cpu + chunk_cpu, worker_stepping + chunk_stepping
                 future.release()
                 bar.show(finished, failed)
         finally:
@@ -567,4 +569,4 @@ def run_sweep(cases, *, output_dir: str | os.PathLike, stop_time: float = 3.0,
             "cases": len(cases), "failed": failed,
             "chunks": len(chunks), "chunks_run": len(pending), "bytes": written,
             "seconds": drawn - started, "figure_seconds": drawn - drawing,
-            "worker_cpu_seconds": worker_cpu}
+            "worker_cpu_seconds": worker_cpu, "worker_stepping_seconds": worker_stepping}
