@@ -23,6 +23,10 @@
 #define CS_LOOP_EXPORT __attribute__((visibility("default")))
 #endif
 
+/* Changes whenever cs_loop_run's arguments do, so that Python never calls a stale build with
+   the wrong arguments (cs_loop.py checks it). */
+CS_LOOP_EXPORT int cs_loop_interface(void) { return 2; }
+
 /* The FMU's functions, in this order (cs_loop.py passes them as an array of addresses). */
 typedef struct {
     fmi2ResetTYPE *reset;

@@ -30,20 +30,26 @@ _FMI_FUNCTIONS = ("fmi2Reset", "fmi2SetupExperiment", "fmi2EnterInitializationMo
                   "fmi2GetReal", "fmi2DoStep")
 
 
+# What _cs_loop.c's cs_loop_interface() returns for the arguments this module passes.
+INTERFACE = 2
+
+
 @lru_cache(maxsize=1)
 def _library():
-    """The compiled loop's run function, or None when it was not built."""
-    here = Path(__file__).resolve().parent
-    for suffix in importlib.machinery.EXTENSION_SUFFIXES:
-        path = here / f"_cs_loop{suffix}"
-        if path.is_file():
-            run = ctypes.CDLL(str(path)).cs_loop_run
-            pointer, size = ctypes.c_void_p, ctypes.c_size_t
-            run.argtypes = ([pointer] * 3 + [size] + [pointer] * 2 + [size, pointer, size, size]
-                            + [pointer] * 8)
-            run.restype = ctypes.c_int
-            return run
-    return None
+    """The compiled loop's run function, or None when it was not built (or is a stale build)."""
+    # setup.py gives it the platform's plain extension name (_cs_loop.so, _cs_loop.pyd).
+    path = Path(__file__).resolve().parent / f"_cs_loop{importlib.machinery.EXTENSION_SUFFIXES[-1]}"
+    if not path.is_file():
+        return None
+    library = ctypes.CDLL(str(path))
+    if not hasattr(library, "cs_loop_interface") or library.cs_loop_interface() != INTERFACE:
+        return None
+    run = library.cs_loop_run
+    pointer, size = ctypes.c_void_p, ctypes.c_size_t
+    run.argtypes = ([pointer] * 3 + [size] + [pointer] * 2 + [size, pointer, size, size]
+                    + [pointer] * 8)
+    run.restype = ctypes.c_int
+    return run
 
 
 def available() -> bool:
