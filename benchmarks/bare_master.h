@@ -81,6 +81,11 @@ static void *symbol(Library library, const char *name) {
     return pointer;
 }
 
+/* Declares a pointer named after an FMI function (fmi2DoStep, fmi3DoStep...) and looks it up, so
+   a call reads as the standard names it. The pointer shadows the FMI header's declaration of the
+   function on purpose: a master never links against an FMU, it only loads one. */
+#define LOOK_UP(library, function) function##TYPE *const function = symbol(library, #function)
+
 /* fmi2OK and fmi3OK are both 0, so one check serves either version's status. */
 static void check(int status, const char *call, long step) {
     if (status != 0) {

@@ -19,52 +19,50 @@ static void logger(fmi3InstanceEnvironment environment, fmi3Status status, fmi3S
 
 int main(int argc, char **argv) {
     const MasterRun run = start_master(argc, argv);
-    fmi3InstantiateCoSimulationTYPE *instantiate = symbol(run.library, "fmi3InstantiateCoSimulation");
-    fmi3EnterInitializationModeTYPE *enter_initialization =
-        symbol(run.library, "fmi3EnterInitializationMode");
-    fmi3ExitInitializationModeTYPE *exit_initialization =
-        symbol(run.library, "fmi3ExitInitializationMode");
-    fmi3SetFloat64TYPE *set_float64 = symbol(run.library, "fmi3SetFloat64");
-    fmi3GetFloat64TYPE *get_float64 = symbol(run.library, "fmi3GetFloat64");
-    fmi3DoStepTYPE *do_step = symbol(run.library, "fmi3DoStep");
-    fmi3TerminateTYPE *terminate = symbol(run.library, "fmi3Terminate");
-    fmi3FreeInstanceTYPE *free_instance = symbol(run.library, "fmi3FreeInstance");
+    LOOK_UP(run.library, fmi3InstantiateCoSimulation);
+    LOOK_UP(run.library, fmi3EnterInitializationMode);
+    LOOK_UP(run.library, fmi3ExitInitializationMode);
+    LOOK_UP(run.library, fmi3SetFloat64);
+    LOOK_UP(run.library, fmi3GetFloat64);
+    LOOK_UP(run.library, fmi3DoStep);
+    LOOK_UP(run.library, fmi3Terminate);
+    LOOK_UP(run.library, fmi3FreeInstance);
 
     /* No event mode, no early return, no intermediate updates: FMI 3.0's plain co-simulation,
        the same loop as FMI 2.0's. */
-    fmi3Instance fmu = instantiate("master", run.token, NULL, fmi3False, fmi3False, fmi3False,
-                                   fmi3False, NULL, 0, NULL, logger, NULL);
+    fmi3Instance fmu = fmi3InstantiateCoSimulation("master", run.token, NULL, fmi3False, fmi3False,
+                                                   fmi3False, fmi3False, NULL, 0, NULL, logger, NULL);
     if (!fmu) return 1;
-    check(enter_initialization(fmu, run.tolerance > 0, run.tolerance, 0.0, fmi3False, 0.0),
+    check(fmi3EnterInitializationMode(fmu, run.tolerance > 0, run.tolerance, 0.0, fmi3False, 0.0),
           "fmi3EnterInitializationMode", 0);
-    check(exit_initialization(fmu), "fmi3ExitInitializationMode", 0);
+    check(fmi3ExitInitializationMode(fmu), "fmi3ExitInitializationMode", 0);
 
     const fmi3ValueReference torque_vr = VR_TORQUE, theta_vr = VR_THETA;
     const double torque = TORQUE;
     double theta;
-    check(get_float64(fmu, &theta_vr, 1, &theta, 1), "fmi3GetFloat64", 0);
+    check(fmi3GetFloat64(fmu, &theta_vr, 1, &theta, 1), "fmi3GetFloat64", 0);
     record_theta(&run, theta);
     for (long k = 0; k < run.steps; k++) {
         /* Time as n*h, not a running sum, so it never drifts from where the FMU stands. */
         const double time = k * run.step_size;
         fmi3Boolean event_handling_needed, terminate_simulation, early_return;
         fmi3Float64 last_successful_time;
-        check(set_float64(fmu, &torque_vr, 1, &torque, 1), "fmi3SetFloat64", k);
-        check(do_step(fmu, time, run.step_size, fmi3True, &event_handling_needed,
-                      &terminate_simulation, &early_return, &last_successful_time),
+        check(fmi3SetFloat64(fmu, &torque_vr, 1, &torque, 1), "fmi3SetFloat64", k);
+        check(fmi3DoStep(fmu, time, run.step_size, fmi3True, &event_handling_needed,
+                         &terminate_simulation, &early_return, &last_successful_time),
               "fmi3DoStep", k);
         /* The FMU never asks for either; a step that did would not have reached t + h. */
         if (terminate_simulation || early_return) {
             fprintf(stderr, MASTER_NAME ": fmi3DoStep stopped before t + h at step %ld\n", k);
             return 1;
         }
-        check(get_float64(fmu, &theta_vr, 1, &theta, 1), "fmi3GetFloat64", k);
+        check(fmi3GetFloat64(fmu, &theta_vr, 1, &theta, 1), "fmi3GetFloat64", k);
         record_theta(&run, theta);
     }
     close_trajectory(&run);
 
-    terminate(fmu);
-    free_instance(fmu);
+    fmi3Terminate(fmu);
+    fmi3FreeInstance(fmu);
     close_library(run.library);
     return 0;
 }

@@ -21,44 +21,42 @@ static void logger(fmi2ComponentEnvironment environment, fmi2String instance_nam
 
 int main(int argc, char **argv) {
     const MasterRun run = start_master(argc, argv);
-    fmi2InstantiateTYPE *instantiate = symbol(run.library, "fmi2Instantiate");
-    fmi2SetupExperimentTYPE *setup_experiment = symbol(run.library, "fmi2SetupExperiment");
-    fmi2EnterInitializationModeTYPE *enter_initialization =
-        symbol(run.library, "fmi2EnterInitializationMode");
-    fmi2ExitInitializationModeTYPE *exit_initialization =
-        symbol(run.library, "fmi2ExitInitializationMode");
-    fmi2SetRealTYPE *set_real = symbol(run.library, "fmi2SetReal");
-    fmi2GetRealTYPE *get_real = symbol(run.library, "fmi2GetReal");
-    fmi2DoStepTYPE *do_step = symbol(run.library, "fmi2DoStep");
-    fmi2TerminateTYPE *terminate = symbol(run.library, "fmi2Terminate");
-    fmi2FreeInstanceTYPE *free_instance = symbol(run.library, "fmi2FreeInstance");
+    LOOK_UP(run.library, fmi2Instantiate);
+    LOOK_UP(run.library, fmi2SetupExperiment);
+    LOOK_UP(run.library, fmi2EnterInitializationMode);
+    LOOK_UP(run.library, fmi2ExitInitializationMode);
+    LOOK_UP(run.library, fmi2SetReal);
+    LOOK_UP(run.library, fmi2GetReal);
+    LOOK_UP(run.library, fmi2DoStep);
+    LOOK_UP(run.library, fmi2Terminate);
+    LOOK_UP(run.library, fmi2FreeInstance);
 
     const fmi2CallbackFunctions callbacks = {logger, NULL, NULL, NULL, NULL};
-    fmi2Component fmu = instantiate("master", fmi2CoSimulation, run.token, "", &callbacks,
-                                    fmi2False, fmi2False);
+    fmi2Component fmu = fmi2Instantiate("master", fmi2CoSimulation, run.token, "", &callbacks,
+                                        fmi2False, fmi2False);
     if (!fmu) return 1;
-    check(setup_experiment(fmu, run.tolerance > 0, run.tolerance, 0.0, fmi2False, 0.0),
+    check(fmi2SetupExperiment(fmu, run.tolerance > 0, run.tolerance, 0.0, fmi2False, 0.0),
           "fmi2SetupExperiment", 0);
-    check(enter_initialization(fmu), "fmi2EnterInitializationMode", 0);
-    check(exit_initialization(fmu), "fmi2ExitInitializationMode", 0);
+    check(fmi2EnterInitializationMode(fmu), "fmi2EnterInitializationMode", 0);
+    check(fmi2ExitInitializationMode(fmu), "fmi2ExitInitializationMode", 0);
 
     const fmi2ValueReference torque_vr = VR_TORQUE, theta_vr = VR_THETA;
     const double torque = TORQUE;
     double theta;
-    check(get_real(fmu, &theta_vr, 1, &theta), "fmi2GetReal", 0);
+    check(fmi2GetReal(fmu, &theta_vr, 1, &theta), "fmi2GetReal", 0);
     record_theta(&run, theta);
     for (long k = 0; k < run.steps; k++) {
         /* Time as n*h, not a running sum, so it never drifts from where the FMU stands. */
         const double time = k * run.step_size;
-        check(set_real(fmu, &torque_vr, 1, &torque), "fmi2SetReal", k);
-        check(do_step(fmu, time, run.step_size, fmi2True), "fmi2DoStep", k);
-        check(get_real(fmu, &theta_vr, 1, &theta), "fmi2GetReal", k);
+        check(fmi2SetReal(fmu, &torque_vr, 1, &torque), "fmi2SetReal", k);
+        check(fmi2DoStep(fmu, time, run.step_size, fmi2True), "fmi2DoStep", k);
+        check(fmi2GetReal(fmu, &theta_vr, 1, &theta), "fmi2GetReal", k);
         record_theta(&run, theta);
     }
     close_trajectory(&run);
 
-    terminate(fmu);
-    free_instance(fmu);
+    fmi2Terminate(fmu);
+    fmi2FreeInstance(fmu);
     close_library(run.library);
     return 0;
 }
