@@ -17,7 +17,8 @@ from pendulum_fmu.build import FMI_HEADERS, PLATFORMS, BuildError, build_fmu, co
 
 HERE = Path(__file__).resolve().parent
 NULL_FMU_SOURCES = HERE / "null_fmu"
-STEP_MASTER_SOURCE = HERE / "step_master.c"
+# The bare C master of each FMI version; bare_master.h holds what they share.
+STEP_MASTER_SOURCES = {2: HERE / "step_master.c", 3: HERE / "fmi3_step_master.c"}
 
 
 @dataclass(frozen=True)
@@ -60,14 +61,15 @@ def build_null_fmu(out_dir: Path) -> BuiltFmu:
     return unzipped(fmu, out_dir)
 
 
-def build_step_master(out_dir: Path, platform: str = "linux64") -> Path:
-    """Compile step_master.c, the bare C master, for a platform of pendulum_fmu.build.PLATFORMS
-    with that platform's compiler (the tests run the win64 one under wine, the aarch64-linux one
-    under qemu-aarch64)."""
+def build_step_master(out_dir: Path, platform: str = "linux64", fmi_version: int = 2) -> Path:
+    """Compile the bare C master of an FMI version (step_master.c, fmi3_step_master.c) for a
+    platform of pendulum_fmu.build.PLATFORMS with that platform's compiler (the tests run the win64
+    one under wine, the aarch64-linux one under qemu-aarch64)."""
     target = PLATFORMS[platform]
-    master = out_dir / f"step_master_{platform}{'.exe' if target.windows else ''}"
+    source = STEP_MASTER_SOURCES[fmi_version]
+    master = out_dir / f"{source.stem}_{platform}{'.exe' if target.windows else ''}"
     command = [*find_compiler(target), "-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", f"-I{FMI_HEADERS}",
-               str(STEP_MASTER_SOURCE), *([] if target.windows else ["-ldl"]), "-o", str(master)]
+               str(source), *([] if target.windows else ["-ldl"]), "-o", str(master)]
     result = subprocess.run(command, capture_output=True, text=True)
     if result.returncode != 0:
         raise BuildError(f"compiling the step master failed:\n{' '.join(command)}\n{result.stderr}")
