@@ -94,6 +94,38 @@ def replacing_on(filesystem, path: str):
         on_failure.pop_all()  # moved into place: nothing to remove
 
 
+class InUse(OSError):
+    """Another process holds the lock; the message says which folder and what to do."""
+
+
+@contextlib.contextmanager
+def held_lock(path: str | os.PathLike, what: str):
+    """Hold an exclusive lock on the file path (created if absent) while the block runs, or raise
+    InUse at once when another process holds it. The operating system releases the lock when the
+    process ends, however it ends, so a killed run never leaves a stale lock behind."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with open(path, "a+b") as file:
+        try:
+            _lock(file)
+        except OSError:
+            raise InUse(f"{what} is in use by another run (it holds {path}); wait for that run "
+                        "to end, or choose another output") from None
+        yield
+
+
+if os.name == "nt":
+    import msvcrt
+
+    def _lock(file) -> None:
+        msvcrt.locking(file.fileno(), msvcrt.LK_NBLCK, 1)
+else:
+    import fcntl
+
+    def _lock(file) -> None:
+        fcntl.flock(file.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+
+
 def _remove_if_there(filesystem, path: str) -> None:
     with contextlib.suppress(FileNotFoundError):
         filesystem.rm(path)

@@ -42,7 +42,7 @@ import numpy as np
 
 from . import cs_loop
 from . import default_fmu
-from .files import TEMPORARY_GLOB, replacing_on
+from .files import TEMPORARY_GLOB, held_lock, replacing_on
 from .parameters import START_VALUES, default_parameters, value_reference
 from .signal import TorqueSchedule, communication_points
 from .simulate import FmuError, initialize, open_fmu, run_schedule_python
@@ -57,6 +57,8 @@ TARGET_CHUNKS = 64
 MAX_CHUNK_CASES = 256
 # And a chunk's recordings (every point of every case, before thinning) stay this small.
 MAX_CHUNK_BYTES = 64_000_000
+# Held by the run writing a study (see _only_run); hidden, and never part of a table.
+LOCK_FILE = ".sweep.lock"
 # Up to this many cases the figure draws every trajectory; above, quantile bands of the summaries.
 LINES_UP_TO = 20
 
@@ -373,6 +375,17 @@ def _prepare(study: _Study, definition: dict, resume: bool, count: int, points: 
     return chunk_cases
 
 
+def _only_run(study: _Study, output_dir):
+    """Two runs into one folder would replace each other's parts: the second is refused while the
+    first runs. A lock held on a local folder; on other file systems (object stores have no
+    locks) keeping runs apart is the user's part."""
+    from fsspec.implementations.local import LocalFileSystem
+
+    if not isinstance(study.filesystem, LocalFileSystem):
+        return contextlib.nullcontext()
+    return held_lock(Path(study.root) / LOCK_FILE, f"output directory {output_dir}")
+
+
 class SchedulerUnreachable(ConnectionError):
     """The dask scheduler did not answer; the message names the address."""
 
@@ -526,8 +539,9 @@ def run_sweep(cases, *, output_dir: str | os.PathLike, stop_time: float = 3.0,
                    step_size=float(step_size), outputs=outputs, stride=stride, format=format)
     bar = _Progress(len(cases), progress)
     written, worker_cpu, worker_stepping = 0, 0.0, 0.0
-    # Connected first, so that a scheduler that does not answer leaves the output untouched.
-    with _client(scheduler, workers, connect_timeout) as client:
+    # The folder taken first, so that a second run is refused before it starts a cluster; then
+    # connected, so that a scheduler that does not answer leaves the study untouched.
+    with _only_run(study, url), _client(scheduler, workers, connect_timeout) as client:
         chunk_cases = _prepare(study, _definition(cases, names, study), resume, len(cases), points, url)
         chunks = range(math.ceil(len(cases) / chunk_cases))
         done = _done_chunks(study)
