@@ -100,18 +100,28 @@ class InUse(OSError):
 
 @contextlib.contextmanager
 def held_lock(path: str | os.PathLike, what: str):
-    """Hold an exclusive lock on the file path (created if absent) while the block runs, or raise
-    InUse at once when another process holds it. The operating system releases the lock when the
-    process ends, however it ends, so a killed run never leaves a stale lock behind."""
+    """Hold an exclusive lock on the file path while the block runs, or raise InUse at once when
+    another process holds it. The file is created for the block and removed after it; the
+    operating system releases the lock when the process ends, however it ends, so a killed run
+    leaves at most a file that locks nothing."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     with open(path, "a+b") as file:
         try:
             _lock(file)
+            # A holder that finished removed the file we opened: the lock is on a file no other
+            # run can see.
+            held = os.path.samestat(os.fstat(file.fileno()), os.stat(path))
         except OSError:
+            held = False
+        if not held:
             raise InUse(f"{what} is in use by another run (it holds {path}); wait for that run "
-                        "to end, or choose another output") from None
-        yield
+                        "to end, or choose another output")
+        try:
+            yield
+        finally:
+            with contextlib.suppress(OSError):  # Windows keeps an open file
+                os.unlink(path)
 
 
 if os.name == "nt":
