@@ -16,7 +16,6 @@ import contextlib
 import json
 import os
 import socket
-import statistics
 import subprocess
 import sys
 import tempfile
@@ -24,6 +23,7 @@ from pathlib import Path
 
 from .builds import BuiltFmu
 from .report import Row
+from .timing import median
 
 PART = "scale"
 REPOSITORY = Path(__file__).resolve().parent.parent
@@ -138,7 +138,7 @@ def _load() -> str:
 
 def _median_study(results: list[dict]) -> dict:
     """Each figure's median over rounds."""
-    return {key: statistics.median(result[key] for result in results) for key in results[0]}
+    return {key: median([result[key] for result in results]) for key in results[0]}
 
 
 def scale_rows(fmu: BuiltFmu, quick: bool) -> list[Row]:

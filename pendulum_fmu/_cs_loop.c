@@ -10,8 +10,8 @@
    The call sequence is the one of the Python code in pendulum_fmu/simulate.py (initialize and
    the loop of run_schedule_python, the readable reference), so the two give bit-identical
    results: per step k, set the inputs, set their first derivatives (when rates are given), read
-   the outputs, step from time[k] by time[k+1] - time[k]; after the last step read the inputs
-   and the outputs once more. */
+   the outputs, step from time[k] by time[k+1] - time[k]; after the last step read the outputs
+   once more. */
 
 #include <stddef.h>
 
@@ -25,7 +25,7 @@
 
 /* Changes whenever cs_loop_run's arguments do, so that Python never calls a stale build with
    the wrong arguments (cs_loop.py checks it). */
-CS_LOOP_EXPORT int cs_loop_interface(void) { return 2; }
+CS_LOOP_EXPORT int cs_loop_interface(void) { return 3; }
 
 /* The FMU's functions, in this order (cs_loop.py passes them as an array of addresses). */
 typedef struct {
@@ -41,9 +41,9 @@ typedef struct {
 
 /* Which call failed, as reported through *failed_call. */
 enum { CALL_SET_REAL = 0, CALL_SET_RATE = 1, CALL_GET_REAL = 2, CALL_DO_STEP = 3,
-       CALL_GET_INPUTS_AT_END = 4, CALL_GET_OUTPUTS_AT_END = 5, CALL_RESET = 6,
-       CALL_SETUP_EXPERIMENT = 7, CALL_ENTER_INITIALIZATION_MODE = 8, CALL_SET_START_VALUES = 9,
-       CALL_EXIT_INITIALIZATION_MODE = 10 };
+       CALL_GET_OUTPUTS_AT_END = 4, CALL_RESET = 5, CALL_SETUP_EXPERIMENT = 6,
+       CALL_ENTER_INITIALIZATION_MODE = 7, CALL_SET_START_VALUES = 8,
+       CALL_EXIT_INITIALIZATION_MODE = 9 };
 
 /* Runs one case.
 
@@ -58,7 +58,6 @@ enum { CALL_SET_REAL = 0, CALL_SET_RATE = 1, CALL_GET_REAL = 2, CALL_DO_STEP = 3
                                      (fmi2SetRealInputDerivatives is not called)
    outputs[k*n_outputs + j]          output j at point k (k = 0..n_steps), read after the
                                      inputs of step k were set
-   final_inputs[i]                   the inputs read back after the last step (may be NULL)
 
    Returns fmi2OK or fmi2Warning when every call succeeded (a warning is the worst status seen),
    else the failing call's status, with *failed_step = k (0 for the restart, n_steps for the
@@ -71,7 +70,7 @@ CS_LOOP_EXPORT int cs_loop_run(
     const fmi2ValueReference *output_references, size_t n_outputs,
     size_t n_steps, const double *time, const double *inputs,
     const fmi2Integer *input_orders, const double *input_rates,
-    double *outputs, double *final_inputs,
+    double *outputs,
     size_t *failed_step, int *failed_call)
 {
     fmi2Status worst = fmi2OK, status;
@@ -107,9 +106,6 @@ CS_LOOP_EXPORT int cs_loop_run(
               CALL_GET_REAL);
         CHECK(fmi->do_step(component, time[k], time[k + 1] - time[k], fmi2True), CALL_DO_STEP);
     }
-    if (final_inputs != NULL && n_inputs)
-        CHECK(fmi->get_real(component, input_references, n_inputs, final_inputs),
-              CALL_GET_INPUTS_AT_END);
     CHECK(fmi->get_real(component, output_references, n_outputs, outputs + k * n_outputs),
           CALL_GET_OUTPUTS_AT_END);
 #undef CHECK

@@ -18,12 +18,13 @@ from pathlib import Path
 
 import numpy as np
 
-# The call that failed, by the index _cs_loop.c reports; from RESTART on, the restart's.
+# The call that failed, by the index _cs_loop.c reports: _AT_END the read after the last step,
+# from _RESTART on the restart's.
 _CALLS = ("fmi2SetReal", "fmi2SetRealInputDerivatives", "fmi2GetReal", "fmi2DoStep",
-          "fmi2GetReal of the inputs", "fmi2GetReal", "fmi2Reset", "fmi2SetupExperiment",
+          "fmi2GetReal", "fmi2Reset", "fmi2SetupExperiment",
           "fmi2EnterInitializationMode", "fmi2SetReal of the start values",
           "fmi2ExitInitializationMode")
-_RESTART = 6
+_AT_END, _RESTART = 4, 5
 # In the order of CsFunctions in _cs_loop.c.
 _FMI_FUNCTIONS = ("fmi2Reset", "fmi2SetupExperiment", "fmi2EnterInitializationMode",
                   "fmi2ExitInitializationMode", "fmi2SetReal", "fmi2SetRealInputDerivatives",
@@ -31,7 +32,7 @@ _FMI_FUNCTIONS = ("fmi2Reset", "fmi2SetupExperiment", "fmi2EnterInitializationMo
 
 
 # What _cs_loop.c's cs_loop_interface() returns for the arguments this module passes.
-INTERFACE = 2
+INTERFACE = 3
 
 
 @lru_cache(maxsize=1)
@@ -47,13 +48,18 @@ def _library():
     run = library.cs_loop_run
     pointer, size = ctypes.c_void_p, ctypes.c_size_t
     run.argtypes = ([pointer] * 3 + [size] + [pointer] * 2 + [size, pointer, size, size]
-                    + [pointer] * 8)
+                    + [pointer] * 7)
     run.restype = ctypes.c_int
     return run
 
 
 def available() -> bool:
     return _library() is not None
+
+
+def drives(slave) -> bool:
+    """Whether the native loop can step this fmpy slave: it was compiled, and the FMU is FMI 2.0."""
+    return available() and slave.fmi_version == 2
 
 
 def _address(array: np.ndarray | None, shape: tuple[int, ...], dtype, what: str) -> int | None:
@@ -95,12 +101,12 @@ class Stepper:
         self._reports = ctypes.byref(self._failed_step), ctypes.byref(self._failed_call)
 
     def run(self, inputs: np.ndarray, input_rates: np.ndarray | None, outputs: np.ndarray,
-            final_inputs: np.ndarray | None = None, start_values: np.ndarray | None = None) -> None:
+            start_values: np.ndarray | None = None) -> None:
         """inputs, input_rates: (N, inputs) values and first derivatives of the inputs over each
         step (input_rates None: held, fmi2SetRealInputDerivatives is not called; inputs None
         when there are no inputs). outputs:
         (N + 1, outputs), filled with the outputs at every point, read after the step's inputs
-        were set. final_inputs: (inputs,) the inputs read back after the last step.
+        were set.
         start_values: (start_references,) restart the instance first (reset, and initialize at
         time[0] with these start values), or None when it is initialized already. A failing call
         raises the slave's MessageLog error, with the FMU's messages and the time of the failing
@@ -116,11 +122,10 @@ class Stepper:
             None if input_rates is None else self._first_order.ctypes.data,
             _address(input_rates, (self.steps, self.inputs), np.float64, "input_rates"),
             _address(outputs, (self.steps + 1, self.outputs), np.float64, "outputs"),
-            _address(final_inputs, (self.inputs,), np.float64, "final_inputs"),
             *self._reports)
         if status > 1:
             call = self._failed_call.value
             if call >= _RESTART:
                 raise self.messages.initialization_error(f"{_CALLS[call]} failed")
-            where = "at the end" if call >= 4 else f"at t = {self.time[self._failed_step.value]:.17g}"
+            where = "at the end" if call == _AT_END else f"at t = {self.time[self._failed_step.value]:.17g}"
             raise self.messages.error(status, f"{_CALLS[call]} {where}")

@@ -155,7 +155,7 @@ def run_schedule(slave: FMU2Slave | FMU3Slave, plan: TorqueSchedule) -> np.ndarr
     One call into the native loop (cs_loop.py) when it was compiled and the FMU is FMI 2.0, else
     the Python loop, the readable reference; the two give the same numbers bit for bit.
     """
-    if not cs_loop.available() or slave.fmi_version != 2:
+    if not cs_loop.drives(slave):
         return run_schedule_python(slave, plan)
     torque_vr = np.array([value_reference("torque", slave.fmu_path)], np.uint32)
     recorded_vr = np.array([value_reference(n, slave.fmu_path) for n in RECORDED], np.uint32)
@@ -262,9 +262,13 @@ def simulate_plan(plan: TorqueSchedule, *, parameters: dict | None = None, theta
                   omega0: float = 0.0, tolerance: float | None = None,
                   fmu_path: str | Path | None = None) -> np.ndarray:
     """A schedule through a fresh instance of the FMU, freed afterwards (see simulate)."""
-    resolve_parameters(parameters, fmu_path)  # refused with the same words as every other tool
-    slave = open_fmu(fmu_path, parameters=parameters, theta0=theta0, omega0=omega0,
-                     tolerance=tolerance, start_time=float(plan.time[0]))
+    merged_parameters(parameters, fmu_path)  # names, values and the FMU file, before opening it
+    try:
+        slave = open_fmu(fmu_path, parameters=parameters, theta0=theta0, omega0=omega0,
+                         tolerance=tolerance, start_time=float(plan.time[0]))
+    except FmuError:
+        resolve_parameters(parameters, fmu_path)  # refused with the same words as every other tool
+        raise
     try:
         return run_schedule(slave, plan)
     finally:

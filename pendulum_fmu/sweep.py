@@ -45,9 +45,9 @@ from . import default_fmu
 from .files import TEMPORARY_GLOB, held_lock, replacing_on
 from .parameters import START_VALUES, default_parameters, value_reference
 from .signal import TorqueSchedule, communication_points
-from .simulate import FmuError, initialize, open_fmu, run_schedule_python
+from .simulate import RECORDED, FmuError, initialize, open_fmu, run_schedule_python
 
-OUTPUTS = ("theta", "omega", "alpha")
+OUTPUTS = RECORDED[1:]  # theta, omega, alpha
 FORMATS = ("parquet", "csv")
 SUMMARIES = ("final_theta", "final_omega", "final_alpha", "max_abs_theta")
 # A study is cut into about this many chunks, so that up to 16 workers each get several (the
@@ -57,7 +57,7 @@ TARGET_CHUNKS = 64
 MAX_CHUNK_CASES = 256
 # And a chunk's recordings (every point of every case, before thinning) stay this small.
 MAX_CHUNK_BYTES = 64_000_000
-# Held by the run writing a study (see _only_run); hidden, and never part of a table.
+# There while a run writes the study (see _only_run); hidden, and never part of a table.
 LOCK_FILE = ".sweep.lock"
 # Up to this many cases the figure draws every trajectory; above, quantile bands of the summaries.
 LINES_UP_TO = 20
@@ -119,12 +119,13 @@ def sweep_grid(torques, gravities=(9.81,), extra: dict | None = None) -> Grid:
     values theta0, omega0. A case is a dict {'torque': .., 'gravity': .., <extra names>: ..}.
     """
     extra = dict(extra or {})
+    extra_names = _extra_names()
     for name in extra:
         if name in ("torque", "gravity"):
             argument = {"torque": "torques", "gravity": "gravities"}[name]
             raise ValueError(f"give {name} values as the {argument} argument, not in extra")
-        if name not in _extra_names():
-            raise ValueError(f"cannot sweep {name!r}: extra takes {', '.join(_extra_names())}")
+        if name not in extra_names:
+            raise ValueError(f"cannot sweep {name!r}: extra takes {', '.join(extra_names)}")
     axes = {"torque": torques, "gravity": gravities, **extra}
     return Grid({name: _values(name, values) for name, values in axes.items()})
 
@@ -138,13 +139,13 @@ def _check_cases(cases, fmu_path=None) -> list[str]:
     names = list(cases[0])
     if "torque" not in names:
         raise ValueError("every case needs a 'torque'")
-    seen = {}
+    sweepable, seen = _sweepable(fmu_path), {}
     for number, case in enumerate(cases):
         if list(case) != names:
             raise ValueError(f"case {number} has keys {list(case)}; every case needs {names}")
         for name, value in case.items():
-            if name not in _sweepable(fmu_path):
-                raise ValueError(f"cannot sweep {name!r}: choose from {', '.join(_sweepable(fmu_path))}")
+            if name not in sweepable:
+                raise ValueError(f"cannot sweep {name!r}: choose from {', '.join(sweepable)}")
             if not isinstance(value, numbers.Real) or not math.isfinite(value):
                 raise ValueError(f"case {number}: {name} = {value!r} must be a finite number")
         # A repeat would only cost time, and share the first one's line in the figure.
@@ -203,8 +204,8 @@ class _Runner:
             if self.slave is None:
                 self.slave = open_fmu(self.fmu, start_time=float(points[0]))
             self.slave.messages.lines.clear()
-            if cs_loop.available() and self.slave.fmi_version == 2:
-                if self.stepper is None or self.stepper.time is not points:
+            if cs_loop.drives(self.slave):
+                if self.stepper is None or not np.array_equal(self.stepper.time, points):
                     self.stepper = cs_loop.Stepper(self.slave, np.empty(0, np.uint32), self.outputs,
                                                    points, self.start_references)
                 self.stepper.run(None, None, outputs, start_values=start_values)
