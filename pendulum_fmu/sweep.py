@@ -10,6 +10,7 @@ A study goes to an output directory, a local path or any fsspec URL every worker
                                       final_omega, final_alpha, max_abs_theta, status ("ok" or
                                       "failed") and message (why the FMU refused the case)
     sweep.png                         the figure
+    .sweep.lock                       there while a run writes a local folder: a second run is refused
 
 The worker that ran a chunk writes its two files, trajectories first, so a chunk is done when its
 cases part exists; --resume runs the chunks that are not. The client submits chunks, shows
