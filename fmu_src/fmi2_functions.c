@@ -3,7 +3,6 @@
    per function (FMI 2.0, tables in sections 3.2.3 and 4.2.4). */
 
 #include <stddef.h>
-#include <stdio.h>
 
 #include "fmi2Functions.h"
 #include "instance.h"
@@ -103,15 +102,9 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     if (!functions) return NULL;
     const Logger logger = {forward_to_fmi2_logger, (AnyFunction)functions->logger,
                            functions->componentEnvironment};
-    if (fmuType != fmi2CoSimulation && fmuType != fmi2ModelExchange) {
-        char message[128];
-        snprintf(message, sizeof(message), "%s: fmuType %d is neither fmi2ModelExchange (0) nor "
-                 "fmi2CoSimulation (1)", function, (int)fmuType);
-        if (functions->logger)
-            functions->logger(functions->componentEnvironment, instanceName ? instanceName : "?",
-                              fmi2Error, "logStatusError", message);
-        return NULL;
-    }
+    if (fmuType != fmi2CoSimulation && fmuType != fmi2ModelExchange)
+        return instance_refuse(function, instanceName, &logger, "fmuType %d is neither "
+                               "fmi2ModelExchange (0) nor fmi2CoSimulation (1)", (int)fmuType);
     return instance_create(function, instanceName, "fmuGUID", fmuGUID,
                            fmuType == fmi2CoSimulation ? INTERFACE_CO_SIMULATION
                                                        : INTERFACE_MODEL_EXCHANGE,

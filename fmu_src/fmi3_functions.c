@@ -105,10 +105,10 @@
         return fmi3Error;
 
 /* Every variable is a scalar, so each array of values has one entry per value reference. */
-#define REQUIRE_COUNT(name, count, expected)                                           \
+#define REQUIRE_COUNT(count, expected)                                                 \
     if ((count) != (expected))                                                         \
         return STATUS(instance_error(instance, function, "%s = %lu, expected %lu (every " \
-                                     "variable is a scalar)", #name, (unsigned long)(count), \
+                                     "variable is a scalar)", #count, (unsigned long)(count), \
                                      (unsigned long)(expected)));
 
 /* fmi3Status has the core's values. */
@@ -119,7 +119,7 @@ typedef char status_values_match[(STATUS_OK == (int)fmi3OK && STATUS_WARNING == 
                                   && STATUS_DISCARD == (int)fmi3Discard && STATUS_ERROR == (int)fmi3Error
                                   && STATUS_FATAL == (int)fmi3Fatal) ? 1 : -1];
 
-#define NOT_SUPPORTED(why) return STATUS(instance_not_supported(instance, function, why))
+#define NOT_SUPPORTED(why) return STATUS(instance_error(instance, function, "not supported: %s", why))
 
 static const char NO_CLOCKS[] = "the model has no clocks";
 
@@ -184,12 +184,10 @@ fmi3Instance fmi3InstantiateScheduledExecution(fmi3String instanceName, fmi3Stri
                                                fmi3UnlockPreemptionCallback unlockPreemption) {
     (void)instantiationToken, (void)resourcePath, (void)visible, (void)loggingOn;
     (void)clockUpdate, (void)lockPreemption, (void)unlockPreemption;
-    if (logMessage)
-        logMessage(instanceEnvironment, fmi3Error, "logStatusError",
-                   "fmi3InstantiateScheduledExecution: not supported: the model has no clocks "
-                   "to schedule (the model description has no <ScheduledExecution>)");
-    (void)instanceName;
-    return NULL;
+    const Logger logger = {forward_to_fmi3_logger, (AnyFunction)logMessage, instanceEnvironment};
+    return instance_refuse("fmi3InstantiateScheduledExecution", instanceName, &logger,
+                           "not supported: the model has no clocks to schedule (the model "
+                           "description has no <ScheduledExecution>)");
 }
 
 void fmi3FreeInstance(fmi3Instance c) {
@@ -236,7 +234,7 @@ fmi3Status fmi3GetFloat64(fmi3Instance c, const fmi3ValueReference valueReferenc
     ENTER(fmi3GetFloat64)
     REQUIRE_ARRAY(valueReferences, nValueReferences)
     REQUIRE_ARRAY(values, nValues)
-    REQUIRE_COUNT(nValues, nValues, nValueReferences)
+    REQUIRE_COUNT(nValues, nValueReferences)
     for (size_t i = 0; i < nValueReferences; i++) {
         if (valueReferences[i] == VR_TIME) {
             values[i] = instance->data.time;
@@ -253,7 +251,7 @@ fmi3Status fmi3SetFloat64(fmi3Instance c, const fmi3ValueReference valueReferenc
     ENTER(fmi3SetFloat64)
     REQUIRE_ARRAY(valueReferences, nValueReferences)
     REQUIRE_ARRAY(values, nValues)
-    REQUIRE_COUNT(nValues, nValues, nValueReferences)
+    REQUIRE_COUNT(nValues, nValueReferences)
     for (size_t i = 0; i < nValueReferences; i++) {
         if (valueReferences[i] == VR_TIME)
             return STATUS(instance_error(instance, function, "cannot set time: it is the "
@@ -395,8 +393,8 @@ fmi3Status fmi3GetDirectionalDerivative(fmi3Instance c, const fmi3ValueReference
     REQUIRE_ARRAY(knowns, nKnowns)
     REQUIRE_ARRAY(seed, nSeed)
     REQUIRE_ARRAY(sensitivity, nSensitivity)
-    REQUIRE_COUNT(nSeed, nSeed, nKnowns)
-    REQUIRE_COUNT(nSensitivity, nSensitivity, nUnknowns)
+    REQUIRE_COUNT(nSeed, nKnowns)
+    REQUIRE_COUNT(nSensitivity, nUnknowns)
     return STATUS(instance_directional_derivative(instance, function, unknowns, nUnknowns, knowns,
                                                   nKnowns, seed, sensitivity));
 }
@@ -410,8 +408,8 @@ fmi3Status fmi3GetAdjointDerivative(fmi3Instance c, const fmi3ValueReference unk
     REQUIRE_ARRAY(knowns, nKnowns)
     REQUIRE_ARRAY(seed, nSeed)
     REQUIRE_ARRAY(sensitivity, nSensitivity)
-    REQUIRE_COUNT(nSeed, nSeed, nUnknowns)
-    REQUIRE_COUNT(nSensitivity, nSensitivity, nKnowns)
+    REQUIRE_COUNT(nSeed, nUnknowns)
+    REQUIRE_COUNT(nSensitivity, nKnowns)
     return STATUS(instance_adjoint_derivative(instance, function, unknowns, nUnknowns, knowns,
                                               nKnowns, seed, sensitivity));
 }
@@ -604,7 +602,7 @@ fmi3Status fmi3GetOutputDerivatives(fmi3Instance c, const fmi3ValueReference val
     REQUIRE_ARRAY(valueReferences, nValueReferences)
     REQUIRE_ARRAY(orders, nValueReferences)
     REQUIRE_ARRAY(values, nValues)
-    REQUIRE_COUNT(nValues, nValues, nValueReferences)
+    REQUIRE_COUNT(nValues, nValueReferences)
     return STATUS(instance_get_output_derivatives(instance, function, valueReferences,
                                                   nValueReferences, orders, values));
 }

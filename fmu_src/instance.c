@@ -43,10 +43,6 @@ Status instance_error(const Instance *instance, const char *function, const char
     return STATUS_ERROR;
 }
 
-Status instance_not_supported(const Instance *instance, const char *function, const char *why) {
-    return instance_error(instance, function, "not supported: %s", why);
-}
-
 static const char *state_name(int state) {
     switch (state) {
         case STATE_INSTANTIATED: return "instantiated";
@@ -74,28 +70,41 @@ int instance_null_argument(const Instance *instance, const char *function, const
     return 1;
 }
 
-Instance *instance_create(const char *function, const char *name, const char *token_argument,
-                          const char *token, InterfaceType type, const Logger *logger, int logging_on) {
-    /* Without a logger there is nobody to tell why we refuse: both standards require one. */
+Instance *instance_refuse(const char *function, const char *name, const Logger *logger,
+                          const char *format, ...) {
     if (!logger || !logger->master_logger) return NULL;
+    /* No instance yet: a stand-in carries the master's logger and the name for the message. */
     Instance probe;
     memset(&probe, 0, sizeof(probe));
     probe.logger = *logger;
     snprintf(probe.name, sizeof(probe.name), "%s", name ? name : "?");
+    char message[448];
+    va_list args;
+    va_start(args, format);
+    vsnprintf(message, sizeof(message), format, args);
+    va_end(args);
+    instance_error(&probe, function, "%s", message);
+    return NULL;
+}
 
+Instance *instance_create(const char *function, const char *name, const char *token_argument,
+                          const char *token, InterfaceType type, const Logger *logger, int logging_on) {
+    /* Without a logger there is nobody to tell why we refuse: both standards require one. */
+    if (!logger || !logger->master_logger) return NULL;
     if (!name || !name[0])
-        return instance_error(&probe, function, "instanceName must be a non-empty string"), NULL;
+        return instance_refuse(function, name, logger, "instanceName must be a non-empty string");
     if (!token || strcmp(token, MODEL_GUID) != 0)
-        return instance_error(&probe, function,
-                              "%s %s does not match this FMU's %s (was the model description "
-                              "taken from another FMU?)", token_argument, token ? token : "NULL",
-                              MODEL_GUID), NULL;
-    probe.type = type;
+        return instance_refuse(function, name, logger,
+                               "%s %s does not match this FMU's %s (was the model description "
+                               "taken from another FMU?)", token_argument, token ? token : "NULL",
+                               MODEL_GUID);
 
     Instance *instance = calloc(1, sizeof(Instance));
     if (!instance)
-        return instance_error(&probe, function, "out of memory"), NULL;
-    *instance = probe;
+        return instance_refuse(function, name, logger, "out of memory");
+    instance->logger = *logger;
+    snprintf(instance->name, sizeof(instance->name), "%s", name);
+    instance->type = type;
     instance->log_categories = logging_on ? (LOG_STATUS_WARNING | LOG_STATUS_DISCARD
                                              | LOG_STATUS_ERROR | LOG_ALL) : 0;
     instance_reset(instance);

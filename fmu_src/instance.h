@@ -97,6 +97,10 @@ typedef struct {
 /* NULL (after logging why, when there is a logger) unless the arguments make an instance. */
 Instance *instance_create(const char *function, const char *name, const char *token_argument,
                           const char *token, InterfaceType type, const Logger *logger, int logging_on);
+/* Logs why an instantiation is refused (when there is a logger) as instance_error does, and
+   returns NULL: for refusals before there is an instance. */
+Instance *instance_refuse(const char *function, const char *name, const Logger *logger,
+                          const char *format, ...);
 void instance_free(Instance *instance);
 void instance_reset(Instance *instance);
 
@@ -110,8 +114,6 @@ Status instance_error(const Instance *instance, const char *function, const char
 int instance_state_allows(const Instance *instance, int mask, const char *function);
 int instance_null_argument(const Instance *instance, const char *function, const char *argument,
                            const void *pointer);
-/* An error for a function the FMU does not support, saying why. */
-Status instance_not_supported(const Instance *instance, const char *function, const char *why);
 /* 1 when the value references are all variables of this FMU, else logs which is not. */
 int instance_known_references(const Instance *instance, const char *function,
                               const unsigned int vr[], size_t nvr);

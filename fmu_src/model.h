@@ -10,7 +10,6 @@
 
 /* What a master said of how its inputs move over a step: first and second time derivatives at
    the step's start (FMI 2.0's input derivatives; all zero holds the inputs). */
-#define MAX_INPUT_DERIVATIVE_ORDER 2
 typedef struct {
     double first[N_VARIABLES];
     double second[N_VARIABLES];
