@@ -32,11 +32,11 @@ class BuildPyWithFmu(build_py):
         # An editable install runs from the checkout, which builds dist/Pendulum.fmu on demand.
         if getattr(self, "editable_mode", False):
             return
-        from pendulum_fmu import __version__
+        from pendulum_fmu import FMU_FILES, __version__
         from pendulum_fmu.build import build_fmu
 
         data = Path(self.build_lib, "pendulum_fmu", "data")
-        for name, fmi_version in (("Pendulum.fmu", 2), ("Pendulum-fmi3.fmu", 3)):
+        for fmi_version, name in FMU_FILES.items():
             fmu = build_fmu(data / name, fmi_version=fmi_version)
             print(f"pendulum_fmu {__version__}: built {fmu}")
 

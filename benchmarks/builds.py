@@ -6,14 +6,13 @@ they are, never of a stale dist/Pendulum.fmu.
 
 from __future__ import annotations
 
-import subprocess
 import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 
 from fmpy import extract, read_model_description
 
-from pendulum_fmu.build import FMI_HEADERS, PLATFORMS, BuildError, build_fmu, compile_library, find_compiler
+from pendulum_fmu.build import FMI_HEADERS, PLATFORMS, build_fmu, compile_library, find_compiler, run_compiler
 
 HERE = Path(__file__).resolve().parent
 NULL_FMU_SOURCES = HERE / "null_fmu"
@@ -70,7 +69,5 @@ def build_step_master(out_dir: Path, platform: str = "linux64", fmi_version: int
     master = out_dir / f"{source.stem}_{platform}{'.exe' if target.windows else ''}"
     command = [*find_compiler(target), "-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", f"-I{FMI_HEADERS}",
                str(source), *([] if target.windows else ["-ldl"]), "-o", str(master)]
-    result = subprocess.run(command, capture_output=True, text=True)
-    if result.returncode != 0:
-        raise BuildError(f"compiling the step master failed:\n{' '.join(command)}\n{result.stderr}")
+    run_compiler(command, "the step master")
     return master

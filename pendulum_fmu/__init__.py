@@ -6,10 +6,11 @@ __version__ = "0.1.0"
 # Nothing is imported here at import time, not even the standard library's importlib.resources:
 # the program (pendulum_fmu.entry) sets its signal handlers as soon as this package is loaded,
 # before anything that takes a noticeable time.
-__all__ = ["__version__", "default_fmu"]
+__all__ = ["FMU_FILES", "__version__", "default_fmu"]
 
-# FMI version -> the FMU's file name, in a checkout's dist/ and in the installed package's data/.
-_FMU_FILES = {2: "Pendulum.fmu", 3: "Pendulum-fmi3.fmu"}
+# FMI version -> the FMU's file name, in a checkout's dist/ and in the installed package's data/:
+# the one list of the FMI versions this package builds.
+FMU_FILES = {2: "Pendulum.fmu", 3: "Pendulum-fmi3.fmu"}
 # Holds open the real files of packaged FMUs that importlib.resources had to extract (a zipped
 # install); a plain install hands out the files themselves. Made on first use.
 _extracted = None
@@ -28,12 +29,12 @@ def default_fmu(fmi_version: int = 2):
     from importlib import resources
     from pathlib import Path
 
-    from .build import DEFAULT_FMU, build_fmu, fmu_is_stale, is_source_checkout
+    from .build import CHECKOUT_FMUS, build_fmu, fmu_is_stale, is_source_checkout
 
-    if fmi_version not in _FMU_FILES:
-        raise ValueError(f"no FMI {fmi_version} FMU: the FMI versions are {', '.join(map(str, _FMU_FILES))}")
-    packaged_name = _FMU_FILES[fmi_version]
-    checkout_fmu = DEFAULT_FMU.parent / packaged_name
+    if fmi_version not in FMU_FILES:
+        raise ValueError(f"no FMI {fmi_version} FMU: the FMI versions are {', '.join(map(str, FMU_FILES))}")
+    packaged_name = FMU_FILES[fmi_version]
+    checkout_fmu = CHECKOUT_FMUS[fmi_version]
     if is_source_checkout():
         if fmu_is_stale(checkout_fmu):
             build_fmu(checkout_fmu, fmi_version=fmi_version)

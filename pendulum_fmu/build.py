@@ -30,15 +30,16 @@ from pathlib import Path
 import fmpy
 from fmpy import read_model_description
 
-from . import __version__, fmi3
+from . import FMU_FILES, __version__, fmi3
 from .files import replacing_path
 
 ROOT = Path(__file__).resolve().parent.parent
 SOURCE_DIR = ROOT / "fmu_src"
 MODEL_DESCRIPTION = ROOT / "modelDescription.xml"
-DEFAULT_FMU = ROOT / "dist" / "Pendulum.fmu"
-DEFAULT_FMU3 = ROOT / "dist" / "Pendulum-fmi3.fmu"
-FMI_VERSIONS = (2, 3)
+FMI_VERSIONS = tuple(FMU_FILES)
+# FMI version -> the FMU a checkout builds and runs when none is named.
+CHECKOUT_FMUS = {version: ROOT / "dist" / name for version, name in FMU_FILES.items()}
+DEFAULT_FMU = CHECKOUT_FMUS[2]
 GENERATED_SOURCES = ("model_variables.h", "model_variables.c")
 MODEL_FILES = ("config.h", "model.c")
 PID_CONTROLLER_DIR = SOURCE_DIR / "pid_controller"
@@ -149,8 +150,7 @@ def _enum_name(causality: str) -> str:
 def _check_source_files(model_description, xml: Path, sources: Path, fmi_version: int = 2) -> None:
     for configuration in model_description.buildConfigurations:
         listed = set(configuration.sourceFileSets[0].sourceFiles)
-        if fmi_version == 3:
-            listed = listed - {fmi3.FMI2_ADAPTER} | {fmi3.FMI3_ADAPTER}
+        listed = set(fmi3.with_adapter(listed, fmi_version))
         present = {p.name for p in sources.glob("*.c")}
         if listed != present:
             raise BuildError(
@@ -182,7 +182,8 @@ def _assemble_sources(model_dir: Path, model_description, sources: Path, fmi_ver
     generate_variables(model_description, sources)
 
 
-def _compile(command: list[str], what: str) -> None:
+def run_compiler(command: list[str], what: str) -> None:
+    """Run a compiler command; BuildError with its output when it fails."""
     try:
         result = subprocess.run(command, capture_output=True, text=True)
     except OSError as error:
@@ -237,7 +238,7 @@ def compile_library(source_dir: Path, out_file: Path, platform: str = "linux64",
     # -flto lets the integrator inline the model's right-hand side across files.
     lto = ["-flto"] if supports_lto(tuple(compiler), target.windows) else []
     user_flags = shlex.split(os.environ.get("CFLAGS", "")) if target.native else []
-    _compile([
+    run_compiler([
         *compiler, "-std=c99", "-O2", *lto, "-shared", "-Wall", "-Wextra", "-Werror", *user_flags,
         f"-I{source_dir}", f"-I{FMI_HEADERS}", *sorted(str(p) for p in source_dir.glob("*.c")),
         *linking, "-o", str(out_file),
@@ -282,6 +283,14 @@ where it was.</p>
 </table>
 </body></html>
 """
+
+
+def check_platforms(names) -> None:
+    """BuildError unless names are one or more of PLATFORMS."""
+    unknown = [name for name in names if name not in PLATFORMS]
+    if unknown or not names:
+        raise BuildError(f"unknown platform(s) {', '.join(unknown) or '(none given)'}: choose "
+                         f"among {', '.join(PLATFORMS)}")
 
 
 class PlatformSkipped(UserWarning):
@@ -335,10 +344,7 @@ def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, *, model_dir: Path = SO
         raise BuildError(f"FMI version {fmi_version}: choose among {', '.join(map(str, FMI_VERSIONS))}")
     if platforms is None:
         platforms = available_platforms()
-    unknown = [name for name in platforms if name not in PLATFORMS]
-    if unknown or not platforms:
-        raise BuildError(f"unknown platform(s) {', '.join(unknown) or '(none given)'}: choose "
-                         f"among {', '.join(PLATFORMS)}")
+    check_platforms(platforms)
     model_description = read_model_description(str(model_description_file))
     identifier = model_description.coSimulation.modelIdentifier
     with tempfile.TemporaryDirectory(prefix="pendulum_fmu_build_") as tmp:
@@ -367,9 +373,9 @@ def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, *, model_dir: Path = SO
     return Path(out_file)
 
 
-def build_pid_controller(out_file: str | os.PathLike, *, platforms: tuple[str, ...] | None = None) -> Path:
+def build_pid_controller(out_file: str | os.PathLike) -> Path:
     """The PID controller FMU that closes the loop around the pendulum in co-simulation."""
-    return build_fmu(out_file, model_dir=PID_CONTROLLER_DIR, platforms=platforms,
+    return build_fmu(out_file, model_dir=PID_CONTROLLER_DIR,
                      model_description_file=PID_CONTROLLER_DIR / "modelDescription.xml")
 
 

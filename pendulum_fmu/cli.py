@@ -14,7 +14,10 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__
-from .build import DEFAULT_FMU, DEFAULT_FMU3, PLATFORMS, BuildError, PlatformSkipped, build_fmu
+from .build import (CHECKOUT_FMUS, FMI_VERSIONS, PLATFORMS, BuildError, PlatformSkipped, build_fmu,
+                    check_platforms)
+from .entry import STOPPING_SIGNALS
+from .signal import DEFAULT_MAX_STEPS
 
 TUTORIAL_TORQUE = 20.0
 
@@ -74,7 +77,7 @@ def _add_signal_arguments(parser, required=True):
     parser.add_argument("--theta0", type=_float, default=0.0, help="initial angle in rad")
     parser.add_argument("--omega0", type=_float, default=0.0, help="initial rate in rad/s")
     parser.add_argument("--max-steps", type=_positive_int, default=None,
-                        help="refuse runs longer than this many steps (default: 10,000,000)")
+                        help=f"refuse runs longer than this many steps (default: {DEFAULT_MAX_STEPS:,})")
     _add_fmu_argument(parser)
 
 
@@ -86,15 +89,15 @@ def _add_fmu_argument(parser):
 
 def _platforms(text: str) -> tuple[str, ...]:
     platforms = tuple(name.strip() for name in text.split(",") if name.strip())
-    unknown = [name for name in platforms if name not in PLATFORMS]
-    if unknown or not platforms:
-        raise argparse.ArgumentTypeError(
-            f"unknown platform(s) {', '.join(unknown) or '(none)'}: choose among {', '.join(PLATFORMS)}")
+    try:
+        check_platforms(platforms)
+    except BuildError as error:
+        raise argparse.ArgumentTypeError(str(error)) from None
     return platforms
 
 
 def cmd_build(args) -> int:
-    output = args.output or (DEFAULT_FMU3 if args.fmi_version == 3 else DEFAULT_FMU)
+    output = args.output or CHECKOUT_FMUS[args.fmi_version]
     path = build_fmu(output, platforms=args.platforms, fmi_version=args.fmi_version)
     with zipfile.ZipFile(path) as fmu:
         binaries = [name for name in fmu.namelist() if name.startswith("binaries/")]
@@ -183,11 +186,11 @@ def _stop_on_signals():
     follows (closing the cluster, removing temporaries) runs to its end. Returns the old handlers."""
 
     def stop(number, frame):
-        for name in (signal.SIGINT, signal.SIGTERM):
+        for name in STOPPING_SIGNALS:
             signal.signal(name, signal.SIG_IGN)
         raise _Stopped(number)
 
-    return {name: signal.signal(name, stop) for name in (signal.SIGINT, signal.SIGTERM)}
+    return {name: signal.signal(name, stop) for name in STOPPING_SIGNALS}
 
 
 def _sweep_outputs(text: str) -> tuple[str, ...]:
@@ -205,7 +208,7 @@ def cmd_sweep(args) -> int:
                             resume=args.resume, scheduler=args.scheduler, workers=args.workers,
                             connect_timeout=args.connect_timeout, fmu_path=args.fmu)
     except _Stopped as stopped:
-        what = "interrupted" if stopped.signal_number == signal.SIGINT else "terminated"
+        what = STOPPING_SIGNALS[stopped.signal_number]
         print(f"pendulum-fmu sweep: {what}; the chunks that finished are kept in {args.output_dir}: "
               "run the same command with --resume to run the rest", file=sys.stderr)
         return 128 + stopped.signal_number
@@ -278,9 +281,9 @@ def build_parser() -> argparse.ArgumentParser:
                                 description="Build the FMU from fmu_src/ and modelDescription.xml "
                                             "(a source checkout or the unpacked sdist).")
     build.add_argument("--output", type=Path, default=None,
-                       help=f"where to write the FMU (default: {DEFAULT_FMU}, or {DEFAULT_FMU3} "
+                       help=f"where to write the FMU (default: {CHECKOUT_FMUS[2]}, or {CHECKOUT_FMUS[3]} "
                             "for FMI 3.0)")
-    build.add_argument("--fmi-version", type=int, choices=(2, 3), default=2,
+    build.add_argument("--fmi-version", type=int, choices=FMI_VERSIONS, default=2,
                        help="FMI standard of the FMU (default: %(default)s)")
     build.add_argument("--platforms", type=_platforms, default=None,
                        help=f"comma-separated, among {', '.join(PLATFORMS)} (default: every one "
@@ -407,8 +410,7 @@ def main(argv=None) -> int:
         if args.debug:
             raise
         number = getattr(stopped, "signal_number", signal.SIGINT)
-        what = "interrupted" if number == signal.SIGINT else "terminated"
-        print(f"{command}: {what}; no output file was left half written", file=sys.stderr)
+        print(f"{command}: {STOPPING_SIGNALS[number]}; no output file was left half written", file=sys.stderr)
         return 128 + number
     except (ValueError, TorqueFileError, FmuError, BuildError, ImportError, OSError) as error:
         if args.debug:

@@ -9,22 +9,23 @@ import os
 import signal
 import sys
 
-_WHAT = {signal.SIGINT: "interrupted", signal.SIGTERM: "terminated"}
+# The signals that stop the program, and the word its one line says for each (cli.main too).
+STOPPING_SIGNALS = {signal.SIGINT: "interrupted", signal.SIGTERM: "terminated"}
 
 
 def _while_starting(number, frame):
     # No command has started, so nothing is being written: leave at once.
-    os.write(2, f"pendulum-fmu: {_WHAT[number]} while starting; nothing was written\n".encode())
+    os.write(2, f"pendulum-fmu: {STOPPING_SIGNALS[number]} while starting; nothing was written\n".encode())
     os._exit(128 + number)
 
 
 def run() -> None:
-    for number in _WHAT:
+    for number in STOPPING_SIGNALS:
         signal.signal(number, _while_starting)
     from .cli import main  # sets the command's own handlers while it runs
 
     code = main()
     # Every file is in place: a signal while the interpreter shuts down changes nothing.
-    for number in _WHAT:
+    for number in STOPPING_SIGNALS:
         signal.signal(number, signal.SIG_IGN)
     sys.exit(code)

@@ -13,7 +13,10 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-FMI2_ADAPTER, FMI3_ADAPTER = "fmi2_functions.c", "fmi3_functions.c"
+# FMI version -> the C file of its entry points: a build compiles its own version's and leaves
+# out the other's.
+ADAPTERS = {2: "fmi2_functions.c", 3: "fmi3_functions.c"}
+FMI2_ADAPTER = ADAPTERS[2]
 # Capabilities both interfaces declare (FMI 2.0 name -> FMI 3.0 name).
 _COMMON_FLAGS = {"needsExecutionTool": "needsExecutionTool",
                  "canBeInstantiatedOnlyOncePerProcess": "canBeInstantiatedOnlyOncePerProcess",
@@ -24,13 +27,19 @@ _COMMON_FLAGS = {"needsExecutionTool": "needsExecutionTool",
 
 def adapter_left_out(fmi_version: int) -> str:
     """The entry-point file of the other standard, which a build for fmi_version leaves out."""
-    return FMI3_ADAPTER if fmi_version == 2 else FMI2_ADAPTER
+    return ADAPTERS[3 if fmi_version == 2 else 2]
+
+
+def with_adapter(fmi2_sources, fmi_version: int) -> list[str]:
+    """The C files of the build for fmi_version: the FMI 2.0 list (as modelDescription.xml's
+    <SourceFiles> gives it) with fmi_version's adapter in place of the FMI 2.0 one."""
+    return [ADAPTERS[fmi_version] if name == FMI2_ADAPTER else name for name in fmi2_sources]
 
 
 def source_files(fmi2_root: ET.Element) -> list[str]:
     """The C files of the FMI 3.0 build: the FMI 2.0 list with the adapter swapped."""
     listed = [f.get("name") for f in fmi2_root.find("CoSimulation/SourceFiles").iter("File")]
-    return [FMI3_ADAPTER if name == FMI2_ADAPTER else name for name in listed]
+    return with_adapter(listed, 3)
 
 
 def _interface(fmi2_root: ET.Element, tag: str) -> dict[str, str] | None:
