@@ -18,16 +18,29 @@ from pendulum_fmu.reference import reference
 from pendulum_fmu.simulate import simulate
 
 
-def _random_steps(seed: int, running_sum: bool) -> list[tuple]:
-    rng = np.random.default_rng(seed)
+def random_step_rows(rng: np.random.Generator, stop_time: float = 4.0,
+                     running_sum: bool = False) -> list[tuple]:
+    """A random step signal: levels held for random decimal durations (ms resolution). With
+    running_sum the times are what a tool accumulating durations writes (0.39100000000000029).
+    tests/test_signal_exactness.py draws its signals here too."""
     durations = rng.integers(20, 400, size=60) / 1000
-    times = np.cumsum(durations) if running_sum else np.cumsum(rng.integers(20, 400, size=60)) / 1000
-    times = times[times < 4.0]
+    if running_sum:
+        times = np.cumsum(durations)
+    else:
+        times = np.cumsum(rng.integers(20, 400, size=60)) / 1000
+    times = times[times < stop_time]
     levels = rng.uniform(-40, 40, size=len(times) + 1)
     rows = [(0.0, levels[0])]
     for t, before, after in zip(times, levels, levels[1:]):
         rows += [(repr(float(t)), before), (repr(float(t)), after)]
-    return rows + [(4.0, levels[len(times)])]
+    rows.append((stop_time, levels[len(times)]))
+    return rows
+
+
+def write_rows(path: Path, rows) -> Path:
+    """A time,torque CSV of (time, torque) rows, each written with str()."""
+    path.write_text("time,torque\n" + "".join(f"{t},{u}\n" for t, u in rows))
+    return path
 
 
 CASES = [
@@ -36,8 +49,10 @@ CASES = [
     ("jumps at 0.33 and 0.45 s, 30 ms steps",
      [(0, 5), (0.33, 5), (0.33, -30), (0.45, -30), (0.45, 25), (1.5, 25)], dict(step_size=0.03)),
     ("first row a jump, 1 ms steps", [(0, 0), (0, 20), (1, 20)], dict(step_size=1e-3)),
-    ("4 s random steps, decimal times, 1 ms", _random_steps(1, False), dict(step_size=1e-3)),
-    ("4 s random steps, running-sum times, 1 ms", _random_steps(1, True), dict(step_size=1e-3)),
+    ("4 s random steps, decimal times, 1 ms", random_step_rows(np.random.default_rng(1)),
+     dict(step_size=1e-3)),
+    ("4 s random steps, running-sum times, 1 ms",
+     random_step_rows(np.random.default_rng(1), running_sum=True), dict(step_size=1e-3)),
     ("kink at 0.3915 s, ramp, 10 ms steps", [(0, 0), (0.3915, 20), (1, -5), (2, 10)],
      dict(step_size=0.01, ramp=True)),
     ("kink at 0.3915 s, ramp, 100 ms steps", [(0, 0), (0.3915, 20), (1, -5), (2, 10)],
@@ -46,8 +61,7 @@ CASES = [
 
 
 def run_case(rows, arguments, folder: Path) -> tuple[float, float]:
-    csv = folder / "signal.csv"
-    csv.write_text("time,torque\n" + "".join(f"{t},{u}\n" for t, u in rows))
+    csv = write_rows(folder / "signal.csv", rows)
     run = simulate(csv, tolerance=1e-12, **arguments)
     oracle = reference(csv, at=run["time"], **arguments)
     return (float(np.max(np.abs(run["theta"] - oracle["theta"]))),

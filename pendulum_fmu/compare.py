@@ -153,11 +153,9 @@ def compare(torque: TorqueSignal, tools=TOOLS, *, output_dir: str | Path, step_s
                     max_steps=max_steps)
     steps = len(plan.time) - 1
     runs, seconds = {}, {}
-    started = clock.perf_counter()
     runs[REFERENCE] = reference(torque, start_time=start_time, stop_time=stop_time, step_size=step_size,
                                 ramp=ramp, parameters=parameters, theta0=theta0, omega0=omega0,
                                 at=plan.time, fmu_path=fmu_path)
-    seconds[REFERENCE] = (clock.perf_counter() - started) / steps
     for tool in parsed:
         if tool.label != REFERENCE:  # the judge above takes the reference's place
             started = clock.perf_counter()

@@ -21,20 +21,21 @@ from __future__ import annotations
 
 import math
 import re
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from fmpy import extract, read_model_description, simulate_fmu
+from fmpy import simulate_fmu
 from fmpy.fmi2 import FMU2Slave
 from fmpy.fmi3 import FMU3Slave
 
 from .engines import check_held, check_mode, held_results
-from .parameters import START_VALUES, default_parameters, resolve_parameters
+from .parameters import (START_VALUES, default_parameters, model_description, resolve_parameters,
+                         variables)
 from .signal import TorqueSchedule
+from .simulate import RECORDED, _unzipped
 
-OUTPUTS = ("theta", "omega", "alpha")
+OUTPUTS = RECORDED[1:]  # theta, omega, alpha
 REQUIRED = ("torque", "theta")
 # accurate: the tolerance the FMU or CVode is asked for; default: what it uses when not asked.
 TOLERANCE = {"accurate": 1e-12, "default": None}
@@ -87,7 +88,7 @@ class OtherFmu:
         if not self.path.is_file():
             raise MapError(f"{label}: no FMU at {self.path}")
         try:
-            self.description = read_model_description(str(self.path))
+            self.description = model_description(self.path)
         except Exception as error:
             raise MapError(f"{label}: {self.path} is not a readable FMU: {error}") from None
         if self.description.fmiVersion not in ("2.0", "3.0"):
@@ -100,7 +101,7 @@ class OtherFmu:
         if self.interface not in available:
             raise MapError(f"{label}: {self.path} has no {self.interface} interface "
                            f"(it has {', '.join(available)})")
-        self.variables = {v.name: v for v in self.description.modelVariables}
+        self.variables = variables(self.path)  # shared, read only
         given = parse_map(mapping) if isinstance(mapping, str) or mapping is None else dict(mapping)
         self.mapping = self._complete(given)
 
@@ -158,48 +159,47 @@ class OtherFmu:
     def _co_simulation(self, plan, start, tolerance):
         """Hold each step's torque, read the outputs at each communication point."""
         fmi3 = self.description.fmiVersion == "3.0"
-        with tempfile.TemporaryDirectory(prefix="pendulum_other_fmu_") as folder:
-            extract(str(self.path), unzipdir=folder)
-            cls = FMU3Slave if fmi3 else FMU2Slave
-            slave = cls(guid=self.description.guid, unzipDirectory=folder,
-                        modelIdentifier=self.description.coSimulation.modelIdentifier,
-                        instanceName=self.label)
-            outputs = self._output_variables()
-            vr = {name: self.variables[name].valueReference for name in (*start, *outputs.values())}
-            torque = self.mapping["torque"]
-            torque_vr = [self.variables[torque.variable].valueReference]
-            output_vrs = [vr[variable] for variable in outputs.values()]
-            set_values = slave.setFloat64 if fmi3 else slave.setReal
-            get_values = slave.getFloat64 if fmi3 else slave.getReal
-            recorded = np.full((len(plan.time), len(outputs)), np.nan)
-            t0 = float(plan.time[0])
-            call = "instantiate"
-            slave.instantiate()
-            try:
-                if not fmi3:
-                    call = "fmi2SetupExperiment"
-                    slave.setupExperiment(tolerance=tolerance, startTime=t0)
-                call = "setting the parameters and start values"
-                set_values([vr[name] for name in start], list(start.values()))
-                set_values(torque_vr, [plan.torque[0] / torque.factor])
-                call = "initialization"
-                if fmi3:
-                    slave.enterInitializationMode(tolerance=tolerance, startTime=t0)
-                else:
-                    slave.enterInitializationMode()
-                slave.exitInitializationMode()
-                for k, (t, h, u) in enumerate(zip(plan.time.tolist(), plan.step_size.tolist(),
-                                                  plan.torque.tolist())):
-                    call = f"the step from t = {t:.17g}"
-                    set_values(torque_vr, [u / torque.factor])
-                    recorded[k] = get_values(output_vrs)
-                    slave.doStep(currentCommunicationPoint=t, communicationStepSize=h)
-                recorded[-1] = get_values(output_vrs)
-                slave.terminate()
-            except Exception as error:
-                raise RuntimeError(f"{self.label}: {call} failed: {error}") from None
-            finally:
-                slave.freeInstance()
+        folder, _ = _unzipped(self.path)
+        cls = FMU3Slave if fmi3 else FMU2Slave
+        slave = cls(guid=self.description.guid, unzipDirectory=folder,
+                    modelIdentifier=self.description.coSimulation.modelIdentifier,
+                    instanceName=self.label)
+        outputs = self._output_variables()
+        vr = {name: self.variables[name].valueReference for name in (*start, *outputs.values())}
+        torque = self.mapping["torque"]
+        torque_vr = [self.variables[torque.variable].valueReference]
+        output_vrs = [vr[variable] for variable in outputs.values()]
+        set_values = slave.setFloat64 if fmi3 else slave.setReal
+        get_values = slave.getFloat64 if fmi3 else slave.getReal
+        recorded = np.full((len(plan.time), len(outputs)), np.nan)
+        t0 = float(plan.time[0])
+        call = "instantiate"
+        slave.instantiate()
+        try:
+            if not fmi3:
+                call = "fmi2SetupExperiment"
+                slave.setupExperiment(tolerance=tolerance, startTime=t0)
+            call = "setting the parameters and start values"
+            set_values([vr[name] for name in start], list(start.values()))
+            set_values(torque_vr, [plan.torque[0] / torque.factor])
+            call = "initialization"
+            if fmi3:
+                slave.enterInitializationMode(tolerance=tolerance, startTime=t0)
+            else:
+                slave.enterInitializationMode()
+            slave.exitInitializationMode()
+            for k, (t, h, u) in enumerate(zip(plan.time.tolist(), plan.step_size.tolist(),
+                                              plan.torque.tolist())):
+                call = f"the step from t = {t:.17g}"
+                set_values(torque_vr, [u / torque.factor])
+                recorded[k] = get_values(output_vrs)
+                slave.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+            recorded[-1] = get_values(output_vrs)
+            slave.terminate()
+        except Exception as error:
+            raise RuntimeError(f"{self.label}: {call} failed: {error}") from None
+        finally:
+            slave.freeInstance()
         return {name: recorded[:, i] for i, name in enumerate(outputs)}
 
     def _model_exchange(self, plan, start, tolerance):
@@ -215,7 +215,8 @@ class OtherFmu:
         signal["time"], signal[torque.variable] = times, values / torque.factor
         outputs = self._output_variables()
         try:
-            raw = simulate_fmu(str(self.path), fmi_type="ModelExchange", solver="CVode",
+            raw = simulate_fmu(_unzipped(self.path)[0], model_description=self.description,
+                               fmi_type="ModelExchange", solver="CVode",
                                relative_tolerance=tolerance, start_time=float(plan.time[0]),
                                stop_time=float(plan.time[-1]),
                                output_interval=float(plan.step_size.min()), input=signal,
@@ -228,11 +229,3 @@ class OtherFmu:
         if np.any(np.abs(raw["time"][rows] - plan.time) > 1e-9 * plan.step_size.min()):
             raise RuntimeError(f"{self.label}: fmpy did not report every communication point")
         return {name: raw[variable][rows] for name, variable in outputs.items()}
-
-
-def run(plan: TorqueSchedule, *, parameters: dict | None = None, theta0: float = 0.0,
-        omega0: float = 0.0, mode: str = "accurate", path: str | Path, mapping: str | None = None,
-        interface: str | None = None, label: str = "other") -> np.ndarray:
-    """The runner signature with the FMU's path and map added."""
-    return OtherFmu(path, mapping, interface=interface, label=label).run(
-        plan, parameters=parameters, theta0=theta0, omega0=omega0, mode=mode)

@@ -87,10 +87,12 @@ class _TorqueFile:
 
 def _grid(start: Fraction, stop: Fraction, step: Fraction) -> list[Fraction]:
     """start + k*step up to stop; stop itself ends a shorter last step unless it is on the grid."""
-    points, k = [], 0
-    while start + k * step < stop - _tolerance(stop, step):
-        points.append(start + k * step)
+    points, k, last = [], 0, stop - _tolerance(stop, step)
+    point = start
+    while point < last:
+        points.append(point)
         k += 1
+        point = start + k * step
     return points + [stop]
 
 

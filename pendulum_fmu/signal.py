@@ -31,6 +31,7 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 from typing import Callable, Sequence, Union
 
@@ -58,6 +59,12 @@ def event_tolerance(time, step_size: float):
     """How close an event must be to a communication point to be that point (s)."""
     return np.maximum(EVENT_TOLERANCE_STEPS * step_size,
                       EVENT_TOLERANCE_ULPS * np.spacing(np.abs(np.asarray(time, dtype=float))))
+
+
+def _nearest(points: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """The point of the sorted `points` (two or more) nearest to each t."""
+    i = np.clip(np.searchsorted(points, t), 1, len(points) - 1)
+    return np.where(np.abs(points[i] - t) < np.abs(points[i - 1] - t), points[i], points[i - 1])
 
 
 class TorqueFileError(ValueError):
@@ -100,9 +107,7 @@ class TorqueTable:
 
     def snapped(self, points: np.ndarray, step_size: float) -> "TorqueTable":
         """The same table with every row time within event_tolerance of a point moved onto it."""
-        i = np.clip(np.searchsorted(points, self.time), 1, len(points) - 1)
-        nearest = np.where(np.abs(points[i] - self.time) < np.abs(points[i - 1] - self.time),
-                           points[i], points[i - 1])
+        nearest = _nearest(points, self.time)
         close = np.abs(nearest - self.time) <= event_tolerance(self.time, step_size)
         return TorqueTable(np.where(close, nearest, self.time), self.torque)
 
@@ -113,7 +118,7 @@ class TorqueSchedule:
     torque: np.ndarray
     torque_rate: np.ndarray
 
-    @property
+    @cached_property  # works on a frozen dataclass: it writes the instance's __dict__ directly
     def step_size(self) -> np.ndarray:
         return np.diff(self.time)
 
@@ -286,15 +291,14 @@ def step_count(start_time: float, stop_time: float, step_size: float,
     return steps
 
 
-def communication_points(start_time: float, stop_time: float, step_size: float,
-                         events: np.ndarray | None = None, max_steps: int | None = None) -> np.ndarray:
-    """start, start + h, ... up to stop, plus the events that are not within event_tolerance of a
-    grid point (those are the grid point). A grid point is start + k*h, never a running sum, so
-    no rounding accumulates over a long run. max_steps: see step_count."""
+def communication_points(start_time: float, stop_time: float, step_size: float, *,
+                         max_steps: int | None = None) -> np.ndarray:
+    """start, start + h, ... up to stop. A grid point is start + k*h, never a running sum, so no
+    rounding accumulates over a long run. max_steps: see step_count."""
     steps = step_count(start_time, stop_time, step_size, max_steps)
     grid = start_time + step_size * np.arange(steps + 1, dtype=float)
     grid[-1] = stop_time if abs(grid[-1] - stop_time) > event_tolerance(stop_time, step_size) else grid[-1]
-    return _with_events(grid, events, step_size)
+    return grid
 
 
 def _with_events(grid: np.ndarray, events: np.ndarray | None, step_size: float) -> np.ndarray:
@@ -303,8 +307,7 @@ def _with_events(grid: np.ndarray, events: np.ndarray | None, step_size: float) 
         return grid
     events = np.unique(events[(events > grid[0]) & (events < grid[-1])])
     if len(events):
-        i = np.clip(np.searchsorted(grid, events), 1, len(grid) - 1)
-        distance = np.minimum(np.abs(grid[i] - events), np.abs(events - grid[i - 1]))
+        distance = np.abs(_nearest(grid, events) - events)
         events = events[distance > event_tolerance(events, step_size)]
     return np.union1d(grid, events)
 
@@ -318,7 +321,8 @@ def _array_schedule(values, start_time: float, stop_time: float | None, step_siz
         raise ValueError("a per-step torque array is held over each step; ramp needs a CSV or a callable")
     if stop_time is None:
         stop_time = start_time + len(torque) * step_size
-    steps = step_count(start_time, stop_time, step_size, max_steps)
+    time = communication_points(start_time, stop_time, step_size, max_steps=max_steps)
+    steps = len(time) - 1
     if steps != len(torque):
         raise ValueError(f"the torque array has {len(torque)} values but {start_time:g} to {stop_time:g} s "
                          f"in steps of {step_size:g} s is {steps} steps; give one value per step or "
@@ -326,7 +330,6 @@ def _array_schedule(values, start_time: float, stop_time: float | None, step_siz
     bad = np.flatnonzero(~np.isfinite(torque))
     if len(bad):
         raise ValueError(f"the torque array's value {bad[0]} is {torque[bad[0]]}; values must be finite")
-    time = communication_points(start_time, stop_time, step_size, max_steps=max_steps)
     return TorqueSchedule(time=time, torque=torque, torque_rate=np.zeros(len(torque)))
 
 

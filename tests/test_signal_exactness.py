@@ -8,6 +8,7 @@ and randomized signals over step sizes that include the awkward ones."""
 import numpy as np
 import pytest
 
+from benchmarks.signal_cases import random_step_rows, write_rows
 from pendulum_fmu import compare as compare_module
 from pendulum_fmu.compare import compare
 from pendulum_fmu.reference import reference
@@ -18,11 +19,6 @@ from pendulum_fmu.simulate import simulate
 # falls an ulp below a jump written at a multiple of them; 1/3 ms is no decimal at all.
 AWKWARD_STEPS = (3e-4, 6e-4, 7e-4, 9e-4, 1e-3, 9e-3, 0.03, 0.3, 1 / 3000)
 BOUND = 1e-9
-
-
-def write(path, rows):
-    path.write_text("time,torque\n" + "".join(f"{t},{u}\n" for t, u in rows))
-    return path
 
 
 def worst(run, oracle):
@@ -43,19 +39,19 @@ def check(fmu, signal, **arguments):
 
 def test_jump_at_a_grid_point_an_ulp_above_k_h(fmu, tmp_path):
     # 3 * 0.009 = 0.026999999999999996 < 0.027: the issue's repro, 3.5e-3 rad off before.
-    csv = write(tmp_path / "j.csv", [(0, 10), (0.027, 10), (0.027, -20), (2, -20)])
+    csv = write_rows(tmp_path / "j.csv", [(0, 10), (0.027, 10), (0.027, -20), (2, -20)])
     run, _ = check(fmu, csv, step_size=0.009)
     k = np.flatnonzero(np.isclose(run["time"], 0.027, rtol=0, atol=1e-15))
     assert len(k) == 1 and run["torque"][k[0]] == -20 and run["torque"][k[0] - 1] == 10
 
 
 def test_jumps_at_decimal_times_on_a_30_ms_grid(fmu, tmp_path):
-    csv = write(tmp_path / "j.csv", [(0, 5), (0.33, 5), (0.33, -30), (0.45, -30), (0.45, 25), (1.5, 25)])
+    csv = write_rows(tmp_path / "j.csv", [(0, 5), (0.33, 5), (0.33, -30), (0.45, -30), (0.45, 25), (1.5, 25)])
     check(fmu, csv, step_size=0.03)
 
 
 def test_first_row_jump(fmu, tmp_path):
-    csv = write(tmp_path / "j.csv", [(0, 0), (0, 20), (1, 20)])
+    csv = write_rows(tmp_path / "j.csv", [(0, 0), (0, 20), (1, 20)])
     run, _ = check(fmu, csv, step_size=1e-3)
     assert run["torque"][0] == 20
 
@@ -70,31 +66,14 @@ def test_jumps_at_every_multiple_of_an_awkward_step(fmu, tmp_path, step_size):
         rows += [(t, level), (t, -level)]
         level = -level
     rows.append((times[-1] + 5 * step_size, level))
-    check(fmu, write(tmp_path / "j.csv", rows), step_size=step_size)
-
-
-def random_step_rows(rng, stop_time=4.0, running_sum=False):
-    """A random step signal: levels held for random decimal durations (ms resolution). With
-    running_sum the times are what a tool accumulating durations writes (0.39100000000000029)."""
-    durations = rng.integers(20, 400, size=60) / 1000
-    if running_sum:
-        times = np.cumsum(durations)
-    else:
-        times = np.cumsum(rng.integers(20, 400, size=60)) / 1000
-    times = times[times < stop_time]
-    levels = rng.uniform(-40, 40, size=len(times) + 1)
-    rows = [(0.0, levels[0])]
-    for t, before, after in zip(times, levels, levels[1:]):
-        rows += [(repr(float(t)), before), (repr(float(t)), after)]
-    rows.append((stop_time, levels[len(times)]))
-    return rows
+    check(fmu, write_rows(tmp_path / "j.csv", rows), step_size=step_size)
 
 
 @pytest.mark.parametrize("seed", range(4))
 def test_random_step_signal_with_running_sum_times(fmu, tmp_path, seed):
     rows = random_step_rows(np.random.default_rng(seed), running_sum=True)
     assert any(len(str(t)) > 8 for t, _ in rows)  # the running sums are not round decimals
-    check(fmu, write(tmp_path / "r.csv", rows), step_size=1e-3)
+    check(fmu, write_rows(tmp_path / "r.csv", rows), step_size=1e-3)
 
 
 @pytest.mark.parametrize("seed", range(6))
@@ -102,13 +81,13 @@ def test_random_step_signal_at_random_awkward_steps(fmu, tmp_path, seed):
     rng = np.random.default_rng(100 + seed)
     step_size = AWKWARD_STEPS[rng.integers(len(AWKWARD_STEPS))]
     rows = random_step_rows(rng, stop_time=2.0)
-    check(fmu, write(tmp_path / "r.csv", rows), step_size=step_size)
+    check(fmu, write_rows(tmp_path / "r.csv", rows), step_size=step_size)
 
 
 @pytest.mark.parametrize("step_size", [0.01, 0.1])
 def test_ramp_follows_kinks_between_communication_points(fmu, tmp_path, step_size):
     # The kink at 0.3915 s lies inside a step at both sizes: before, 1.7e-5 and 1.0e-3 rad.
-    csv = write(tmp_path / "k.csv", [(0, 0), (0.3915, 20), (1, -5), (1.2345, 12), (2, 10)])
+    csv = write_rows(tmp_path / "k.csv", [(0, 0), (0.3915, 20), (1, -5), (1.2345, 12), (2, 10)])
     run, _ = check(fmu, csv, step_size=step_size, ramp=True)
     assert 0.3915 in run["time"] and 1.2345 in run["time"]
 
@@ -119,7 +98,7 @@ def test_random_piecewise_linear_signal_ramped(fmu, tmp_path, seed):
     times = np.unique(np.round(np.sort(rng.uniform(0, 2, size=25)), 4))
     rows = [(0, 0.0)] + [(repr(float(t)), rng.uniform(-30, 30)) for t in times] + [(2.5, 5.0)]
     step_size = AWKWARD_STEPS[rng.integers(len(AWKWARD_STEPS) - 1)]
-    check(fmu, write(tmp_path / "p.csv", rows), step_size=step_size, ramp=True)
+    check(fmu, write_rows(tmp_path / "p.csv", rows), step_size=step_size, ramp=True)
 
 
 def test_a_per_step_array_is_held(fmu):
@@ -147,7 +126,7 @@ def test_constant_and_callable_signals(fmu):
 
 def test_compare_catches_a_schedule_that_does_not_carry_the_signal(tmp_path, monkeypatch):
     # The old schedule read the value at a grid point an ulp below the jump: the pre-jump value.
-    csv = write(tmp_path / "j.csv", [(0, 10), (0.027, 10), (0.027, -20), (0.5, -20)])
+    csv = write_rows(tmp_path / "j.csv", [(0, 10), (0.027, 10), (0.027, -20), (0.5, -20)])
 
     def late_by_one_step(*args, **kwargs):
         plan = schedule(*args, **kwargs)
@@ -163,11 +142,11 @@ def test_compare_catches_a_schedule_that_does_not_carry_the_signal(tmp_path, mon
 
 
 def test_compare_agrees_on_the_awkward_cases(fmu, tmp_path):
-    csv = write(tmp_path / "j.csv", [(0, 10), (0.027, 10), (0.027, -20), (0.5, -20)])
+    csv = write_rows(tmp_path / "j.csv", [(0, 10), (0.027, 10), (0.027, -20), (0.5, -20)])
     comparison = compare(csv, ["fmu", "reference"], output_dir=tmp_path / "held", step_size=0.009,
                          fmu_path=fmu)
     assert comparison.agree and comparison.torque_worst < 1e-12
-    kinks = write(tmp_path / "k.csv", [(0, 0), (0.3915, 20), (1, -5)])
+    kinks = write_rows(tmp_path / "k.csv", [(0, 0), (0.3915, 20), (1, -5)])
     ramped = compare(kinks, ["fmu", "reference"], output_dir=tmp_path / "ramp", step_size=0.1,
                      ramp=True, fmu_path=fmu)
     assert ramped.agree and ramped.worst < BOUND
@@ -175,6 +154,6 @@ def test_compare_agrees_on_the_awkward_cases(fmu, tmp_path):
 
 def test_compare_ramp_refuses_a_tool_that_cannot_ramp(tmp_path):
     pytest.importorskip("opensim")
-    kinks = write(tmp_path / "k.csv", [(0, 0), (0.3915, 20), (1, -5)])
+    kinks = write_rows(tmp_path / "k.csv", [(0, 0), (0.3915, 20), (1, -5)])
     with pytest.raises(ValueError, match="opensim holds the torque over each step and cannot ramp"):
         compare(kinks, ["fmu", "opensim"], output_dir=tmp_path, ramp=True)
