@@ -18,6 +18,7 @@ from .build import (CHECKOUT_FMUS, FMI_VERSIONS, PLATFORMS, BuildError, Platform
                     check_platforms)
 from .entry import STOPPING_SIGNALS
 from .signal import DEFAULT_MAX_STEPS
+from .sweep import DEFAULT_MAX_CASES
 
 TUTORIAL_TORQUE = 20.0
 
@@ -206,7 +207,8 @@ def cmd_sweep(args) -> int:
                             step_size=args.step_size, outputs=_sweep_outputs(args.outputs),
                             output_interval=args.output_interval, format=args.format,
                             resume=args.resume, scheduler=args.scheduler, workers=args.workers,
-                            connect_timeout=args.connect_timeout, fmu_path=args.fmu)
+                            connect_timeout=args.connect_timeout, fmu_path=args.fmu,
+                            max_cases=args.max_cases)
     except _Stopped as stopped:
         what = STOPPING_SIGNALS[stopped.signal_number]
         print(f"pendulum-fmu sweep: {what}; the chunks that finished are kept in {args.output_dir}: "
@@ -367,6 +369,8 @@ def build_parser() -> argparse.ArgumentParser:
     sweep.add_argument("--connect-timeout", type=_float, default=10.0,
                        help="seconds to wait for --scheduler to answer (default: %(default)s)")
     sweep.add_argument("--workers", type=int, default=None, help="local cluster workers (default: 2)")
+    sweep.add_argument("--max-cases", type=_positive_int, default=DEFAULT_MAX_CASES,
+                       help=f"refuse studies of more cases than this (default: {DEFAULT_MAX_CASES:,})")
     _add_fmu_argument(sweep)
     sweep.set_defaults(run=cmd_sweep)
 

@@ -62,6 +62,10 @@ MAX_CHUNK_BYTES = 64_000_000
 LOCK_FILE = ".sweep.lock"
 # Up to this many cases the figure draws every trajectory; above, quantile bands of the summaries.
 LINES_UP_TO = 20
+# A study larger than this is refused unless asked for (max_cases, --max-cases): at a
+# millisecond a case it is a quarter of an hour on 1,000 cores, and a grid multiplied out by a
+# stray value list is likelier than a study that large.
+DEFAULT_MAX_CASES = 1_000_000
 
 
 def _sweepable(fmu_path=None) -> list[str]:
@@ -491,7 +495,7 @@ def run_sweep(cases, *, output_dir: str | os.PathLike, stop_time: float = 3.0,
               step_size: float = 1e-3, outputs=OUTPUTS, output_interval: float | None = None,
               format: str = "parquet", resume: bool = False, scheduler: str | None = None,
               workers: int | None = None, connect_timeout: float = 10.0, progress: bool = True,
-              fmu_path: str | Path | None = None) -> dict:
+              fmu_path: str | Path | None = None, max_cases: int = DEFAULT_MAX_CASES) -> dict:
     """Run every case on dask; the workers write the study into output_dir (see the module doc).
 
     cases: sweep_grid(...) or a list of {'torque': .., <parameter or start value>: ..} dicts.
@@ -502,7 +506,9 @@ def run_sweep(cases, *, output_dir: str | os.PathLike, stop_time: float = 3.0,
     scheduler: the address of a running dask.distributed scheduler, which must answer within
     connect_timeout seconds; without one a local cluster of `workers` processes (default 2) runs
     for this call (its workers are spawned, so a script calling this needs the
-    `if __name__ == "__main__":` guard). progress: a progress line on stderr.
+    `if __name__ == "__main__":` guard). progress: a progress line on stderr. max_cases: the
+    largest study accepted (default DEFAULT_MAX_CASES); a larger one is refused before anything
+    starts.
     Returns {'output_dir', 'trajectories', 'cases_table', 'figure': paths or URLs; 'cases',
     'failed': counts; 'chunks', 'chunks_run'; 'bytes': written by this run; 'seconds' in all,
     'figure_seconds' of them reading the cases table and drawing; 'worker_cpu_seconds' the
@@ -511,6 +517,10 @@ def run_sweep(cases, *, output_dir: str | os.PathLike, stop_time: float = 3.0,
     import fsspec
 
     started = time.perf_counter()
+    if len(cases) > max_cases:
+        raise ValueError(f"{len(cases):,} cases is over the limit of {max_cases:,}: give fewer "
+                         "values, or raise the limit (--max-cases) if the study is meant to be "
+                         "that large")
     names = _check_cases(cases, fmu_path)
     if not (isinstance(stop_time, numbers.Real) and math.isfinite(stop_time)):
         raise ValueError(f"stop time {stop_time} must be a finite number")

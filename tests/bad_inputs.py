@@ -86,6 +86,9 @@ CASES = [
     _case("sweep", "sweep --torque 5 --set mass=heavy --output-dir {files}/out", 2,
           "--set mass=heavy: expected comma-separated numbers"),
     _case("sweep", "sweep --torque 5 --stop-time inf --output-dir {files}/out", 2, "stop time inf must be a finite number"),
+    _case("sweep", "sweep --torque 1 2 3 4 5 6 7 8 9 10 --set mass=1,2,3,4,5,6,7,8,9,10 "
+                   "--set length=1,2,3,4,5,6,7,8,9,10 --max-cases 999 --output-dir {files}/out", 2,
+          "1,000 cases is over the limit of 999: give fewer values"),
     _case("output", "simulate --torque 1 --stop-time 0.01 --output {files}/bad_number.csv/out.csv", 2,
           "bad_number.csv is a file, not a folder; choose another output path"),
 ]

@@ -477,6 +477,7 @@ def test_a_grid_is_the_product_of_its_axes():
     ([{"torque": 1.0}], {"format": "xlsx"}, "format 'xlsx': choose parquet or csv"),
     ([{"torque": 1.0}], {"connect_timeout": 0}, "connect timeout 0 must be a positive number"),
     ([{"torque": 1.0}], {"connect_timeout": float("inf")}, "connect timeout inf must be a positive"),
+    ([{"torque": 1.0}, {"torque": 2.0}, {"torque": 3.0}], {"max_cases": 2}, "3 cases is over the limit of 2"),
 ])
 def test_bad_runs_are_refused_before_any_cluster_starts(tmp_path, cases, options, message):
     with pytest.raises(ValueError, match=message):
