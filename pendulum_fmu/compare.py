@@ -37,8 +37,11 @@ def run_tools(plan: TorqueSchedule, tools, *, parameters: dict | None = None, th
     """{tool label: result array} for the same schedule, parameters and start values; tools as
     --tools gives them (see tools.py), mapping the --map of other FMUs. "reference" here is
     reference_schedule: the schedule's own torques through scipy."""
+    parsed = parse_tools(tools, mapping=mapping, fmu_path=fmu_path)
+    # Every tool gets the whole set, so the defaults are fmu_path's for all of them.
+    parameters = resolve_parameters(parameters, fmu_path)
     return {tool.label: tool.run(plan, parameters=parameters, theta0=theta0, omega0=omega0)
-            for tool in parse_tools(tools, mapping=mapping, fmu_path=fmu_path)}
+            for tool in parsed}
 
 
 def check_tolerance(tolerance: float) -> float:
@@ -148,7 +151,9 @@ def compare(torque: TorqueSignal, tools=TOOLS, *, output_dir: str | Path, step_s
         raise ToolSpecError(f"compare needs at least two tools, got {parsed[0].label}: "
                             f"e.g. --tools fmu,{REFERENCE}")
     tolerance = check_tolerance(tolerance)
-    resolve_parameters(parameters, fmu_path)  # a bad parameter is refused before any tool runs
+    # Refused here before any tool runs; and every tool gets the whole set, so the defaults are
+    # fmu_path's for all of them.
+    parameters = resolve_parameters(parameters, fmu_path)
     plan = schedule(torque, start_time=start_time, stop_time=stop_time, step_size=step_size, ramp=ramp,
                     max_steps=max_steps)
     steps = len(plan.time) - 1
