@@ -13,7 +13,8 @@ A study goes to an output directory, a local path or any fsspec URL every worker
     .sweep.lock                       there while a run writes a local folder: a second run is refused
 
 The worker that ran a chunk writes its two files, trajectories first, so a chunk is done when its
-cases part exists; --resume runs the chunks that are not. The client submits chunks, shows
+cases part exists; --resume runs the chunks that are not, and an interrupted run removes
+what they left. The client submits chunks, shows
 progress and draws the figure from the cases table: it never holds a trajectory, so its memory
 and its work per case stay small however large the study. A worker steps each case in the native
 loop (cs_loop.py) through one FMU instance that it resets between cases. With format "csv" the
@@ -341,9 +342,14 @@ def _definition(cases, names, study: _Study) -> dict:
             "format": study.format, "fmu_sha256": fmu}
 
 
+def _parts(study: _Study, table: str) -> dict[int, str]:
+    """{chunk index: path} of a table's parts."""
+    pattern = f"{study.root}/{table}/part-*.{study.format}"
+    return {int(Path(path).stem.split("-")[1]): path for path in study.filesystem.glob(pattern)}
+
+
 def _done_chunks(study: _Study) -> set[int]:
-    pattern = f"{study.root}/cases/part-*.{study.format}"
-    return {int(Path(path).stem.split("-")[1]) for path in study.filesystem.glob(pattern)}
+    return set(_parts(study, "cases"))
 
 
 def _remove(study: _Study, patterns) -> None:
@@ -354,9 +360,15 @@ def _remove(study: _Study, patterns) -> None:
                 fs.rm(path)
 
 
-def _temporaries() -> tuple[str, ...]:
-    """Where an interrupted writer (a killed worker) leaves a temporary (see files.py)."""
-    return (TEMPORARY_GLOB, f"trajectories/{TEMPORARY_GLOB}", f"cases/{TEMPORARY_GLOB}")
+def _remove_unfinished(study: _Study) -> None:
+    """What interrupted chunks leave: the temporaries of writes cut short (a killed worker, see
+    files.py), and trajectory parts whose chunk did not get to write its cases part."""
+    _remove(study, (TEMPORARY_GLOB, f"trajectories/{TEMPORARY_GLOB}", f"cases/{TEMPORARY_GLOB}"))
+    done = _done_chunks(study)
+    for index, path in _parts(study, "trajectories").items():
+        if index not in done:
+            with contextlib.suppress(FileNotFoundError):
+                study.filesystem.rm(path)
 
 
 def _prepare(study: _Study, definition: dict, resume: bool, count: int, points: int,
@@ -553,33 +565,37 @@ def run_sweep(cases, *, output_dir: str | os.PathLike, stop_time: float = 3.0,
     written, worker_cpu, worker_stepping = 0, 0.0, 0.0
     # The folder taken first, so that a second run is refused before it starts a cluster; then
     # connected, so that a scheduler that does not answer leaves the study untouched.
-    with _only_run(study, url), _client(scheduler, workers, connect_timeout) as client:
-        chunk_cases = _prepare(study, _definition(cases, names, study), resume, len(cases), points, url)
-        chunks = range(math.ceil(len(cases) / chunk_cases))
-        done = _done_chunks(study)
-        pending = [index for index in chunks if index not in done]
-        finished = sum(min(chunk_cases, len(cases) - i * chunk_cases) for i in done)
+    with _only_run(study, url):
         try:
-            futures = [client.submit(_run_chunk, index, index * chunk_cases,
-                                     _columns(cases, names, index * chunk_cases,
-                                              min(len(cases), (index + 1) * chunk_cases)),
-                                     study, pure=False) for index in pending]
-            # Done callbacks rather than as_completed: on Ctrl-C no waiting coroutine is left to
-            # fail, with a traceback, when the cluster closes.
-            finished_futures = queue.SimpleQueue()
-            for future in futures:
-                future.add_done_callback(finished_futures.put)
-            failed = 0
-            for _ in futures:
-                future = finished_futures.get()
-                _, count, chunk_failed, chunk_bytes, chunk_cpu, chunk_stepping = future.result()
-                finished, failed, written = finished + count, failed + chunk_failed, written + chunk_bytes
-                worker_cpu, worker_stepping = worker_cpu + chunk_cpu, worker_stepping + chunk_stepping
-                future.release()
-                bar.show(finished, failed)
+            with _client(scheduler, workers, connect_timeout) as client:
+                chunk_cases = _prepare(study, _definition(cases, names, study), resume, len(cases),
+                                       points, url)
+                chunks = range(math.ceil(len(cases) / chunk_cases))
+                done = _done_chunks(study)
+                pending = [index for index in chunks if index not in done]
+                finished = sum(min(chunk_cases, len(cases) - i * chunk_cases) for i in done)
+                futures = [client.submit(_run_chunk, index, index * chunk_cases,
+                                         _columns(cases, names, index * chunk_cases,
+                                                  min(len(cases), (index + 1) * chunk_cases)),
+                                         study, pure=False) for index in pending]
+                # Done callbacks rather than as_completed: on Ctrl-C no waiting coroutine is left
+                # to fail, with a traceback, when the cluster closes.
+                finished_futures = queue.SimpleQueue()
+                for future in futures:
+                    future.add_done_callback(finished_futures.put)
+                failed = 0
+                for _ in futures:
+                    future = finished_futures.get()
+                    _, count, chunk_failed, chunk_bytes, chunk_cpu, chunk_stepping = future.result()
+                    finished, failed = finished + count, failed + chunk_failed
+                    written, worker_cpu = written + chunk_bytes, worker_cpu + chunk_cpu
+                    worker_stepping += chunk_stepping
+                    future.release()
+                    bar.show(finished, failed)
         finally:
-            # A worker killed mid-write (Ctrl-C reaches the whole process group) leaves its temporary.
-            _remove(study, _temporaries())
+            # After a local cluster closed, so that none of its workers writes any more (a remote
+            # cluster's may still finish the chunk they were running).
+            _remove_unfinished(study)
     drawing = time.perf_counter()
     table = _read_cases(study, names)
     _draw(study, table, names, f"{study.root}/sweep.png")
