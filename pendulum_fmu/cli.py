@@ -16,9 +16,9 @@ import numpy as np
 from . import __version__
 from .build import (CHECKOUT_FMUS, FMI_VERSIONS, PLATFORMS, BuildError, PlatformSkipped, build_fmu,
                     check_platforms)
-from .entry import STOPPING_SIGNALS
-from .signal import DEFAULT_MAX_STEPS
+from .stop_signals import STOPPING_SIGNALS, Stopped, stop_on_signals
 from .sweep import DEFAULT_MAX_CASES
+from .torque_schedule import DEFAULT_MAX_STEPS
 
 TUTORIAL_TORQUE = 20.0
 
@@ -116,7 +116,7 @@ def cmd_cross_check(args) -> int:
 
 def cmd_simulate(args) -> int:
     from . import results
-    from .files import replacing
+    from .atomic_files import replacing
     from .plot import plot_overlay
     from .simulate import simulate
 
@@ -173,27 +173,6 @@ def _sweep_values(assignments) -> dict[str, list[float]]:
     return values
 
 
-class _Stopped(BaseException):
-    """SIGINT or SIGTERM, raised where the program is, so that every file being written is
-    cleaned up on the way out (a BaseException, so no `except Exception` swallows it)."""
-
-    def __init__(self, signal_number: int):
-        super().__init__(signal_number)
-        self.signal_number = signal_number
-
-
-def _stop_on_signals():
-    """Make SIGINT and SIGTERM raise _Stopped once; further ones are ignored so the cleanup that
-    follows (closing the cluster, removing temporaries) runs to its end. Returns the old handlers."""
-
-    def stop(number, frame):
-        for name in STOPPING_SIGNALS:
-            signal.signal(name, signal.SIG_IGN)
-        raise _Stopped(number)
-
-    return {name: signal.signal(name, stop) for name in STOPPING_SIGNALS}
-
-
 def _sweep_outputs(text: str) -> tuple[str, ...]:
     return () if text.strip() == "none" else tuple(name.strip() for name in text.split(","))
 
@@ -209,7 +188,7 @@ def cmd_sweep(args) -> int:
                             resume=args.resume, scheduler=args.scheduler, workers=args.workers,
                             connect_timeout=args.connect_timeout, fmu_path=args.fmu,
                             max_cases=args.max_cases)
-    except _Stopped as stopped:
+    except Stopped as stopped:
         what = STOPPING_SIGNALS[stopped.signal_number]
         print(f"pendulum-fmu sweep: {what}; the chunks that finished are kept in {args.output_dir}: "
               "run the same command with --resume to run the rest", file=sys.stderr)
@@ -391,7 +370,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
-    from .signal import TorqueFileError
+    from .torque_schedule import TorqueFileError
     from .simulate import FmuError
 
     args = build_parser().parse_args(argv)
@@ -405,12 +384,12 @@ def main(argv=None) -> int:
             shown(message, category, *where, **more)
 
     # Signal handlers can only be set from the main thread; elsewhere Ctrl-C stays Python's.
-    previous = _stop_on_signals() if threading.current_thread() is threading.main_thread() else {}
+    previous = stop_on_signals() if threading.current_thread() is threading.main_thread() else {}
     try:
         with warnings.catch_warnings():
             warnings.showwarning = one_line
             return args.run(args)
-    except (_Stopped, KeyboardInterrupt) as stopped:
+    except (Stopped, KeyboardInterrupt) as stopped:
         if args.debug:
             raise
         number = getattr(stopped, "signal_number", signal.SIGINT)
@@ -430,9 +409,3 @@ def main(argv=None) -> int:
     finally:
         for number, handler in previous.items():
             signal.signal(number, handler)
-
-
-if __name__ == "__main__":
-    from .entry import run
-
-    run()

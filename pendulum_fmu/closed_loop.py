@@ -20,7 +20,8 @@ from fmpy.model_description import CoSimulation, DefaultExperiment, ModelDescrip
 from scipy.integrate import solve_ivp
 
 from .build import PID_CONTROLLER_DIR, build_fmu, build_pid_controller
-from .parameters import resolve_parameters, total_inertia
+from .parameters import total_inertia
+from .simulate import resolve_parameters
 
 # Pendulum output -> controller input, and back.
 WIRES = (("pendulum", "theta", "controller", "theta"),

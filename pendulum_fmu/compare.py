@@ -1,6 +1,6 @@
 """One torque signal through several tools, each judged against the independent oracle.
 
-Every tool is fed the schedule that `signal.schedule` makes of the user's signal. The
+Every tool is fed the schedule that `torque_schedule.schedule` makes of the user's signal. The
 reference (`reference.reference`) reads the signal itself and shares no code with that schedule,
 so a schedule that does not carry the signal shows as a difference: in theta and omega, and in
 the torque each tool received against the signal's value at the start of each step.
@@ -17,12 +17,12 @@ from pathlib import Path
 
 import numpy as np
 
-from .files import replacing
-from .parameters import resolve_parameters
+from .atomic_files import replacing
+from .compare_tools import ToolSpecError, parse_tools
 from .plot import plot_comparison
 from .reference import reference
-from .signal import TorqueSchedule, TorqueSignal, schedule
-from .tools import ToolSpecError, parse_tools
+from .simulate import resolve_parameters
+from .torque_schedule import TorqueSchedule, TorqueSignal, schedule
 
 REFERENCE = "reference"
 TOOLS = ("fmu", REFERENCE, "opensim")
@@ -35,7 +35,7 @@ def run_tools(plan: TorqueSchedule, tools, *, parameters: dict | None = None, th
               omega0: float = 0.0, fmu_path: str | Path | None = None,
               mapping: str | None = None) -> dict[str, np.ndarray]:
     """{tool label: result array} for the same schedule, parameters and start values; tools as
-    --tools gives them (see tools.py), mapping the --map of other FMUs. "reference" here is
+    --tools gives them (see compare_tools.py), mapping the --map of other FMUs. "reference" here is
     reference_schedule: the schedule's own torques through scipy."""
     parsed = parse_tools(tools, mapping=mapping, fmu_path=fmu_path)
     # Every tool gets the whole set, so the defaults are fmu_path's for all of them.
@@ -135,7 +135,7 @@ def compare(torque: TorqueSignal, tools=TOOLS, *, output_dir: str | Path, step_s
             mapping: str | None = None, max_steps: int | None = None) -> Comparison:
     """Run one signal through each tool and judge each against the reference.
 
-    tools: as --tools gives them (tools.py): fmu, reference, opensim, mujoco, drake, pybullet
+    tools: as --tools gives them (compare_tools.py): fmu, reference, opensim, mujoco, drake, pybullet
     (NAME:default for an engine's own defaults), LABEL=path/to/Their.fmu with mapping the --map.
     The reference is the independent oracle reading the signal itself; it always runs, as the
     judge, whether or not `tools` names it. Writes to output_dir:

@@ -18,11 +18,11 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__, default_fmu
+from .atomic_files import replacing, replacing_path
 from .build import PLATFORMS
-from .files import replacing, replacing_path
 from .parameters import model_description
-from .signal import TorqueTable
 from .simulate import simulate
+from .torque_schedule import TorqueTable
 
 START_TIME, STOP_TIME, STEP_SIZE, RELATIVE_TOLERANCE = 0.0, 4.0, 1e-3, 1e-10
 # The torque in N.m from the start, then (time of a jump, torque after it).

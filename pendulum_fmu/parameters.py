@@ -23,7 +23,7 @@ def _read(path: str, modified_ns: int):
 
 
 def _described(fmu_path: str | Path | None):
-    path = _fmu_file(fmu_path)
+    path = fmu_file(fmu_path)
     try:
         modified_ns = path.stat().st_mtime_ns
     except OSError as error:
@@ -53,7 +53,7 @@ def default_parameters(fmu_path: str | Path | None = None) -> dict[str, float]:
 def merged_parameters(overrides: dict[str, float] | None = None,
                       fmu_path: str | Path | None = None) -> dict[str, float]:
     """The FMU's defaults with overrides applied; unknown names and non-finite values are refused.
-    What the FMU itself refuses is left to it: see resolve_parameters."""
+    What the FMU itself refuses is left to it: see simulate.resolve_parameters."""
     parameters = default_parameters(fmu_path)
     for name, value in (overrides or {}).items():
         if name not in parameters:
@@ -65,42 +65,12 @@ def merged_parameters(overrides: dict[str, float] | None = None,
     return parameters
 
 
-def resolve_parameters(overrides: dict[str, float] | None = None,
-                       fmu_path: str | Path | None = None) -> dict[str, float]:
-    """merged_parameters, and a set the FMU accepts.
-
-    The physical checks (mass > 0, an inertia about the pivot > 0, ...) live in one place, the
-    FMU's model.c, and every tool goes through them here: the FMU, the scipy reference, OpenSim,
-    the engines. Each refuses a bad set with the FMU's own message, word for word.
-    """
-    parameters = merged_parameters(overrides, fmu_path)
-    path = _fmu_file(fmu_path)
-    refusal = _refusal(str(path.resolve()), path.stat().st_mtime_ns, tuple(parameters.items()))
-    if refusal:
-        raise ValueError(refusal)
-    return parameters
-
-
-def _fmu_file(fmu_path: str | Path | None) -> Path:
+def fmu_file(fmu_path: str | Path | None) -> Path:
+    """The FMU file a function here is about: fmu_path, or pendulum_fmu.default_fmu()."""
     if fmu_path is None:
         from . import default_fmu
         return default_fmu()
     return Path(fmu_path)
-
-
-@lru_cache(maxsize=256)
-def _refusal(fmu: str, modified_ns: int, items: tuple) -> str | None:
-    """What the FMU says when it refuses these parameters at initialization, or None."""
-    from .simulate import FmuError, open_fmu
-
-    try:
-        slave = open_fmu(fmu, parameters=dict(items))
-    except FmuError as error:
-        # "initialization failed: [ERROR] fmi2ExitInitializationMode: mass must be > 0"
-        return f"the FMU refuses the parameters: {str(error).rsplit(': ', 1)[-1]}"
-    slave.terminate()
-    slave.freeInstance()
-    return None
 
 
 def total_inertia(parameters: dict[str, float]) -> float:

@@ -1,6 +1,6 @@
 """The independent oracle: a torque signal as docs/signals.md defines it, through scipy.
 
-`reference()` shares no code with the path that feeds the tools (`signal.schedule`). It reads a
+`reference()` shares no code with the path that feeds the tools (`torque_schedule.schedule`). It reads a
 CSV with its own small reader, keeps the times as exact fractions of the decimals written in the
 file, and finds the communication points and the torque of each step from the written
 definition. A schedule that does not carry the user's signal to the tools then shows as a
@@ -24,7 +24,8 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from . import results
-from .parameters import resolve_parameters, total_inertia
+from .parameters import total_inertia
+from .simulate import resolve_parameters
 
 # docs/signals.md: an event within max(1e-9 step, 64 ulp of its time) of a communication point
 # is that point. Written again here on purpose: the oracle must not borrow the schedule's code.

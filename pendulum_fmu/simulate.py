@@ -8,6 +8,7 @@ import itertools
 import tempfile
 import threading
 import weakref
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -16,8 +17,8 @@ from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
 from fmpy.fmi3 import FMU3Slave
 
 from . import cs_loop, default_fmu, results
-from .parameters import merged_parameters, model_description, resolve_parameters, value_reference
-from .signal import TorqueSignal, TorqueSchedule, schedule
+from .parameters import fmu_file, merged_parameters, model_description, value_reference
+from .torque_schedule import TorqueSignal, TorqueSchedule, schedule
 
 _STATUS = ["OK", "WARNING", "DISCARD", "ERROR", "FATAL", "PENDING"]
 # What a result records at every communication point, read back from the FMU after the step's
@@ -132,7 +133,7 @@ def initialize(slave: FMU2Slave | FMU3Slave, *, parameters: dict | None = None, 
                omega0: float = 0.0, tolerance: float | None = None, start_time: float = 0.0) -> None:
     """Set the parameters and start values of an instantiated (or reset) slave from open_fmu and
     leave it in step mode; FmuError says why the FMU refused."""
-    # The FMU checks the parameters itself, here as everywhere (parameters.resolve_parameters).
+    # The FMU checks the parameters itself, here as everywhere (resolve_parameters).
     start = {**merged_parameters(parameters, slave.fmu_path), "theta": float(theta0), "omega": float(omega0)}
     references = [value_reference(n, slave.fmu_path) for n in start]
     try:
@@ -248,7 +249,7 @@ def simulate(torque: TorqueSignal = 20.0, *, start_time: float = 0.0, stop_time:
     value just after its start, or ramps (ramp=True) through fmi2SetRealInputDerivatives along
     the CSV's own piecewise-linear signal. parameters: overrides of mass, length, inertia, gravity, damping.
     tolerance: relative tolerance for fmi2SetupExperiment (None: the FMU's 1e-10).
-    max_steps: the longest run accepted (default signal.DEFAULT_MAX_STEPS); a longer one, or one
+    max_steps: the longest run accepted (default torque_schedule.DEFAULT_MAX_STEPS); a longer one, or one
     that would not fit in memory, is refused before anything is allocated.
     Returns a structured array with fields time, torque, theta, omega, alpha (see results.py).
     """
@@ -274,3 +275,32 @@ def simulate_plan(plan: TorqueSchedule, *, parameters: dict | None = None, theta
     finally:
         slave.terminate()
         slave.freeInstance()
+
+
+def resolve_parameters(overrides: dict[str, float] | None = None,
+                       fmu_path: str | Path | None = None) -> dict[str, float]:
+    """parameters.merged_parameters, and a set the FMU accepts.
+
+    The physical checks (mass > 0, an inertia about the pivot > 0, ...) live in one place, the
+    FMU's model.c, and every tool goes through them here: the FMU, the scipy reference, OpenSim,
+    the engines. Each refuses a bad set with the FMU's own message, word for word.
+    """
+    parameters = merged_parameters(overrides, fmu_path)
+    path = fmu_file(fmu_path)
+    refusal = _refusal(str(path.resolve()), path.stat().st_mtime_ns, tuple(parameters.items()))
+    if refusal:
+        raise ValueError(refusal)
+    return parameters
+
+
+@lru_cache(maxsize=256)
+def _refusal(fmu: str, modified_ns: int, items: tuple) -> str | None:
+    """What the FMU says when it refuses these parameters at initialization, or None."""
+    try:
+        slave = open_fmu(fmu, parameters=dict(items))
+    except FmuError as error:
+        # "initialization failed: [ERROR] fmi2ExitInitializationMode: mass must be > 0"
+        return f"the FMU refuses the parameters: {str(error).rsplit(': ', 1)[-1]}"
+    slave.terminate()
+    slave.freeInstance()
+    return None

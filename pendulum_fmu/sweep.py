@@ -44,10 +44,10 @@ import numpy as np
 
 from . import cs_loop
 from . import default_fmu
-from .files import TEMPORARY_GLOB, held_lock, replacing_on
+from .atomic_files import TEMPORARY_GLOB, held_lock, replacing_on
 from .parameters import START_VALUES, default_parameters, value_reference
-from .signal import TorqueSchedule, communication_points
 from .simulate import RECORDED, FmuError, initialize, open_fmu, run_schedule_python
+from .torque_schedule import TorqueSchedule, communication_points
 
 OUTPUTS = RECORDED[1:]  # theta, omega, alpha
 FORMATS = ("parquet", "csv")
@@ -362,7 +362,7 @@ def _remove(study: _Study, patterns) -> None:
 
 def _remove_unfinished(study: _Study) -> None:
     """What interrupted chunks leave: the temporaries of writes cut short (a killed worker, see
-    files.py), and trajectory parts whose chunk did not get to write its cases part."""
+    atomic_files.py), and trajectory parts whose chunk did not get to write its cases part."""
     _remove(study, (TEMPORARY_GLOB, f"trajectories/{TEMPORARY_GLOB}", f"cases/{TEMPORARY_GLOB}"))
     done = _done_chunks(study)
     for index, path in _parts(study, "trajectories").items():

@@ -50,7 +50,7 @@ def test_simulate_torque_file(tmp_path):
 
 
 def test_argument_errors_exit_2_without_traceback():
-    result = subprocess.run([sys.executable, "-m", "pendulum_fmu.cli", "simulate", "--torque", "abc"],
+    result = subprocess.run([sys.executable, "-m", "pendulum_fmu", "simulate", "--torque", "abc"],
                             capture_output=True, text=True)
     assert result.returncode == 2
     assert "'abc' is not a number" in result.stderr and "Traceback" not in result.stderr

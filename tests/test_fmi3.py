@@ -18,8 +18,8 @@ from pendulum_fmu.build import MODEL_DESCRIPTION
 from pendulum_fmu.cli import main
 from pendulum_fmu.parameters import default_parameters, total_inertia
 from pendulum_fmu.reference import reference, reference_schedule
-from pendulum_fmu.signal import TorqueSchedule, schedule
 from pendulum_fmu.simulate import open_fmu, run_schedule, simulate
+from pendulum_fmu.torque_schedule import TorqueSchedule, schedule
 
 TORQUE, THETA, OMEGA, ALPHA, MASS, DAMPING = 0, 1, 2, 3, 4, 8
 TIME = 9  # the independent variable's value reference in the FMI 3.0 description

@@ -26,8 +26,8 @@ from pendulum_fmu import default_fmu
 from pendulum_fmu.cli import main
 from pendulum_fmu.parameters import value_reference
 from pendulum_fmu.reference import reference, reference_schedule
-from pendulum_fmu.signal import TorqueTable, schedule
 from pendulum_fmu.sweep import OUTPUTS, run_sweep, sweep_grid
+from pendulum_fmu.torque_schedule import TorqueTable, schedule
 
 I_TOTAL = 20.0 + 40.0 * 0.5**2  # the tutorial's pendulum about its pivot
 STOP_TIME, STEP_SIZE = 0.5, 1e-3
@@ -257,7 +257,7 @@ def test_output_to_fsspec_memory(threads_scheduler):
 def test_a_failed_write_to_a_url_leaves_neither_file_nor_temporary():
     import fsspec
 
-    from pendulum_fmu.files import replacing_on
+    from pendulum_fmu.atomic_files import replacing_on
 
     filesystem = fsspec.filesystem("memory")
     with replacing_on(filesystem, "/writes/kept.bin") as file:
@@ -369,7 +369,7 @@ def test_an_unreachable_or_wrong_scheduler_is_one_line_within_the_timeout(tmp_pa
 
 def _sweep_command(output_dir, *arguments):
     default_fmu()  # built (when stale) here once, not by every process at once
-    return [sys.executable, "-m", "pendulum_fmu.cli", "sweep", "--output-dir", str(output_dir), *arguments]
+    return [sys.executable, "-m", "pendulum_fmu", "sweep", "--output-dir", str(output_dir), *arguments]
 
 
 @pytest.mark.parametrize("signal_number, code, word", [(signal.SIGINT, 130, "interrupted"),

@@ -17,8 +17,8 @@ from typing import Callable
 import numpy as np
 
 from .. import results
-from ..parameters import resolve_parameters
-from ..signal import TorqueSchedule
+from ..simulate import resolve_parameters
+from ..torque_schedule import TorqueSchedule
 
 MODES = ("accurate", "default")
 

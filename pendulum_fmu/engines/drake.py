@@ -28,8 +28,8 @@ from pydrake.multibody.tree import FixedOffsetFrame, RevoluteJoint, SpatialInert
 from pydrake.systems.analysis import ResetIntegratorFromFlags, Simulator
 from pydrake.systems.framework import DiagramBuilder
 
-from ..signal import TorqueSchedule
 from . import held_results, runner
+from ..torque_schedule import TorqueSchedule
 
 
 @dataclass(frozen=True)

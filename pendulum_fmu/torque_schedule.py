@@ -227,7 +227,7 @@ def write_torque_csv(path: str | Path, plan: TorqueSchedule) -> Path:
     """Write a schedule in fmpy's convention: a row where each run of equal steps starts and
     ends, so a held torque reads as steps and a ramp as a line. Times are written with 17
     significant digits, so they read back as the same doubles."""
-    from .files import replacing
+    from .atomic_files import replacing
 
     end = plan.torque + plan.torque_rate * plan.step_size
     points = []

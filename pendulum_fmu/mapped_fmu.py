@@ -30,10 +30,9 @@ from fmpy.fmi2 import FMU2Slave
 from fmpy.fmi3 import FMU3Slave
 
 from .engines import check_held, check_mode, held_results
-from .parameters import (START_VALUES, default_parameters, model_description, resolve_parameters,
-                         variables)
-from .signal import TorqueSchedule
-from .simulate import RECORDED, _unzipped
+from .parameters import START_VALUES, default_parameters, model_description, variables
+from .simulate import RECORDED, _unzipped, resolve_parameters
+from .torque_schedule import TorqueSchedule
 
 OUTPUTS = RECORDED[1:]  # theta, omega, alpha
 REQUIRED = ("torque", "theta")
@@ -79,7 +78,7 @@ def parse_map(text: str | None) -> dict[str, Mapped]:
     return mapping
 
 
-class OtherFmu:
+class MappedFmu:
     """An FMU and its map, checked once; run() has the runner signature of every tool."""
 
     def __init__(self, path: str | Path, mapping: dict[str, Mapped] | str | None = None, *,
