@@ -178,30 +178,30 @@ def _sweep_outputs(text: str) -> tuple[str, ...]:
 
 
 def cmd_sweep(args) -> int:
-    from .sweep import run_sweep, sweep_grid
+    from .sweep import Study, run_sweep, sweep_grid
 
-    cases = sweep_grid(args.torque, args.gravity, _sweep_values(args.assignments))
+    study = Study(sweep_grid(args.torque, args.gravity, _sweep_values(args.assignments)),
+                  stop_time=args.stop_time, step_size=args.step_size,
+                  outputs=_sweep_outputs(args.outputs), output_interval=args.output_interval,
+                  format=args.format, fmu_path=args.fmu)
     try:
-        summary = run_sweep(cases, output_dir=args.output_dir, stop_time=args.stop_time,
-                            step_size=args.step_size, outputs=_sweep_outputs(args.outputs),
-                            output_interval=args.output_interval, format=args.format,
-                            resume=args.resume, scheduler=args.scheduler, workers=args.workers,
-                            connect_timeout=args.connect_timeout, fmu_path=args.fmu,
-                            max_cases=args.max_cases)
+        result = run_sweep(study, output_dir=args.output_dir, resume=args.resume,
+                           scheduler=args.scheduler, workers=args.workers,
+                           connect_timeout=args.connect_timeout, max_cases=args.max_cases)
     except Stopped as stopped:
         what = STOPPING_SIGNALS[stopped.signal_number]
         print(f"pendulum-fmu sweep: {what}; the chunks that finished are kept in {args.output_dir}: "
               "run the same command with --resume to run the rest", file=sys.stderr)
         return 128 + stopped.signal_number
-    resumed = summary["chunks_run"] < summary["chunks"]
-    print(f"{summary['cases']} cases in {summary['seconds']:.1f} s"
-          + (f" ({summary['chunks_run']} of {summary['chunks']} chunks run; the others were "
+    resumed = result.chunks_run < result.chunks
+    print(f"{result.cases} cases in {result.seconds:.1f} s"
+          + (f" ({result.chunks_run} of {result.chunks} chunks run; the others were "
              "written by an earlier run)" if resumed else ""))
-    for key in ("trajectories", "cases_table", "figure"):
-        print(f"wrote {summary[key]}")
-    if summary["failed"]:
+    for path in (result.trajectories, result.cases_table, result.figure):
+        print(f"wrote {path}")
+    if result.failed:
         # The other cases ran and are written; a script still learns that some did not.
-        print(f"pendulum-fmu sweep: {summary['failed']} of {summary['cases']} cases failed: their "
+        print(f"pendulum-fmu sweep: {result.failed} of {result.cases} cases failed: their "
               "status and message are in the cases table", file=sys.stderr)
         return 1
     return 0
@@ -212,7 +212,7 @@ def cmd_demo(args) -> int:
     from .compare import compare
     from .parameters import default_parameters, total_inertia
     from .plot import plot_overlay
-    from .sweep import run_sweep, sweep_grid
+    from .sweep import Study, run_sweep, sweep_grid
 
     out = Path(args.output_dir)
     tools = ["fmu", "reference"]
@@ -241,10 +241,10 @@ def cmd_demo(args) -> int:
                            out / "gravity_effect.png", "Effect of Gravity on Torque-Driven Pendulum")
     print(f"\nwrote {overlay}")
     print("\nParameter study: torque 5, 10, 20, 40 N.m with gravity, on a local dask cluster")
-    summary = run_sweep(sweep_grid([5.0, 10.0, 20.0, 40.0], [9.81]), output_dir=out / "parameter_study",
-                        workers=args.workers)
-    print(f"{summary['cases']} cases in {summary['seconds']:.1f} s\nwrote {summary['cases_table']}\n"
-          f"wrote {summary['figure']}")
+    result = run_sweep(Study(sweep_grid([5.0, 10.0, 20.0, 40.0], [9.81])),
+                       output_dir=out / "parameter_study", workers=args.workers)
+    print(f"{result.cases} cases in {result.seconds:.1f} s\nwrote {result.cases_table}\n"
+          f"wrote {result.figure}")
     return 0 if agree else 1
 
 

@@ -19,6 +19,7 @@ import numpy as np
 
 from .atomic_files import replacing
 from .compare_tools import ToolSpecError, parse_tools
+from .errors import InvalidInput
 from .plot import plot_comparison
 from .reference import reference
 from .simulate import resolve_parameters
@@ -46,7 +47,7 @@ def run_tools(plan: TorqueSchedule, tools, *, parameters: dict | None = None, th
 
 def check_tolerance(tolerance: float) -> float:
     if not (math.isfinite(tolerance) and tolerance > 0):
-        raise ValueError(f"the tolerance {tolerance} must be a positive finite number (rad, rad/s)")
+        raise InvalidInput(f"the tolerance {tolerance} must be a positive finite number (rad, rad/s)")
     return float(tolerance)
 
 

@@ -27,12 +27,13 @@ import numpy as np
 
 from . import results
 from .engines import MODES, check_held, check_mode
+from .errors import InvalidInput
 from .reference import reference_schedule
 from .simulate import resolve_parameters, simulate_plan
 from .torque_schedule import TorqueSchedule
 
 
-class ToolSpecError(ValueError):
+class ToolSpecError(InvalidInput):
     """A --tools or --map that names no runnable tool; the message says which and what to do."""
 
 

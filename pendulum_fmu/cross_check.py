@@ -20,6 +20,7 @@ import numpy as np
 from . import __version__, default_fmu
 from .atomic_files import replacing, replacing_path
 from .build import PLATFORMS
+from .errors import InvalidInput
 from .parameters import model_description
 from .simulate import simulate
 from .torque_schedule import TorqueTable
@@ -73,7 +74,7 @@ def write_cross_check(output_dir: str | Path, fmu_path: str | Path | None = None
         platforms = sorted({name.split("/")[1] for name in archive.namelist()
                             if name.startswith("binaries/") and name.count("/") == 2 and not name.endswith("/")})
     if not platforms:
-        raise ValueError(f"{fmu} carries no binaries: a cross-check needs one to run")
+        raise InvalidInput(f"{fmu} carries no binaries: a cross-check needs one to run")
     rows = _input_rows()
     torque = TorqueTable(np.array([t for t, _ in rows]), np.array([u for _, u in rows]))
     run = simulate(torque, start_time=START_TIME, stop_time=STOP_TIME, step_size=STEP_SIZE,

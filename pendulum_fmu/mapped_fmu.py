@@ -30,8 +30,9 @@ from fmpy.fmi2 import FMU2Slave
 from fmpy.fmi3 import FMU3Slave
 
 from .engines import check_held, check_mode, held_results
+from .errors import InvalidInput
 from .parameters import START_VALUES, default_parameters, model_description, variables
-from .simulate import RECORDED, _unzipped, resolve_parameters
+from .simulate import RECORDED, FmuError, _unzipped, resolve_parameters
 from .torque_schedule import TorqueSchedule
 
 OUTPUTS = RECORDED[1:]  # theta, omega, alpha
@@ -41,7 +42,7 @@ TOLERANCE = {"accurate": 1e-12, "default": None}
 _FACTOR = re.compile(r"^(?P<variable>.+?)\*(?P<factor>[-+0-9.eE]+)$")
 
 
-class MapError(ValueError):
+class MapError(InvalidInput):
     """A --map or an FMU that does not fit it; the message says which and what to do."""
 
 
@@ -196,7 +197,7 @@ class MappedFmu:
             recorded[-1] = get_values(output_vrs)
             slave.terminate()
         except Exception as error:
-            raise RuntimeError(f"{self.label}: {call} failed: {error}") from None
+            raise FmuError(f"{self.label}: {call} failed: {error}") from None
         finally:
             slave.freeInstance()
         return {name: recorded[:, i] for i, name in enumerate(outputs)}
@@ -221,10 +222,10 @@ class MappedFmu:
                                output_interval=float(plan.step_size.min()), input=signal,
                                output=list(outputs.values()), start_values=start)
         except Exception as error:
-            raise RuntimeError(f"{self.label}: Model Exchange simulation failed: {error}") from None
+            raise FmuError(f"{self.label}: Model Exchange simulation failed: {error}") from None
         # At a jump fmpy records the time twice; the row after the event is the one whose outputs
         # see the new torque.
         rows = np.searchsorted(raw["time"], plan.time + 1e-9 * plan.step_size.min(), side="right") - 1
         if np.any(np.abs(raw["time"][rows] - plan.time) > 1e-9 * plan.step_size.min()):
-            raise RuntimeError(f"{self.label}: fmpy did not report every communication point")
+            raise FmuError(f"{self.label}: fmpy did not report every communication point")
         return {name: raw[variable][rows] for name, variable in outputs.items()}

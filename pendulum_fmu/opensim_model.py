@@ -11,6 +11,8 @@ import os
 
 import numpy as np
 
+from .errors import InvalidInput, MissingDependency
+
 
 def _import_opensim():
     # Importing opensim otherwise drops an opensim.log into the working directory.
@@ -18,7 +20,7 @@ def _import_opensim():
     try:
         import opensim
     except ImportError as error:
-        raise ImportError(
+        raise MissingDependency(
             "opensim_simulate needs the OpenSim Python package; "
             "install the extra: pip install '.[opensim]'"
         ) from error
@@ -91,11 +93,11 @@ def opensim_simulate(time, torque, *, mass=40.0, length=0.5, inertia=20.0, gravi
     time = np.asarray(time, dtype=float)
     torque = np.asarray(torque, dtype=float)
     if time.ndim != 1 or time.size < 2:
-        raise ValueError("time must be a 1-D array of at least two points")
+        raise InvalidInput("time must be a 1-D array of at least two points")
     if torque.shape != (time.size - 1,):
-        raise ValueError("torque must hold one value per step: len(time) - 1")
+        raise InvalidInput("torque must hold one value per step: len(time) - 1")
     if np.any(np.diff(time) <= 0):
-        raise ValueError("time must be strictly increasing")
+        raise InvalidInput("time must be strictly increasing")
 
     model, coordinate, actuator = _build_pendulum_model(
         osim, mass, length, inertia, gravity, damping)

@@ -12,6 +12,8 @@ from pathlib import Path
 
 from fmpy import read_model_description
 
+from .errors import InvalidInput, MissingFile
+
 # The start values a user gives, and the FMU's variables they start.
 START_VALUES = {"theta0": "theta", "omega0": "omega"}
 
@@ -27,7 +29,7 @@ def _described(fmu_path: str | Path | None):
     try:
         modified_ns = path.stat().st_mtime_ns
     except OSError as error:
-        raise FileNotFoundError(f"FMU {path}: {error.strerror}") from None
+        raise MissingFile(f"FMU {path}: {error.strerror}") from None
     return _read(str(path.resolve()), modified_ns)
 
 
@@ -57,10 +59,10 @@ def merged_parameters(overrides: dict[str, float] | None = None,
     parameters = default_parameters(fmu_path)
     for name, value in (overrides or {}).items():
         if name not in parameters:
-            raise ValueError(f"unknown parameter {name!r}: the parameters are {', '.join(parameters)}")
+            raise InvalidInput(f"unknown parameter {name!r}: the parameters are {', '.join(parameters)}")
         value = float(value)
         if not math.isfinite(value):
-            raise ValueError(f"parameter {name} = {value} must be finite")
+            raise InvalidInput(f"parameter {name} = {value} must be finite")
         parameters[name] = value
     return parameters
 

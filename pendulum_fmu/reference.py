@@ -24,6 +24,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from . import results
+from .errors import InvalidInput
 from .parameters import total_inertia
 from .simulate import resolve_parameters
 
@@ -139,7 +140,7 @@ def _signal_pieces(torque, start: Fraction, stop: Fraction | None, step: Fractio
         values = [float(u) for u in torque]
         points = _grid(start, start + len(values) * step if stop is None else stop, step)
         if len(points) - 1 != len(values):
-            raise ValueError(f"the torque array has {len(values)} values for {len(points) - 1} steps")
+            raise InvalidInput(f"the torque array has {len(values)} values for {len(points) - 1} steps")
     else:
         points = _grid(start, _DEFAULT_STOP_TIME if stop is None else stop, step)
         sample = torque if callable(torque) else (lambda t, u=float(torque): u)
@@ -223,10 +224,10 @@ def reference(torque=20.0, *, start_time: float = 0.0, stop_time: float | None =
     points). Same result format as simulate().
     """
     if not (isinstance(torque, (str, Path, list, tuple, np.ndarray, int, float)) or callable(torque)):
-        raise ValueError(f"the reference takes a constant, a callable, a per-step array or a CSV path, "
+        raise InvalidInput(f"the reference takes a constant, a callable, a per-step array or a CSV path, "
                          f"not a {type(torque).__name__}: it reads the signal itself")
     if isinstance(torque, (list, tuple, np.ndarray)) and ramp:
-        raise ValueError("a per-step torque array is held over each step; ramp needs a CSV or a callable")
+        raise InvalidInput("a per-step torque array is held over each step; ramp needs a CSV or a callable")
     step = _exact(step_size)
     start = _exact(start_time)
     pieces = _signal_pieces(torque, start, None if stop_time is None else _exact(stop_time), step, ramp)

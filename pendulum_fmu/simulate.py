@@ -17,6 +17,7 @@ from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
 from fmpy.fmi3 import FMU3Slave
 
 from . import cs_loop, default_fmu, results
+from .errors import InvalidInput, PendulumFmuError
 from .parameters import fmu_file, merged_parameters, model_description, value_reference
 from .torque_schedule import TorqueSignal, TorqueSchedule, schedule
 
@@ -26,7 +27,7 @@ _STATUS = ["OK", "WARNING", "DISCARD", "ERROR", "FATAL", "PENDING"]
 RECORDED = ("torque", "theta", "omega", "alpha")
 
 
-class FmuError(RuntimeError):
+class FmuError(PendulumFmuError, RuntimeError):
     """An FMI call failed; the message carries what the FMU logged."""
 
 
@@ -188,7 +189,7 @@ def run_schedule_python(slave: FMU2Slave | FMU3Slave, plan: TorqueSchedule) -> n
     dll, messages, fmi3 = slave.dll, slave.messages, slave.fmi_version == 3
     ramped = bool(np.any(plan.torque_rate))
     if fmi3 and ramped:
-        raise ValueError("FMI 3.0 has no input derivatives, so an FMI 3.0 FMU cannot ramp the "
+        raise InvalidInput("FMI 3.0 has no input derivatives, so an FMI 3.0 FMU cannot ramp the "
                          "torque: hold it over each step (no --ramp), or use the FMI 2.0 FMU")
     names = (("fmi3SetFloat64", "fmi3GetFloat64", None, "fmi3DoStep") if fmi3 else
              ("fmi2SetReal", "fmi2GetReal", "fmi2SetRealInputDerivatives", "fmi2DoStep"))
@@ -289,7 +290,7 @@ def resolve_parameters(overrides: dict[str, float] | None = None,
     path = fmu_file(fmu_path)
     refusal = _refusal(str(path.resolve()), path.stat().st_mtime_ns, tuple(parameters.items()))
     if refusal:
-        raise ValueError(refusal)
+        raise InvalidInput(refusal)
     return parameters
 
 

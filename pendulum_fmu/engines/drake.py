@@ -29,6 +29,7 @@ from pydrake.systems.analysis import ResetIntegratorFromFlags, Simulator
 from pydrake.systems.framework import DiagramBuilder
 
 from . import held_results, runner
+from ..errors import InvalidInput
 from ..torque_schedule import TorqueSchedule
 
 
@@ -48,7 +49,7 @@ class Setup:
 SETUPS = {"accurate": Setup(discrete=False), "default": Setup(discrete=True)}
 
 
-class UnequalSteps(ValueError):
+class UnequalSteps(InvalidInput):
     """Drake's discrete plant has one period; default mode needs equal communication steps."""
 
 
