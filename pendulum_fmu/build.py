@@ -32,6 +32,7 @@ from fmpy import read_model_description
 
 from . import FMU_FILES, __version__, fmi3
 from .atomic_files import replacing_path
+from .errors import PendulumFmuError
 
 ROOT = Path(__file__).resolve().parent.parent
 SOURCE_DIR = ROOT / "fmu_src"
@@ -85,7 +86,7 @@ PLATFORMS = {platform.fmi2_folder: platform for platform in (
 )}
 
 
-class BuildError(RuntimeError):
+class BuildError(PendulumFmuError, RuntimeError):
     """The FMU could not be built; the message says why."""
 
 

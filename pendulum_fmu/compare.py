@@ -181,3 +181,12 @@ def compare(torque: TorqueSignal, tools=TOOLS, *, output_dir: str | Path, step_s
         figure=plot_comparison(runs, output_dir / "comparison.png",
                                title or f"Torque-driven pendulum: {', '.join(runs)}"),
     )
+
+
+def format_comparison(comparison: Comparison) -> str:
+    """The table of differences and the verdict, as the command line prints them."""
+    verdict = "agree" if comparison.agree else "DIFFER"
+    return (f"{format_table(comparison.differences)}\n"
+            f"tools {verdict}: worst difference {comparison.worst:.3e} against tolerance "
+            f"{comparison.tolerance:g}; torque received vs the signal: {comparison.torque_worst:.3e} "
+            f"N.m (allowed {comparison.torque_limit:.1e})")

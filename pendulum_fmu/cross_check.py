@@ -84,8 +84,8 @@ def write_cross_check(output_dir: str | Path, fmu_path: str | Path | None = None
     computed_on = next((name for name, platform in PLATFORMS.items() if platform.native), "this machine's")
     folders = []
     for platform in platforms:
+        # Each write below makes the folder, or says in one line why it cannot.
         folder = Path(output_dir, "fmus", description.fmiVersion, "cs", platform, TOOL, __version__, model_name)
-        folder.mkdir(parents=True, exist_ok=True)
         with replacing_path(folder / f"{model_name}.fmu") as copy:
             shutil.copyfile(fmu, copy)
         _write_csv(folder / f"{model_name}_in.csv", ("time", "torque"),

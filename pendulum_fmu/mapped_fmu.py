@@ -89,8 +89,8 @@ class MappedFmu:
             raise MapError(f"{label}: no FMU at {self.path}")
         try:
             self.description = model_description(self.path)
-        except Exception as error:
-            raise MapError(f"{label}: {self.path} is not a readable FMU: {error}") from None
+        except InvalidInput as error:  # "FMU ... cannot be read: ..."
+            raise MapError(f"{label}: {error}") from None
         if self.description.fmiVersion not in ("2.0", "3.0"):
             raise MapError(f"{label}: {self.path} is FMI {self.description.fmiVersion}; "
                            "only FMI 2.0 and 3.0 FMUs can be compared")

@@ -30,7 +30,11 @@ def _described(fmu_path: str | Path | None):
         modified_ns = path.stat().st_mtime_ns
     except OSError as error:
         raise MissingFile(f"FMU {path}: {error.strerror}") from None
-    return _read(str(path.resolve()), modified_ns)
+    try:
+        return _read(str(path.resolve()), modified_ns)
+    except Exception as error:  # fmpy's, whatever the file is instead: no zip, no or bad XML
+        raise InvalidInput(f"FMU {path} cannot be read: {error}; pass an FMI 2.0 or 3.0 FMU "
+                           "file") from None
 
 
 def model_description(fmu_path: str | Path | None = None):

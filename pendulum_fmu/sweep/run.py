@@ -11,7 +11,8 @@ from pathlib import Path
 import numpy as np
 
 from .. import default_fmu
-from ..errors import InvalidInput
+from ..errors import InvalidInput, MissingDependency
+from ..parameters import model_description
 from .client import dask_client, progress_bar, run_chunks
 from .figure import draw
 from .grid import columns
@@ -77,27 +78,17 @@ def run_sweep(study: Study, *, output_dir: str | os.PathLike, resume: bool = Fal
     SchedulerUnreachable
         The scheduler did not answer within connect_timeout.
     """
-    import fsspec
     from fsspec.implementations.local import LocalFileSystem
 
     started = time.perf_counter()
     if not isinstance(study, Study):
         raise TypeError(f"run_sweep takes a Study(cases, ...), not a {type(study).__name__}")
     cases = study.cases
-    if len(cases) > max_cases:
-        raise InvalidInput(f"{len(cases):,} cases is over the limit of {max_cases:,}: give fewer "
-                           "values, or raise the limit (--max-cases) if the study is meant to be "
-                           "that large")
-    if scheduler is not None and workers is not None:
-        raise InvalidInput("workers sizes the local cluster; with a scheduler the cluster has its own")
-    if workers is not None and (not isinstance(workers, numbers.Integral) or workers < 1):
-        raise InvalidInput(f"workers must be a positive integer, got {workers!r}")
-    if not (isinstance(connect_timeout, numbers.Real) and 0 < connect_timeout < math.inf):
-        raise InvalidInput(f"connect timeout {connect_timeout} must be a positive number of seconds")
-    filesystem, root = fsspec.core.url_to_fs(str(output_dir))
+    _check_options(len(cases), max_cases, scheduler, workers, connect_timeout)
     url = str(output_dir)
-    store = Store(filesystem=filesystem, root=root.rstrip("/"), format=study.format)
+    store = Store(*_file_system(url), format=study.format)
     fmu = str(Path(study.fmu_path).resolve() if study.fmu_path else default_fmu())
+    model_description(fmu)  # a missing or unreadable FMU refused here, before anything starts
     task = Task(fmu=fmu, store=store, stop_time=float(study.stop_time),
                 step_size=float(study.step_size), outputs=study.outputs, stride=study.stride)
     # The folder taken first, so that a second run is refused before it starts a cluster; then
@@ -125,7 +116,7 @@ def run_sweep(study: Study, *, output_dir: str | os.PathLike, resume: bool = Fal
     draw(store, table, study.names, study.outputs, f"{store.root}/sweep.png")
     drawn = time.perf_counter()
     # Paths on the local file system, URLs elsewhere.
-    where = (Path(store.root).joinpath if isinstance(filesystem, LocalFileSystem)
+    where = (Path(store.root).joinpath if isinstance(store.filesystem, LocalFileSystem)
              else f"{url.rstrip('/')}/".__add__)
     return SweepResult(
         output_dir=where(""), trajectories=where("trajectories"), cases_table=where("cases"),
@@ -135,3 +126,30 @@ def run_sweep(study: Study, *, output_dir: str | os.PathLike, resume: bool = Fal
         seconds=drawn - started, figure_seconds=drawn - drawing,
         worker_cpu_seconds=totals.worker_cpu_seconds,
         worker_stepping_seconds=totals.worker_stepping_seconds)
+
+
+def _check_options(count: int, max_cases: int, scheduler: str | None, workers: int | None,
+                   connect_timeout: float) -> None:
+    if count > max_cases:
+        raise InvalidInput(f"{count:,} cases is over the limit of {max_cases:,}: give fewer "
+                           "values, or raise the limit (--max-cases) if the study is meant to be "
+                           "that large")
+    if scheduler is not None and workers is not None:
+        raise InvalidInput("workers sizes the local cluster; with a scheduler the cluster has its own")
+    if workers is not None and (not isinstance(workers, numbers.Integral) or workers < 1):
+        raise InvalidInput(f"workers must be a positive integer, got {workers!r}")
+    if not (isinstance(connect_timeout, numbers.Real) and 0 < connect_timeout < math.inf):
+        raise InvalidInput(f"connect timeout {connect_timeout} must be a positive number of seconds")
+
+
+def _file_system(url: str) -> tuple[object, str]:
+    """(fsspec file system, the folder's path on it) of an output directory."""
+    import fsspec
+
+    try:
+        filesystem, root = fsspec.core.url_to_fs(url)
+    except ImportError as error:  # "Install s3fs to access S3"
+        raise MissingDependency(f"output directory {url}: {error}") from None
+    except ValueError as error:  # "Protocol not known: ..."
+        raise InvalidInput(f"output directory {url}: {error}") from None
+    return filesystem, root.rstrip("/")
