@@ -22,6 +22,25 @@ def default_fmu(fmi_version: int = 2):
     In a source checkout (a clone or an editable install): dist/Pendulum.fmu, rebuilt first when
     any of its sources is newer. In an installed package: the FMU packaged with it. Nothing is
     ever written into site-packages.
+
+    Parameters
+    ----------
+    fmi_version : {2, 3}, optional
+        The FMI standard of the FMU.
+
+    Returns
+    -------
+    Path
+        The FMU file.
+
+    Raises
+    ------
+    InvalidInput
+        An FMI version the package does not build.
+    MissingFile
+        An installed package without its packaged FMU.
+    BuildError
+        A checkout whose FMU is stale and cannot be rebuilt here.
     """
     global _extracted
     import atexit

@@ -45,7 +45,25 @@ def _connector(variable: ModelVariable) -> ModelVariable:
 
 def create_closed_loop_fmu(out_file: str | Path, *, step_size: float = 1e-3) -> Path:
     """One FMU (fmpy's container) holding the pendulum and the PID controller, wired together,
-    with outputs theta and torque."""
+    with outputs theta and torque.
+
+    Parameters
+    ----------
+    out_file : str or Path
+        The FMU to write.
+    step_size : float, optional
+        The container's fixed communication step in s.
+
+    Returns
+    -------
+    Path
+        out_file.
+
+    Raises
+    ------
+    BuildError
+        The pendulum or the controller cannot be built here.
+    """
     out_file = Path(out_file)
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)

@@ -136,16 +136,51 @@ def compare(torque: TorqueSignal, tools=TOOLS, *, output_dir: str | Path, step_s
             mapping: str | None = None, max_steps: int | None = None) -> Comparison:
     """Run one signal through each tool and judge each against the reference.
 
-    tools: as --tools gives them (compare_tools.py): fmu, reference, opensim, mujoco, drake, pybullet
-    (NAME:default for an engine's own defaults), LABEL=path/to/Their.fmu with mapping the --map.
     The reference is the independent oracle reading the signal itself; it always runs, as the
-    judge, whether or not `tools` names it. Writes to output_dir:
-    - trajectories.csv: every tool's torque, theta, omega, alpha;
-    - differences.csv: each tool against the reference (max and RMS of theta, omega, alpha;
-      max |torque received - signal|; wall time per step) and every pair of other tools;
-    - comparison.png: the tools overlaid, and their differences on a log scale.
+    judge, whether or not `tools` names it. Every tool gets the same schedule, parameters and
+    start values.
 
-    ramp=True ramps the torque over each step in every tool that can; a tool that cannot says so.
+    Parameters
+    ----------
+    torque : float, callable, sequence of float, str or Path
+        The signal, as simulate() takes it.
+    tools : str or sequence of str, optional
+        As --tools gives them (compare_tools.py): fmu, reference, opensim, mujoco, drake,
+        pybullet (NAME:default for an engine's own defaults), LABEL=path/to/Their.fmu.
+    output_dir : str or Path
+        Where to write trajectories.csv (every tool's torque, theta, omega, alpha),
+        differences.csv (each tool against the reference: max and RMS of theta, omega, alpha,
+        max |torque received - signal|, wall time per step; and every pair of other tools) and
+        comparison.png (the tools overlaid, and their differences on a log scale).
+    step_size, start_time, stop_time, parameters, theta0, omega0, max_steps, fmu_path
+        As simulate() takes them; fmu_path's parameters and defaults apply to every tool.
+    ramp : bool, optional
+        Ramp the torque over each step in every tool that can; a tool that cannot says so.
+    tolerance : float, optional
+        The largest difference in theta (rad) or omega (rad/s) for the tools to agree.
+    title : str, optional
+        The figure's title.
+    mapping : str, optional
+        The --map of the tools given as LABEL=path (mapped_fmu.py).
+
+    Returns
+    -------
+    Comparison
+        The runs, the table of differences, the verdict (agree, worst) and the files written.
+
+    Raises
+    ------
+    ToolSpecError
+        A tools list that names no two runnable tools, or a tool that is not installed.
+    MapError
+        A mapping, or an FMU that does not fit it.
+    InvalidInput
+        A tolerance, signal, time or parameter the package refuses; a ramp given to a tool
+        that holds the torque (ToolCannotRamp).
+    FmuError
+        An FMU refused a step.
+    CannotWrite
+        output_dir cannot be written.
     """
     parsed = parse_tools(tools, mapping=mapping, fmu_path=fmu_path)
     if len(parsed) < 2:

@@ -80,13 +80,32 @@ def opensim_simulate(time, torque, *, mass=40.0, length=0.5, inertia=20.0, gravi
                      damping=0.0, theta0=0.0, omega0=0.0, accuracy=1e-12):
     """Simulate the pendulum in OpenSim with a torque held constant per step.
 
-    ``time`` holds the N+1 communication points t_0 < ... < t_N (the steps may
-    differ in size); ``torque[k]`` (N values) acts on [t_k, t_k+1].
+    Parameters
+    ----------
+    time : array_like
+        The N+1 communication points t_0 < ... < t_N in s (the steps may differ in size).
+    torque : array_like
+        N values in N.m; torque[k] acts on [t_k, t_k+1].
+    mass, length, inertia, gravity, damping : float, optional
+        The pendulum (kg, m, kg.m2 about the head's centre, m/s2, N.m.s/rad).
+    theta0, omega0 : float, optional
+        Start angle in rad and rate in rad/s.
+    accuracy : float, optional
+        The Manager's integrator accuracy; None keeps its own default.
 
-    Returns a dict of numpy arrays of length N+1: 'time', 'torque' (last value
-    repeated), 'theta', 'omega' and 'alpha', where alpha at t_k is the angular
-    acceleration under the torque of the step that starts at t_k (torque[N-1]
-    at t_N).
+    Returns
+    -------
+    dict of numpy.ndarray
+        'time', 'torque' (last value repeated), 'theta', 'omega' and 'alpha', each of length
+        N+1, where alpha at t_k is the angular acceleration under the torque of the step that
+        starts at t_k (torque[N-1] at t_N).
+
+    Raises
+    ------
+    MissingDependency
+        OpenSim is not installed.
+    InvalidInput
+        time and torque that are not N+1 increasing points and N values.
     """
     osim = _import_opensim()
 

@@ -216,12 +216,36 @@ def reference(torque=20.0, *, start_time: float = 0.0, stop_time: float | None =
               step_size: float = 1e-3, ramp: bool = False, parameters: dict | None = None,
               theta0: float = 0.0, omega0: float = 0.0, at: np.ndarray | None = None,
               rtol: float = 1e-12, atol: float = 1e-12, fmu_path: str | Path | None = None) -> np.ndarray:
-    """The trajectory under a signal as docs/signals.md defines it, through scipy DOP853.
+    """The trajectory under a signal as docs/signals.md defines it, through scipy DOP853: the
+    independent oracle, which reads the signal itself.
 
-    Takes the signal and the arguments of simulate(): a constant, a callable of time, a per-step
-    array or a CSV path; parameters override the defaults of the FMU at fmu_path (default:
-    pendulum_fmu.default_fmu()). at: the times to report (default: the signal's communication
-    points). Same result format as simulate().
+    Parameters
+    ----------
+    torque : float, callable, sequence of float, str or Path
+        As simulate() takes it: a constant (N.m), a callable of time, a per-step array or a CSV
+        path.
+    start_time, stop_time, step_size, ramp, theta0, omega0
+        As simulate() takes them.
+    parameters : dict, optional
+        Overrides of the defaults of the FMU at fmu_path.
+    at : numpy.ndarray, optional
+        The times to report, in s (default: the signal's communication points).
+    rtol, atol : float, optional
+        solve_ivp's tolerances.
+    fmu_path : str or Path, optional
+        The FMU whose parameters and defaults apply (default: pendulum_fmu.default_fmu()).
+
+    Returns
+    -------
+    numpy.ndarray
+        Same result format as simulate(); torque is the signal's value just after each time.
+
+    Raises
+    ------
+    InvalidInput
+        A signal the reference cannot read, or parameters the FMU refuses.
+    RuntimeError
+        solve_ivp failed.
     """
     if not (isinstance(torque, (str, Path, list, tuple, np.ndarray, int, float)) or callable(torque)):
         raise InvalidInput(f"the reference takes a constant, a callable, a per-step array or a CSV path, "
@@ -239,8 +263,28 @@ def reference(torque=20.0, *, start_time: float = 0.0, stop_time: float | None =
 def reference_schedule(plan, *, parameters: dict | None = None, theta0: float = 0.0,
                        omega0: float = 0.0, rtol: float = 1e-12, atol: float = 1e-12,
                        fmu_path: str | Path | None = None) -> np.ndarray:
-    """Integrate exactly the torques of a schedule (time, torque, torque_rate), reported at its
-    communication points: the judge of a tool that was fed that schedule."""
+    """Integrate exactly the torques of a schedule, reported at its communication points: the
+    judge of a tool that was fed that schedule.
+
+    Parameters
+    ----------
+    plan : TorqueSchedule
+        time (N + 1 points, s), torque (N start values, N.m) and torque_rate (N, N.m/s).
+    parameters, theta0, omega0, rtol, atol, fmu_path
+        As reference() takes them.
+
+    Returns
+    -------
+    numpy.ndarray
+        Same result format as simulate().
+
+    Raises
+    ------
+    InvalidInput
+        Parameters the FMU refuses.
+    RuntimeError
+        solve_ivp failed.
+    """
     points = [Fraction(float(t)) for t in plan.time]
     u0, rate = plan.torque.tolist(), plan.torque_rate.tolist()
     # The schedule's points are the tools' own: no tolerance beyond rounding.

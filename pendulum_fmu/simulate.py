@@ -243,16 +243,52 @@ def simulate(torque: TorqueSignal = 20.0, *, start_time: float = 0.0, stop_time:
              step_size: float = 1e-3, ramp: bool = False, parameters: dict | None = None,
              theta0: float = 0.0, omega0: float = 0.0, tolerance: float | None = None,
              fmu_path: str | Path | None = None, max_steps: int | None = None) -> np.ndarray:
-    """Simulate the pendulum FMU under a torque signal.
+    """Simulate the pendulum FMU under a torque signal, one communication step at a time.
 
-    torque: a constant (N.m), a callable of time, a per-step array (one held value per step) or
-    a CSV path (fmpy's convention; docs/signals.md). Each communication step holds the signal's
-    value just after its start, or ramps (ramp=True) through fmi2SetRealInputDerivatives along
-    the CSV's own piecewise-linear signal. parameters: overrides of mass, length, inertia, gravity, damping.
-    tolerance: relative tolerance for fmi2SetupExperiment (None: the FMU's 1e-10).
-    max_steps: the longest run accepted (default torque_schedule.DEFAULT_MAX_STEPS); a longer one, or one
-    that would not fit in memory, is refused before anything is allocated.
-    Returns a structured array with fields time, torque, theta, omega, alpha (see results.py).
+    The whole schedule runs in one call into the native loop (cs_loop.py) when it was compiled
+    and the FMU is FMI 2.0, else in the Python loop; the two give the same numbers bit for bit.
+
+    Parameters
+    ----------
+    torque : float, callable, sequence of float, str or Path
+        A constant (N.m), a callable of time (sampled at each step's start), a per-step array
+        (one held value per step) or a CSV path in fmpy's convention (docs/signals.md). Each
+        step holds the signal's value just after its start unless ramp.
+    start_time, stop_time : float, optional
+        In s; stop_time defaults to the CSV's last time, the array's last step, or 3 s.
+    step_size : float, optional
+        Communication step in s.
+    ramp : bool, optional
+        Ramp the torque over each step through fmi2SetRealInputDerivatives, along the CSV's own
+        piecewise-linear signal (FMI 2.0 only).
+    parameters : dict, optional
+        Overrides of the FMU's parameters (mass, length, inertia, gravity, damping).
+    theta0, omega0 : float, optional
+        Start angle in rad and rate in rad/s.
+    tolerance : float, optional
+        Relative tolerance of the FMU's integrator (None: the FMU's 1e-10).
+    fmu_path : str or Path, optional
+        The FMU to run (default: pendulum_fmu.default_fmu()); its own parameters apply.
+    max_steps : int, optional
+        The longest run accepted (default torque_schedule.DEFAULT_MAX_STEPS); a longer one, or
+        one that would not fit in memory, is refused before anything is allocated.
+
+    Returns
+    -------
+    numpy.ndarray
+        A structured array with fields time, torque, theta, omega, alpha, one row per
+        communication point (see results.py); torque is what the FMU received.
+
+    Raises
+    ------
+    InvalidInput
+        A signal, time, step, parameter or run length the package refuses.
+    TorqueFileError
+        A torque CSV that is not a signal (names the file, line and problem).
+    FmuError
+        The FMU refused the parameters or a step; the message carries what it logged.
+    MissingFile
+        No FMU at fmu_path.
     """
     plan = schedule(torque, start_time=start_time, stop_time=stop_time, step_size=step_size,
                     ramp=ramp, max_steps=max_steps)
