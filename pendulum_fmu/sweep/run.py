@@ -96,7 +96,7 @@ def run_sweep(study: Study, *, output_dir: str | os.PathLike, resume: bool = Fal
     with store.only_run(url):
         try:
             with dask_client(scheduler, workers, connect_timeout) as client:
-                chunk_cases = store.prepare(study.definition(fmu), resume, len(cases), study.points, url)
+                chunk_cases = store.prepare(study.definition(fmu), resume, study.chunk_cases(), url)
                 chunks = range(math.ceil(len(cases) / chunk_cases))
                 done = store.done_chunks()
                 pending = [index for index in chunks if index not in done]

@@ -10,23 +10,14 @@ from __future__ import annotations
 
 import contextlib
 import json
-import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
 
 from ..atomic_files import TEMPORARY_GLOB, replacing_on
 from ..errors import CannotWrite, InvalidInput, PendulumFmuError
-from .study import OUTPUTS
 
 SUMMARIES = ("final_theta", "final_omega", "final_alpha", "max_abs_theta")
-# A study is cut into about this many chunks, so that up to 16 workers each get several (the
-# load evens out and progress shows), but no chunk holds more than MAX_CHUNK_CASES cases, so a
-# chunk's files stay tens of megabytes and a lost worker loses little.
-TARGET_CHUNKS = 64
-MAX_CHUNK_CASES = 256
-# And a chunk's recordings (every point of every case, before thinning) stay this small.
-MAX_CHUNK_BYTES = 64_000_000
 # There while a run writes the study (see Store.only_run); hidden, and never part of a table.
 LOCK_FILE = ".sweep.lock"
 
@@ -96,8 +87,9 @@ class Store:
                 with contextlib.suppress(FileNotFoundError):
                     self.filesystem.rm(path)
 
-    def prepare(self, definition: dict, resume: bool, count: int, points: int, output_dir) -> int:
-        """Write study.json (or check it, on resume); returns the cases per chunk."""
+    def prepare(self, definition: dict, resume: bool, chunk_cases: int, output_dir) -> int:
+        """Write study.json with the cases per chunk (or check it, on resume, and keep the
+        earlier run's chunks); returns the cases per chunk."""
         fs, manifest = self.filesystem, f"{self.root}/study.json"
         if resume and fs.exists(manifest):
             with fs.open(manifest, "r") as file:
@@ -110,8 +102,6 @@ class Store:
             return previous["chunk_cases"]
         # A new study replaces whatever study was there.
         self.remove(("study.json", "sweep.png", "trajectories/part-*", "cases/part-*"))
-        fitting = MAX_CHUNK_BYTES // (points * len(OUTPUTS) * 8)
-        chunk_cases = max(1, min(MAX_CHUNK_CASES, fitting, math.ceil(count / TARGET_CHUNKS)))
         with replacing_on(fs, manifest) as file:
             file.write(json.dumps({"study": definition, "chunk_cases": chunk_cases}, indent=1).encode())
         return chunk_cases

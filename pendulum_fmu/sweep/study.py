@@ -11,13 +11,20 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import results
 from ..errors import InvalidInput
-from ..simulate import RECORDED
 from ..torque_schedule import communication_points
 from .grid import Grid, check_cases, columns
 
-OUTPUTS = RECORDED[1:]  # theta, omega, alpha
+OUTPUTS = results.FIELDS[2:]  # theta, omega, alpha: what a case records besides time and torque
 FORMATS = ("parquet", "csv")
+# A study is cut into about this many chunks, so that up to 16 workers each get several (the
+# load evens out and progress shows), but no chunk holds more than MAX_CHUNK_CASES cases, so a
+# chunk's files stay tens of megabytes and a lost worker loses little.
+TARGET_CHUNKS = 64
+MAX_CHUNK_CASES = 256
+# And a chunk's recordings (every point of every case, before thinning) stay this small.
+MAX_CHUNK_BYTES = 64_000_000
 
 
 @dataclass(frozen=True)
@@ -83,6 +90,11 @@ class Study:
             raise InvalidInput(f"format {self.format!r}: choose {' or '.join(FORMATS)}")
         for name, value in derived.items():
             object.__setattr__(self, name, value)  # frozen: the only way in, once
+
+    def chunk_cases(self) -> int:
+        """The cases of a chunk, each chunk written as one part of each table."""
+        fitting = MAX_CHUNK_BYTES // (self.points * len(OUTPUTS) * 8)
+        return max(1, min(MAX_CHUNK_CASES, fitting, math.ceil(len(self.cases) / TARGET_CHUNKS)))
 
     def definition(self, fmu: str) -> dict:
         """What makes two runs the same study, for --resume (study.json keeps it)."""
