@@ -8,10 +8,10 @@ import numpy as np
 from fmpy.fmi2 import FMU2Slave
 
 from pendulum_fmu import results
-from pendulum_fmu.parameters import value_reference
-from pendulum_fmu.signal import TorqueSchedule, schedule
 from pendulum_fmu import cs_loop
+from pendulum_fmu.parameters import value_reference
 from pendulum_fmu.simulate import open_fmu, run_schedule, run_schedule_python
+from pendulum_fmu.torque_schedule import TorqueSchedule, schedule
 
 from . import tutorial
 from .builds import BuiltFmu

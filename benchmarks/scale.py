@@ -82,16 +82,16 @@ def measure_client(address: str, cases: int, stop_time: float, fmu: str, output_
 
     # A small study first: the workers import the package and unzip the FMU once in their lives,
     # and this process imports what drawing needs; neither is a cost per case.
-    sweep.run_sweep(sweep.sweep_grid([1.0, 2.0]), output_dir=f"{output_dir}/warm-up", stop_time=0.01,
-                    scheduler=address, progress=False, fmu_path=fmu)
+    sweep.run_sweep(sweep.Study(sweep.sweep_grid([1.0, 2.0]), stop_time=0.01, fmu_path=fmu),
+                    output_dir=f"{output_dir}/warm-up", scheduler=address, progress=False)
     before = cpu()
-    summary = sweep.run_sweep(grid, output_dir=output_dir, stop_time=stop_time, scheduler=address,
-                              progress=False, fmu_path=fmu)
+    result = sweep.run_sweep(sweep.Study(grid, stop_time=stop_time, fmu_path=fmu), output_dir=output_dir,
+                             scheduler=address, progress=False)
     client_cpu = cpu() - before
-    print(json.dumps({"seconds": summary["seconds"], "cpu": client_cpu, "figure": summary["figure_seconds"],
-                      "bytes": summary["bytes"], "failed": summary["failed"],
-                      "worker_cpu": summary["worker_cpu_seconds"],
-                      "worker_stepping": summary["worker_stepping_seconds"],
+    print(json.dumps({"seconds": result.seconds, "cpu": client_cpu, "figure": result.figure_seconds,
+                      "bytes": result.bytes, "failed": result.failed,
+                      "worker_cpu": result.worker_cpu_seconds,
+                      "worker_stepping": result.worker_stepping_seconds,
                       "peak_rss": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024}))
 
 

@@ -5,21 +5,21 @@ import argparse
 
 import pyarrow.parquet as pq
 
-from pendulum_fmu.sweep import run_sweep, sweep_grid
+from pendulum_fmu.sweep import Study, run_sweep, sweep_grid
 
 
 def run(torques=(5.0, 10.0, 20.0, 40.0), stop_time=3.0, output_dir="out/parameter_study", scheduler=None):
     """Returns the trajectories with each case's torque joined in, as numpy columns."""
-    summary = run_sweep(sweep_grid(torques, [9.81]), output_dir=output_dir, stop_time=stop_time,
-                        scheduler=scheduler)
-    cases = pq.read_table(summary["cases_table"]).sort_by("case")
+    result = run_sweep(Study(sweep_grid(torques, [9.81]), stop_time=stop_time), output_dir=output_dir,
+                       scheduler=scheduler)
+    cases = pq.read_table(result.cases_table).sort_by("case")
     for case in cases.to_pylist():
         print(f"torque {case['torque']:5g} N.m: max |theta| = {case['max_abs_theta']:.6f} rad, "
               f"theta({stop_time:g} s) = {case['final_theta']:.6f} rad")
-    trajectories = (pq.read_table(summary["trajectories"]).join(cases.select(["case", "torque"]), "case")
+    trajectories = (pq.read_table(result.trajectories).join(cases.select(["case", "torque"]), "case")
                     .sort_by([("case", "ascending"), ("time", "ascending")]))
-    print(f"{summary['cases']} cases in {summary['seconds']:.1f} s; wrote {summary['trajectories']}, "
-          f"{summary['cases_table']} and {summary['figure']}")
+    print(f"{result.cases} cases in {result.seconds:.1f} s; wrote {result.trajectories}, "
+          f"{result.cases_table} and {result.figure}")
     return {name: trajectories[name].to_numpy() for name in trajectories.column_names}
 
 

@@ -22,6 +22,25 @@ def default_fmu(fmi_version: int = 2):
     In a source checkout (a clone or an editable install): dist/Pendulum.fmu, rebuilt first when
     any of its sources is newer. In an installed package: the FMU packaged with it. Nothing is
     ever written into site-packages.
+
+    Parameters
+    ----------
+    fmi_version : {2, 3}, optional
+        The FMI standard of the FMU.
+
+    Returns
+    -------
+    Path
+        The FMU file.
+
+    Raises
+    ------
+    InvalidInput
+        An FMI version the package does not build.
+    MissingFile
+        An installed package without its packaged FMU.
+    BuildError
+        A checkout whose FMU is stale and cannot be rebuilt here.
     """
     global _extracted
     import atexit
@@ -30,9 +49,10 @@ def default_fmu(fmi_version: int = 2):
     from pathlib import Path
 
     from .build import CHECKOUT_FMUS, build_fmu, fmu_is_stale, is_source_checkout
+    from .errors import InvalidInput, MissingFile
 
     if fmi_version not in FMU_FILES:
-        raise ValueError(f"no FMI {fmi_version} FMU: the FMI versions are {', '.join(map(str, FMU_FILES))}")
+        raise InvalidInput(f"no FMI {fmi_version} FMU: the FMI versions are {', '.join(map(str, FMU_FILES))}")
     packaged_name = FMU_FILES[fmi_version]
     checkout_fmu = CHECKOUT_FMUS[fmi_version]
     if is_source_checkout():
@@ -41,7 +61,7 @@ def default_fmu(fmi_version: int = 2):
         return checkout_fmu
     packaged = resources.files(__name__) / "data" / packaged_name
     if not packaged.is_file():
-        raise FileNotFoundError(
+        raise MissingFile(
             f"pendulum_fmu {__version__} at {Path(__file__).parent} has neither its packaged "
             f"data/{packaged_name} nor the FMU's sources beside it: reinstall it from its wheel or "
             "sdist, or pass the FMU's path")

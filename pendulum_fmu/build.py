@@ -31,7 +31,8 @@ import fmpy
 from fmpy import read_model_description
 
 from . import FMU_FILES, __version__, fmi3
-from .files import replacing_path
+from .atomic_files import replacing_path
+from .errors import PendulumFmuError
 
 ROOT = Path(__file__).resolve().parent.parent
 SOURCE_DIR = ROOT / "fmu_src"
@@ -85,7 +86,7 @@ PLATFORMS = {platform.fmi2_folder: platform for platform in (
 )}
 
 
-class BuildError(RuntimeError):
+class BuildError(PendulumFmuError, RuntimeError):
     """The FMU could not be built; the message says why."""
 
 
@@ -329,15 +330,38 @@ def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, *, model_dir: Path = SO
               platforms: tuple[str, ...] | None = None, fmi_version: int = 2) -> Path:
     """Build an FMU (binaries/, sources/, documentation/) and return its path.
 
-    fmi_version 3 builds the FMI 3.0 FMU from the same sources: its model description and
-    sources/buildDescription.xml are generated from the FMI 2.0 one by fmi3.py, its binaries go
-    into the FMI 3.0 platform folders and export only fmi3* functions.
+    Everything is compiled in a private temporary folder and the zip is renamed into place
+    whole, so builds into the same path at the same time all succeed.
 
-    platforms: FMI 2.0 folder names (see PLATFORMS); None builds every platform whose compiler is
-    present and warns (PlatformSkipped) about the others. A platform named explicitly must build.
-    model_dir and model_description_file name another model's config.h/model.c and XML to build
-    over the same plumbing. Everything is compiled in a private temporary folder and the zip is
-    renamed into place whole, so builds into the same path at the same time all succeed.
+    Parameters
+    ----------
+    out_file : str or os.PathLike, optional
+        The FMU to write (default: dist/Pendulum.fmu of the checkout).
+    model_dir : Path, optional
+        The model's config.h and model.c, built over the same FMI plumbing.
+    model_description_file : Path, optional
+        The model's FMI 2.0 modelDescription.xml.
+    platforms : tuple of str, optional
+        FMI 2.0 folder names (see PLATFORMS); None builds every platform whose compiler is
+        present and warns (PlatformSkipped) about the others. A platform named explicitly must
+        build.
+    fmi_version : {2, 3}, optional
+        3 builds the FMI 3.0 FMU from the same sources: its model description and
+        sources/buildDescription.xml are generated from the FMI 2.0 one by fmi3.py, its binaries
+        go into the FMI 3.0 platform folders and export only fmi3* functions.
+
+    Returns
+    -------
+    Path
+        out_file.
+
+    Raises
+    ------
+    BuildError
+        The sources are missing, a platform is unknown or its compiler is missing or fails, or
+        the FMI version is not built.
+    CannotWrite
+        out_file cannot be written.
     """
     _check_sources_present()
     if fmi_version not in FMI_VERSIONS:

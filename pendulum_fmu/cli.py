@@ -1,9 +1,14 @@
-"""pendulum-fmu: build, simulate and compare the torque-driven pendulum FMU."""
+"""pendulum-fmu: build, simulate and compare the torque-driven pendulum FMU.
+
+The command line only parses and calls: each command's function below turns its arguments
+into one call of the package's API and prints what came back. A user's error (a
+PendulumFmuError) is one line and exit 2; anything else is a bug of ours, one line too, with the
+traceback on --debug.
+"""
 
 from __future__ import annotations
 
 import argparse
-import importlib.util
 import signal
 import sys
 import threading
@@ -14,13 +19,11 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__
-from .build import (CHECKOUT_FMUS, FMI_VERSIONS, PLATFORMS, BuildError, PlatformSkipped, build_fmu,
-                    check_platforms)
-from .entry import STOPPING_SIGNALS
-from .signal import DEFAULT_MAX_STEPS
+from .build import CHECKOUT_FMUS, FMI_VERSIONS, PLATFORMS, BuildError, PlatformSkipped, check_platforms
+from .errors import InvalidInput, PendulumFmuError
+from .stop_signals import STOPPING_SIGNALS, Stopped, stop_on_signals
 from .sweep import DEFAULT_MAX_CASES
-
-TUTORIAL_TORQUE = 20.0
+from .torque_schedule import DEFAULT_MAX_STEPS
 
 
 def _assignment(text: str) -> tuple[str, str]:
@@ -53,7 +56,7 @@ def _parameters(assignments) -> dict[str, float]:
         try:
             parameters[name] = float(value)
         except ValueError:
-            raise ValueError(f"--set {name}={value}: {value!r} is not a number") from None
+            raise InvalidInput(f"--set {name}={value}: {value!r} is not a number") from None
     return parameters
 
 
@@ -61,8 +64,8 @@ def _torque_signal(args):
     return args.torque_file if args.torque_file is not None else args.torque
 
 
-def _add_signal_arguments(parser, required=True):
-    group = parser.add_mutually_exclusive_group(required=required)
+def _add_signal_arguments(parser) -> None:
+    group = parser.add_mutually_exclusive_group(required=True)
     group.add_argument("--torque", type=_float, help="constant torque in N.m")
     group.add_argument("--torque-file", type=Path,
                        help="CSV with columns time,torque in fmpy's convention: linear between "
@@ -82,7 +85,7 @@ def _add_signal_arguments(parser, required=True):
     _add_fmu_argument(parser)
 
 
-def _add_fmu_argument(parser):
+def _add_fmu_argument(parser) -> None:
     parser.add_argument("--fmu", type=Path, default=None,
                         help="the FMU to run, whose own parameters and defaults apply (default: "
                              "the packaged FMU, or dist/Pendulum.fmu in a source checkout)")
@@ -97,7 +100,11 @@ def _platforms(text: str) -> tuple[str, ...]:
     return platforms
 
 
+# --- the commands: each parses its arguments into one call and prints what came back ----------
+
 def cmd_build(args) -> int:
+    from .build import build_fmu
+
     output = args.output or CHECKOUT_FMUS[args.fmi_version]
     path = build_fmu(output, platforms=args.platforms, fmi_version=args.fmi_version)
     with zipfile.ZipFile(path) as fmu:
@@ -116,8 +123,6 @@ def cmd_cross_check(args) -> int:
 
 def cmd_simulate(args) -> int:
     from . import results
-    from .files import replacing
-    from .plot import plot_overlay
     from .simulate import simulate
 
     run = simulate(_torque_signal(args), stop_time=args.stop_time, step_size=args.step_size,
@@ -129,35 +134,25 @@ def cmd_simulate(args) -> int:
           f"omega = {last['omega']:.12g} rad/s, alpha = {last['alpha']:.12g} rad/s2; "
           f"max |theta| = {np.max(np.abs(run['theta'])):.6g} rad")
     if args.output:
-        header = ",".join(results.FIELDS)
-        with replacing(args.output) as file:
-            np.savetxt(file, run.view(np.float64).reshape(len(run), -1), delimiter=",",
-                       header=header, comments="", fmt="%.17g")
-        print(f"wrote {args.output} ({header}; units {', '.join(results.UNITS.values())})")
+        results.write_csv(run, args.output)
+        print(f"wrote {args.output} ({','.join(results.FIELDS)}; units "
+              f"{', '.join(results.UNITS.values())})")
     if args.plot:
+        from .plot import plot_overlay
+
         print(f"wrote {plot_overlay({'FMU': run}, args.plot, 'Torque-driven pendulum')}")
     return 0
 
 
-def _print_comparison(comparison) -> None:
-    from .compare import format_table
-
-    print(format_table(comparison.differences))
-    verdict = "agree" if comparison.agree else "DIFFER"
-    print(f"tools {verdict}: worst difference {comparison.worst:.3e} against tolerance "
-          f"{comparison.tolerance:g}; torque received vs the signal: {comparison.torque_worst:.3e} N.m "
-          f"(allowed {comparison.torque_limit:.1e})")
-
-
 def cmd_compare(args) -> int:
-    from .compare import compare
+    from .compare import compare, format_comparison
 
     comparison = compare(_torque_signal(args), args.tools, output_dir=args.output_dir,
                          step_size=args.step_size, stop_time=args.stop_time, ramp=args.ramp,
                          parameters=_parameters(args.assignments), theta0=args.theta0,
                          omega0=args.omega0, tolerance=args.tol, mapping=args.mapping,
                          max_steps=args.max_steps, fmu_path=args.fmu)
-    _print_comparison(comparison)
+    print(format_comparison(comparison))
     for path in (comparison.trajectories, comparison.table, comparison.figure):
         print(f"wrote {path}")
     return 0 if comparison.agree else 1
@@ -169,29 +164,8 @@ def _sweep_values(assignments) -> dict[str, list[float]]:
         try:
             values[name] = [float(v) for v in text.split(",")]
         except ValueError:
-            raise ValueError(f"--set {name}={text}: expected comma-separated numbers") from None
+            raise InvalidInput(f"--set {name}={text}: expected comma-separated numbers") from None
     return values
-
-
-class _Stopped(BaseException):
-    """SIGINT or SIGTERM, raised where the program is, so that every file being written is
-    cleaned up on the way out (a BaseException, so no `except Exception` swallows it)."""
-
-    def __init__(self, signal_number: int):
-        super().__init__(signal_number)
-        self.signal_number = signal_number
-
-
-def _stop_on_signals():
-    """Make SIGINT and SIGTERM raise _Stopped once; further ones are ignored so the cleanup that
-    follows (closing the cluster, removing temporaries) runs to its end. Returns the old handlers."""
-
-    def stop(number, frame):
-        for name in STOPPING_SIGNALS:
-            signal.signal(name, signal.SIG_IGN)
-        raise _Stopped(number)
-
-    return {name: signal.signal(name, stop) for name in STOPPING_SIGNALS}
 
 
 def _sweep_outputs(text: str) -> tuple[str, ...]:
@@ -199,86 +173,44 @@ def _sweep_outputs(text: str) -> tuple[str, ...]:
 
 
 def cmd_sweep(args) -> int:
-    from .sweep import run_sweep, sweep_grid
+    from .sweep import Study, run_sweep, sweep_grid
 
-    cases = sweep_grid(args.torque, args.gravity, _sweep_values(args.assignments))
+    study = Study(sweep_grid(args.torque, args.gravity, _sweep_values(args.assignments)),
+                  stop_time=args.stop_time, step_size=args.step_size,
+                  outputs=_sweep_outputs(args.outputs), output_interval=args.output_interval,
+                  format=args.format, fmu_path=args.fmu)
     try:
-        summary = run_sweep(cases, output_dir=args.output_dir, stop_time=args.stop_time,
-                            step_size=args.step_size, outputs=_sweep_outputs(args.outputs),
-                            output_interval=args.output_interval, format=args.format,
-                            resume=args.resume, scheduler=args.scheduler, workers=args.workers,
-                            connect_timeout=args.connect_timeout, fmu_path=args.fmu,
-                            max_cases=args.max_cases)
-    except _Stopped as stopped:
+        result = run_sweep(study, output_dir=args.output_dir, resume=args.resume,
+                           scheduler=args.scheduler, workers=args.workers,
+                           connect_timeout=args.connect_timeout, max_cases=args.max_cases)
+    except Stopped as stopped:
         what = STOPPING_SIGNALS[stopped.signal_number]
         print(f"pendulum-fmu sweep: {what}; the chunks that finished are kept in {args.output_dir}: "
               "run the same command with --resume to run the rest", file=sys.stderr)
         return 128 + stopped.signal_number
-    resumed = summary["chunks_run"] < summary["chunks"]
-    print(f"{summary['cases']} cases in {summary['seconds']:.1f} s"
-          + (f" ({summary['chunks_run']} of {summary['chunks']} chunks run; the others were "
+    resumed = result.chunks_run < result.chunks
+    print(f"{result.cases} cases in {result.seconds:.1f} s"
+          + (f" ({result.chunks_run} of {result.chunks} chunks run; the others were "
              "written by an earlier run)" if resumed else ""))
-    for key in ("trajectories", "cases_table", "figure"):
-        print(f"wrote {summary[key]}")
-    if summary["failed"]:
+    for path in (result.trajectories, result.cases_table, result.figure):
+        print(f"wrote {path}")
+    if result.failed:
         # The other cases ran and are written; a script still learns that some did not.
-        print(f"pendulum-fmu sweep: {summary['failed']} of {summary['cases']} cases failed: their "
+        print(f"pendulum-fmu sweep: {result.failed} of {result.cases} cases failed: their "
               "status and message are in the cases table", file=sys.stderr)
         return 1
     return 0
 
 
 def cmd_demo(args) -> int:
-    """The tutorial end to end."""
-    from .compare import compare
-    from .parameters import default_parameters, total_inertia
-    from .plot import plot_overlay
-    from .sweep import run_sweep, sweep_grid
+    from .demo import run_demo
 
-    out = Path(args.output_dir)
-    tools = ["fmu", "reference"]
-    if importlib.util.find_spec("opensim") is not None:
-        tools.append("opensim")
-    else:
-        print("OpenSim is not installed, so it is left out (pip install opensim)")
-    torque = TUTORIAL_TORQUE
-    print(f"Tutorial case: constant torque {torque:g} N.m, 3 s in 1 ms steps; tools: {', '.join(tools)}")
-    runs, agree = {}, True
-    for label, gravity, folder in (("No Gravity", 0.0, "no_gravity"), ("With Gravity", 9.81, "gravity")):
-        comparison = compare(torque, tools, output_dir=out / folder, parameters={"gravity": gravity},
-                             title=rf"Constant Torque $\tau = {torque:g}$ Nm — {label}")
-        print(f"\n{label} (gravity = {gravity:g} m/s2)")
-        _print_comparison(comparison)
-        fmu = comparison.runs["fmu"]
-        if gravity == 0.0:
-            parabola = 0.5 * torque / total_inertia(default_parameters()) * fmu["time"] ** 2
-            print(f"fmu vs analytic theta = tau t^2 / (2 I): {np.max(np.abs(fmu['theta'] - parabola)):.3e} rad")
-        print(f"theta(3 s) = {fmu['theta'][-1]:.10f} rad, omega(3 s) = {fmu['omega'][-1]:.10f} rad/s")
-        print(f"wrote {comparison.figure}")
-        runs[label] = fmu
-        agree &= comparison.agree
-    overlay = plot_overlay({rf"No gravity ($\tau = {torque:g}$ Nm)": runs["No Gravity"],
-                            rf"With gravity ($\tau = {torque:g}$ Nm)": runs["With Gravity"]},
-                           out / "gravity_effect.png", "Effect of Gravity on Torque-Driven Pendulum")
-    print(f"\nwrote {overlay}")
-    print("\nParameter study: torque 5, 10, 20, 40 N.m with gravity, on a local dask cluster")
-    summary = run_sweep(sweep_grid([5.0, 10.0, 20.0, 40.0], [9.81]), output_dir=out / "parameter_study",
-                        workers=args.workers)
-    print(f"{summary['cases']} cases in {summary['seconds']:.1f} s\nwrote {summary['cases_table']}\n"
-          f"wrote {summary['figure']}")
-    return 0 if agree else 1
+    return 0 if run_demo(args.output_dir, workers=args.workers) else 1
 
 
-def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
-        prog="pendulum-fmu",
-        description="A torque-driven pendulum as an FMI 2.0 (or 3.0) FMU: build it, "
-                    "simulate it, and compare it with scipy and OpenSim.")
-    parser.add_argument("--version", action="version", version=f"pendulum-fmu {__version__}")
-    parser.add_argument("--debug", action="store_true", default=False,
-                        help="show the Python traceback of an error instead of one line")
-    commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+# --- the parser: one function per command ---------------------------------------------------
 
+def _add_build(commands) -> argparse.ArgumentParser:
     build = commands.add_parser("build", help="build the FMU (same as python build_fmu.py)",
                                 description="Build the FMU from fmu_src/ and modelDescription.xml "
                                             "(a source checkout or the unpacked sdist).")
@@ -291,7 +223,10 @@ def build_parser() -> argparse.ArgumentParser:
                        help=f"comma-separated, among {', '.join(PLATFORMS)} (default: every one "
                             "whose compiler is installed; the others are skipped with a note)")
     build.set_defaults(run=cmd_build)
+    return build
 
+
+def _add_cross_check(commands) -> argparse.ArgumentParser:
     cross_check = commands.add_parser(
         "cross-check", help="reference results in the FMI cross-check layout",
         description="Write fmus/2.0/cs/<platform>/pendulum_fmu/<version>/Pendulum/ (the FMU, "
@@ -301,7 +236,10 @@ def build_parser() -> argparse.ArgumentParser:
                              help="the cross-check repository's root")
     _add_fmu_argument(cross_check)
     cross_check.set_defaults(run=cmd_cross_check)
+    return cross_check
 
+
+def _add_simulate(commands) -> argparse.ArgumentParser:
     simulate = commands.add_parser("simulate", help="simulate the FMU under a torque signal",
                                    description="Simulate the FMU through fmpy; the torque is held "
                                                "over each communication step unless --ramp.")
@@ -313,7 +251,10 @@ def build_parser() -> argparse.ArgumentParser:
     simulate.add_argument("--output", type=Path, help="write time,torque,theta,omega,alpha CSV")
     simulate.add_argument("--plot", type=Path, help="write a PNG of theta and omega")
     simulate.set_defaults(run=cmd_simulate)
+    return simulate
 
+
+def _add_compare(commands) -> argparse.ArgumentParser:
     compare = commands.add_parser("compare", help="run one torque signal through several tools",
                                   description="Run one torque signal through the FMU and OpenSim "
                                               "and judge each against the independent scipy "
@@ -341,16 +282,22 @@ def build_parser() -> argparse.ArgumentParser:
                          help="largest allowed |dtheta| (rad) or |domega| (rad/s), positive and "
                               "finite (default: %(default)s)")
     compare.set_defaults(run=cmd_compare)
+    return compare
 
+
+def _add_sweep(commands) -> argparse.ArgumentParser:
     sweep = commands.add_parser("sweep", help="parameter study as a grid, on dask",
                                 description="Run every combination of the given values on dask: a "
                                             "local cluster, or an existing scheduler.")
     sweep.add_argument("--torque", type=_float, nargs="+", required=True, help="torques in N.m")
-    sweep.add_argument("--gravity", type=_float, nargs="+", default=[9.81], help="default: 9.81")
+    sweep.add_argument("--gravity", type=_float, nargs="+", default=[9.81],
+                       help="gravities in m/s2 (default: 9.81)")
     sweep.add_argument("--set", dest="assignments", type=_assignment, action="append",
                        metavar="NAME=V1,V2", help="more values of a parameter or theta0/omega0")
-    sweep.add_argument("--stop-time", type=_float, default=3.0, help="default: %(default)s s")
-    sweep.add_argument("--step-size", type=_float, default=1e-3, help="default: %(default)s s")
+    sweep.add_argument("--stop-time", type=_float, default=3.0,
+                       help="end of every case in s (default: %(default)s)")
+    sweep.add_argument("--step-size", type=_float, default=1e-3,
+                       help="communication step in s (default: %(default)s)")
     sweep.add_argument("--output-dir", required=True,
                        help="local folder or fsspec URL (s3://..., a shared file system) every "
                             "worker can write to: trajectories/ and cases/ (a file per chunk), "
@@ -373,7 +320,10 @@ def build_parser() -> argparse.ArgumentParser:
                        help=f"refuse studies of more cases than this (default: {DEFAULT_MAX_CASES:,})")
     _add_fmu_argument(sweep)
     sweep.set_defaults(run=cmd_sweep)
+    return sweep
 
+
+def _add_demo(commands) -> argparse.ArgumentParser:
     demo = commands.add_parser("demo", help="the OpenSim tutorial end to end",
                                description="Gravity off and on against the reference (and "
                                            "OpenSim when installed), the overlay and the "
@@ -383,17 +333,28 @@ def build_parser() -> argparse.ArgumentParser:
                       help="folder for the figures and tables (default: %(default)s)")
     demo.add_argument("--workers", type=int, default=None, help="local dask workers (default: 2)")
     demo.set_defaults(run=cmd_demo)
-    for command in commands.choices.values():
+    return demo
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="pendulum-fmu",
+        description="A torque-driven pendulum as an FMI 2.0 (or 3.0) FMU: build it, "
+                    "simulate it, and compare it with scipy and OpenSim.")
+    parser.add_argument("--version", action="version", version=f"pendulum-fmu {__version__}")
+    parser.add_argument("--debug", action="store_true", default=False,
+                        help="show the Python traceback of an error instead of one line")
+    commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    for add in (_add_build, _add_cross_check, _add_simulate, _add_compare, _add_sweep, _add_demo):
         # Also after the command's name; SUPPRESS keeps it from hiding one given before it.
-        command.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
-                             help="show the Python traceback of an error instead of one line")
+        add(commands).add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
+                                   help="show the Python traceback of an error instead of one line")
     return parser
 
 
 def main(argv=None) -> int:
-    from .signal import TorqueFileError
-    from .simulate import FmuError
-
+    """Run one command line; returns the exit status (0, 1 when a comparison or a sweep found
+    what it reports, 2 for a user's error, 3 for a bug of ours, 128 + n on signal n)."""
     args = build_parser().parse_args(argv)
     command = f"pendulum-fmu {args.command}"
     shown = warnings.showwarning
@@ -405,18 +366,18 @@ def main(argv=None) -> int:
             shown(message, category, *where, **more)
 
     # Signal handlers can only be set from the main thread; elsewhere Ctrl-C stays Python's.
-    previous = _stop_on_signals() if threading.current_thread() is threading.main_thread() else {}
+    previous = stop_on_signals() if threading.current_thread() is threading.main_thread() else {}
     try:
         with warnings.catch_warnings():
             warnings.showwarning = one_line
             return args.run(args)
-    except (_Stopped, KeyboardInterrupt) as stopped:
+    except (Stopped, KeyboardInterrupt) as stopped:
         if args.debug:
             raise
         number = getattr(stopped, "signal_number", signal.SIGINT)
         print(f"{command}: {STOPPING_SIGNALS[number]}; no output file was left half written", file=sys.stderr)
         return 128 + number
-    except (ValueError, TorqueFileError, FmuError, BuildError, ImportError, OSError) as error:
+    except PendulumFmuError as error:
         if args.debug:
             raise
         print(f"{command}: error: {error}", file=sys.stderr)
@@ -430,9 +391,3 @@ def main(argv=None) -> int:
     finally:
         for number, handler in previous.items():
             signal.signal(number, handler)
-
-
-if __name__ == "__main__":
-    from .entry import run
-
-    run()

@@ -20,7 +20,8 @@ from fmpy.model_description import CoSimulation, DefaultExperiment, ModelDescrip
 from scipy.integrate import solve_ivp
 
 from .build import PID_CONTROLLER_DIR, build_fmu, build_pid_controller
-from .parameters import resolve_parameters, total_inertia
+from .parameters import total_inertia
+from .simulate import resolve_parameters
 
 # Pendulum output -> controller input, and back.
 WIRES = (("pendulum", "theta", "controller", "theta"),
@@ -44,7 +45,25 @@ def _connector(variable: ModelVariable) -> ModelVariable:
 
 def create_closed_loop_fmu(out_file: str | Path, *, step_size: float = 1e-3) -> Path:
     """One FMU (fmpy's container) holding the pendulum and the PID controller, wired together,
-    with outputs theta and torque."""
+    with outputs theta and torque.
+
+    Parameters
+    ----------
+    out_file : str or Path
+        The FMU to write.
+    step_size : float, optional
+        The container's fixed communication step in s.
+
+    Returns
+    -------
+    Path
+        out_file.
+
+    Raises
+    ------
+    BuildError
+        The pendulum or the controller cannot be built here.
+    """
     out_file = Path(out_file)
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)

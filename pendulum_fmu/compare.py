@@ -1,6 +1,6 @@
 """One torque signal through several tools, each judged against the independent oracle.
 
-Every tool is fed the schedule that `signal.schedule` makes of the user's signal. The
+Every tool is fed the schedule that `torque_schedule.schedule` makes of the user's signal. The
 reference (`reference.reference`) reads the signal itself and shares no code with that schedule,
 so a schedule that does not carry the signal shows as a difference: in theta and omega, and in
 the torque each tool received against the signal's value at the start of each step.
@@ -17,12 +17,13 @@ from pathlib import Path
 
 import numpy as np
 
-from .files import replacing
-from .parameters import resolve_parameters
+from .atomic_files import replacing
+from .compare_tools import ToolSpecError, parse_tools
+from .errors import InvalidInput
 from .plot import plot_comparison
 from .reference import reference
-from .signal import TorqueSchedule, TorqueSignal, schedule
-from .tools import ToolSpecError, parse_tools
+from .simulate import resolve_parameters
+from .torque_schedule import TorqueSchedule, TorqueSignal, schedule
 
 REFERENCE = "reference"
 TOOLS = ("fmu", REFERENCE, "opensim")
@@ -35,7 +36,7 @@ def run_tools(plan: TorqueSchedule, tools, *, parameters: dict | None = None, th
               omega0: float = 0.0, fmu_path: str | Path | None = None,
               mapping: str | None = None) -> dict[str, np.ndarray]:
     """{tool label: result array} for the same schedule, parameters and start values; tools as
-    --tools gives them (see tools.py), mapping the --map of other FMUs. "reference" here is
+    --tools gives them (see compare_tools.py), mapping the --map of other FMUs. "reference" here is
     reference_schedule: the schedule's own torques through scipy."""
     parsed = parse_tools(tools, mapping=mapping, fmu_path=fmu_path)
     # Every tool gets the whole set, so the defaults are fmu_path's for all of them.
@@ -46,7 +47,7 @@ def run_tools(plan: TorqueSchedule, tools, *, parameters: dict | None = None, th
 
 def check_tolerance(tolerance: float) -> float:
     if not (math.isfinite(tolerance) and tolerance > 0):
-        raise ValueError(f"the tolerance {tolerance} must be a positive finite number (rad, rad/s)")
+        raise InvalidInput(f"the tolerance {tolerance} must be a positive finite number (rad, rad/s)")
     return float(tolerance)
 
 
@@ -135,16 +136,51 @@ def compare(torque: TorqueSignal, tools=TOOLS, *, output_dir: str | Path, step_s
             mapping: str | None = None, max_steps: int | None = None) -> Comparison:
     """Run one signal through each tool and judge each against the reference.
 
-    tools: as --tools gives them (tools.py): fmu, reference, opensim, mujoco, drake, pybullet
-    (NAME:default for an engine's own defaults), LABEL=path/to/Their.fmu with mapping the --map.
     The reference is the independent oracle reading the signal itself; it always runs, as the
-    judge, whether or not `tools` names it. Writes to output_dir:
-    - trajectories.csv: every tool's torque, theta, omega, alpha;
-    - differences.csv: each tool against the reference (max and RMS of theta, omega, alpha;
-      max |torque received - signal|; wall time per step) and every pair of other tools;
-    - comparison.png: the tools overlaid, and their differences on a log scale.
+    judge, whether or not `tools` names it. Every tool gets the same schedule, parameters and
+    start values.
 
-    ramp=True ramps the torque over each step in every tool that can; a tool that cannot says so.
+    Parameters
+    ----------
+    torque : float, callable, sequence of float, str or Path
+        The signal, as simulate() takes it.
+    tools : str or sequence of str, optional
+        As --tools gives them (compare_tools.py): fmu, reference, opensim, mujoco, drake,
+        pybullet (NAME:default for an engine's own defaults), LABEL=path/to/Their.fmu.
+    output_dir : str or Path
+        Where to write trajectories.csv (every tool's torque, theta, omega, alpha),
+        differences.csv (each tool against the reference: max and RMS of theta, omega, alpha,
+        max |torque received - signal|, wall time per step; and every pair of other tools) and
+        comparison.png (the tools overlaid, and their differences on a log scale).
+    step_size, start_time, stop_time, parameters, theta0, omega0, max_steps, fmu_path
+        As simulate() takes them; fmu_path's parameters and defaults apply to every tool.
+    ramp : bool, optional
+        Ramp the torque over each step in every tool that can; a tool that cannot says so.
+    tolerance : float, optional
+        The largest difference in theta (rad) or omega (rad/s) for the tools to agree.
+    title : str, optional
+        The figure's title.
+    mapping : str, optional
+        The --map of the tools given as LABEL=path (mapped_fmu.py).
+
+    Returns
+    -------
+    Comparison
+        The runs, the table of differences, the verdict (agree, worst) and the files written.
+
+    Raises
+    ------
+    ToolSpecError
+        A tools list that names no two runnable tools, or a tool that is not installed.
+    MapError
+        A mapping, or an FMU that does not fit it.
+    InvalidInput
+        A tolerance, signal, time or parameter the package refuses; a ramp given to a tool
+        that holds the torque (ToolCannotRamp).
+    FmuError
+        An FMU refused a step.
+    CannotWrite
+        output_dir cannot be written.
     """
     parsed = parse_tools(tools, mapping=mapping, fmu_path=fmu_path)
     if len(parsed) < 2:
@@ -180,3 +216,12 @@ def compare(torque: TorqueSignal, tools=TOOLS, *, output_dir: str | Path, step_s
         figure=plot_comparison(runs, output_dir / "comparison.png",
                                title or f"Torque-driven pendulum: {', '.join(runs)}"),
     )
+
+
+def format_comparison(comparison: Comparison) -> str:
+    """The table of differences and the verdict, as the command line prints them."""
+    verdict = "agree" if comparison.agree else "DIFFER"
+    return (f"{format_table(comparison.differences)}\n"
+            f"tools {verdict}: worst difference {comparison.worst:.3e} against tolerance "
+            f"{comparison.tolerance:g}; torque received vs the signal: {comparison.torque_worst:.3e} "
+            f"N.m (allowed {comparison.torque_limit:.1e})")

@@ -18,11 +18,12 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__, default_fmu
+from .atomic_files import replacing, replacing_path
 from .build import PLATFORMS
-from .files import replacing, replacing_path
+from .errors import InvalidInput
 from .parameters import model_description
-from .signal import TorqueTable
 from .simulate import simulate
+from .torque_schedule import TorqueTable
 
 START_TIME, STOP_TIME, STEP_SIZE, RELATIVE_TOLERANCE = 0.0, 4.0, 1e-3, 1e-10
 # The torque in N.m from the start, then (time of a jump, torque after it).
@@ -73,7 +74,7 @@ def write_cross_check(output_dir: str | Path, fmu_path: str | Path | None = None
         platforms = sorted({name.split("/")[1] for name in archive.namelist()
                             if name.startswith("binaries/") and name.count("/") == 2 and not name.endswith("/")})
     if not platforms:
-        raise ValueError(f"{fmu} carries no binaries: a cross-check needs one to run")
+        raise InvalidInput(f"{fmu} carries no binaries: a cross-check needs one to run")
     rows = _input_rows()
     torque = TorqueTable(np.array([t for t, _ in rows]), np.array([u for _, u in rows]))
     run = simulate(torque, start_time=START_TIME, stop_time=STOP_TIME, step_size=STEP_SIZE,
@@ -83,8 +84,8 @@ def write_cross_check(output_dir: str | Path, fmu_path: str | Path | None = None
     computed_on = next((name for name, platform in PLATFORMS.items() if platform.native), "this machine's")
     folders = []
     for platform in platforms:
+        # Each write below makes the folder, or says in one line why it cannot.
         folder = Path(output_dir, "fmus", description.fmiVersion, "cs", platform, TOOL, __version__, model_name)
-        folder.mkdir(parents=True, exist_ok=True)
         with replacing_path(folder / f"{model_name}.fmu") as copy:
             shutil.copyfile(fmu, copy)
         _write_csv(folder / f"{model_name}_in.csv", ("time", "torque"),

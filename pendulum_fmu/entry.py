@@ -9,8 +9,7 @@ import os
 import signal
 import sys
 
-# The signals that stop the program, and the word its one line says for each (cli.main too).
-STOPPING_SIGNALS = {signal.SIGINT: "interrupted", signal.SIGTERM: "terminated"}
+from .stop_signals import STOPPING_SIGNALS
 
 
 def _while_starting(number, frame):

@@ -11,6 +11,8 @@ import os
 
 import numpy as np
 
+from .errors import InvalidInput, MissingDependency
+
 
 def _import_opensim():
     # Importing opensim otherwise drops an opensim.log into the working directory.
@@ -18,7 +20,7 @@ def _import_opensim():
     try:
         import opensim
     except ImportError as error:
-        raise ImportError(
+        raise MissingDependency(
             "opensim_simulate needs the OpenSim Python package; "
             "install the extra: pip install '.[opensim]'"
         ) from error
@@ -78,24 +80,43 @@ def opensim_simulate(time, torque, *, mass=40.0, length=0.5, inertia=20.0, gravi
                      damping=0.0, theta0=0.0, omega0=0.0, accuracy=1e-12):
     """Simulate the pendulum in OpenSim with a torque held constant per step.
 
-    ``time`` holds the N+1 communication points t_0 < ... < t_N (the steps may
-    differ in size); ``torque[k]`` (N values) acts on [t_k, t_k+1].
+    Parameters
+    ----------
+    time : array_like
+        The N+1 communication points t_0 < ... < t_N in s (the steps may differ in size).
+    torque : array_like
+        N values in N.m; torque[k] acts on [t_k, t_k+1].
+    mass, length, inertia, gravity, damping : float, optional
+        The pendulum (kg, m, kg.m2 about the head's centre, m/s2, N.m.s/rad).
+    theta0, omega0 : float, optional
+        Start angle in rad and rate in rad/s.
+    accuracy : float, optional
+        The Manager's integrator accuracy; None keeps its own default.
 
-    Returns a dict of numpy arrays of length N+1: 'time', 'torque' (last value
-    repeated), 'theta', 'omega' and 'alpha', where alpha at t_k is the angular
-    acceleration under the torque of the step that starts at t_k (torque[N-1]
-    at t_N).
+    Returns
+    -------
+    dict of numpy.ndarray
+        'time', 'torque' (last value repeated), 'theta', 'omega' and 'alpha', each of length
+        N+1, where alpha at t_k is the angular acceleration under the torque of the step that
+        starts at t_k (torque[N-1] at t_N).
+
+    Raises
+    ------
+    MissingDependency
+        OpenSim is not installed.
+    InvalidInput
+        time and torque that are not N+1 increasing points and N values.
     """
     osim = _import_opensim()
 
     time = np.asarray(time, dtype=float)
     torque = np.asarray(torque, dtype=float)
     if time.ndim != 1 or time.size < 2:
-        raise ValueError("time must be a 1-D array of at least two points")
+        raise InvalidInput("time must be a 1-D array of at least two points")
     if torque.shape != (time.size - 1,):
-        raise ValueError("torque must hold one value per step: len(time) - 1")
+        raise InvalidInput("torque must hold one value per step: len(time) - 1")
     if np.any(np.diff(time) <= 0):
-        raise ValueError("time must be strictly increasing")
+        raise InvalidInput("time must be strictly increasing")
 
     model, coordinate, actuator = _build_pendulum_model(
         osim, mass, length, inertia, gravity, damping)

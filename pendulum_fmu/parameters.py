@@ -12,6 +12,8 @@ from pathlib import Path
 
 from fmpy import read_model_description
 
+from .errors import InvalidInput, MissingFile
+
 # The start values a user gives, and the FMU's variables they start.
 START_VALUES = {"theta0": "theta", "omega0": "omega"}
 
@@ -23,12 +25,16 @@ def _read(path: str, modified_ns: int):
 
 
 def _described(fmu_path: str | Path | None):
-    path = _fmu_file(fmu_path)
+    path = fmu_file(fmu_path)
     try:
         modified_ns = path.stat().st_mtime_ns
     except OSError as error:
-        raise FileNotFoundError(f"FMU {path}: {error.strerror}") from None
-    return _read(str(path.resolve()), modified_ns)
+        raise MissingFile(f"FMU {path}: {error.strerror}") from None
+    try:
+        return _read(str(path.resolve()), modified_ns)
+    except Exception as error:  # fmpy's, whatever the file is instead: no zip, no or bad XML
+        raise InvalidInput(f"FMU {path} cannot be read: {error}; pass an FMI 2.0 or 3.0 FMU "
+                           "file") from None
 
 
 def model_description(fmu_path: str | Path | None = None):
@@ -53,54 +59,24 @@ def default_parameters(fmu_path: str | Path | None = None) -> dict[str, float]:
 def merged_parameters(overrides: dict[str, float] | None = None,
                       fmu_path: str | Path | None = None) -> dict[str, float]:
     """The FMU's defaults with overrides applied; unknown names and non-finite values are refused.
-    What the FMU itself refuses is left to it: see resolve_parameters."""
+    What the FMU itself refuses is left to it: see simulate.resolve_parameters."""
     parameters = default_parameters(fmu_path)
     for name, value in (overrides or {}).items():
         if name not in parameters:
-            raise ValueError(f"unknown parameter {name!r}: the parameters are {', '.join(parameters)}")
+            raise InvalidInput(f"unknown parameter {name!r}: the parameters are {', '.join(parameters)}")
         value = float(value)
         if not math.isfinite(value):
-            raise ValueError(f"parameter {name} = {value} must be finite")
+            raise InvalidInput(f"parameter {name} = {value} must be finite")
         parameters[name] = value
     return parameters
 
 
-def resolve_parameters(overrides: dict[str, float] | None = None,
-                       fmu_path: str | Path | None = None) -> dict[str, float]:
-    """merged_parameters, and a set the FMU accepts.
-
-    The physical checks (mass > 0, an inertia about the pivot > 0, ...) live in one place, the
-    FMU's model.c, and every tool goes through them here: the FMU, the scipy reference, OpenSim,
-    the engines. Each refuses a bad set with the FMU's own message, word for word.
-    """
-    parameters = merged_parameters(overrides, fmu_path)
-    path = _fmu_file(fmu_path)
-    refusal = _refusal(str(path.resolve()), path.stat().st_mtime_ns, tuple(parameters.items()))
-    if refusal:
-        raise ValueError(refusal)
-    return parameters
-
-
-def _fmu_file(fmu_path: str | Path | None) -> Path:
+def fmu_file(fmu_path: str | Path | None) -> Path:
+    """The FMU file a function here is about: fmu_path, or pendulum_fmu.default_fmu()."""
     if fmu_path is None:
         from . import default_fmu
         return default_fmu()
     return Path(fmu_path)
-
-
-@lru_cache(maxsize=256)
-def _refusal(fmu: str, modified_ns: int, items: tuple) -> str | None:
-    """What the FMU says when it refuses these parameters at initialization, or None."""
-    from .simulate import FmuError, open_fmu
-
-    try:
-        slave = open_fmu(fmu, parameters=dict(items))
-    except FmuError as error:
-        # "initialization failed: [ERROR] fmi2ExitInitializationMode: mass must be > 0"
-        return f"the FMU refuses the parameters: {str(error).rsplit(': ', 1)[-1]}"
-    slave.terminate()
-    slave.freeInstance()
-    return None
 
 
 def total_inertia(parameters: dict[str, float]) -> float:

@@ -10,7 +10,7 @@ matplotlib.use("Agg")  # files only: works on machines without a display
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .files import replacing_path  # noqa: E402
+from .atomic_files import replacing_path  # noqa: E402
 
 THETA_LABEL = r"Position $\theta$ in rad"
 OMEGA_LABEL = r"Velocity $\omega$ in rad/s"

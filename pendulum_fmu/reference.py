@@ -1,6 +1,6 @@
 """The independent oracle: a torque signal as docs/signals.md defines it, through scipy.
 
-`reference()` shares no code with the path that feeds the tools (`signal.schedule`). It reads a
+`reference()` shares no code with the path that feeds the tools (`torque_schedule.schedule`). It reads a
 CSV with its own small reader, keeps the times as exact fractions of the decimals written in the
 file, and finds the communication points and the torque of each step from the written
 definition. A schedule that does not carry the user's signal to the tools then shows as a
@@ -24,7 +24,9 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from . import results
-from .parameters import resolve_parameters, total_inertia
+from .errors import InvalidInput
+from .parameters import total_inertia
+from .simulate import resolve_parameters
 
 # docs/signals.md: an event within max(1e-9 step, 64 ulp of its time) of a communication point
 # is that point. Written again here on purpose: the oracle must not borrow the schedule's code.
@@ -138,7 +140,7 @@ def _signal_pieces(torque, start: Fraction, stop: Fraction | None, step: Fractio
         values = [float(u) for u in torque]
         points = _grid(start, start + len(values) * step if stop is None else stop, step)
         if len(points) - 1 != len(values):
-            raise ValueError(f"the torque array has {len(values)} values for {len(points) - 1} steps")
+            raise InvalidInput(f"the torque array has {len(values)} values for {len(points) - 1} steps")
     else:
         points = _grid(start, _DEFAULT_STOP_TIME if stop is None else stop, step)
         sample = torque if callable(torque) else (lambda t, u=float(torque): u)
@@ -214,18 +216,42 @@ def reference(torque=20.0, *, start_time: float = 0.0, stop_time: float | None =
               step_size: float = 1e-3, ramp: bool = False, parameters: dict | None = None,
               theta0: float = 0.0, omega0: float = 0.0, at: np.ndarray | None = None,
               rtol: float = 1e-12, atol: float = 1e-12, fmu_path: str | Path | None = None) -> np.ndarray:
-    """The trajectory under a signal as docs/signals.md defines it, through scipy DOP853.
+    """The trajectory under a signal as docs/signals.md defines it, through scipy DOP853: the
+    independent oracle, which reads the signal itself.
 
-    Takes the signal and the arguments of simulate(): a constant, a callable of time, a per-step
-    array or a CSV path; parameters override the defaults of the FMU at fmu_path (default:
-    pendulum_fmu.default_fmu()). at: the times to report (default: the signal's communication
-    points). Same result format as simulate().
+    Parameters
+    ----------
+    torque : float, callable, sequence of float, str or Path
+        As simulate() takes it: a constant (N.m), a callable of time, a per-step array or a CSV
+        path.
+    start_time, stop_time, step_size, ramp, theta0, omega0
+        As simulate() takes them.
+    parameters : dict, optional
+        Overrides of the defaults of the FMU at fmu_path.
+    at : numpy.ndarray, optional
+        The times to report, in s (default: the signal's communication points).
+    rtol, atol : float, optional
+        solve_ivp's tolerances.
+    fmu_path : str or Path, optional
+        The FMU whose parameters and defaults apply (default: pendulum_fmu.default_fmu()).
+
+    Returns
+    -------
+    numpy.ndarray
+        Same result format as simulate(); torque is the signal's value just after each time.
+
+    Raises
+    ------
+    InvalidInput
+        A signal the reference cannot read, or parameters the FMU refuses.
+    RuntimeError
+        solve_ivp failed.
     """
     if not (isinstance(torque, (str, Path, list, tuple, np.ndarray, int, float)) or callable(torque)):
-        raise ValueError(f"the reference takes a constant, a callable, a per-step array or a CSV path, "
+        raise InvalidInput(f"the reference takes a constant, a callable, a per-step array or a CSV path, "
                          f"not a {type(torque).__name__}: it reads the signal itself")
     if isinstance(torque, (list, tuple, np.ndarray)) and ramp:
-        raise ValueError("a per-step torque array is held over each step; ramp needs a CSV or a callable")
+        raise InvalidInput("a per-step torque array is held over each step; ramp needs a CSV or a callable")
     step = _exact(step_size)
     start = _exact(start_time)
     pieces = _signal_pieces(torque, start, None if stop_time is None else _exact(stop_time), step, ramp)
@@ -237,8 +263,28 @@ def reference(torque=20.0, *, start_time: float = 0.0, stop_time: float | None =
 def reference_schedule(plan, *, parameters: dict | None = None, theta0: float = 0.0,
                        omega0: float = 0.0, rtol: float = 1e-12, atol: float = 1e-12,
                        fmu_path: str | Path | None = None) -> np.ndarray:
-    """Integrate exactly the torques of a schedule (time, torque, torque_rate), reported at its
-    communication points: the judge of a tool that was fed that schedule."""
+    """Integrate exactly the torques of a schedule, reported at its communication points: the
+    judge of a tool that was fed that schedule.
+
+    Parameters
+    ----------
+    plan : TorqueSchedule
+        time (N + 1 points, s), torque (N start values, N.m) and torque_rate (N, N.m/s).
+    parameters, theta0, omega0, rtol, atol, fmu_path
+        As reference() takes them.
+
+    Returns
+    -------
+    numpy.ndarray
+        Same result format as simulate().
+
+    Raises
+    ------
+    InvalidInput
+        Parameters the FMU refuses.
+    RuntimeError
+        solve_ivp failed.
+    """
     points = [Fraction(float(t)) for t in plan.time]
     u0, rate = plan.torque.tolist(), plan.torque_rate.tolist()
     # The schedule's points are the tools' own: no tolerance beyond rounding.

@@ -8,6 +8,7 @@ import itertools
 import tempfile
 import threading
 import weakref
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -16,8 +17,9 @@ from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
 from fmpy.fmi3 import FMU3Slave
 
 from . import cs_loop, default_fmu, results
-from .parameters import merged_parameters, model_description, resolve_parameters, value_reference
-from .signal import TorqueSignal, TorqueSchedule, schedule
+from .errors import InvalidInput, PendulumFmuError
+from .parameters import fmu_file, merged_parameters, model_description, value_reference
+from .torque_schedule import TorqueSignal, TorqueSchedule, schedule
 
 _STATUS = ["OK", "WARNING", "DISCARD", "ERROR", "FATAL", "PENDING"]
 # What a result records at every communication point, read back from the FMU after the step's
@@ -25,7 +27,7 @@ _STATUS = ["OK", "WARNING", "DISCARD", "ERROR", "FATAL", "PENDING"]
 RECORDED = ("torque", "theta", "omega", "alpha")
 
 
-class FmuError(RuntimeError):
+class FmuError(PendulumFmuError, RuntimeError):
     """An FMI call failed; the message carries what the FMU logged."""
 
 
@@ -132,7 +134,7 @@ def initialize(slave: FMU2Slave | FMU3Slave, *, parameters: dict | None = None, 
                omega0: float = 0.0, tolerance: float | None = None, start_time: float = 0.0) -> None:
     """Set the parameters and start values of an instantiated (or reset) slave from open_fmu and
     leave it in step mode; FmuError says why the FMU refused."""
-    # The FMU checks the parameters itself, here as everywhere (parameters.resolve_parameters).
+    # The FMU checks the parameters itself, here as everywhere (resolve_parameters).
     start = {**merged_parameters(parameters, slave.fmu_path), "theta": float(theta0), "omega": float(omega0)}
     references = [value_reference(n, slave.fmu_path) for n in start]
     try:
@@ -187,7 +189,7 @@ def run_schedule_python(slave: FMU2Slave | FMU3Slave, plan: TorqueSchedule) -> n
     dll, messages, fmi3 = slave.dll, slave.messages, slave.fmi_version == 3
     ramped = bool(np.any(plan.torque_rate))
     if fmi3 and ramped:
-        raise ValueError("FMI 3.0 has no input derivatives, so an FMI 3.0 FMU cannot ramp the "
+        raise InvalidInput("FMI 3.0 has no input derivatives, so an FMI 3.0 FMU cannot ramp the "
                          "torque: hold it over each step (no --ramp), or use the FMI 2.0 FMU")
     names = (("fmi3SetFloat64", "fmi3GetFloat64", None, "fmi3DoStep") if fmi3 else
              ("fmi2SetReal", "fmi2GetReal", "fmi2SetRealInputDerivatives", "fmi2DoStep"))
@@ -241,16 +243,52 @@ def simulate(torque: TorqueSignal = 20.0, *, start_time: float = 0.0, stop_time:
              step_size: float = 1e-3, ramp: bool = False, parameters: dict | None = None,
              theta0: float = 0.0, omega0: float = 0.0, tolerance: float | None = None,
              fmu_path: str | Path | None = None, max_steps: int | None = None) -> np.ndarray:
-    """Simulate the pendulum FMU under a torque signal.
+    """Simulate the pendulum FMU under a torque signal, one communication step at a time.
 
-    torque: a constant (N.m), a callable of time, a per-step array (one held value per step) or
-    a CSV path (fmpy's convention; docs/signals.md). Each communication step holds the signal's
-    value just after its start, or ramps (ramp=True) through fmi2SetRealInputDerivatives along
-    the CSV's own piecewise-linear signal. parameters: overrides of mass, length, inertia, gravity, damping.
-    tolerance: relative tolerance for fmi2SetupExperiment (None: the FMU's 1e-10).
-    max_steps: the longest run accepted (default signal.DEFAULT_MAX_STEPS); a longer one, or one
-    that would not fit in memory, is refused before anything is allocated.
-    Returns a structured array with fields time, torque, theta, omega, alpha (see results.py).
+    The whole schedule runs in one call into the native loop (cs_loop.py) when it was compiled
+    and the FMU is FMI 2.0, else in the Python loop; the two give the same numbers bit for bit.
+
+    Parameters
+    ----------
+    torque : float, callable, sequence of float, str or Path
+        A constant (N.m), a callable of time (sampled at each step's start), a per-step array
+        (one held value per step) or a CSV path in fmpy's convention (docs/signals.md). Each
+        step holds the signal's value just after its start unless ramp.
+    start_time, stop_time : float, optional
+        In s; stop_time defaults to the CSV's last time, the array's last step, or 3 s.
+    step_size : float, optional
+        Communication step in s.
+    ramp : bool, optional
+        Ramp the torque over each step through fmi2SetRealInputDerivatives, along the CSV's own
+        piecewise-linear signal (FMI 2.0 only).
+    parameters : dict, optional
+        Overrides of the FMU's parameters (mass, length, inertia, gravity, damping).
+    theta0, omega0 : float, optional
+        Start angle in rad and rate in rad/s.
+    tolerance : float, optional
+        Relative tolerance of the FMU's integrator (None: the FMU's 1e-10).
+    fmu_path : str or Path, optional
+        The FMU to run (default: pendulum_fmu.default_fmu()); its own parameters apply.
+    max_steps : int, optional
+        The longest run accepted (default torque_schedule.DEFAULT_MAX_STEPS); a longer one, or
+        one that would not fit in memory, is refused before anything is allocated.
+
+    Returns
+    -------
+    numpy.ndarray
+        A structured array with fields time, torque, theta, omega, alpha, one row per
+        communication point (see results.py); torque is what the FMU received.
+
+    Raises
+    ------
+    InvalidInput
+        A signal, time, step, parameter or run length the package refuses.
+    TorqueFileError
+        A torque CSV that is not a signal (names the file, line and problem).
+    FmuError
+        The FMU refused the parameters or a step; the message carries what it logged.
+    MissingFile
+        No FMU at fmu_path.
     """
     plan = schedule(torque, start_time=start_time, stop_time=stop_time, step_size=step_size,
                     ramp=ramp, max_steps=max_steps)
@@ -274,3 +312,32 @@ def simulate_plan(plan: TorqueSchedule, *, parameters: dict | None = None, theta
     finally:
         slave.terminate()
         slave.freeInstance()
+
+
+def resolve_parameters(overrides: dict[str, float] | None = None,
+                       fmu_path: str | Path | None = None) -> dict[str, float]:
+    """parameters.merged_parameters, and a set the FMU accepts.
+
+    The physical checks (mass > 0, an inertia about the pivot > 0, ...) live in one place, the
+    FMU's model.c, and every tool goes through them here: the FMU, the scipy reference, OpenSim,
+    the engines. Each refuses a bad set with the FMU's own message, word for word.
+    """
+    parameters = merged_parameters(overrides, fmu_path)
+    path = fmu_file(fmu_path)
+    refusal = _refusal(str(path.resolve()), path.stat().st_mtime_ns, tuple(parameters.items()))
+    if refusal:
+        raise InvalidInput(refusal)
+    return parameters
+
+
+@lru_cache(maxsize=256)
+def _refusal(fmu: str, modified_ns: int, items: tuple) -> str | None:
+    """What the FMU says when it refuses these parameters at initialization, or None."""
+    try:
+        slave = open_fmu(fmu, parameters=dict(items))
+    except FmuError as error:
+        # "initialization failed: [ERROR] fmi2ExitInitializationMode: mass must be > 0"
+        return f"the FMU refuses the parameters: {str(error).rsplit(': ', 1)[-1]}"
+    slave.terminate()
+    slave.freeInstance()
+    return None

@@ -134,7 +134,7 @@ def main(argv=None):
     with tempfile.TemporaryDirectory() as folder:
         write_files(Path(folder))
         rows = [(case, *run_case(case, Path(folder))) for case in CASES]
-    from pendulum_fmu.files import replacing
+    from pendulum_fmu.atomic_files import replacing
 
     with replacing(out) as file:
         file.write(markdown(rows))

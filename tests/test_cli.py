@@ -7,6 +7,7 @@ import numpy as np
 import pyarrow.parquet as pq
 
 from pendulum_fmu.cli import build_parser, main
+from pendulum_fmu.errors import InvalidInput
 from pendulum_fmu.reference import reference
 
 I_TOTAL = 30.0
@@ -49,8 +50,26 @@ def test_simulate_torque_file(tmp_path):
     assert np.max(np.abs(data["theta"] - reference(csv, step_size=0.01)["theta"])) < 1e-10
 
 
+def test_a_users_error_is_one_line_and_anything_else_an_internal_error(monkeypatch, capsys):
+    def refuse(*arguments, **options):
+        raise InvalidInput("stop time -1 must be after start time 0")
+
+    monkeypatch.setattr("pendulum_fmu.simulate.simulate", refuse)
+    assert main(["simulate", "--torque", "1"]) == 2
+    assert capsys.readouterr().err == "pendulum-fmu simulate: error: stop time -1 must be after start time 0\n"
+
+    def fail(*arguments, **options):
+        raise ValueError("a bug of ours")  # a ValueError, but no user's error
+
+    monkeypatch.setattr("pendulum_fmu.simulate.simulate", fail)
+    assert main(["simulate", "--torque", "1"]) == 3
+    err = capsys.readouterr().err
+    assert err.startswith("pendulum-fmu simulate: internal error: ValueError: a bug of ours") and "report it" in err
+    assert err.count("\n") == 1
+
+
 def test_argument_errors_exit_2_without_traceback():
-    result = subprocess.run([sys.executable, "-m", "pendulum_fmu.cli", "simulate", "--torque", "abc"],
+    result = subprocess.run([sys.executable, "-m", "pendulum_fmu", "simulate", "--torque", "abc"],
                             capture_output=True, text=True)
     assert result.returncode == 2
     assert "'abc' is not a number" in result.stderr and "Traceback" not in result.stderr
@@ -67,19 +86,6 @@ def test_compare_passes_and_fails_on_tolerance(tmp_path, capsys):
     assert (tmp_path / "comparison.png").exists()
     assert main(args + ["--tol", "1e-16"]) == 1
     assert "DIFFER" in capsys.readouterr().out
-
-
-def test_demo_runs_the_tutorial_end_to_end(tmp_path, capsys):
-    assert main(["demo", "--output-dir", str(tmp_path)]) == 0
-    out = capsys.readouterr().out
-    assert out.count("tools agree") == 2
-    assert "theta(3 s) = 3.0000000000 rad" in out  # gravity off: tau t^2 / (2 I) = 3 rad at 3 s
-    assert "theta(3 s) = 0.0814310965 rad" in out
-    for figure in ("no_gravity/comparison.png", "gravity/comparison.png", "gravity_effect.png",
-                   "parameter_study/sweep.png"):
-        assert (tmp_path / figure).read_bytes()[:4] == b"\x89PNG"
-    study = pq.read_table(tmp_path / "parameter_study/cases")
-    assert sorted(study["torque"].to_pylist()) == [5.0, 10.0, 20.0, 40.0]
 
 
 def test_sweep_command(tmp_path, capsys):

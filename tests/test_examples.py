@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from pendulum_fmu.reference import reference, reference_schedule
-from pendulum_fmu.signal import TorqueSchedule
+from pendulum_fmu.torque_schedule import TorqueSchedule
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 

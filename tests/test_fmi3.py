@@ -18,8 +18,8 @@ from pendulum_fmu.build import MODEL_DESCRIPTION
 from pendulum_fmu.cli import main
 from pendulum_fmu.parameters import default_parameters, total_inertia
 from pendulum_fmu.reference import reference, reference_schedule
-from pendulum_fmu.signal import TorqueSchedule, schedule
 from pendulum_fmu.simulate import open_fmu, run_schedule, simulate
+from pendulum_fmu.torque_schedule import TorqueSchedule, schedule
 
 TORQUE, THETA, OMEGA, ALPHA, MASS, DAMPING = 0, 1, 2, 3, 4, 8
 TIME = 9  # the independent variable's value reference in the FMI 3.0 description
@@ -238,14 +238,14 @@ def test_compare_and_sweep_take_the_fmi3_fmu(fmu, fmu3, tmp_path):
     import pyarrow.parquet as pq
 
     from pendulum_fmu.compare import run_tools
-    from pendulum_fmu.sweep import run_sweep
+    from pendulum_fmu.sweep import Study, run_sweep
 
     plan = schedule(lambda t: 20.0 if t < 0.5 else -5.0, stop_time=1.0)
     runs = run_tools(plan, ("fmu", "reference"), fmu_path=fmu3)
     assert np.array_equal(runs["fmu"], run_tools(plan, ("fmu",), fmu_path=fmu)["fmu"])
     assert np.max(np.abs(runs["fmu"]["theta"] - runs["reference"]["theta"])) < 1e-10
     cases = [{"torque": 10.0, "gravity": 0.0}, {"torque": 40.0, "gravity": 9.81}]
-    tables = [pq.read_table(run_sweep(cases, output_dir=tmp_path / name, stop_time=1.0, workers=1,
-                                      progress=False, fmu_path=path)["trajectories"]).sort_by("case")
+    tables = [pq.read_table(run_sweep(Study(cases, stop_time=1.0, fmu_path=path), output_dir=tmp_path / name,
+                                      workers=1, progress=False).trajectories).sort_by("case")
               for name, path in (("fmi3", fmu3), ("fmi2", fmu))]
     assert tables[0].equals(tables[1]) and tables[0].num_rows == 2 * 1001

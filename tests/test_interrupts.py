@@ -15,7 +15,7 @@ STEPS = 1_000_000  # several seconds even on a fast machine: writing 1e6 rows ta
 
 
 def start(arguments, folder):
-    return subprocess.Popen([sys.executable, "-m", "pendulum_fmu.cli", *arguments], cwd=folder,
+    return subprocess.Popen([sys.executable, "-m", "pendulum_fmu", *arguments], cwd=folder,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 

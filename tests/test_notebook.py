@@ -5,7 +5,7 @@ from pathlib import Path
 
 import pytest
 
-from pendulum_fmu.tools import KINDS, installed
+from pendulum_fmu.compare_tools import KINDS, installed
 
 nbformat = pytest.importorskip("nbformat")
 nbclient = pytest.importorskip("nbclient")
@@ -33,9 +33,9 @@ def test_engines_notebook_runs_with_the_tools_installed(tmp_path):
     # OpenSim, the slowest and tested elsewhere, is hidden as if it were not installed, so the
     # skip note is checked too.
     notebook.cells.insert(1, nbformat.v4.new_code_cell(
-        "import pendulum_fmu.tools\n"
-        "_installed = pendulum_fmu.tools.installed\n"
-        "pendulum_fmu.tools.installed = lambda name: name != 'opensim' and _installed(name)"))
+        "import pendulum_fmu.compare_tools\n"
+        "_installed = pendulum_fmu.compare_tools.installed\n"
+        "pendulum_fmu.compare_tools.installed = lambda name: name != 'opensim' and _installed(name)"))
     nbclient.NotebookClient(notebook, timeout=600, kernel_name="python3",
                             resources={"metadata": {"path": str(tmp_path)}}).execute()
     text = outputs_text(notebook)

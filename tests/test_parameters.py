@@ -1,6 +1,6 @@
 """One validation: every tool refuses a parameter set the FMU refuses, with the FMU's own words.
 
-The physical checks live once, in the FMU's model.c; parameters.resolve_parameters asks the FMU,
+The physical checks live once, in the FMU's model.c; simulate.resolve_parameters asks the FMU,
 and the scipy reference, OpenSim and the engines all go through it."""
 
 import importlib.util
@@ -8,10 +8,10 @@ import importlib.util
 import numpy as np
 import pytest
 
+from pendulum_fmu.compare_tools import KINDS, parse_tools
 from pendulum_fmu.reference import reference
-from pendulum_fmu.signal import schedule
 from pendulum_fmu.simulate import simulate
-from pendulum_fmu.tools import KINDS, parse_tools
+from pendulum_fmu.torque_schedule import schedule
 
 BAD = [
     ({"mass": 0.0}, "mass must be > 0"),

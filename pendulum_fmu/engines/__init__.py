@@ -17,13 +17,14 @@ from typing import Callable
 import numpy as np
 
 from .. import results
-from ..parameters import resolve_parameters
-from ..signal import TorqueSchedule
+from ..errors import InvalidInput
+from ..simulate import resolve_parameters
+from ..torque_schedule import TorqueSchedule
 
 MODES = ("accurate", "default")
 
 
-class ToolCannotRamp(ValueError):
+class ToolCannotRamp(InvalidInput):
     """A tool that holds the torque over a step was given a ramped schedule."""
 
 
@@ -36,7 +37,7 @@ def check_held(plan: TorqueSchedule, tool: str) -> None:
 
 def check_mode(mode: str, tool: str) -> None:
     if mode not in MODES:
-        raise ValueError(f"{tool}: unknown mode {mode!r}; choose {' or '.join(MODES)}")
+        raise InvalidInput(f"{tool}: unknown mode {mode!r}; choose {' or '.join(MODES)}")
 
 
 def substeps(step_size: np.ndarray, largest: float) -> np.ndarray:

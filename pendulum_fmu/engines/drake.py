@@ -28,8 +28,9 @@ from pydrake.multibody.tree import FixedOffsetFrame, RevoluteJoint, SpatialInert
 from pydrake.systems.analysis import ResetIntegratorFromFlags, Simulator
 from pydrake.systems.framework import DiagramBuilder
 
-from ..signal import TorqueSchedule
 from . import held_results, runner
+from ..errors import InvalidInput
+from ..torque_schedule import TorqueSchedule
 
 
 @dataclass(frozen=True)
@@ -48,7 +49,7 @@ class Setup:
 SETUPS = {"accurate": Setup(discrete=False), "default": Setup(discrete=True)}
 
 
-class UnequalSteps(ValueError):
+class UnequalSteps(InvalidInput):
     """Drake's discrete plant has one period; default mode needs equal communication steps."""
 
 

@@ -20,8 +20,8 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from ..signal import TorqueSchedule
 from . import held_results, runner, substeps
+from ..torque_schedule import TorqueSchedule
 
 
 @dataclass(frozen=True)

@@ -46,8 +46,8 @@ def _import_quietly():
 
 pybullet = _import_quietly()
 
-from ..signal import TorqueSchedule
 from . import held_results, runner, substeps
+from ..torque_schedule import TorqueSchedule
 
 
 @dataclass(frozen=True)

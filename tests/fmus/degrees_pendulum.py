@@ -1,4 +1,4 @@
-"""A pendulum as another tool would export it, for tests/test_tools.py: FMI 3.0, Model Exchange
+"""A pendulum as another tool would export it, for tests/test_compare_tools.py: FMI 3.0, Model Exchange
 and Co-Simulation (pythonfmu3), angles in degrees, its own names (tau, phi, w, a; m, L, J, g, c),
 the start angle and rate as parameters of their own. A Co-Simulation step integrates with
 scipy's DOP853 at 1e-12, in degrees."""

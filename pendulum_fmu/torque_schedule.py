@@ -37,6 +37,8 @@ from typing import Callable, Sequence, Union
 
 import numpy as np
 
+from .errors import InvalidInput
+
 TorqueSignal = Union[float, int, Callable[[float], float], str, Path, Sequence[float], np.ndarray,
                      "TorqueTable"]
 
@@ -67,7 +69,7 @@ def _nearest(points: np.ndarray, t: np.ndarray) -> np.ndarray:
     return np.where(np.abs(points[i] - t) < np.abs(points[i - 1] - t), points[i], points[i - 1])
 
 
-class TorqueFileError(ValueError):
+class TorqueFileError(InvalidInput):
     """A torque CSV that cannot be read; the message names the file, line and problem."""
 
 
@@ -227,7 +229,7 @@ def write_torque_csv(path: str | Path, plan: TorqueSchedule) -> Path:
     """Write a schedule in fmpy's convention: a row where each run of equal steps starts and
     ends, so a held torque reads as steps and a ramp as a line. Times are written with 17
     significant digits, so they read back as the same doubles."""
-    from .files import replacing
+    from .atomic_files import replacing
 
     end = plan.torque + plan.torque_rate * plan.step_size
     points = []
@@ -248,11 +250,11 @@ def write_torque_csv(path: str | Path, plan: TorqueSchedule) -> Path:
 def _check_times(start_time: float, stop_time: float, step_size: float) -> None:
     for name, value in (("start time", start_time), ("stop time", stop_time), ("step size", step_size)):
         if not math.isfinite(value):
-            raise ValueError(f"{name} {value} must be a finite number of seconds")
+            raise InvalidInput(f"{name} {value} must be a finite number of seconds")
     if not step_size > 0:
-        raise ValueError(f"step size {step_size} must be positive")
+        raise InvalidInput(f"step size {step_size} must be positive")
     if not stop_time > start_time:
-        raise ValueError(f"stop time {stop_time} must be after start time {start_time}")
+        raise InvalidInput(f"stop time {stop_time} must be after start time {start_time}")
 
 
 def _available_memory() -> int:
@@ -282,11 +284,11 @@ def step_count(start_time: float, stop_time: float, step_size: float,
     limit = DEFAULT_MAX_STEPS if max_steps is None else max_steps
     what = f"{start_time:g} to {stop_time:g} s in steps of {step_size:g} s is {steps:,} steps"
     if steps > limit:
-        raise ValueError(f"{what}, over the limit of {limit:,}: use a coarser step size or a shorter "
+        raise InvalidInput(f"{what}, over the limit of {limit:,}: use a coarser step size or a shorter "
                          "stop time, or raise the limit (--max-steps) if the run is meant to be that long")
     needed, available = steps * BYTES_PER_STEP, _available_memory()
     if needed > available:
-        raise ValueError(f"{what}, which needs {needed / 2**30:.1f} GiB and the machine has "
+        raise InvalidInput(f"{what}, which needs {needed / 2**30:.1f} GiB and the machine has "
                          f"{available / 2**30:.1f} GiB free: use a coarser step size or a shorter stop time")
     return steps
 
@@ -316,20 +318,20 @@ def _array_schedule(values, start_time: float, stop_time: float | None, step_siz
                     ramp: bool, max_steps: int | None) -> TorqueSchedule:
     torque = np.asarray(values, dtype=float)
     if torque.ndim != 1 or len(torque) == 0:
-        raise ValueError(f"a torque array needs one value per step (a flat list of numbers); got shape {torque.shape}")
+        raise InvalidInput(f"a torque array needs one value per step (a flat list of numbers); got shape {torque.shape}")
     if ramp:
-        raise ValueError("a per-step torque array is held over each step; ramp needs a CSV or a callable")
+        raise InvalidInput("a per-step torque array is held over each step; ramp needs a CSV or a callable")
     if stop_time is None:
         stop_time = start_time + len(torque) * step_size
     time = communication_points(start_time, stop_time, step_size, max_steps=max_steps)
     steps = len(time) - 1
     if steps != len(torque):
-        raise ValueError(f"the torque array has {len(torque)} values but {start_time:g} to {stop_time:g} s "
+        raise InvalidInput(f"the torque array has {len(torque)} values but {start_time:g} to {stop_time:g} s "
                          f"in steps of {step_size:g} s is {steps} steps; give one value per step or "
                          "leave out the stop time")
     bad = np.flatnonzero(~np.isfinite(torque))
     if len(bad):
-        raise ValueError(f"the torque array's value {bad[0]} is {torque[bad[0]]}; values must be finite")
+        raise InvalidInput(f"the torque array's value {bad[0]} is {torque[bad[0]]}; values must be finite")
     return TorqueSchedule(time=time, torque=torque, torque_rate=np.zeros(len(torque)))
 
 
@@ -346,7 +348,7 @@ def schedule(torque: TorqueSignal, *, start_time: float = 0.0, stop_time: float 
     if isinstance(torque, TorqueTable):
         stop = float(torque.time[-1]) if stop_time is None else stop_time
         if stop <= start_time and stop_time is None:
-            raise ValueError(f"{source} ends at {stop:g} s, not after the start time {start_time:g} s; "
+            raise InvalidInput(f"{source} ends at {stop:g} s, not after the start time {start_time:g} s; "
                              "give a stop time")
         grid = communication_points(start_time, stop, step_size, max_steps=max_steps)
         table = torque.snapped(grid, step_size)
@@ -362,11 +364,11 @@ def schedule(torque: TorqueSignal, *, start_time: float = 0.0, stop_time: float 
             try:
                 samples = np.full(len(time), float(torque))
             except (TypeError, ValueError):
-                raise ValueError(f"a torque is a number, a callable of time, a per-step array or a CSV "
+                raise InvalidInput(f"a torque is a number, a callable of time, a per-step array or a CSV "
                                  f"path; got {type(torque).__name__}") from None
         if not np.all(np.isfinite(samples)):
             bad = np.flatnonzero(~np.isfinite(samples))[0]
-            raise ValueError(f"the torque is {samples[bad]} at t = {time[bad]}; it must be finite")
+            raise InvalidInput(f"the torque is {samples[bad]} at t = {time[bad]}; it must be finite")
         start_values, end_values = samples[:-1], samples[1:]
     rate = (end_values - start_values) / np.diff(time) if ramp else np.zeros(len(time) - 1)
     return TorqueSchedule(time=time, torque=start_values, torque_rate=rate)

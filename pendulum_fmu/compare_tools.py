@@ -5,7 +5,7 @@
 
 An item is a tool's name, optionally with a mode (accurate, the default, or default: what the
 engine does with its own settings), or LABEL=PATH for any other FMU, run through the --map (see
-other_fmu.py). Every tool has the same runner:
+mapped_fmu.py). Every tool has the same runner:
 
     tool.run(plan, parameters=..., theta0=..., omega0=...) -> results array (results.py)
 
@@ -27,13 +27,13 @@ import numpy as np
 
 from . import results
 from .engines import MODES, check_held, check_mode
-from .parameters import resolve_parameters
+from .errors import InvalidInput
 from .reference import reference_schedule
-from .signal import TorqueSchedule
-from .simulate import simulate_plan
+from .simulate import resolve_parameters, simulate_plan
+from .torque_schedule import TorqueSchedule
 
 
-class ToolSpecError(ValueError):
+class ToolSpecError(InvalidInput):
     """A --tools or --map that names no runnable tool; the message says which and what to do."""
 
 
@@ -95,9 +95,9 @@ class Kind:
 
 
 KINDS = {
-    "fmu": Kind("pendulum_fmu.tools:run_fmu"),
-    "reference": Kind("pendulum_fmu.tools:run_reference"),
-    "opensim": Kind("pendulum_fmu.tools:run_opensim", "opensim", "opensim", MODES),
+    "fmu": Kind("pendulum_fmu.compare_tools:run_fmu"),
+    "reference": Kind("pendulum_fmu.compare_tools:run_reference"),
+    "opensim": Kind("pendulum_fmu.compare_tools:run_opensim", "opensim", "opensim", MODES),
     "mujoco": Kind("pendulum_fmu.engines.mujoco:run", "mujoco", "mujoco", MODES),
     "drake": Kind("pendulum_fmu.engines.drake:run", "pydrake", "drake", MODES),
     "pybullet": Kind("pendulum_fmu.engines.pybullet:run", "pybullet", "pybullet", MODES),
@@ -111,14 +111,14 @@ def installed(name: str) -> bool:
     return package is None or importlib.util.find_spec(package) is not None
 
 
-def _other_fmu(label: str, path: str, mapping: str | None) -> Tool:
-    from .other_fmu import OtherFmu
+def _mapped_fmu(label: str, path: str, mapping: str | None) -> Tool:
+    from .mapped_fmu import MappedFmu
 
     if not _LABEL.match(label) or label.split(":")[0] in KINDS:
         raise ToolSpecError(f"--tools {label}={path}: the label must be a name (letters, digits, "
                             f"_ . -) other than {', '.join(KINDS)}")
     try:
-        return Tool(label, OtherFmu(path, mapping, label=label).run)
+        return Tool(label, MappedFmu(path, mapping, label=label).run)
     except ValueError as error:
         raise ToolSpecError(str(error)) from None
 
@@ -159,7 +159,7 @@ def parse_tools(spec: str | Sequence[str], *, mapping: str | None = None,
     tools: list[Tool] = []
     for item in items:
         label, equals, path = (part.strip() for part in item.partition("="))
-        tool = _other_fmu(label, path, mapping) if equals else _named(item, fmu_path)
+        tool = _mapped_fmu(label, path, mapping) if equals else _named(item, fmu_path)
         if any(tool.label == other.label for other in tools):
             raise ToolSpecError(f"--tools names {tool.label} twice")
         tools.append(tool)

@@ -30,10 +30,10 @@ from fmpy.fmi2 import FMU2Slave
 from fmpy.fmi3 import FMU3Slave
 
 from .engines import check_held, check_mode, held_results
-from .parameters import (START_VALUES, default_parameters, model_description, resolve_parameters,
-                         variables)
-from .signal import TorqueSchedule
-from .simulate import RECORDED, _unzipped
+from .errors import InvalidInput
+from .parameters import START_VALUES, default_parameters, model_description, variables
+from .simulate import RECORDED, FmuError, _unzipped, resolve_parameters
+from .torque_schedule import TorqueSchedule
 
 OUTPUTS = RECORDED[1:]  # theta, omega, alpha
 REQUIRED = ("torque", "theta")
@@ -42,7 +42,7 @@ TOLERANCE = {"accurate": 1e-12, "default": None}
 _FACTOR = re.compile(r"^(?P<variable>.+?)\*(?P<factor>[-+0-9.eE]+)$")
 
 
-class MapError(ValueError):
+class MapError(InvalidInput):
     """A --map or an FMU that does not fit it; the message says which and what to do."""
 
 
@@ -79,7 +79,7 @@ def parse_map(text: str | None) -> dict[str, Mapped]:
     return mapping
 
 
-class OtherFmu:
+class MappedFmu:
     """An FMU and its map, checked once; run() has the runner signature of every tool."""
 
     def __init__(self, path: str | Path, mapping: dict[str, Mapped] | str | None = None, *,
@@ -89,8 +89,8 @@ class OtherFmu:
             raise MapError(f"{label}: no FMU at {self.path}")
         try:
             self.description = model_description(self.path)
-        except Exception as error:
-            raise MapError(f"{label}: {self.path} is not a readable FMU: {error}") from None
+        except InvalidInput as error:  # "FMU ... cannot be read: ..."
+            raise MapError(f"{label}: {error}") from None
         if self.description.fmiVersion not in ("2.0", "3.0"):
             raise MapError(f"{label}: {self.path} is FMI {self.description.fmiVersion}; "
                            "only FMI 2.0 and 3.0 FMUs can be compared")
@@ -197,7 +197,7 @@ class OtherFmu:
             recorded[-1] = get_values(output_vrs)
             slave.terminate()
         except Exception as error:
-            raise RuntimeError(f"{self.label}: {call} failed: {error}") from None
+            raise FmuError(f"{self.label}: {call} failed: {error}") from None
         finally:
             slave.freeInstance()
         return {name: recorded[:, i] for i, name in enumerate(outputs)}
@@ -222,10 +222,10 @@ class OtherFmu:
                                output_interval=float(plan.step_size.min()), input=signal,
                                output=list(outputs.values()), start_values=start)
         except Exception as error:
-            raise RuntimeError(f"{self.label}: Model Exchange simulation failed: {error}") from None
+            raise FmuError(f"{self.label}: Model Exchange simulation failed: {error}") from None
         # At a jump fmpy records the time twice; the row after the event is the one whose outputs
         # see the new torque.
         rows = np.searchsorted(raw["time"], plan.time + 1e-9 * plan.step_size.min(), side="right") - 1
         if np.any(np.abs(raw["time"][rows] - plan.time) > 1e-9 * plan.step_size.min()):
-            raise RuntimeError(f"{self.label}: fmpy did not report every communication point")
+            raise FmuError(f"{self.label}: fmpy did not report every communication point")
         return {name: raw[variable][rows] for name, variable in outputs.items()}

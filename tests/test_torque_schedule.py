@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from pendulum_fmu.signal import TorqueFileError, read_torque_csv, schedule, write_torque_csv
+from pendulum_fmu.torque_schedule import TorqueFileError, read_torque_csv, schedule, write_torque_csv
 
 
 def test_csv_jumps_become_communication_points(tmp_path):

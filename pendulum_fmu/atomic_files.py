@@ -9,15 +9,19 @@ leaves the old file, or none, and no temporary.
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import tempfile
 import uuid
 from pathlib import Path
 
+from .errors import CannotWrite
 
 # Every temporary a writer here leaves if it is killed (SIGKILL, a lost worker) matches this, so
 # that whoever owns the folder can sweep them up.
 TEMPORARY_GLOB = ".*.partial*"
+# A write that fails with one of these found no room where it writes.
+_FULL = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG)
 
 
 def _read_umask() -> int:
@@ -35,12 +39,19 @@ def _temporary_beside(path: Path, suffix: str) -> tuple[int, str]:
     which would hide an FMU or a table from the other users of a shared folder)."""
     for folder in (path.parent, *path.parent.parents):
         if folder.exists() and not folder.is_dir():
-            raise NotADirectoryError(f"cannot write {path}: {folder} is a file, not a folder; "
-                                     "choose another output path")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    descriptor, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
+            raise CannotWrite(f"cannot write {path}: {folder} is a file, not a folder; "
+                              "choose another output path")
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        descriptor, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
+    except OSError as error:
+        raise _cannot_write(path, error) from None
     os.chmod(temporary, 0o666 & ~_UMASK)
     return descriptor, temporary
+
+
+def _cannot_write(path: Path, error: OSError) -> CannotWrite:
+    return CannotWrite(f"cannot write {path}: {error.strerror or error}; choose another output path")
 
 
 @contextlib.contextmanager
@@ -62,8 +73,16 @@ def replacing_path(path: str | os.PathLike):
     descriptor, temporary = _temporary_beside(path, f".partial{path.suffix}")
     os.close(descriptor)
     try:
-        yield Path(temporary)
-        os.replace(temporary, path)
+        try:
+            yield Path(temporary)
+            os.replace(temporary, path)
+        except OSError as error:
+            # Only a failure to write this file is the place's doing (a folder where the file
+            # goes, no permission, no room); any other is the writer's, and goes on as it is.
+            about_this = error.filename is not None and os.fspath(error.filename) == temporary
+            if not (about_this or error.errno in _FULL):
+                raise
+            raise _cannot_write(path, error) from None
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(temporary)
@@ -92,48 +111,6 @@ def replacing_on(filesystem, path: str):
             yield file
         filesystem.mv(temporary, path)
         on_failure.pop_all()  # moved into place: nothing to remove
-
-
-class InUse(OSError):
-    """Another process holds the lock; the message says which folder and what to do."""
-
-
-@contextlib.contextmanager
-def held_lock(path: str | os.PathLike, what: str):
-    """Hold an exclusive lock on the file path while the block runs, or raise InUse at once when
-    another process holds it. The file is created for the block and removed after it; the
-    operating system releases the lock when the process ends, however it ends, so a killed run
-    leaves at most a file that locks nothing."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with open(path, "a+b") as file:
-        try:
-            _lock(file)
-            # A holder that finished removed the file we opened: the lock is on a file no other
-            # run can see.
-            held = os.path.samestat(os.fstat(file.fileno()), os.stat(path))
-        except OSError:
-            held = False
-        if not held:
-            raise InUse(f"{what} is in use by another run (it holds {path}); wait for that run "
-                        "to end, or choose another output")
-        try:
-            yield
-        finally:
-            with contextlib.suppress(OSError):  # Windows keeps an open file
-                os.unlink(path)
-
-
-if os.name == "nt":
-    import msvcrt
-
-    def _lock(file) -> None:
-        msvcrt.locking(file.fileno(), msvcrt.LK_NBLCK, 1)
-else:
-    import fcntl
-
-    def _lock(file) -> None:
-        fcntl.flock(file.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
 
 
 def _remove_if_there(filesystem, path: str) -> None:

@@ -1,5 +1,5 @@
 """A user's torque signal reaches the FMU as written, judged by the independent oracle
-(reference.reference reads the CSV itself and shares no code with signal.schedule).
+(reference.reference reads the CSV itself and shares no code with torque_schedule.schedule).
 
 The cases are the ones that went wrong: jumps at plain decimal times whose grid point is an ulp
 below them, running-sum times, kinks between communication points under --ramp, per-step arrays,
@@ -12,8 +12,8 @@ from benchmarks.signal_cases import random_step_rows, write_rows
 from pendulum_fmu import compare as compare_module
 from pendulum_fmu.compare import compare
 from pendulum_fmu.reference import reference
-from pendulum_fmu.signal import schedule
 from pendulum_fmu.simulate import simulate
+from pendulum_fmu.torque_schedule import schedule
 
 # 0.0003, 0.0006, 0.0007, 0.0009, 0.009, 0.03 and 0.3 are doubles below their decimals, so k*h
 # falls an ulp below a jump written at a multiple of them; 1/3 ms is no decimal at all.

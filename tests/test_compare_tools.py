@@ -5,13 +5,13 @@ import shutil
 import numpy as np
 import pytest
 
-from pendulum_fmu import tools
+from pendulum_fmu import compare_tools
 from pendulum_fmu.build import MODEL_DESCRIPTION, SOURCE_DIR, build_fmu
 from pendulum_fmu.cli import main
 from pendulum_fmu.compare import run_tools
-from pendulum_fmu.other_fmu import MapError, Mapped, OtherFmu, parse_map
+from pendulum_fmu.mapped_fmu import MapError, Mapped, MappedFmu, parse_map
 from pendulum_fmu.reference import reference_schedule
-from pendulum_fmu.signal import schedule
+from pendulum_fmu.torque_schedule import schedule
 
 RENAMES = {"torque": "u", "theta": "phi", "omega": "w", "alpha": "a", "mass": "m", "length": "L",
            "inertia": "J", "gravity": "g", "damping": "d"}
@@ -44,7 +44,7 @@ def max_error(run, expected, field="theta"):
 def test_tools_parse_in_order_with_modes():
     pytest.importorskip("pydrake")
     pytest.importorskip("mujoco")
-    parsed = tools.parse_tools("fmu, reference,drake:default,mujoco:accurate")
+    parsed = compare_tools.parse_tools("fmu, reference,drake:default,mujoco:accurate")
     assert [tool.label for tool in parsed] == ["fmu", "reference", "drake:default", "mujoco"]
 
 
@@ -59,15 +59,15 @@ def test_tools_parse_in_order_with_modes():
 ])
 def test_bad_tool_lists_are_refused_in_one_line(spec, message):
     with pytest.raises(ValueError) as raised:
-        tools.parse_tools(spec)
+        compare_tools.parse_tools(spec)
     assert message in str(raised.value) and "\n" not in str(raised.value)
 
 
 def test_a_missing_extra_names_the_pip_command(monkeypatch):
-    monkeypatch.setattr(tools, "installed", lambda name: name != "pybullet")
-    with pytest.raises(tools.ToolSpecError, match=r'pybullet is not installed; install it with: '
+    monkeypatch.setattr(compare_tools, "installed", lambda name: name != "pybullet")
+    with pytest.raises(compare_tools.ToolSpecError, match=r'pybullet is not installed; install it with: '
                                                    r'pip install "pendulum-fmu\[pybullet\]"'):
-        tools.parse_tools("fmu,pybullet")
+        compare_tools.parse_tools("fmu,pybullet")
 
 
 def test_cli_refuses_a_duplicate_tool_in_one_line(tmp_path, capsys):
@@ -83,15 +83,15 @@ def test_map_parsing():
                           ("theta=a,theta=b", "theta is mapped twice"), ("theta=phi*0", "finite and nonzero")]:
         with pytest.raises(MapError, match=message):
             parse_map(text)
-    with pytest.raises(tools.ToolSpecError, match="--map applies to FMUs"):
-        tools.parse_tools("fmu,reference", mapping="torque=u")
+    with pytest.raises(compare_tools.ToolSpecError, match="--map applies to FMUs"):
+        compare_tools.parse_tools("fmu,reference", mapping="torque=u")
 
 
 @pytest.mark.parametrize("interface", ["CoSimulation", "ModelExchange"])
 def test_another_fmu_under_other_names_matches_the_reference(renamed_fmu, interface):
     parameters = {"damping": 3.0, "length": 0.7}
     expected = reference_schedule(PLAN, parameters=parameters, theta0=0.2, omega0=-1.0)
-    run = OtherFmu(renamed_fmu, FULL_MAP, interface=interface).run(
+    run = MappedFmu(renamed_fmu, FULL_MAP, interface=interface).run(
         PLAN, parameters=parameters, theta0=0.2, omega0=-1.0)
     assert max_error(run, expected) < 1e-9
     assert max_error(run, expected, "alpha") < 1e-7
@@ -101,17 +101,17 @@ def test_a_scale_factor_converts_both_ways(renamed_fmu):
     # theta = phi * 0.5: the start value 0.1 sets phi to 0.2, and theta reads back half of phi,
     # which swings as the pendulum started at 0.2.
     half = FULL_MAP.replace("theta=phi", "theta=phi*0.5")
-    run = OtherFmu(renamed_fmu, half).run(PLAN, theta0=0.1)
+    run = MappedFmu(renamed_fmu, half).run(PLAN, theta0=0.1)
     from_double = reference_schedule(PLAN, theta0=0.2)
     assert np.max(np.abs(run["theta"] - 0.5 * from_double["theta"])) < 1e-10
 
 
 def test_an_unmapped_quantity(renamed_fmu):
     with pytest.raises(MapError, match="has no variable 'torque': name it with --map torque=VARIABLE"):
-        OtherFmu(renamed_fmu, "theta=phi")
+        MappedFmu(renamed_fmu, "theta=phi")
     with pytest.raises(MapError, match="has no variable 'psi' \\(mapped to theta\\)"):
-        OtherFmu(renamed_fmu, "torque=u,theta=psi")
-    partial = OtherFmu(renamed_fmu, "torque=u,theta=phi")
+        MappedFmu(renamed_fmu, "torque=u,theta=psi")
+    partial = MappedFmu(renamed_fmu, "torque=u,theta=phi")
     with pytest.raises(MapError, match="no variable for gravity = 0: map it with --map gravity=VARIABLE"):
         partial.run(PLAN, parameters={"gravity": 0.0})
     # omega and alpha unmapped: reported as NaN; the FMU's own parameters are the defaults.
@@ -146,7 +146,7 @@ def degrees_fmu(tmp_path_factory):
 @pytest.mark.parametrize("interface", ["CoSimulation", "ModelExchange"])
 def test_an_fmi3_fmu_in_degrees_matches_the_reference(degrees_fmu, interface):
     parameters = {"damping": 3.0, "mass": 25.0}
-    theirs = OtherFmu(degrees_fmu, DEGREES_MAP, interface=interface)
+    theirs = MappedFmu(degrees_fmu, DEGREES_MAP, interface=interface)
     run = theirs.run(PLAN, parameters=parameters, theta0=0.2, omega0=-1.0)
     expected = reference_schedule(PLAN, parameters=parameters, theta0=0.2, omega0=-1.0)
     assert max_error(run, expected) < 1e-10

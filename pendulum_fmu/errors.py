@@ -1,0 +1,40 @@
+"""The base of every error a user's input causes, and the kinds shared across modules.
+
+Every error the package raises for what its user gave derives from PendulumFmuError, and its
+message is one line saying what, where and what to do. The command line prints exactly these as
+that line (exit 2); anything else is a bug of ours, reported as an internal error. Each type also
+derives from the built-in exception a Python caller would expect (ValueError for a bad value,
+OSError for a file, ...). The kinds that belong to one module live there:
+
+    torque_schedule.TorqueFileError   a torque CSV that is not a signal
+    simulate.FmuError                 an FMI call failed or the FMU refused a value
+    compare_tools.ToolSpecError       a --tools list that names no runnable tool
+    mapped_fmu.MapError               a --map, or an FMU that does not fit it
+    engines.ToolCannotRamp            a ramp given to a tool that holds the torque
+    engines.drake.UnequalSteps        unequal steps given to drake:default
+    sweep.store.InUse                 an output folder another run holds
+    sweep.client.SchedulerUnreachable a dask scheduler that does not answer
+    build.BuildError                  an FMU that cannot be built
+"""
+
+
+class PendulumFmuError(Exception):
+    """Base of every error the user's input causes; the message is the one line to show."""
+
+
+class InvalidInput(PendulumFmuError, ValueError):
+    """An argument, option, parameter or case the package refuses: a time, a step, a tolerance,
+    a parameter's name or value, a sweep's values."""
+
+
+class MissingFile(PendulumFmuError, FileNotFoundError):
+    """A file the user named, or the FMU the package needs, is not there."""
+
+
+class CannotWrite(PendulumFmuError, OSError):
+    """An output cannot be written where it was asked for (a file where a folder must be, no
+    permission, a full disk)."""
+
+
+class MissingDependency(PendulumFmuError, ImportError):
+    """An optional package a tool needs is not installed; the message gives the pip command."""

@@ -1,0 +1,38 @@
+"""Parameter studies on dask.distributed: workers simulate chunks of cases and write them.
+
+    from pendulum_fmu.sweep import Study, run_sweep, sweep_grid
+
+    result = run_sweep(Study(sweep_grid([5, 10, 20], [0, 9.81]), stop_time=3.0), output_dir="study")
+
+A study goes to an output directory, a local path or any fsspec URL every worker can write to
+(a shared file system, s3://, gs://, ...):
+
+    study.json                        what the study is (cases, times, outputs, chunking)
+    trajectories/part-000000.parquet  per chunk: case, time and the chosen outputs at each kept
+                                      communication point
+    cases/part-000000.parquet         per chunk, one row per case: case, its values, final_theta,
+                                      final_omega, final_alpha, max_abs_theta, status ("ok" or
+                                      "failed") and message (why the FMU refused the case)
+    sweep.png                         the figure
+    .sweep.lock                       there while a run writes a local folder: a second run is refused
+
+With format "csv" the same files are CSV. One line of pandas, pyarrow, dask or DuckDB reads
+either table, e.g. pandas.read_parquet("out/trajectories").
+
+The package, in the order a run goes through it:
+
+    study.py   Study, what goes in (the cases, times, outputs, FMU), and SweepResult, what comes out
+    grid.py    the cases: sweep_grid's every combination, or a list of dicts, checked
+    run.py     run_sweep: the folder locked, the chunks run on dask, the figure drawn
+    client.py  the dask client, the chunks submitted and gathered, the progress line
+    worker.py  a chunk on a worker: its cases through the native loop, its two parts written
+    store.py   the output folder: study.json, the parts, the lock, the cases table read back
+    figure.py  sweep.png from the cases table
+"""
+
+from .grid import Grid, sweep_grid
+from .run import DEFAULT_MAX_CASES, run_sweep
+from .study import FORMATS, OUTPUTS, Study, SweepResult
+
+__all__ = ["DEFAULT_MAX_CASES", "FORMATS", "OUTPUTS", "Grid", "Study", "SweepResult", "run_sweep",
+           "sweep_grid"]

@@ -1,0 +1,118 @@
+"""The study's side of dask: a client on a local cluster or a scheduler, the chunks submitted and
+gathered as they finish, and the progress line.
+
+The client never holds a trajectory: a chunk's worker writes it, and what comes back is counts.
+So the client's memory and its work per case stay small however large the study.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import queue
+import sys
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+from ..errors import PendulumFmuError
+from .worker import Task, run_chunk
+
+
+class SchedulerUnreachable(PendulumFmuError, ConnectionError):
+    """The dask scheduler did not answer; the message names the address."""
+
+
+@contextlib.contextmanager
+def dask_client(scheduler: str | None, workers: int | None, connect_timeout: float):
+    """A dask client: on a local cluster of `workers` processes started (and closed) here, or on
+    the scheduler at an address, refused within connect_timeout when it does not answer."""
+    from dask.distributed import Client, LocalCluster
+
+    if scheduler is None:
+        # Port 0 for the scheduler's HTTP server: another cluster may hold dask's usual 8787.
+        with LocalCluster(n_workers=workers or 2, threads_per_worker=1, processes=True,
+                          dashboard_address=":0", silence_logs=logging.CRITICAL) as cluster, \
+                Client(cluster) as client:
+            yield client
+        return
+    try:
+        # A port that answers but is no dask scheduler would otherwise be waited on for ever, or
+        # have its bytes read as a message length.
+        client = Client(scheduler, timeout=connect_timeout)
+    except Exception as error:
+        reason = str(error).splitlines()[0] if str(error) else type(error).__name__
+        raise SchedulerUnreachable(
+            f"no dask scheduler answered at {scheduler} within {connect_timeout:g} s ({reason}); "
+            "check the address (start one with `dask scheduler`), raise --connect-timeout, or "
+            "leave out --scheduler for a local cluster") from None
+    with client:
+        yield client
+
+
+class _Lines:
+    """tqdm's output for a log: each redraw a line of its own, where a terminal's is redrawn in
+    place (tqdm starts it with a carriage return)."""
+
+    def __init__(self, stream):
+        self.stream = stream
+
+    def write(self, text: str) -> None:
+        text = text.strip("\r\n ")
+        if text:
+            self.stream.write(text + "\n")
+
+    def flush(self) -> None:
+        self.stream.flush()
+
+
+def progress_bar(total: int, done: int, enabled: bool):
+    """A tqdm bar of the cases on stderr, `done` of them already: redrawn in place on a terminal;
+    elsewhere (a log) a plain line every few seconds, and the last count."""
+    from tqdm import tqdm
+
+    counts = "{n_fmt}/{total_fmt} cases{postfix}, {elapsed_s:.1f} s"
+    # miniters=1: every update counts and only the interval thins them out, so tqdm's monitor
+    # thread never redraws a bar on its own.
+    if sys.stderr.isatty():
+        return tqdm(total=total, initial=done, disable=not enabled, file=sys.stderr, miniters=1,
+                    mininterval=0.2, ascii=" #", postfix="0 failed",
+                    bar_format="sweep [{bar:30}] " + counts)
+    return tqdm(total=total, initial=done, disable=not enabled, file=_Lines(sys.stderr), miniters=1,
+                mininterval=5.0, delay=5.0, leave=False, postfix="0 failed",
+                bar_format="sweep: " + counts)
+
+
+@dataclass
+class Totals:
+    """What the chunks of one run reported."""
+
+    failed: int = 0
+    bytes: int = 0
+    worker_cpu_seconds: float = 0.0
+    worker_stepping_seconds: float = 0.0
+
+
+def run_chunks(client, task: Task, chunks: Iterable[tuple[int, int, dict]], bar) -> Totals:
+    """Run each chunk (its index, the number of its first case, its values) on a worker,
+    advancing the bar as each finishes."""
+    totals = Totals()
+    futures = [client.submit(run_chunk, index, first, values, task, pure=False)
+               for index, first, values in chunks]
+    # Done callbacks rather than as_completed: on Ctrl-C no waiting coroutine is left to fail,
+    # with a traceback, when the cluster closes.
+    finished = queue.SimpleQueue()
+    for future in futures:
+        future.add_done_callback(finished.put)
+    for _ in futures:
+        future = finished.get()
+        _, count, failed, written, cpu, stepping = future.result()
+        totals.failed += failed
+        totals.bytes += written
+        totals.worker_cpu_seconds += cpu
+        totals.worker_stepping_seconds += stepping
+        future.release()
+        bar.set_postfix_str(f"{totals.failed} failed", refresh=False)
+        bar.update(count)
+    if futures:
+        bar.refresh()  # the last count, which a log would otherwise miss
+    return totals

@@ -1,0 +1,149 @@
+"""What a dask worker does with a chunk of cases: simulate each, write the chunk's two parts.
+
+A worker thread steps its cases through one FMU instance that it restarts between cases, each
+case in one call into the native loop (cs_loop.py); the FMI 3.0 FMU, or a machine without the
+native loop, runs the same case through fmpy's calls.
+"""
+
+from __future__ import annotations
+
+import os
+import threading
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import cs_loop
+from ..parameters import START_VALUES, default_parameters, value_reference
+from ..simulate import FmuError, initialize, open_fmu, run_schedule_python
+from ..torque_schedule import TorqueSchedule, communication_points
+from .store import SUMMARIES, Store
+from .study import OUTPUTS
+
+
+@dataclass(frozen=True)
+class Task:
+    """What every chunk of a study shares; shipped to the workers with each chunk."""
+
+    fmu: str
+    store: Store
+    stop_time: float
+    step_size: float
+    outputs: tuple[str, ...]
+    stride: int  # keep every stride-th communication point (and the last)
+
+
+class Runner:
+    """A worker thread's FMU instance, restarted (reset and initialized again) between cases:
+    instantiating costs about a hundred times what a restart costs.
+
+    A case is the start values of a restart: the parameters, theta and omega, and the torque,
+    which then stays as it was set, so the native loop sets no input per step."""
+
+    def __init__(self, fmu: str):
+        self.fmu, self.slave, self.stepper = fmu, None, None
+        self.defaults = {**default_parameters(fmu), "theta": 0.0, "omega": 0.0, "torque": 0.0}
+        self.start_references = np.array([value_reference(n, fmu) for n in self.defaults], np.uint32)
+        self.outputs = np.array([value_reference(name, fmu) for name in OUTPUTS], np.uint32)
+
+    def start_values(self, values: dict[str, np.ndarray], count: int) -> np.ndarray:
+        """(count, start values) of the cases given as {name: column}, the defaults elsewhere."""
+        given = {START_VALUES.get(name, name): column for name, column in values.items()}
+        return np.column_stack([np.broadcast_to(given.get(name, default), count)
+                                for name, default in self.defaults.items()]).astype(float)
+
+    def run(self, start_values: np.ndarray, points: np.ndarray, outputs: np.ndarray) -> None:
+        """theta, omega and alpha of one case (its row of start_values) at every communication
+        point into outputs (points x 3). FmuError when the FMU refuses the case."""
+        try:
+            if self.slave is None:
+                self.slave = open_fmu(self.fmu, start_time=float(points[0]))
+            self.slave.messages.lines.clear()
+            if cs_loop.drives(self.slave):
+                if self.stepper is None or not np.array_equal(self.stepper.time, points):
+                    self.stepper = cs_loop.Stepper(self.slave, np.empty(0, np.uint32), self.outputs,
+                                                   points, self.start_references)
+                self.stepper.run(None, None, outputs, start_values=start_values)
+            else:
+                self._run_python(dict(zip(self.defaults, start_values.tolist())), points, outputs)
+        except BaseException:
+            # After a refusal the instance is in an error state: the next case starts afresh.
+            self.close()
+            raise
+
+    def _run_python(self, start: dict[str, float], points: np.ndarray, outputs: np.ndarray) -> None:
+        """The same case through fmpy's calls: FMI 3.0 FMUs, or no native loop."""
+        torque, theta0, omega0 = start.pop("torque"), start.pop("theta"), start.pop("omega")
+        self.slave.reset()
+        initialize(self.slave, parameters=start, theta0=theta0, omega0=omega0,
+                   start_time=float(points[0]))
+        plan = TorqueSchedule(time=points, torque=np.full(len(points) - 1, torque),
+                              torque_rate=np.zeros(len(points) - 1))
+        run = run_schedule_python(self.slave, plan)
+        outputs[:] = np.column_stack([run[name] for name in OUTPUTS])
+
+    def close(self) -> None:
+        if self.slave is not None:
+            self.slave.freeInstance()
+            self.slave = self.stepper = None
+
+
+_runners = threading.local()
+
+
+def _runner(fmu: str) -> Runner:
+    """This thread's runner for the FMU file (a new one when the file changed)."""
+    key = (fmu, os.stat(fmu).st_mtime_ns)
+    current = getattr(_runners, "runner", None)
+    if current is None or current[0] != key:
+        if current is not None:
+            current[1].close()
+        current = _runners.runner = key, Runner(fmu)
+    return current[1]
+
+
+def kept_points(points: int, stride: int) -> np.ndarray:
+    """Indices of the communication points written: every stride-th, and the last."""
+    return np.unique(np.append(np.arange(0, points, stride), points - 1))
+
+
+def run_chunk(index: int, first: int, values: dict[str, np.ndarray], task: Task) -> tuple:
+    """Simulate a chunk of cases on a worker and write its parts.
+
+    values: the chunk's cases, one array per name; first: the number of its first case.
+    Returns (index, cases, failed, bytes written, CPU seconds of this thread, of which stepping).
+    """
+    cpu = time.thread_time()
+    points = communication_points(0.0, task.stop_time, task.step_size)
+    count = len(next(iter(values.values())))
+    recorded = np.empty((count, len(points), len(OUTPUTS)))
+    messages = [""] * count
+    runner = _runner(task.fmu)
+    start_values = runner.start_values(values, count)
+    stepping = time.thread_time()
+    for i in range(count):
+        try:
+            runner.run(start_values[i], points, recorded[i])
+        except FmuError as error:
+            messages[i] = str(error)
+            recorded[i] = np.nan
+    stepping = time.thread_time() - stepping
+    ok = np.array([not message for message in messages], bool)
+    numbers = first + np.arange(count)
+    written = 0
+    if task.outputs:
+        keep = kept_points(len(points), task.stride)
+        kept = recorded if ok.all() else recorded[ok]  # a copy only when a case failed
+        if len(keep) < len(points):
+            kept = kept[:, keep]
+        written += task.store.write_table("trajectories", index, {
+            "case": np.repeat(numbers[ok], len(keep)), "time": np.tile(points[keep], int(ok.sum())),
+            **{name: kept[:, :, OUTPUTS.index(name)].ravel() for name in task.outputs}},
+            split=("time", *task.outputs))
+    final = recorded[:, -1]
+    summaries = [*final.T, np.max(np.abs(recorded[:, :, 0]), axis=1)]
+    written += task.store.write_table("cases", index, {
+        "case": numbers, **values, **dict(zip(SUMMARIES, summaries)),
+        "status": np.where(ok, "ok", "failed").tolist(), "message": messages})
+    return index, count, count - int(ok.sum()), written, time.thread_time() - cpu, stepping

@@ -1,0 +1,75 @@
+"""The native co-simulation loop against the Python loop, bit for bit, and against scipy; its
+failures and its restarts."""
+
+import numpy as np
+import pytest
+
+from pendulum_fmu import cs_loop, simulate
+from pendulum_fmu.parameters import value_reference
+from pendulum_fmu.reference import reference_schedule
+from pendulum_fmu.sweep import OUTPUTS
+from pendulum_fmu.torque_schedule import TorqueTable, schedule
+
+
+def test_the_native_loop_is_built():
+    assert cs_loop.available(), "build it: pip install -e ."
+
+
+@pytest.mark.parametrize("ramp", [False, True])
+def test_native_loop_matches_the_python_loop_bit_for_bit(fmu, ramp):
+    # Uneven steps: a jump at 0.2505 s becomes a communication point between two 1 ms steps.
+    table = TorqueTable(time=np.array([0.0, 0.2505, 0.2505, 0.6]), torque=np.array([5.0, 30.0, -8.0, 12.0]))
+    plan = schedule(table, step_size=1e-3, ramp=ramp)
+    assert len(set(np.round(np.diff(plan.time), 12))) > 1
+    runs = []
+    for loop in (simulate.run_schedule, simulate.run_schedule_python):
+        slave = simulate.open_fmu(fmu, parameters={"damping": 1.5}, theta0=0.2)
+        try:
+            runs.append(loop(slave, plan))
+        finally:
+            slave.terminate()
+            slave.freeInstance()
+    native, python = runs
+    for name in native.dtype.names:
+        assert np.array_equal(native[name], python[name]), name
+    # And both are the physics: the scipy oracle of the same schedule.
+    oracle = reference_schedule(plan, theta0=0.2, parameters={"damping": 1.5})
+    assert np.max(np.abs(native["theta"] - oracle["theta"])) < 1e-9
+
+
+def test_native_loop_reports_the_failing_step(fmu):
+    slave = simulate.open_fmu(fmu)
+    try:
+        plan = schedule(1.0, stop_time=0.01, step_size=1e-3)
+        wrong = plan.time + 0.5  # fmi2DoStep refuses a step from where the instance is not
+        with pytest.raises(simulate.FmuError, match=r"fmi2DoStep at t = 0.5 returned ERROR: .*not where"):
+            stepper = cs_loop.Stepper(slave, np.array([0], np.uint32), np.array([1, 2, 3], np.uint32), wrong)
+            stepper.run(plan.torque[:, None].copy(), None, np.empty((len(wrong), 3)))
+    finally:
+        slave.freeInstance()
+
+
+def test_native_restart_matches_a_fresh_instance_bit_for_bit(fmu):
+    """A restart in C (fmi2Reset, initialization with new start values, the torque among them)
+    gives what a new instance initialized in Python and fed the torque every step gives."""
+    plan = schedule(12.0, stop_time=0.2, step_size=1e-3)
+    names = ("mass", "damping", "theta", "torque")
+    references = np.array([value_reference(n, fmu) for n in names], np.uint32)
+    outputs = np.array([value_reference(n, fmu) for n in OUTPUTS], np.uint32)
+    slave = simulate.open_fmu(fmu)  # initialized with the defaults, then restarted twice
+    try:
+        stepper = cs_loop.Stepper(slave, np.empty(0, np.uint32), outputs, plan.time, references)
+        for mass in (30.0, 55.0):
+            restarted = np.empty((len(plan.time), 3))
+            stepper.run(None, None, restarted, start_values=np.array([mass, 2.0, 0.4, 12.0]))
+            fresh = simulate.open_fmu(fmu, parameters={"mass": mass, "damping": 2.0}, theta0=0.4)
+            try:
+                expected = simulate.run_schedule_python(fresh, plan)
+            finally:
+                fresh.freeInstance()
+            for column, name in enumerate(OUTPUTS):
+                assert np.array_equal(restarted[:, column], expected[name]), (mass, name)
+        with pytest.raises(simulate.FmuError, match="initialization failed: .*mass must be > 0"):
+            stepper.run(None, None, restarted, start_values=np.array([-1.0, 0.0, 0.0, 0.0]))
+    finally:
+        slave.freeInstance()
