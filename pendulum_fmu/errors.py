@@ -13,6 +13,7 @@ OSError for a file, ...). The kinds that belong to one module live there:
     engines.ToolCannotRamp            a ramp given to a tool that holds the torque
     engines.drake.UnequalSteps        unequal steps given to drake:default
     sweep.store.InUse                 an output folder another run holds
+    sweep.store.StudyExists           an output folder holding a study the run was not asked to replace
     sweep.client.SchedulerUnreachable a dask scheduler that does not answer
     build.BuildError                  an FMU that cannot be built
 """
