@@ -28,6 +28,11 @@ class InvalidInput(PendulumFmuError, ValueError):
     a parameter's name or value, a sweep's values."""
 
 
+class WrongType(PendulumFmuError, TypeError):
+    """An argument of a kind the function does not take (None for a folder, a list for a Study);
+    the message says what it takes."""
+
+
 class MissingFile(PendulumFmuError, FileNotFoundError):
     """A file the user named, or the FMU the package needs, is not there."""
 

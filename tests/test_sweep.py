@@ -372,15 +372,14 @@ def test_an_unreachable_silent_or_wrong_scheduler_is_one_line_within_the_timeout
 
         threading.Thread(target=accept_and_never_answer, daemon=True).start()
         threading.Thread(target=babble, daemon=True).start()
-        for server, reason in ((None, "Timed out trying to connect"),
-                               (silent, "no answer to dask's handshake after 2 s"), (impostor, "")):
+        for server in (None, silent, impostor):
             address = f"tcp://127.0.0.1:{server.getsockname()[1]}" if server else closed
             started = time.perf_counter()
             assert main(["sweep", "--torque", "1", "--stop-time", "0.01", "--scheduler", address,
                          "--connect-timeout", "2", "--output-dir", str(tmp_path)]) == 2
             assert time.perf_counter() - started < 2 + 3  # the timeout, and a margin for a loaded machine
             err = capsys.readouterr().err
-            assert err.count("\n") == 1 and f"no dask scheduler answered at {address} within 2 s ({reason}" in err
+            assert err.count("\n") == 1 and f"no dask scheduler answered at {address} within 2 s" in err
         assert held  # the silent server was reached, and kept the connection open
     for connection in held:
         connection.close()

@@ -48,9 +48,9 @@ def dask_client(scheduler: str | None, workers: int | None, connect_timeout: flo
             reason = _first_line(error)
     if reason is not None:
         raise SchedulerUnreachable(
-            f"no dask scheduler answered at {scheduler} within {connect_timeout:g} s ({reason}); "
-            "check the address (start one with `dask scheduler`), raise --connect-timeout, or "
-            "leave out --scheduler for a local cluster")
+            f"no dask scheduler answered at {scheduler} within {connect_timeout:g} s"
+            f"{f' ({reason})' if reason else ''}; check the address (start one with `dask "
+            "scheduler`), raise --connect-timeout, or leave out --scheduler for a local cluster")
     with client:
         yield client
 
@@ -61,7 +61,8 @@ def _first_line(error: BaseException) -> str:
 
 def _why_no_scheduler(scheduler: str, timeout: float) -> str | None:
     """Why the address does not answer dask's handshake and an identity request as a scheduler
-    within timeout seconds, all told; None when it does.
+    within timeout seconds, all told: "" when nothing answered in time (nothing listens there,
+    or it never answers), else what answered; None when a scheduler did.
 
     dask's Client bounds only the TCP connection by its timeout and then waits for the handshake
     for ever: a port that accepts and never answers (a wrong port, a firewall's tarpit) would hold
@@ -86,16 +87,17 @@ def _why_no_scheduler(scheduler: str, timeout: float) -> str | None:
     def ask() -> None:
         try:
             answers.append(asyncio.run(asyncio.wait_for(identity(), timeout)))
-        except asyncio.TimeoutError:
-            answers.append(f"no answer to dask's handshake after {timeout:g} s")
-        except Exception as error:
+        except (asyncio.TimeoutError, OSError):
+            # Which of the two comes first, dask's connect giving up or the bound here, is chance.
+            answers.append("")
+        except Exception as error:  # an address dask cannot parse
             answers.append(_first_line(error))
 
     asking = threading.Thread(target=ask, name="pendulum_fmu scheduler handshake", daemon=True)
     asking.start()
     asking.join(timeout + 5.0)  # wait_for ends it by then: the margin is for a loaded machine
     if not answers:
-        return f"no answer to dask's handshake after {timeout:g} s"
+        return ""
     answer = answers[0]
     if isinstance(answer, str):
         return answer

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import default_fmu
-from ..errors import InvalidInput, MissingDependency
+from ..errors import InvalidInput, MissingDependency, WrongType
 from ..parameters import model_description
 from .client import dask_client, progress_bar, run_chunks
 from .figure import draw
@@ -88,7 +88,9 @@ def run_sweep(study: Study, *, output_dir: str | os.PathLike, resume: bool = Fal
 
     started = time.perf_counter()
     if not isinstance(study, Study):
-        raise TypeError(f"run_sweep takes a Study(cases, ...), not a {type(study).__name__}")
+        raise WrongType(f"run_sweep takes a Study(cases, ...), not a {type(study).__name__}")
+    if not isinstance(output_dir, str | os.PathLike):
+        raise WrongType(f"output_dir is a folder's path or an fsspec URL, not {output_dir!r}")
     cases = study.cases
     _check_options(len(cases), max_cases, scheduler, workers, connect_timeout, resume, overwrite)
     url = str(output_dir)

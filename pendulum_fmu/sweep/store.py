@@ -182,8 +182,9 @@ class Store:
             raise InUse(f"output directory {output_dir} is in use by another run (it holds {path}); "
                         "wait for that run to end, or choose another output") from None
         except OSError as error:
-            raise CannotWrite(f"cannot write {output_dir}: {error.strerror or error}; choose "
-                              "another output directory") from None
+            reason = "it is a file, not a folder" if path.parent.is_file() else error.strerror or error
+            raise CannotWrite(f"cannot write {output_dir}: {reason}; choose another output "
+                              "directory") from None
         try:
             yield
         finally:
