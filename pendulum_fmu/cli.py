@@ -325,7 +325,8 @@ def _add_sweep(commands) -> argparse.ArgumentParser:
                             "(without --resume or --overwrite, a folder holding a study is refused)")
     sweep.add_argument("--scheduler", help="address of a running dask.distributed scheduler")
     sweep.add_argument("--connect-timeout", type=_float, default=10.0,
-                       help="seconds to wait for --scheduler to answer (default: %(default)s)")
+                       help="seconds --scheduler has to answer dask's handshake, all told "
+                            "(default: %(default)s)")
     sweep.add_argument("--workers", type=int, default=None, help="local cluster workers (default: 2)")
     sweep.add_argument("--max-cases", type=_positive_int, default=DEFAULT_MAX_CASES,
                        help=f"refuse studies of more cases than this (default: {DEFAULT_MAX_CASES:,})")

@@ -15,6 +15,9 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
+if __name__ == "__main__":  # a script documents the clone it is in, whatever package is installed
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
 # Input files the cases name, written into {files} before they run.
 FILES = {
     "bad_number.csv": "time,torque\n0,1\n1,x\n",
