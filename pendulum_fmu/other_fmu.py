@@ -30,8 +30,8 @@ from fmpy.fmi2 import FMU2Slave
 from fmpy.fmi3 import FMU3Slave
 
 from .engines import check_held, check_mode, held_results
-from .parameters import (START_VALUES, default_parameters, model_description, resolve_parameters,
-                         variables)
+from .parameters import (START_VALUES, FmuFileError, default_parameters, model_description,
+                         resolve_parameters, variables)
 from .signal import TorqueSchedule
 from .simulate import RECORDED, _unzipped
 
@@ -89,11 +89,8 @@ class OtherFmu:
             raise MapError(f"{label}: no FMU at {self.path}")
         try:
             self.description = model_description(self.path)
-        except Exception as error:
-            raise MapError(f"{label}: {self.path} is not a readable FMU: {error}") from None
-        if self.description.fmiVersion not in ("2.0", "3.0"):
-            raise MapError(f"{label}: {self.path} is FMI {self.description.fmiVersion}; "
-                           "only FMI 2.0 and 3.0 FMUs can be compared")
+        except FmuFileError as error:  # not a zip, no model description, not FMI 2.0 or 3.0
+            raise MapError(f"{label}: {error}") from None
         available = [name for name, present in (("CoSimulation", self.description.coSimulation),
                                                  ("ModelExchange", self.description.modelExchange))
                      if present]

@@ -138,6 +138,7 @@ def sweep_grid(torques, gravities=(9.81,), extra: dict | None = None) -> Grid:
 
 def _check_cases(cases, fmu_path=None) -> list[str]:
     """The cases' common keys, which become the cases table's value columns."""
+    sweepable, seen = _sweepable(fmu_path), {}  # refuses a file that is no pendulum FMU, first
     if isinstance(cases, Grid):
         return list(cases.axes)  # checked when the grid was made
     if not cases:
@@ -145,7 +146,6 @@ def _check_cases(cases, fmu_path=None) -> list[str]:
     names = list(cases[0])
     if "torque" not in names:
         raise ValueError("every case needs a 'torque'")
-    sweepable, seen = _sweepable(fmu_path), {}
     for number, case in enumerate(cases):
         if list(case) != names:
             raise ValueError(f"case {number} has keys {list(case)}; every case needs {names}")
