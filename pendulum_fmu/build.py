@@ -31,7 +31,7 @@ import fmpy
 from fmpy import read_model_description
 
 from . import FMU_FILES, __version__, fmi3
-from .files import replacing_path
+from .files import check_writable, replacing_path
 
 ROOT = Path(__file__).resolve().parent.parent
 SOURCE_DIR = ROOT / "fmu_src"
@@ -345,6 +345,7 @@ def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, *, model_dir: Path = SO
     if platforms is None:
         platforms = available_platforms()
     check_platforms(platforms)
+    check_writable(out_file)  # before the compilers run
     model_description = read_model_description(str(model_description_file))
     identifier = model_description.coSimulation.modelIdentifier
     with tempfile.TemporaryDirectory(prefix="pendulum_fmu_build_") as tmp:

@@ -116,10 +116,11 @@ def cmd_cross_check(args) -> int:
 
 def cmd_simulate(args) -> int:
     from . import results
-    from .files import replacing
+    from .files import check_writable, replacing
     from .plot import plot_overlay
     from .simulate import simulate
 
+    check_writable(*(path for path in (args.output, args.plot) if path))
     run = simulate(_torque_signal(args), stop_time=args.stop_time, step_size=args.step_size,
                    ramp=args.ramp, parameters=_parameters(args.assignments), theta0=args.theta0,
                    omega0=args.omega0, tolerance=args.tolerance, max_steps=args.max_steps,

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .files import replacing
+from .files import check_writable, replacing
 from .parameters import resolve_parameters
 from .plot import plot_comparison
 from .reference import reference
@@ -156,6 +156,9 @@ def compare(torque: TorqueSignal, tools=TOOLS, *, output_dir: str | Path, step_s
     parameters = resolve_parameters(parameters, fmu_path)
     plan = schedule(torque, start_time=start_time, stop_time=stop_time, step_size=step_size, ramp=ramp,
                     max_steps=max_steps)
+    output_dir = Path(output_dir)
+    outputs = {name: output_dir / name for name in ("trajectories.csv", "differences.csv", "comparison.png")}
+    check_writable(*outputs.values())
     steps = len(plan.time) - 1
     runs, seconds = {}, {}
     runs[REFERENCE] = reference(torque, start_time=start_time, stop_time=stop_time, step_size=step_size,
@@ -172,11 +175,10 @@ def compare(torque: TorqueSignal, tools=TOOLS, *, output_dir: str | Path, step_s
              "seconds_per_step": seconds[tool]} for tool in others]
     rows += [{"tool": a, "against": b, **differences(runs[a], runs[b]), "seconds_per_step": None}
              for a, b in itertools.combinations(others, 2)]
-    output_dir = Path(output_dir)
     return Comparison(
         runs=runs, differences=rows, tolerance=tolerance,
-        trajectories=write_trajectories(runs, output_dir / "trajectories.csv"),
-        table=write_differences(rows, output_dir / "differences.csv"),
-        figure=plot_comparison(runs, output_dir / "comparison.png",
+        trajectories=write_trajectories(runs, outputs["trajectories.csv"]),
+        table=write_differences(rows, outputs["differences.csv"]),
+        figure=plot_comparison(runs, outputs["comparison.png"],
                                title or f"Torque-driven pendulum: {', '.join(runs)}"),
     )

@@ -19,7 +19,7 @@ import numpy as np
 
 from . import __version__, default_fmu
 from .build import PLATFORMS
-from .files import replacing, replacing_path
+from .files import check_writable, replacing, replacing_path
 from .parameters import model_description, pendulum_variables
 from .signal import TorqueTable
 from .simulate import simulate
@@ -73,6 +73,9 @@ def write_cross_check(output_dir: str | Path, fmu_path: str | Path | None = None
     with zipfile.ZipFile(fmu) as archive:
         platforms = sorted({name.split("/")[1] for name in archive.namelist()
                             if name.startswith("binaries/") and name.count("/") == 2 and not name.endswith("/")})
+    folders = [Path(output_dir, "fmus", description.fmiVersion, "cs", platform, TOOL, __version__, model_name)
+               for platform in platforms]
+    check_writable(*(folder / f"{model_name}.fmu" for folder in folders))  # before the run
     rows = _input_rows()
     torque = TorqueTable(np.array([t for t, _ in rows]), np.array([u for _, u in rows]))
     run = simulate(torque, start_time=START_TIME, stop_time=STOP_TIME, step_size=STEP_SIZE,
@@ -80,9 +83,7 @@ def write_cross_check(output_dir: str | Path, fmu_path: str | Path | None = None
     reference_rows = [[repr(float(t)), *(repr(float(v)) for v in values)]
                       for t, *values in zip(run["time"], *(run[name] for name in OUTPUTS))]
     computed_on = next((name for name, platform in PLATFORMS.items() if platform.native), "this machine's")
-    folders = []
-    for platform in platforms:
-        folder = Path(output_dir, "fmus", description.fmiVersion, "cs", platform, TOOL, __version__, model_name)
+    for folder in folders:
         folder.mkdir(parents=True, exist_ok=True)
         with replacing_path(folder / f"{model_name}.fmu") as copy:
             shutil.copyfile(fmu, copy)
@@ -94,5 +95,4 @@ def write_cross_check(output_dir: str | Path, fmu_path: str | Path | None = None
                           f"StepSize, {STEP_SIZE!r}\nRelTol, {RELATIVE_TOLERANCE!r}\n")
         with replacing(folder / "ReadMe.md") as readme:
             readme.write(_readme(computed_on, model_name))
-        folders.append(folder)
     return folders

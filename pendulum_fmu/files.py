@@ -30,6 +30,11 @@ def _read_umask() -> int:
 _UMASK = _read_umask()
 
 
+class NotWritable(OSError):
+    """No file can be written where the user asked; the message names the user's path (never a
+    temporary) and what to do."""
+
+
 def _temporary_beside(path: Path, suffix: str) -> tuple[int, str]:
     """A new file beside path with the permissions a plain open() would give (mkstemp's are 0600,
     which would hide an FMU or a table from the other users of a shared folder)."""
@@ -37,10 +42,45 @@ def _temporary_beside(path: Path, suffix: str) -> tuple[int, str]:
         if folder.exists() and not folder.is_dir():
             raise NotADirectoryError(f"cannot write {path}: {folder} is a file, not a folder; "
                                      "choose another output path")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    descriptor, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise NotWritable(f"cannot write {path}: the folder {error.filename} cannot be created "
+                          f"({error.strerror}); choose another output path") from None
+    try:
+        descriptor, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
+    except OSError as error:
+        raise NotWritable(f"cannot write {path}: no file can be created in {path.parent} "
+                          f"({error.strerror}); choose another output path") from None
     os.chmod(temporary, 0o666 & ~_UMASK)
     return descriptor, temporary
+
+
+def check_writable(*paths: str | os.PathLike) -> None:
+    """Refuse, before a long run, an output path that `replacing` could not write after it.
+
+    The unique temporary `replacing` would write is created beside each path and removed again,
+    with the folders made for it, so the check leaves nothing behind.
+
+    Raises
+    ------
+    NotWritable
+        A path is a folder, or no file can be created beside it.
+    NotADirectoryError
+        A folder on the way is a file.
+    """
+    for path in map(Path, paths):
+        if path.is_dir():
+            raise NotWritable(f"cannot write {path}: it is a folder; give a file name")
+        made = [folder for folder in (path.parent, *path.parent.parents) if not folder.exists()]
+        try:
+            descriptor, temporary = _temporary_beside(path, f".partial{path.suffix}")
+            os.close(descriptor)
+            os.unlink(temporary)
+        finally:
+            for folder in made:  # deepest first
+                with contextlib.suppress(OSError):
+                    folder.rmdir()
 
 
 @contextlib.contextmanager
@@ -105,7 +145,11 @@ def held_lock(path: str | os.PathLike, what: str):
     operating system releases the lock when the process ends, however it ends, so a killed run
     leaves at most a file that locks nothing."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise NotWritable(f"cannot write in {path.parent}: the folder {error.filename} cannot be "
+                          f"created ({error.strerror}); choose another output folder") from None
     with open(path, "a+b") as file:
         try:
             _lock(file)

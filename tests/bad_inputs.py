@@ -146,6 +146,19 @@ CASES = [
           "1,000 cases is over the limit of 999: give fewer values"),
     _case("output", "simulate --torque 1 --stop-time 0.01 --output {files}/bad_number.csv/out.csv", 2,
           "bad_number.csv is a file, not a folder; choose another output path"),
+    # /proc/self: a folder in which nothing can be created, whoever runs (Linux).
+    _case("output", "simulate --torque 1 --stop-time 0.01 --output /proc/self/out.csv", 2,
+          "cannot write /proc/self/out.csv: no file can be created in /proc/self (No such file or directory)"),
+    _case("output", "simulate --torque 1 --stop-time 0.01 --plot /proc/self/out.png", 2,
+          "cannot write /proc/self/out.png: no file can be created in /proc/self"),
+    _case("output", "simulate --torque 1 --stop-time 0.01 --output {files}", 2,
+          "cannot write {files}: it is a folder; give a file name"),
+    _case("output", "compare --torque 1 --tools fmu,reference --output-dir /proc/self/out", 2,
+          "cannot write /proc/self/out/trajectories.csv: the folder /proc/self/out cannot be created"),
+    _case("output", "build --output /proc/self/Pendulum.fmu --platforms linux64", 2,
+          "cannot write /proc/self/Pendulum.fmu: no file can be created in /proc/self"),
+    _case("output", "sweep --torque 1 --output-dir /proc/self/out", 2,
+          "cannot write in /proc/self/out: the folder /proc/self/out cannot be created"),
 ]
 
 
