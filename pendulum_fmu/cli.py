@@ -117,7 +117,7 @@ def cmd_cross_check(args) -> int:
 def cmd_simulate(args) -> int:
     from . import results
     from .files import check_writable, replacing
-    from .plot import plot_overlay
+    from .plot import case_title, plot_overlay
     from .simulate import simulate
 
     check_writable(*(path for path in (args.output, args.plot) if path))
@@ -136,7 +136,9 @@ def cmd_simulate(args) -> int:
                        header=header, comments="", fmt="%.17g")
         print(f"wrote {args.output} ({header}; units {', '.join(results.UNITS.values())})")
     if args.plot:
-        print(f"wrote {plot_overlay({'FMU': run}, args.plot, 'Torque-driven pendulum')}")
+        title = case_title(_torque_signal(args), _parameters(args.assignments), args.theta0, args.omega0,
+                           args.fmu)
+        print(f"wrote {plot_overlay({'FMU': run}, args.plot, title)}")
     return 0
 
 
@@ -247,7 +249,7 @@ def cmd_demo(args) -> int:
     runs, agree = {}, True
     for label, gravity, folder in (("No Gravity", 0.0, "no_gravity"), ("With Gravity", 9.81, "gravity")):
         comparison = compare(torque, tools, output_dir=out / folder, parameters={"gravity": gravity},
-                             title=rf"Constant Torque $\tau = {torque:g}$ Nm — {label}")
+                             title=rf"Constant Torque $\tau = {torque:g}$ N.m — {label}")
         print(f"\n{label} (gravity = {gravity:g} m/s2)")
         _print_comparison(comparison)
         fmu = comparison.runs["fmu"]
@@ -258,8 +260,8 @@ def cmd_demo(args) -> int:
         print(f"wrote {comparison.figure}")
         runs[label] = fmu
         agree &= comparison.agree
-    overlay = plot_overlay({rf"No gravity ($\tau = {torque:g}$ Nm)": runs["No Gravity"],
-                            rf"With gravity ($\tau = {torque:g}$ Nm)": runs["With Gravity"]},
+    overlay = plot_overlay({rf"No gravity ($\tau = {torque:g}$ N.m)": runs["No Gravity"],
+                            rf"With gravity ($\tau = {torque:g}$ N.m)": runs["With Gravity"]},
                            out / "gravity_effect.png", "Effect of Gravity on Torque-Driven Pendulum")
     print(f"\nwrote {overlay}")
     print("\nParameter study: torque 5, 10, 20, 40 N.m with gravity, on a local dask cluster")

@@ -19,7 +19,7 @@ import numpy as np
 
 from .files import check_writable, replacing
 from .parameters import resolve_parameters
-from .plot import plot_comparison
+from .plot import case_title, plot_comparison
 from .reference import reference
 from .signal import TorqueSchedule, TorqueSignal, schedule
 from .tools import ToolSpecError, parse_tools
@@ -151,6 +151,7 @@ def compare(torque: TorqueSignal, tools=TOOLS, *, output_dir: str | Path, step_s
         raise ToolSpecError(f"compare needs at least two tools, got {parsed[0].label}: "
                             f"e.g. --tools fmu,{REFERENCE}")
     tolerance = check_tolerance(tolerance)
+    shown = case_title(torque, parameters, theta0, omega0, fmu_path)  # the user's own parameters
     # Refused here before any tool runs; and every tool gets the whole set, so the defaults are
     # fmu_path's for all of them.
     parameters = resolve_parameters(parameters, fmu_path)
@@ -179,6 +180,5 @@ def compare(torque: TorqueSignal, tools=TOOLS, *, output_dir: str | Path, step_s
         runs=runs, differences=rows, tolerance=tolerance,
         trajectories=write_trajectories(runs, outputs["trajectories.csv"]),
         table=write_differences(rows, outputs["differences.csv"]),
-        figure=plot_comparison(runs, outputs["comparison.png"],
-                               title or f"Torque-driven pendulum: {', '.join(runs)}"),
+        figure=plot_comparison(runs, outputs["comparison.png"], title or f"{shown}; tools {', '.join(runs)}"),
     )

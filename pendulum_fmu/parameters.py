@@ -105,6 +105,13 @@ def value_reference(name: str, fmu_path: str | Path | None = None) -> int:
     return pendulum_variables(fmu_path)[name].valueReference
 
 
+def unit(name: str, fmu_path: str | Path | None = None) -> str:
+    """The unit the pendulum FMU declares for a variable, a parameter or a start value (theta0:
+    theta's), '' where it declares none; raises as default_parameters, KeyError for a name it
+    does not have."""
+    return pendulum_variables(fmu_path)[START_VALUES.get(name, name)].unit or ""
+
+
 def default_parameters(fmu_path: str | Path | None = None) -> dict[str, float]:
     """{name: start value} of every parameter (mass, length, inertia, gravity, damping).
 

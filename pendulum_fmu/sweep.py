@@ -478,9 +478,11 @@ def _draw(study: _Study, cases_table, names: list[str], target: str) -> None:
     """sweep.png: every trajectory when there are few, else quantile bands of the summaries."""
     import pyarrow.dataset as ds
 
+    from .parameters import unit
     from .plot import plot_case_bands, plot_cases  # here: workers never draw, nor import matplotlib
 
     title = f"Parameter study: {cases_table.num_rows} cases of the torque-driven pendulum"
+    units = {name: unit(name, study.fmu) for name in names}
     with tempfile.TemporaryDirectory(prefix="pendulum_fmu_sweep_") as scratch:
         figure = Path(scratch) / "sweep.png"
         if cases_table.num_rows <= LINES_UP_TO and {"theta", "omega"} <= set(study.outputs):
@@ -491,14 +493,14 @@ def _draw(study: _Study, cases_table, names: list[str], target: str) -> None:
             for row in cases_table.to_pylist():
                 if row["status"] == "ok":
                     rows = case_column == row["case"]
-                    label = ", ".join(f"{name} = {row[name]:g}" for name in names)
+                    label = ", ".join(f"{name} = {row[name]:g} {units[name]}" for name in names)
                     runs[label] = {k: trajectories[k].to_numpy()[rows] for k in ("time", "theta", "omega")}
             plot_cases(runs, figure, title)
         else:
             plot_case_bands({name: cases_table[name].to_numpy() for name in names},
                             {"max |theta| in rad": cases_table["max_abs_theta"].to_numpy(),
                              "final theta in rad": cases_table["final_theta"].to_numpy()},
-                            figure, title)
+                            figure, title, units)
         with replacing_on(study.filesystem, target) as file:
             file.write(figure.read_bytes())
 
