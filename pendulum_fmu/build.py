@@ -31,7 +31,7 @@ import fmpy
 from fmpy import read_model_description
 
 from . import FMU_FILES, __version__, fmi3
-from .atomic_files import replacing_path
+from .atomic_files import check_writable, replacing_path
 from .errors import PendulumFmuError
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -369,6 +369,7 @@ def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, *, model_dir: Path = SO
     if platforms is None:
         platforms = available_platforms()
     check_platforms(platforms)
+    check_writable(out_file)  # before the compilers run
     model_description = read_model_description(str(model_description_file))
     identifier = model_description.coSimulation.modelIdentifier
     with tempfile.TemporaryDirectory(prefix="pendulum_fmu_build_") as tmp:

@@ -123,8 +123,10 @@ def cmd_cross_check(args) -> int:
 
 def cmd_simulate(args) -> int:
     from . import results
+    from .atomic_files import check_writable
     from .simulate import simulate
 
+    check_writable(*(path for path in (args.output, args.plot) if path))
     run = simulate(_torque_signal(args), stop_time=args.stop_time, step_size=args.step_size,
                    ramp=args.ramp, parameters=_parameters(args.assignments), theta0=args.theta0,
                    omega0=args.omega0, tolerance=args.tolerance, max_steps=args.max_steps,
@@ -138,9 +140,11 @@ def cmd_simulate(args) -> int:
         print(f"wrote {args.output} ({','.join(results.FIELDS)}; units "
               f"{', '.join(results.UNITS.values())})")
     if args.plot:
-        from .plot import plot_overlay
+        from .plot import case_title, plot_overlay
 
-        print(f"wrote {plot_overlay({'FMU': run}, args.plot, 'Torque-driven pendulum')}")
+        title = case_title(_torque_signal(args), _parameters(args.assignments), args.theta0, args.omega0,
+                           args.fmu)
+        print(f"wrote {plot_overlay({'FMU': run}, args.plot, title)}")
     return 0
 
 

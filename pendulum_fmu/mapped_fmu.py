@@ -31,7 +31,7 @@ from fmpy.fmi3 import FMU3Slave
 
 from .engines import check_held, check_mode, held_results
 from .errors import InvalidInput
-from .parameters import START_VALUES, default_parameters, model_description, variables
+from .parameters import START_VALUES, FmuFileError, default_parameters, model_description, variables
 from .simulate import RECORDED, FmuError, _unzipped, resolve_parameters
 from .torque_schedule import TorqueSchedule
 
@@ -89,11 +89,8 @@ class MappedFmu:
             raise MapError(f"{label}: no FMU at {self.path}")
         try:
             self.description = model_description(self.path)
-        except InvalidInput as error:  # "FMU ... cannot be read: ..."
+        except FmuFileError as error:  # not a zip, no model description, not FMI 2.0 or 3.0
             raise MapError(f"{label}: {error}") from None
-        if self.description.fmiVersion not in ("2.0", "3.0"):
-            raise MapError(f"{label}: {self.path} is FMI {self.description.fmiVersion}; "
-                           "only FMI 2.0 and 3.0 FMUs can be compared")
         available = [name for name, present in (("CoSimulation", self.description.coSimulation),
                                                  ("ModelExchange", self.description.modelExchange))
                      if present]
