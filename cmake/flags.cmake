@@ -27,9 +27,13 @@ endif()
 
 # Makes target a library that exports the functions named <prefix>* and nothing else: on
 # Windows the ones marked __declspec(dllexport), elsewhere the ones of default visibility, and
-# on ELF a version script says so to the linker too. Its file name has no "lib" prefix.
+# on ELF a version script says so to the linker too. Its file name has no "lib" prefix; on macOS
+# its install name is its own file name, as in the Reference FMUs.
 function(export_only target prefix)
-    if(MINGW)
+    if(APPLE)
+        set_target_properties(${target} PROPERTIES NO_SONAME ON)
+        target_link_options(${target} PRIVATE "LINKER:-install_name,$<TARGET_FILE_NAME:${target}>")
+    elseif(MINGW)
         # No dependency on the mingw runtime DLLs: the binary loads on any Windows.
         target_link_options(${target} PRIVATE -static-libgcc -s)
     elseif(UNIX AND NOT APPLE)

@@ -262,12 +262,16 @@ def _cmake() -> str:
 
 def find_compiler(platform: Platform, fmi_version: int = 2) -> None:
     """BuildError naming the package to install unless every tool that builds platform is here:
-    the compiler of each target, and llvm-lipo where FMI 2.0 merges slices into one binary."""
+    the cross-compiler of each target (or $CC, when set, on a machine of the target's kind: else
+    CMake finds the machine's compiler itself), and llvm-lipo where FMI 2.0 merges slices into
+    one binary."""
     for target in platform.targets:
+        if target.native and not os.environ.get("CC"):
+            continue
         compiler = target.compiler()
         if not compiler or shutil.which(compiler[0]) is None:
             name = shlex.join(compiler) if compiler else "CC (empty)"
-            hint = "apt-get install gcc" if target.native else target.package
+            hint = "set CC to an installed compiler" if target.native else target.package
             raise BuildError(f"{platform.fmi2_folder}: C compiler {name} not found ({hint})")
     if fmi_version == 2 and len(platform.targets) > 1 and _lipo() is None:
         raise BuildError(f"{platform.fmi2_folder}: {LIPO[0]}, which merges its slices into one binary, "
