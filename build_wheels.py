@@ -233,6 +233,7 @@ def build_wheels(output_dir: str | os.PathLike = ROOT / "wheelhouse") -> list[Pa
             native_loop = compile_native_loop(target.platform, tmp / target.platform)
             placed = Path(shutil.copyfile(native_loop, tree / "pendulum_fmu" / target.native_loop))
             packed = tmp / "packed" / target.platform
+            packed.mkdir(parents=True)
             _run([sys.executable, "-m", "wheel", "pack", "--dest-dir", packed, tree], "wheel pack")
             placed.unlink()
             [wheel] = packed.glob("*.whl")
