@@ -5,7 +5,9 @@ Debian's arm64 Python under qemu (tests/arm64_python.py), the Windows wheel's na
 under wine by a C harness (tests/c/cs_loop_harness.c; no Windows Python here). No Mac runs the
 macOS wheel: its files are only read."""
 
+import os
 import re
+import shutil
 import subprocess
 import sys
 import sysconfig
@@ -20,6 +22,7 @@ from fmpy import read_model_description
 from packaging import tags
 from packaging.utils import parse_wheel_filename
 
+from benchmarks.builds import build_bare_master
 from build_wheels import LEGACY_MANYLINUX, WHEELS, WheelhouseError, build_wheels, check_tools, main
 from pendulum_fmu import FMU_FILES, __version__
 from pendulum_fmu.build import PLATFORMS
@@ -29,6 +32,9 @@ from tests.arm64_python import Arm64Python, Unavailable
 
 ROOT = Path(__file__).resolve().parent.parent
 STEPS, STEP_SIZE = 3000, 1e-3  # the tutorial case: 20 N.m, gravity on, 3 s
+HARNESS = ROOT / "tests/c/cs_loop_harness.c"
+# In a clean environment: no PYTHONPATH pointing back at the checkout.
+ENVIRONMENT = {name: value for name, value in os.environ.items() if name != "PYTHONPATH"}
 # What the first bytes of each platform's native loop say (ELF e_machine, PE Machine, Mach-O
 # universal header's CPU types).
 ELF_MACHINES = {"x86_64": 62, "aarch64": 183}
@@ -77,7 +83,7 @@ def _glibc_needed(elf: bytes, tmp_path: Path) -> tuple[int, int]:
 
 @needs_build
 def test_every_wheel_has_the_same_fmus_and_its_own_native_loop(wheelhouse, tmp_path):
-    assert [target.platform for target in WHEELS] == list(PLATFORMS)  # a wheel for every platform
+    assert {target.platform for target in WHEELS} == set(PLATFORMS)  # a wheel for every platform
     contents = {}
     for platform, wheel in wheelhouse.items():
         # wheel unpack checks every file against the RECORD's hash and size.
@@ -212,11 +218,13 @@ def test_x86_64_wheel_installs_and_simulates_in_a_venv(wheelhouse, x86_64_csv, t
     (site_packages / "dependencies_from_the_test_environment.pth").write_text(sysconfig.get_paths()["purelib"] + "\n")
     # pip checks the manylinux tag against this machine's glibc.
     subprocess.run([venv / "bin/python", "-m", "pip", "install", "--no-deps", "--ignore-installed",
-                    "--no-cache-dir", wheelhouse["linux64"]], check=True, capture_output=True)
-    subprocess.run([venv / "bin/python", "-c", "from pendulum_fmu import cs_loop; assert cs_loop.available()"],
-                   check=True, cwd=tmp_path)
+                    "--no-cache-dir", wheelhouse["linux64"]], check=True, capture_output=True, env=ENVIRONMENT)
+    loaded = subprocess.run([venv / "bin/python", "-c", "from pendulum_fmu import cs_loop; "
+                             "print(cs_loop.__file__, cs_loop.available())"],
+                            check=True, cwd=tmp_path, capture_output=True, text=True, env=ENVIRONMENT)
+    assert loaded.stdout.split() == [str(site_packages / "pendulum_fmu/cs_loop.py"), "True"]
     subprocess.run([venv / "bin/pendulum-fmu", "simulate", "--torque", "20", "--output", "out.csv"],
-                   check=True, cwd=tmp_path, capture_output=True)
+                   check=True, cwd=tmp_path, capture_output=True, env=ENVIRONMENT)
     _check_simulated(tmp_path / "out.csv", x86_64_csv)
 
 
@@ -233,6 +241,35 @@ def test_aarch64_wheel_installs_and_simulates_on_arm64_python_under_qemu(wheelho
                     site=site, cwd=tmp_path)
     assert ran.returncode == 0, ran.stderr
     _check_simulated(tmp_path / "out.csv", x86_64_csv)
+
+
+def _theta_by_harness(platform: str, wheel: Path, folder: Path) -> np.ndarray:
+    """theta at every point from the wheel's native loop stepping the wheel's FMI 2.0 binary for
+    platform, both loaded by tests/c/cs_loop_harness.c built for platform (wine runs win64's)."""
+    folder.mkdir()
+    name, loop = _native_loop(wheel)
+    (folder / Path(name).name).write_bytes(loop)
+    library = folder / f"Pendulum{PLATFORMS[platform].suffix}"
+    library.write_bytes(_fmu_binary(wheel, FMU_FILES[2], platform))
+    guid = read_model_description(str(_extracted(wheel, FMU_FILES[2], folder))).guid
+    harness = build_bare_master(folder, HARNESS, platform)
+    environment = {**os.environ, "WINEPREFIX": str(folder / "wineprefix"), "WINEDEBUG": "-all"}
+    subprocess.run([*(["wine"] if platform == "win64" else []), harness, folder / Path(name).name, library, guid,
+                    str(STEPS), repr(STEP_SIZE), "0", folder / "theta.txt"],
+                   check=True, capture_output=True, env=environment, timeout=300)
+    return np.loadtxt(folder / "theta.txt")
+
+
+@needs_build
+@pytest.mark.skipif(shutil.which("wine") is None, reason="needs wine (apt-get install wine64)")
+def test_windows_wheels_native_loop_steps_its_fmu_binary_under_wine_as_on_linux(wheelhouse, x86_64_csv, tmp_path):
+    windows = _theta_by_harness("win64", wheelhouse["win64"], tmp_path / "win64")
+    linux = _theta_by_harness("linux64", wheelhouse["linux64"], tmp_path / "linux64")
+    assert len(windows) == STEPS + 1
+    # mingw's and gcc's builds of the same sources, without FMA contraction: the same bits, and
+    # those of the Python package's run (the native loop through ctypes) here.
+    assert np.array_equal(windows, linux), np.max(np.abs(windows - linux))
+    assert np.array_equal(linux, _simulated_theta(x86_64_csv))
 
 
 def test_a_missing_tool_stops_the_wheelhouse_in_one_line_naming_its_package(monkeypatch, capsys, tmp_path):
