@@ -179,13 +179,18 @@ def test_each_tag_is_the_lowest_that_holds_for_every_binary_of_the_wheel(wheelho
                                  *([f"{legacy}_{target.machine}"] if legacy else [])}, (policy, glibc)
         elif target.system == "macos":
             [platform] = platforms
-            _, loop = _native_loop(wheel)
-            headers = _llvm("llvm-objdump", loop, tmp_path, "--macho", "--private-headers", "--arch=all")
-            [x86_64] = re.findall(r"cmd LC_VERSION_MIN_MACOSX\n\s+cmdsize \d+\n\s+version (\d+)\.(\d+)", headers)
-            assert re.findall(r"cmd LC_BUILD_VERSION\n(?:.*\n){3}\s+minos (\S+)", headers) == ["11.0"]
-            assert platform == f"macosx_{x86_64[0]}_{x86_64[1]}_universal2"
-            # pip installs it on the oldest Intel Mac the slice loads on, and on every Apple Silicon one.
-            assert platform in tags.mac_platforms(tuple(map(int, x86_64)), "x86_64")
+            # The native loop and every FMU binary for a Mac, x86_64 slices and arm64 ones.
+            macho = [_native_loop(wheel)[1], _fmu_binary(wheel, FMU_FILES[2], target.platform),
+                     *(_fmu_binary(wheel, FMU_FILES[3], folder) for folder in PLATFORMS[target.platform].fmi3_folders)]
+            headers = "".join(_llvm("llvm-objdump", binary, tmp_path, "--macho", "--private-headers", "--arch=all")
+                              for binary in macho)
+            x86_64 = re.findall(r"cmd LC_VERSION_MIN_MACOSX\n\s+cmdsize \d+\n\s+version (\d+)\.(\d+)", headers)
+            arm64 = re.findall(r"cmd LC_BUILD_VERSION\n(?:.*\n){3}\s+minos (\S+)", headers)
+            assert len(x86_64) == len(arm64) == 3 and set(arm64) == {"11.0"}, headers
+            oldest = max((int(major), int(minor)) for major, minor in x86_64)
+            assert platform == f"macosx_{oldest[0]}_{oldest[1]}_universal2"
+            # pip installs it on the oldest Intel Mac the slices load on, and on every Apple Silicon one.
+            assert platform in tags.mac_platforms(oldest, "x86_64")
             assert platform in tags.mac_platforms((11, 0), "arm64")
         else:
             assert platforms == {"win_amd64"}
