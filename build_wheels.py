@@ -34,7 +34,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from pendulum_fmu import FMU_FILES, __version__
-from pendulum_fmu.build import PLATFORMS, BuildError, compile_native_loop, find_compiler
+from pendulum_fmu.build import PLATFORMS, BuildError, check_toolchain, compile_native_loop
 from pendulum_fmu.files import replacing_path
 
 ROOT = Path(__file__).resolve().parent
@@ -85,7 +85,7 @@ def check_tools() -> None:
     for wheel in WHEELS:
         try:
             for fmi_version in FMU_FILES:
-                find_compiler(PLATFORMS[wheel.platform], fmi_version)
+                check_toolchain(PLATFORMS[wheel.platform], fmi_version)
         except BuildError as missing:
             raise WheelhouseError(f"the {wheel.system} {wheel.machine} wheel: {missing}") from None
 

@@ -12,7 +12,7 @@ from pathlib import Path
 
 from fmpy import extract, read_model_description
 
-from pendulum_fmu.build import FMI_HEADERS, PLATFORMS, build_fmu, cmake_build, find_compiler, run_tool
+from pendulum_fmu.build import FMI_HEADERS, PLATFORMS, build_fmu, cmake_build, check_toolchain, run_tool
 
 HERE = Path(__file__).resolve().parent
 NULL_FMU_SOURCES = HERE / "null_fmu"
@@ -72,11 +72,11 @@ def build_step_master(out_dir: Path, platform: str = "linux64", fmi_version: int
 def build_bare_master(out_dir: Path, source: Path, platform: str = "linux64") -> Path:
     """Compile a C program over bare_master.h (a step master, tests/c/cs_loop_harness.c) for a
     platform of pendulum_fmu.build.PLATFORMS with that platform's compiler."""
-    target = PLATFORMS[platform]
-    find_compiler(target)
-    [compiler] = (slice_.compiler() for slice_ in target.targets)
-    master = out_dir / f"{source.stem}_{platform}{'.exe' if target.windows else ''}"
-    command = [*compiler, "-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", f"-I{FMI_HEADERS}", f"-I{HERE}",
-               str(source), *([] if target.windows else ["-ldl"]), "-o", str(master)]
+    chosen = PLATFORMS[platform]
+    check_toolchain(chosen)
+    [target] = chosen.targets  # the masters run here, where no universal binary is needed
+    master = out_dir / f"{source.stem}_{platform}{'.exe' if chosen.windows else ''}"
+    command = [*target.compiler(), "-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", f"-I{FMI_HEADERS}",
+               f"-I{HERE}", str(source), *([] if chosen.windows else ["-ldl"]), "-o", str(master)]
     run_tool(command, source.name)
     return master

@@ -260,7 +260,7 @@ def _cmake() -> str:
     return found
 
 
-def find_compiler(platform: Platform, fmi_version: int = 2) -> None:
+def check_toolchain(platform: Platform, fmi_version: int = 2) -> None:
     """BuildError naming the package to install unless every tool that builds platform is here:
     the cross-compiler of each target (or $CC, when set, on a machine of the target's kind: else
     CMake finds the machine's compiler itself), and llvm-lipo where FMI 2.0 merges slices into
@@ -317,7 +317,7 @@ def cmake_build(target: Target, work: Path, cmake_target: str, definitions: dict
     run_tool(configure, what, environment)
     run_tool([cmake, "--build", build, "--target", cmake_target, "--config", "Release"], what, environment)
     run_tool([cmake, "--install", build, "--prefix", installed, "--component", cmake_target,
-          "--config", "Release"], what, environment)
+              "--config", "Release"], what, environment)
     [binary] = [path for path in installed.iterdir() if path.is_file()]
     return binary
 
@@ -354,10 +354,9 @@ def compile_native_loop(platform: str, out_dir: str | os.PathLike) -> Path:
     """
     _check_sources_present()
     check_platforms([platform])
-    target = PLATFORMS[platform]
-    find_compiler(target)
+    check_toolchain(PLATFORMS[platform])
     with tempfile.TemporaryDirectory(prefix="pendulum_fmu_native_loop_") as tmp:
-        slices = [cmake_build(slice_, Path(tmp, slice_.name), "_cs_loop") for slice_ in target.targets]
+        slices = [cmake_build(target, Path(tmp, target.name), "_cs_loop") for target in PLATFORMS[platform].targets]
         built = _merged(slices, Path(tmp, slices[0].name))
         out_file = Path(out_dir, built.name)
         with replacing_path(out_file) as partial:
@@ -418,7 +417,7 @@ def available_platforms(fmi_version: int = 2) -> tuple[str, ...]:
     present = []
     for name, platform in PLATFORMS.items():
         try:
-            find_compiler(platform, fmi_version)
+            check_toolchain(platform, fmi_version)
         except BuildError as error:
             if platform.native:
                 raise  # an FMU that cannot run where it was built is no use
@@ -442,18 +441,39 @@ def _stamped_model_description(xml: Path, fmi_version: int = 2) -> str:
 def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, *, model_dir: Path = PENDULUM_DIR,
               model_description_file: Path = MODEL_DESCRIPTION,
               platforms: tuple[str, ...] | None = None, fmi_version: int = 2) -> Path:
-    """Build an FMU (binaries/, sources/, documentation/) and return its path.
+    """Build an FMU (binaries/, sources/, documentation/) of a model over the FMI plumbing.
 
-    fmi_version 3 builds the FMI 3.0 FMU from the same sources: its model description and
-    sources/buildDescription.xml are generated from the FMI 2.0 one by fmi3.py, its binaries go
-    into the FMI 3.0 platform folders (darwin64's two slices into x86_64-darwin and
-    aarch64-darwin) and export only fmi3* functions.
+    Everything is compiled in a private temporary folder and the zip is renamed into place
+    whole, so builds into the same path at the same time all succeed.
 
-    platforms: FMI 2.0 folder names (see PLATFORMS); None builds every platform whose compiler is
-    present and warns (PlatformSkipped) about the others. A platform named explicitly must build.
-    model_dir and model_description_file name another model's config.h/model.c and XML to build
-    over the same plumbing (see MODELS). Everything is compiled in a private temporary folder and
-    the zip is renamed into place whole, so builds into the same path at the same time all succeed.
+    Parameters
+    ----------
+    out_file : str or os.PathLike
+        Where to write the FMU.
+    model_dir : Path
+        The model's folder (config.h, model.c); see MODELS.
+    model_description_file : Path
+        The model's FMI 2.0 modelDescription.xml, the source of its variables.
+    platforms : tuple of str, optional
+        FMI 2.0 platform folder names (keys of PLATFORMS). None builds every platform whose
+        tools are present and warns (PlatformSkipped) about each other one; a platform named
+        here must build.
+    fmi_version : int
+        2, or 3 for the FMI 3.0 FMU from the same sources: its model description and
+        sources/buildDescription.xml are generated from the FMI 2.0 one (fmi3.py), its binaries
+        go into the FMI 3.0 platform folders (darwin64's two slices into x86_64-darwin and
+        aarch64-darwin) and export only fmi3* functions.
+
+    Returns
+    -------
+    Path
+        out_file.
+
+    Raises
+    ------
+    BuildError
+        When the sources are not beside the package, a platform or FMI version is unknown, a
+        named platform's tools are missing, or a compiler fails.
     """
     _check_sources_present()
     if fmi_version not in FMI_VERSIONS:
@@ -462,7 +482,7 @@ def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, *, model_dir: Path = PE
         platforms = available_platforms(fmi_version)
     check_platforms(platforms)
     for name in platforms:
-        find_compiler(PLATFORMS[name], fmi_version)
+        check_toolchain(PLATFORMS[name], fmi_version)
     model_dir = Path(model_dir)
     model_description = read_model_description(str(model_description_file))
     identifier = model_description.coSimulation.modelIdentifier
