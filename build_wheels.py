@@ -33,7 +33,7 @@ import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 
-from pendulum_fmu import FMU_FILES, __version__
+from pendulum_fmu import FMU_FILES
 from pendulum_fmu.build import PLATFORMS, BuildError, check_toolchain, compile_native_loop
 from pendulum_fmu.files import replacing_path
 
@@ -64,7 +64,7 @@ WHEELS = (WheelPlatform("linux64", "linux", "x86_64"), WheelPlatform("aarch64-li
 
 
 class WheelhouseError(RuntimeError):
-    """A wheel could not be built; the message says why, in one line."""
+    """A wheel could not be built; the message says why (a missing tool in one line)."""
 
 
 def _run(command: list, what: str) -> str:
