@@ -66,12 +66,17 @@ def build_step_master(out_dir: Path, platform: str = "linux64", fmi_version: int
     """Compile the bare C master of an FMI version (step_master.c, fmi3_step_master.c) for a
     platform of pendulum_fmu.build.PLATFORMS with that platform's compiler (the tests run the win64
     one under wine, the aarch64-linux one under qemu-aarch64)."""
+    return build_bare_master(out_dir, STEP_MASTER_SOURCES[fmi_version], platform)
+
+
+def build_bare_master(out_dir: Path, source: Path, platform: str = "linux64") -> Path:
+    """Compile a C program over bare_master.h (a step master, tests/c/cs_loop_harness.c) for a
+    platform of pendulum_fmu.build.PLATFORMS with that platform's compiler."""
     chosen = PLATFORMS[platform]
     check_toolchain(chosen)
     [target] = chosen.targets  # the masters run here, where no universal binary is needed
-    source = STEP_MASTER_SOURCES[fmi_version]
     master = out_dir / f"{source.stem}_{platform}{'.exe' if chosen.windows else ''}"
     command = [*target.compiler(), "-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", f"-I{FMI_HEADERS}",
-               str(source), *([] if chosen.windows else ["-ldl"]), "-o", str(master)]
-    run_tool(command, "the step master")
+               f"-I{HERE}", str(source), *([] if chosen.windows else ["-ldl"]), "-o", str(master)]
+    run_tool(command, source.name)
     return master
