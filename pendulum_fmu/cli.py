@@ -269,6 +269,95 @@ def cmd_demo(args) -> int:
     return 0 if agree else 1
 
 
+# judge and scenarios (issue 25): their commands and their parsers, in one place.
+def cmd_judge(args) -> int:
+    from .judge import DEFAULT_TOLERANCE, format_judgement, format_line, judge, judge_kit, write_json
+    from .plot import plot_judgement
+
+    if args.result.is_dir():
+        if _torque_signal(args) is not None:
+            raise ValueError(f"{args.result} is a scenario kit: each scenario's NAME.json defines its run, "
+                             "so leave out --torque and --torque-file")
+        verdicts = judge_kit(args.result, tolerance=args.tol, mapping=args.mapping, fmu_path=args.fmu)
+        judged = {name: j for name, j in verdicts.items() if j is not None}
+        for name, j in verdicts.items():
+            print(format_line(name, j))
+        passed = sum(j.passed for j in judged.values())
+        print(f"{passed} of {len(judged)} results pass" +
+              (f"; {len(verdicts) - len(judged)} scenarios not run" if len(judged) < len(verdicts) else ""))
+        if args.plot:
+            for name, j in judged.items():
+                print(f"wrote {plot_judgement(j, args.plot / f'{name}.png', name)}")
+    else:
+        signal = _torque_signal(args)
+        if signal is None:
+            raise ValueError("judging a result file needs the run's torque: give --torque N.m or "
+                             "--torque-file F.csv (or judge a scenario kit's folder)")
+        judged = {"": judge(args.result, signal, start_time=args.start_time, stop_time=args.stop_time,
+                            step_size=args.step_size, ramp=args.ramp,
+                            parameters=_parameters(args.assignments), theta0=args.theta0,
+                            omega0=args.omega0, tolerance=DEFAULT_TOLERANCE if args.tol is None else args.tol,
+                            mapping=args.mapping, fmu_path=args.fmu, max_steps=args.max_steps)}
+        verdicts = judged[""]
+        print(format_judgement(verdicts))
+        if args.plot:
+            print(f"wrote {plot_judgement(verdicts, args.plot, args.result.name)}")
+    if args.json:
+        print(f"wrote {write_json(verdicts, args.json)}")
+    return 0 if all(j.passed for j in judged.values()) else 1
+
+
+def cmd_scenarios(args) -> int:
+    from .scenarios import write_scenarios
+
+    for path in write_scenarios(args.output_dir, args.fmu):
+        print(f"wrote {path}")
+    return 0
+
+
+def _add_judge_commands(commands) -> None:
+    from .judge import DEFAULT_TOLERANCE
+
+    judge = commands.add_parser(
+        "judge", help="judge a result file from any tool, and name the mistake",
+        description="Compare a result file from any tool (a CSV with time and theta, optionally "
+                    "omega and alpha) with the independent reference at its own times: pass when "
+                    "max |dtheta| <= --tol (exit 0), else fail (exit 1) with the mistake that "
+                    "explains the difference (input one step late or early, interpolated, held, "
+                    "time grid drift, state not restored, integration error, or unexplained). "
+                    "Given a scenario kit's folder, judges every NAME_out.csv in it.")
+    judge.add_argument("result", type=Path,
+                       help="the result CSV, or a folder written by pendulum-fmu scenarios holding "
+                            "NAME_out.csv files")
+    _add_signal_arguments(judge, required=False)
+    judge.add_argument("--start-time", type=_float, default=0.0, help="start of the run in s (default: 0)")
+    judge.add_argument("--ramp", action="store_true",
+                       help="the run ramped the torque along the CSV's line (input derivatives)")
+    judge.add_argument("--tol", type=_float, default=None,
+                       help=f"largest |dtheta| in rad that passes (default: {DEFAULT_TOLERANCE:g}, or "
+                            "each scenario's own)")
+    judge.add_argument("--map", dest="mapping", default=None, metavar="QUANTITY=COLUMN[*FACTOR],...",
+                       help="the result's column names for time, theta, omega and alpha, with a factor "
+                            "to SI where it uses other units, e.g. theta=phi*0.0174532925")
+    judge.add_argument("--json", type=Path, default=None,
+                       help="write the verdict, diagnosis, max |dtheta|, worst time and every "
+                            "candidate's residual (rad) as JSON")
+    judge.add_argument("--plot", type=Path, default=None,
+                       help="write a PNG of the torque, theta and |dtheta| (for a kit: a folder, one "
+                            "NAME.png per scenario)")
+    judge.set_defaults(run=cmd_judge)
+
+    scenarios = commands.add_parser(
+        "scenarios", help="write a kit of scenarios for testing a master with this FMU",
+        description="Write the FMU (carrying the kit as FMI-LS-REF related files) and, per scenario, "
+                    "its torque (NAME_in.csv), settings (NAME.json) and reference (NAME_ref.csv), "
+                    "with a ReadMe.md: run each in your master, write NAME_out.csv beside it, then "
+                    "pendulum-fmu judge FOLDER.")
+    scenarios.add_argument("--output-dir", type=Path, required=True, help="the kit's folder")
+    _add_fmu_argument(scenarios)
+    scenarios.set_defaults(run=cmd_scenarios)
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="pendulum-fmu",
@@ -383,6 +472,7 @@ def build_parser() -> argparse.ArgumentParser:
                       help="folder for the figures and tables (default: %(default)s)")
     demo.add_argument("--workers", type=int, default=None, help="local dask workers (default: 2)")
     demo.set_defaults(run=cmd_demo)
+    _add_judge_commands(commands)
     for command in commands.choices.values():
         # Also after the command's name; SUPPRESS keeps it from hiding one given before it.
         command.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
