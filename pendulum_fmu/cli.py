@@ -276,8 +276,8 @@ def cmd_judge(args) -> int:
 
     if args.result.is_dir():
         if _torque_signal(args) is not None:
-            raise ValueError(f"{args.result} is a scenario kit: each scenario's NAME.json defines its run, "
-                             "so leave out --torque and --torque-file")
+            raise ValueError(f"{args.result} is a folder, judged as a scenario kit whose NAME.json files "
+                             "define the runs: leave out --torque and --torque-file")
         verdicts = judge_kit(args.result, tolerance=args.tol, mapping=args.mapping, fmu_path=args.fmu)
         judged = {name: j for name, j in verdicts.items() if j is not None}
         for name, j in verdicts.items():

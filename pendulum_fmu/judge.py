@@ -93,6 +93,9 @@ class Judgement:
     # Per candidate: the residual of its best variant and how far that variant is from the
     # reference (rad); None where the candidate does not apply to this run.
     candidates: dict[str, dict | None]
+    # The smallest difference from the reference an input-timing variant that changes this run
+    # makes (rad; None when none does): an integration error must be small beside it.
+    smallest_input_effect: float | None
     result: np.ndarray = field(repr=False)
     reference: np.ndarray = field(repr=False)
     # The variant the diagnosis names, at the result's times (None for agrees and unexplained).
@@ -113,8 +116,8 @@ class Judgement:
         return {"result": self.source, "verdict": self.verdict, "diagnosis": self.diagnosis,
                 "residual": self.residual, "max_abs_dtheta": self.max_abs_dtheta, **worst,
                 "worst_time": self.worst_time, "tolerance": self.tolerance, "points": len(self.result),
-                "candidates": self.candidates,
-                "units": {"residual": "rad", "max_abs_dtheta": "rad", "max_abs_domega": "rad/s",
+                "candidates": self.candidates, "smallest_input_effect": self.smallest_input_effect,
+                "units": {"residual": "rad", "smallest_input_effect": "rad", "max_abs_dtheta": "rad", "max_abs_domega": "rad/s",
                           "max_abs_dalpha": "rad/s2", "worst_time": "s", "tolerance": "rad"}}
 
 
@@ -340,16 +343,15 @@ def _candidates(run: _Run, torque, held: TorqueSchedule | None, correct: np.ndar
 
 
 def _diagnose(raw: float, tolerance: float, scores: dict[str, dict | None],
-              timing_effects: list[float]) -> tuple[str, float]:
-    """The candidate that explains the difference, or integration error, or unexplained.
-    timing_effects: how far each input-timing variant that changes this run is from the reference."""
+              smallest_input_effect: float | None) -> tuple[str, float]:
+    """The candidate that explains the difference, or integration error, or unexplained."""
     applicable = {name: score for name, score in scores.items() if score is not None}
     best = min(applicable, key=lambda name: applicable[name]["residual"], default=None)
     if best is not None and applicable[best]["residual"] <= max(EXPLAINS * raw, NOISE * tolerance):
         return best, applicable[best]["residual"]
     euler = applicable.get(INTEGRATION)
     if (euler is not None and raw <= euler["effect"]
-            and all(raw <= INTEGRATION_SMALL * effect for effect in timing_effects)):
+            and (smallest_input_effect is None or raw <= INTEGRATION_SMALL * smallest_input_effect)):
         return INTEGRATION, raw
     return UNEXPLAINED, applicable[best]["residual"] if best is not None else raw
 
@@ -418,13 +420,14 @@ def judge(result, torque, *, start_time: float = 0.0, stop_time: float | None = 
         i = int(np.argmin(residuals))
         best_variant[name] = made[i]
         scores[name] = {"residual": residuals[i], "effect": effects[i]}
+    smallest_input_effect = min(timing_effects, default=None)
     if raw <= tolerance:
         diagnosis, residual = AGREES, raw
     else:
-        diagnosis, residual = _diagnose(raw, tolerance, scores, timing_effects)
+        diagnosis, residual = _diagnose(raw, tolerance, scores, smallest_input_effect)
     return Judgement(verdict="pass" if raw <= tolerance else "fail", diagnosis=diagnosis, residual=residual,
                      max_abs_dtheta=raw, worst_time=worst_time, tolerance=tolerance, candidates=scores,
-                     result=result, reference=correct,
+                     smallest_input_effect=smallest_input_effect, result=result, reference=correct,
                      explanation=best_variant.get(diagnosis) if diagnosis != AGREES else None, source=source)
 
 
