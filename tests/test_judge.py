@@ -1,34 +1,20 @@
-"""The judge: deliberately wrong masters (tests/masters.py) run the kit's scenarios, each mistake
-must be diagnosed as made; results from the reference itself, other column names and units, and
-bad result files."""
+"""The judge: deliberately wrong masters (benchmarks/masters.py) and fmpy's own solvers run the
+kit's scenarios, each mistake must be diagnosed as made; results from the analytic solution under
+other names and units; the command's exit codes, JSON and figure; bad result files."""
 
 import json
 
 import numpy as np
 import pytest
 
-import masters
+from benchmarks.masters import WRONG_MASTERS, run
 from pendulum_fmu.cli import main
 from pendulum_fmu.judge import (AGREES, DRIFT, EARLY, EXPLAINS, HELD, INTEGRATION,
                                 INTEGRATION_SMALL, INTERPOLATED, LATE, NOT_RESTORED, UNEXPLAINED,
                                 ResultFileError, judge, read_result)
 from pendulum_fmu.parameters import total_inertia
 from pendulum_fmu.plot import _log_difference
-from pendulum_fmu.scenarios import read_settings, write_scenarios
-
-# (scenario, the mistake the master makes, the diagnosis it must get)
-WRONG_MASTERS = [
-    ("random_steps", "late", LATE), ("decimal_steps", "late", LATE), ("ramp", "late", LATE),
-    ("steps_on_grid", "early", EARLY), ("ramp", "early", EARLY),
-    ("random_steps", "ramped", INTERPOLATED), ("steps_on_grid", "ramped", INTERPOLATED),
-    ("ramp", "held", HELD),
-    ("random_steps", "drift", DRIFT), ("decimal_steps", "drift", DRIFT),
-    ("resume", "not_restored", NOT_RESTORED),
-    ("constant_torque", "euler", INTEGRATION), ("random_steps", "euler", INTEGRATION),
-    ("constant_torque", "heun", INTEGRATION), ("random_steps", "heun", INTEGRATION),
-    ("random_steps", "late_once", UNEXPLAINED), ("steps_on_grid", "scaled", UNEXPLAINED),
-    ("constant_torque", "scaled", UNEXPLAINED),
-]
+from pendulum_fmu.scenarios import KIT_FMU, read_settings, write_scenarios
 
 
 @pytest.fixture(scope="module")
@@ -46,7 +32,7 @@ def _judged(kit, name, **changes):
 @pytest.mark.parametrize(("name", "mistake", "expected"), WRONG_MASTERS,
                          ids=[f"{n}-{m}" for n, m, _ in WRONG_MASTERS])
 def test_a_wrong_master_is_diagnosed_as_made(kit, name, mistake, expected):
-    masters.run(kit, name, mistake)
+    run(kit, name, mistake)
     judgement = _judged(kit, name)
     raw = judgement.max_abs_dtheta
     assert judgement.verdict == "fail" and raw > 1e-7
@@ -66,7 +52,7 @@ def test_a_wrong_master_is_diagnosed_as_made(kit, name, mistake, expected):
 
 def test_the_diagnosed_variant_holds_at_fewer_points_than_steps(kit):
     """A master writing every 10th communication point only: still one step late."""
-    out = masters.run(kit, "random_steps", "late")
+    out = run(kit, "random_steps", "late")
     lines = out.read_text().splitlines()
     out.write_text("\n".join(lines[:1] + lines[1::10]) + "\n")
     judgement = _judged(kit, "random_steps")
@@ -93,7 +79,7 @@ def test_the_analytic_parabola_passes_under_other_names_and_units(tmp_path):
 
 
 def test_the_command_exits_0_on_pass_and_1_on_fail_and_writes_json_and_plot(kit, tmp_path, capsys):
-    masters.run(kit, "decimal_steps", "late")
+    run(kit, "decimal_steps", "late")
     arguments = ["judge", str(kit / "decimal_steps_out.csv"), "--torque-file", str(kit / "decimal_steps_in.csv"),
                  "--step-size", "0.009", "--json", str(tmp_path / "j.json"), "--plot", str(tmp_path / "j.png")]
     assert main(arguments) == 1
@@ -109,7 +95,7 @@ def test_the_command_exits_0_on_pass_and_1_on_fail_and_writes_json_and_plot(kit,
     assert summary["max_abs_dtheta"] == pytest.approx(abs(out["theta"] - ref["theta"])[worst], rel=1e-6)
     assert set(summary["candidates"]) == {LATE, EARLY, INTERPOLATED, HELD, DRIFT, NOT_RESTORED, INTEGRATION}
     assert (tmp_path / "j.png").read_bytes()[:4] == b"\x89PNG"
-    masters.run(kit, "decimal_steps")
+    run(kit, "decimal_steps")
     assert main(arguments + ["--tol", "1e-9"]) == 0
     assert f"pass: {AGREES}" in capsys.readouterr().out
     assert not list(tmp_path.glob(".*"))
@@ -144,3 +130,39 @@ def test_bad_result_files_get_one_line(tmp_path):
     (tmp_path / "bad.csv").write_text("time,theta\n0,0\n3.5,0\n")
     with pytest.raises(ResultFileError, match="time 3.5 is after the run's stop time 3 s"):
         judge(tmp_path / "bad.csv", 1.0)
+
+
+def test_fmpy_applying_a_jump_in_the_first_two_rows_late_is_diagnosed(fmu, tmp_path):
+    """fmpy 0.3.32's simulate_fmu applies a jump at t = 0 one step late (docs/signals.md): the
+    first step holds the value before it, 0 N.m. From rest at the equilibrium that is also a
+    restart from the initial state after one step; the tie goes to the input mistake."""
+    from fmpy import simulate_fmu
+
+    signal = np.array([(0.0, 0.0), (0.0, 20.0), (1.0, 20.0)], dtype=[("time", "f8"), ("torque", "f8")])
+    run = simulate_fmu(str(fmu), stop_time=1.0, output_interval=1e-3, input=signal, output=["theta"])
+    result = tmp_path / "fmpy.csv"
+    np.savetxt(result, np.column_stack([run["time"], run["theta"]]), delimiter=",", header="time,theta",
+               comments="", fmt="%.17g")
+    (tmp_path / "jump.csv").write_text("time,torque\n0,0\n0,20\n1,20\n")
+    judgement = judge(result, tmp_path / "jump.csv", fmu_path=fmu)
+    assert judgement.diagnosis == LATE and judgement.residual < 1e-10 < 1e-4 < judgement.max_abs_dtheta
+    assert judgement.candidates[NOT_RESTORED]["residual"] < 1e-10
+
+
+@pytest.mark.parametrize("solver", ["Euler", "CVode"])
+def test_fmpy_model_exchange_solvers_are_integration_errors(kit, solver):
+    """fmpy's own Model Exchange solvers: its Euler is explicit Euler at the step (the variant to
+    the last bit); CVode at its default tolerance is no variant but small and smooth."""
+    from fmpy import simulate_fmu
+
+    signal = np.genfromtxt(kit / "constant_torque_in.csv", delimiter=",", names=True)
+    run_ = simulate_fmu(str(kit / KIT_FMU), fmi_type="ModelExchange", solver=solver, step_size=1e-3,
+                        output_interval=1e-3, stop_time=3.0, input=signal, output=["theta"])
+    np.savetxt(kit / "constant_torque_out.csv", np.column_stack([run_["time"], run_["theta"]]),
+               delimiter=",", header="time,theta", comments="", fmt="%.17g")
+    judgement = _judged(kit, "constant_torque")
+    assert judgement.verdict == "fail" and judgement.diagnosis == INTEGRATION
+    if solver == "Euler":
+        assert judgement.residual == 0.0 and judgement.max_abs_dtheta > 1e-4
+    else:
+        assert 1e-9 < judgement.max_abs_dtheta < INTEGRATION_SMALL * judgement.smallest_input_effect

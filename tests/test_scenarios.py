@@ -1,6 +1,6 @@
 """The scenario kit: its files, its FMI-LS-REF layout, its references against the analytic
-solution, and every scenario run through fmpy (a master on FMU2Slave, and simulate_fmu) and
-through this package's own native loop, each judged a pass."""
+solution, and every scenario run through fmpy (a master on FMU2Slave, benchmarks/masters.py, and
+simulate_fmu) and through this package's own native loop, each judged a pass."""
 
 import json
 import re
@@ -14,7 +14,7 @@ import pytest
 from fmpy import simulate_fmu
 from fmpy.validation import validate_fmu
 
-import masters
+from benchmarks.masters import run
 from pendulum_fmu import cs_loop
 from pendulum_fmu.cli import main
 from pendulum_fmu.judge import AGREES, judge, judge_kit
@@ -110,7 +110,7 @@ def test_the_fmu_carries_the_kit_as_fmi_ls_ref(kit):
 
 @pytest.mark.parametrize("name", NAMES)
 def test_an_fmpy_master_passes_every_scenario(kit, name):
-    masters.run(kit, name)
+    run(kit, name)
     judgement = _judged(kit, name)
     assert judgement.passed and judgement.diagnosis == AGREES
     assert judgement.max_abs_dtheta < 1e-10

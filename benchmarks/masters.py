@@ -1,6 +1,9 @@
 """Masters written as a vendor would, on fmpy's FMU2Slave and FMU2Model, that run a scenario of
 the kit (pendulum_fmu.scenarios) and write NAME_out.csv: a correct one, and ones that make each
-mistake the judge names on purpose. Used by tests/test_scenarios.py and tests/test_judge.py.
+mistake the judge names on purpose. tests/test_scenarios.py and tests/test_judge.py run them;
+this prints what the judge says of each (the README's table and the thresholds of judge.py):
+
+    python -m benchmarks.masters
 
 They read the kit's files themselves (NAME.json, NAME_in.csv) and share no code with the
 package's schedule or reference, as a master elsewhere would not.
@@ -19,9 +22,29 @@ from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Model, FMU2Slave
 
 OUTPUTS = ("theta", "omega", "alpha")
-# What a master may do wrong, on purpose.
-MISTAKES = ("late", "early", "ramped", "held", "drift", "not_restored", "euler", "heun", "late_once",
-            "scaled")
+# (scenario, the mistake a master makes on purpose, the diagnosis it must get)
+WRONG_MASTERS = [
+    ("random_steps", "late", "input one step late"), ("decimal_steps", "late", "input one step late"),
+    ("ramp", "late", "input one step late"),
+    ("steps_on_grid", "early", "input one step early"), ("ramp", "early", "input one step early"),
+    ("random_steps", "ramped", "input interpolated linearly"),
+    ("steps_on_grid", "ramped", "input interpolated linearly"),
+    ("ramp", "held", "input held"),
+    ("random_steps", "drift", "time grid drift"), ("decimal_steps", "drift", "time grid drift"),
+    ("resume", "not_restored", "state not restored"),
+    ("constant_torque", "euler", "integration error"), ("random_steps", "euler", "integration error"),
+    ("constant_torque", "heun", "integration error"), ("random_steps", "heun", "integration error"),
+    ("random_steps", "late_once", "unexplained"), ("steps_on_grid", "scaled", "unexplained"),
+    ("constant_torque", "scaled", "unexplained"),
+]
+# In words, for the table.
+MISTAKES = {
+    "late": "input one step late", "early": "input one step early",
+    "ramped": "input derivatives where the signal holds", "held": "no input derivatives on a ramp",
+    "drift": "time summed in single precision", "not_restored": "resumed without setting the saved state",
+    "euler": "Model Exchange, explicit Euler at the step", "heun": "Model Exchange, Heun at the step",
+    "late_once": "only the first change one step late", "scaled": "1 % too much torque",
+}
 
 
 class Signal:
@@ -196,3 +219,32 @@ def run(folder: Path, name: str, mistake: str | None = None) -> Path:
     if mistake in ("euler", "heun"):
         return model_exchange(kit, mistake)
     return co_simulation(kit, mistake)
+
+
+def main() -> int:
+    """Every wrong master of WRONG_MASTERS on a fresh kit, and what the judge says of it."""
+    import tempfile
+
+    from pendulum_fmu.judge import judge
+    from pendulum_fmu.scenarios import read_settings, write_scenarios
+
+    print(f"{'scenario':<16} {'mistake made':<44} {'diagnosis':<28} {'max|dtheta|':>11} "
+          f"{'residual':>9} {'next':>9}")
+    with tempfile.TemporaryDirectory() as folder:
+        write_scenarios(folder)
+        for name, mistake, _ in WRONG_MASTERS:
+            settings = read_settings(Path(folder, f"{name}.json"))
+            settings.pop("output")
+            judgement = judge(run(Path(folder), name, mistake), **settings)
+            raw = judgement.max_abs_dtheta
+            residuals = sorted(s["residual"] for s in judgement.candidates.values() if s is not None)
+            # The residual of the diagnosis and the smallest other one, as fractions of max|dtheta|.
+            mine = judgement.residual / raw
+            other = residuals[1] if residuals[0] / raw == mine else residuals[0]
+            print(f"{name:<16} {MISTAKES[mistake]:<44} {judgement.diagnosis:<28} {raw:>11.2e} "
+                  f"{mine:>9.1e} {other / raw:>9.1e}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
