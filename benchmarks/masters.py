@@ -41,7 +41,7 @@ WRONG_MASTERS = [
 MISTAKES = {
     "late": "input one step late", "early": "input one step early",
     "ramped": "input derivatives where the signal holds", "held": "no input derivatives on a ramp",
-    "drift": "time summed in single precision", "not_restored": "resumed without setting the saved state",
+    "drift": "time summed in single precision", "not_restored": "resumed without restoring the state",
     "euler": "Model Exchange, explicit Euler at the step", "heun": "Model Exchange, Heun at the step",
     "late_once": "only the first change one step late", "scaled": "1 % too much torque",
 }
@@ -228,8 +228,11 @@ def main() -> int:
     from pendulum_fmu.judge import judge
     from pendulum_fmu.scenarios import read_settings, write_scenarios
 
-    print(f"{'scenario':<16} {'mistake made':<44} {'diagnosis':<28} {'max|dtheta|':>11} "
-          f"{'residual':>9} {'next':>9}")
+    # residual: of the diagnosis (for integration error without a variant, the difference
+    # itself); others: the smallest residual of every other candidate; both as fractions of
+    # max|dtheta|. input: max|dtheta| over the smallest difference an input-timing mistake makes.
+    print(f"{'scenario':<16} {'mistake made':<43} {'diagnosis':<28} {'max|dtheta|':>11} {'residual':>9} "
+          f"{'others':>8} {'input':>8}")
     with tempfile.TemporaryDirectory() as folder:
         write_scenarios(folder)
         for name, mistake, _ in WRONG_MASTERS:
@@ -237,12 +240,12 @@ def main() -> int:
             settings.pop("output")
             judgement = judge(run(Path(folder), name, mistake), **settings)
             raw = judgement.max_abs_dtheta
-            residuals = sorted(s["residual"] for s in judgement.candidates.values() if s is not None)
-            # The residual of the diagnosis and the smallest other one, as fractions of max|dtheta|.
-            mine = judgement.residual / raw
-            other = residuals[1] if residuals[0] / raw == mine else residuals[0]
-            print(f"{name:<16} {MISTAKES[mistake]:<44} {judgement.diagnosis:<28} {raw:>11.2e} "
-                  f"{mine:>9.1e} {other / raw:>9.1e}")
+            others = min(s["residual"] for c, s in judgement.candidates.items()
+                         if s is not None and c != judgement.diagnosis)
+            input_effect = judgement.smallest_input_effect
+            print(f"{name:<16} {MISTAKES[mistake]:<43} {judgement.diagnosis:<28} {raw:>11.2e} "
+                  f"{judgement.residual / raw:>9.1e} {others / raw:>8.1e} "
+                  f"{'' if input_effect is None else f'{raw / input_effect:.1e}':>8}")
     return 0
 
 
