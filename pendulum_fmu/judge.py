@@ -220,7 +220,8 @@ def _late(plan: TorqueSchedule, start_torque: float) -> list[TorqueSchedule]:
     variants = []
     for first in dict.fromkeys((float(plan.torque[0]), start_torque)):
         first_rate = plan.torque_rate[0] if first == plan.torque[0] else 0.0
-        variants.append(_changed(plan, np.r_[first, plan.torque[:-1]], np.r_[first_rate, plan.torque_rate[:-1]]))
+        variants.append(_changed(plan, np.r_[first, plan.torque[:-1]],
+                                 np.r_[first_rate, plan.torque_rate[:-1]]))
     return variants
 
 
@@ -307,7 +308,8 @@ def _not_restored(run: _Run, correct: np.ndarray, first_wrong: int) -> list[np.n
             continue
         restart = run.times[restart_row]
         k = int(np.argmin(np.abs(run.plan.time - restart)))
-        if k + 1 >= len(run.plan.time) or abs(run.plan.time[k] - restart) > event_tolerance(restart, run.step_size):
+        off = abs(run.plan.time[k] - restart) > event_tolerance(restart, run.step_size)
+        if off or k + 1 >= len(run.plan.time):
             continue
         tail = TorqueSchedule(time=run.plan.time[k:], torque=run.plan.torque[k:],
                               torque_rate=run.plan.torque_rate[k:])

@@ -172,11 +172,13 @@ def plot_judgement(judgement, path: str | Path, title: str) -> Path:
     if variant is not None:
         _log_difference(axes[2], time, variant["theta"] - reference["theta"],
                         f"|{judgement.diagnosis} - reference|", linestyle="--", linewidth=1.5)
-    axes[2].axhline(judgement.tolerance, color="grey", linestyle=":", label=f"tolerance {judgement.tolerance:g} rad")
+    axes[2].axhline(judgement.tolerance, color="grey", linestyle=":",
+                    label=f"tolerance {judgement.tolerance:g} rad")
     axes[2].set_yscale("log")
     if zeros:
         note = ("the result equals the reference exactly at every point (difference 0 rad)"
-                if zeros == len(time) else f"difference exactly 0 rad at {zeros:,} of {len(time):,} points (not drawn)")
+                if zeros == len(time) else
+                f"difference exactly 0 rad at {zeros:,} of {len(time):,} points (not drawn)")
         axes[2].text(0.01, 0.04, note, transform=axes[2].transAxes, fontsize=9)
     axes[2].set_ylabel(r"$|\Delta\theta|$ in rad")
     axes[2].set_xlabel(TIME_LABEL)

@@ -80,7 +80,8 @@ def test_the_analytic_parabola_passes_under_other_names_and_units(tmp_path):
 
 def test_the_command_exits_0_on_pass_and_1_on_fail_and_writes_json_and_plot(kit, tmp_path, capsys):
     run(kit, "decimal_steps", "late")
-    arguments = ["judge", str(kit / "decimal_steps_out.csv"), "--torque-file", str(kit / "decimal_steps_in.csv"),
+    arguments = ["judge", str(kit / "decimal_steps_out.csv"),
+                 "--torque-file", str(kit / "decimal_steps_in.csv"),
                  "--step-size", "0.009", "--json", str(tmp_path / "j.json"), "--plot", str(tmp_path / "j.png")]
     assert main(arguments) == 1
     out = capsys.readouterr().out
@@ -139,9 +140,9 @@ def test_fmpy_applying_a_jump_in_the_first_two_rows_late_is_diagnosed(fmu, tmp_p
     from fmpy import simulate_fmu
 
     signal = np.array([(0.0, 0.0), (0.0, 20.0), (1.0, 20.0)], dtype=[("time", "f8"), ("torque", "f8")])
-    run = simulate_fmu(str(fmu), stop_time=1.0, output_interval=1e-3, input=signal, output=["theta"])
+    fmpy_run = simulate_fmu(str(fmu), stop_time=1.0, output_interval=1e-3, input=signal, output=["theta"])
     result = tmp_path / "fmpy.csv"
-    np.savetxt(result, np.column_stack([run["time"], run["theta"]]), delimiter=",", header="time,theta",
+    np.savetxt(result, np.column_stack([fmpy_run["time"], fmpy_run["theta"]]), delimiter=",", header="time,theta",
                comments="", fmt="%.17g")
     (tmp_path / "jump.csv").write_text("time,torque\n0,0\n0,20\n1,20\n")
     judgement = judge(result, tmp_path / "jump.csv", fmu_path=fmu)
@@ -156,9 +157,9 @@ def test_fmpy_model_exchange_solvers_are_integration_errors(kit, solver):
     from fmpy import simulate_fmu
 
     signal = np.genfromtxt(kit / "constant_torque_in.csv", delimiter=",", names=True)
-    run_ = simulate_fmu(str(kit / KIT_FMU), fmi_type="ModelExchange", solver=solver, step_size=1e-3,
+    fmpy_run = simulate_fmu(str(kit / KIT_FMU), fmi_type="ModelExchange", solver=solver, step_size=1e-3,
                         output_interval=1e-3, stop_time=3.0, input=signal, output=["theta"])
-    np.savetxt(kit / "constant_torque_out.csv", np.column_stack([run_["time"], run_["theta"]]),
+    np.savetxt(kit / "constant_torque_out.csv", np.column_stack([fmpy_run["time"], fmpy_run["theta"]]),
                delimiter=",", header="time,theta", comments="", fmt="%.17g")
     judgement = _judged(kit, "constant_torque")
     assert judgement.verdict == "fail" and judgement.diagnosis == INTEGRATION

@@ -21,7 +21,7 @@ from pendulum_fmu.judge import AGREES, judge, judge_kit
 from pendulum_fmu.parameters import default_parameters, total_inertia
 from pendulum_fmu.scenarios import (KIT_FMU, LS_REF_FOLDER, LS_REF_VERSION, SCENARIOS, read_settings,
                                     write_scenarios)
-from pendulum_fmu.signal import schedule
+from pendulum_fmu.signal import TorqueSchedule, schedule
 from pendulum_fmu.simulate import open_fmu, run_schedule
 
 NAMES = [s.name for s in SCENARIOS]
@@ -152,13 +152,14 @@ def _native(kit, name):
         parts.append(run_schedule(slave, _part(plan, cut, len(plan.time) - 1))[1:])
     slave.terminate()
     slave.freeInstance()
-    run = np.concatenate(parts)
-    np.savetxt(kit / f"{name}_out.csv", np.column_stack([run["time"], run["theta"], run["omega"], run["alpha"]]),
+    result = np.concatenate(parts)
+    columns = [result["time"], result["theta"], result["omega"], result["alpha"]]
+    np.savetxt(kit / f"{name}_out.csv", np.column_stack(columns),
                delimiter=",", header="time,theta,omega,alpha", comments="", fmt="%.17g")
 
 
 def _part(plan, first, last):
-    return type(plan)(time=plan.time[first:last + 1], torque=plan.torque[first:last],
+    return TorqueSchedule(time=plan.time[first:last + 1], torque=plan.torque[first:last],
                       torque_rate=plan.torque_rate[first:last])
 
 
