@@ -440,7 +440,19 @@ def judge(result, torque, *, start_time: float = 0.0, stop_time: float | None = 
 
 
 def format_judgement(judgement: Judgement) -> str:
-    """The lines the command prints for one result."""
+    """The lines the command prints for one result: verdict and diagnosis, max |dtheta| and
+    where, and every candidate's residual and effect.
+
+    Parameters
+    ----------
+    judgement : Judgement
+        What judge() returned.
+
+    Returns
+    -------
+    str
+        The lines, joined.
+    """
     lines = [f"{judgement.source}: {judgement.verdict}: {judgement.diagnosis} (residual "
              f"{judgement.residual:.2e} rad)",
              f"max |dtheta| = {judgement.max_abs_dtheta:.3e} rad at t = {judgement.worst_time!r} s "
@@ -455,7 +467,20 @@ def format_judgement(judgement: Judgement) -> str:
 
 
 def format_line(name: str, judgement: Judgement | None) -> str:
-    """One scenario of a kit, on one line."""
+    """One scenario of a kit, on one line.
+
+    Parameters
+    ----------
+    name : str
+        The scenario's name.
+    judgement : Judgement or None
+        What judge_kit() gave for it; None when it was not run.
+
+    Returns
+    -------
+    str
+        The line.
+    """
     if judgement is None:
         return f"{name:<18} not run: no {name}_out.csv"
     return (f"{name:<18} {judgement.verdict:<4}  {judgement.diagnosis:<28} max|dtheta| "
@@ -511,7 +536,21 @@ def judge_kit(folder: str | Path, *, tolerance: float | None = None, mapping: st
 
 
 def write_json(verdicts: dict[str, Judgement | None] | Judgement, path: str | Path) -> Path:
-    """--json: one judgement's summary, or {"scenarios": {name: summary or null}} for a kit."""
+    """Write --json whole or not at all: one judgement's summary (Judgement.summary), or
+    {"scenarios": {name: summary or null}} for a kit.
+
+    Parameters
+    ----------
+    verdicts : Judgement or dict
+        What judge() or judge_kit() returned.
+    path : str or Path
+        The JSON file.
+
+    Returns
+    -------
+    Path
+        path.
+    """
     if isinstance(verdicts, Judgement):
         content = verdicts.summary()
     else:

@@ -139,7 +139,18 @@ def _settings(scenario: Scenario, parameters: dict) -> dict:
 
 
 def read_settings(path: str | Path) -> dict:
-    """A scenario's NAME.json as judge()'s keyword arguments, with "output", the result's file name.
+    """A scenario's settings as judge()'s keyword arguments.
+
+    Parameters
+    ----------
+    path : str or Path
+        The scenario's NAME.json.
+
+    Returns
+    -------
+    dict
+        torque (the input's path), start_time, stop_time, step_size, ramp, parameters, theta0,
+        omega0, tolerance; and output, the name of the result file a master writes.
 
     Raises
     ------
@@ -160,7 +171,18 @@ def read_settings(path: str | Path) -> dict:
 
 
 def settings_files(folder: str | Path) -> dict[str, Path]:
-    """{scenario: NAME.json} of the scenarios in a folder: each NAME.json with a NAME_in.csv beside."""
+    """The scenarios in a folder: each NAME.json with a NAME_in.csv beside it.
+
+    Parameters
+    ----------
+    folder : str or Path
+        A kit's folder.
+
+    Returns
+    -------
+    dict
+        {scenario: its NAME.json}, by name.
+    """
     folder = Path(folder)
     return {path.stem: path for path in sorted(folder.glob("*.json"))
             if (folder / f"{path.stem}_in.csv").is_file()}
