@@ -42,6 +42,7 @@ from .files import replacing
 from .other_fmu import parse_map
 from .parameters import resolve_parameters, variables
 from .reference import equation_of_motion, reference, reference_schedule
+from .scenarios import read_settings, settings_files
 from .signal import TorqueSchedule, TorqueTable, event_tolerance, read_torque_csv, schedule
 
 AGREES = "agrees"
@@ -511,8 +512,6 @@ def judge_kit(folder: str | Path, *, tolerance: float | None = None, mapping: st
     ResultFileError
         A folder that holds no scenario, or none with a result.
     """
-    from .scenarios import read_settings, settings_files
-
     folder = Path(folder)
     found = settings_files(folder)
     if not found:
