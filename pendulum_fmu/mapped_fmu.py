@@ -32,7 +32,7 @@ from fmpy.fmi3 import FMU3Slave
 from .engines import check_held, check_mode, held_results
 from .errors import InvalidInput
 from .parameters import START_VALUES, default_parameters, model_description, variables
-from .simulate import RECORDED, FmuError, _unzipped, resolve_parameters
+from .simulate import RECORDED, FmuError, _unzipped, fmi2_library, resolve_parameters
 from .torque_schedule import TorqueSchedule
 
 OUTPUTS = RECORDED[1:]  # theta, omega, alpha
@@ -162,10 +162,11 @@ class MappedFmu:
         """Hold each step's torque, read the outputs at each communication point."""
         fmi3 = self.description.fmiVersion == "3.0"
         folder, _ = _unzipped(self.path)
-        cls = FMU3Slave if fmi3 else FMU2Slave
-        slave = cls(guid=self.description.guid, unzipDirectory=folder,
-                    modelIdentifier=self.description.coSimulation.modelIdentifier,
-                    instanceName=self.label)
+        identifier = self.description.coSimulation.modelIdentifier
+        arguments = dict(guid=self.description.guid, unzipDirectory=folder, modelIdentifier=identifier,
+                         instanceName=self.label)
+        slave = (FMU3Slave(**arguments) if fmi3
+                 else FMU2Slave(**arguments, libraryPath=fmi2_library(folder, identifier)))
         outputs = self._output_variables()
         vr = {name: self.variables[name].valueReference for name in (*start, *outputs.values())}
         torque = self.mapping["torque"]

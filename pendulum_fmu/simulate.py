@@ -11,6 +11,7 @@ import weakref
 from functools import lru_cache
 from pathlib import Path
 
+import fmpy
 import numpy as np
 from fmpy import extract
 from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
@@ -97,6 +98,31 @@ def _unzipped(fmu_path: Path):
     return folder.name, description
 
 
+def fmi2_library(folder: str, model_identifier: str) -> str | None:
+    """The FMI 2.0 binary for fmpy to load (FMU2Slave's libraryPath), or None to let fmpy choose.
+
+    fmpy 0.3 looks in binaries/linux64 on ARM64 Linux too, where an FMU (this one, the Reference
+    FMUs) keeps its binary in binaries/aarch64-linux: that one, when the FMU has it.
+
+    Parameters
+    ----------
+    folder : str
+        The extracted FMU.
+    model_identifier : str
+        The Co-Simulation model identifier, the binary's file name.
+
+    Returns
+    -------
+    str or None
+        The binary's path on ARM64 Linux when the FMU has binaries/aarch64-linux, else None.
+    """
+    if fmpy.system == "linux" and fmpy.architecture == "aarch64":
+        library = Path(folder, "binaries", "aarch64-linux", f"{model_identifier}.so")
+        if library.is_file():
+            return str(library)
+    return None
+
+
 def open_fmu(fmu_path: str | Path | None = None, *, parameters: dict | None = None,
              theta0: float = 0.0, omega0: float = 0.0, tolerance: float | None = None,
              start_time: float = 0.0, instance_name: str = "pendulum"):
@@ -116,7 +142,7 @@ def open_fmu(fmu_path: str | Path | None = None, *, parameters: dict | None = No
         slave = FMU3Slave(**arguments)
         slave.instantiate(logMessage=messages.log_fmi3)
     else:
-        slave = FMU2Slave(**arguments)
+        slave = FMU2Slave(**arguments, libraryPath=fmi2_library(folder, arguments["modelIdentifier"]))
         slave.instantiate(callbacks=messages.callbacks)
     slave.fmi_version = fmi_version
     slave.messages = messages  # keeps the logger callback alive as long as the slave

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from pendulum_fmu.build import FMI_HEADERS, SOURCE_DIR, assemble_sources
+from pendulum_fmu.build import FMI_HEADERS, PLUMBING_DIR, assemble_sources
 
 DRIVER = Path(__file__).resolve().parent / "c" / "driver.c"
 pytestmark = pytest.mark.skipif(shutil.which("gcc") is None, reason="needs gcc")
@@ -28,7 +28,7 @@ def _compile(sources, out, flags):
 def drivers(tmp_path_factory):
     work = tmp_path_factory.mktemp("driver")
     sources = assemble_sources(work / "sources")
-    shutil.copy2(SOURCE_DIR / "fmi3_functions.c", sources)  # both adapters over one core
+    shutil.copy2(PLUMBING_DIR / "fmi3_functions.c", sources)  # both adapters over one core
     return {"asan": _compile(sources, work / "driver_asan",
                              ["-O1", "-fno-omit-frame-pointer", "-fsanitize=address,undefined",
                               "-fno-sanitize-recover=all"]),
