@@ -43,7 +43,7 @@ from .errors import InvalidInput
 from .mapped_fmu import parse_map
 from .parameters import variables
 from .reference import equation_of_motion, reference, reference_schedule
-from .scenarios import read_settings, settings_files
+from .scenarios import JUDGE_TOLERANCE as DEFAULT_TOLERANCE, read_settings, settings_files
 from .simulate import resolve_parameters
 from .torque_schedule import TorqueSchedule, TorqueTable, event_tolerance, read_torque_csv, schedule
 
@@ -74,7 +74,6 @@ NOISE = 0.1
 # (second order) is 3.2e-3 and 6.4e-3 of the input-timing effects; an input late at one jump only
 # (no candidate of its own) 0.38. 0.05 sits between, about a decade from either.
 INTEGRATION_SMALL = 0.05
-DEFAULT_TOLERANCE = 1e-9  # rad
 RESULT_QUANTITIES = ("time", "theta", "omega", "alpha")
 OPTIONAL = ("omega", "alpha")
 
