@@ -58,15 +58,17 @@ def quantities() -> tuple[str, ...]:
     return ("torque", *OUTPUTS, *START_VALUES, *default_parameters())
 
 
-def parse_map(text: str | None) -> dict[str, Mapped]:
-    """{quantity: Mapped} from 'torque=u,theta=phi*0.0174532925,...'."""
+def parse_map(text: str | None, allowed: tuple[str, ...] | None = None) -> dict[str, Mapped]:
+    """{quantity: Mapped} from 'torque=u,theta=phi*0.0174532925,...'; allowed: the quantities
+    that may be mapped (default: every quantity of a compared FMU, quantities())."""
+    allowed = quantities() if allowed is None else allowed
     mapping: dict[str, Mapped] = {}
     for item in filter(None, (part.strip() for part in (text or "").split(","))):
         quantity, equals, target = (part.strip() for part in item.partition("="))
         if not equals or not quantity or not target:
             raise MapError(f"--map item {item!r} is not QUANTITY=VARIABLE[*FACTOR]")
-        if quantity not in quantities():
-            raise MapError(f"--map: unknown quantity {quantity!r}; map any of {', '.join(quantities())}")
+        if quantity not in allowed:
+            raise MapError(f"--map: unknown quantity {quantity!r}; map any of {', '.join(allowed)}")
         if quantity in mapping:
             raise MapError(f"--map: {quantity} is mapped twice")
         factor = 1.0

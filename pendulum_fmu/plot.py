@@ -192,3 +192,47 @@ def plot_case_bands(values: dict[str, np.ndarray], summaries: dict[str, np.ndarr
             ax.plot(levels, median, color="C0", marker="." if len(levels) < 30 else None,
                     label=once("median"))
     return _finish(fig, axes, title, path)
+
+
+def _log_difference(ax, time: np.ndarray, difference: np.ndarray, label: str, **style) -> int:
+    """|difference| on a log axis, leaving out the points where it is exactly zero (a log axis has
+    no zero, and a floor would draw them as spikes); returns how many were left out."""
+    magnitude = np.abs(difference)
+    zero = magnitude == 0
+    if not zero.all():
+        ax.semilogy(time, np.where(zero, np.nan, magnitude), label=label, **style)
+    return int(zero.sum())
+
+
+def plot_judgement(judgement, path: str | Path, title: str) -> Path:
+    """A judged result (judge.Judgement): the torque the run asks for and, when the diagnosis
+    names a variant, the torque that variant applies (N.m); theta of the result and of the
+    reference (rad); |theta_result - theta_reference| and the variant's own difference from the
+    reference (rad, log), with the tolerance. Exact zeros are said in words, not drawn."""
+    result, reference, variant = judgement.result, judgement.reference, judgement.explanation
+    time = result["time"]
+    fig, axes = plt.subplots(3, 1, figsize=(10, 8), sharex=True)
+    axes[0].step(time, reference["torque"], where="post", linewidth=2, label="the run's torque")
+    if variant is not None and not np.array_equal(variant["torque"], reference["torque"]):
+        axes[0].step(time, variant["torque"], where="post", linestyle="--", linewidth=1.5,
+                     label=f"applied if {judgement.diagnosis}")
+    axes[0].set_ylabel(r"Torque $\tau$ in N.m")
+    axes[1].plot(time, reference["theta"], linewidth=2, label="reference")
+    axes[1].plot(time, result["theta"], linestyle="--", linewidth=1.5, label=judgement.source)
+    axes[1].set_ylabel(THETA_LABEL)
+    zeros = _log_difference(axes[2], time, result["theta"] - reference["theta"],
+                            "|result - reference|", linewidth=1.5)
+    if variant is not None:
+        _log_difference(axes[2], time, variant["theta"] - reference["theta"],
+                        f"|{judgement.diagnosis} - reference|", linestyle="--", linewidth=1.5)
+    axes[2].axhline(judgement.tolerance, color="grey", linestyle=":",
+                    label=f"tolerance {judgement.tolerance:g} rad")
+    axes[2].set_yscale("log")
+    if zeros:
+        note = ("the result equals the reference exactly at every point (difference 0 rad)"
+                if zeros == len(time) else
+                f"difference exactly 0 rad at {zeros:,} of {len(time):,} points (not drawn)")
+        axes[2].text(0.01, 0.04, note, transform=axes[2].transAxes, fontsize=9)
+    axes[2].set_ylabel(r"$|\Delta\theta|$ in rad")
+    axes[2].set_xlabel(TIME_LABEL)
+    return _finish(fig, axes, f"{title}: {judgement.verdict}, {judgement.diagnosis}", path)

@@ -61,6 +61,9 @@ FILES = {
     "no_model_description.fmu": _zip({"documentation/index.html": "<html></html>"}),
     "spring.fmu": _zip({"modelDescription.xml": SPRING}),
     "fmi1.fmu": _zip({"modelDescription.xml": FMI1}),
+    "result.csv": "time,theta\n0,0\n0.001,0\n",
+    "result_no_time.csv": "t,theta\n0,0\n0.001,0\n",
+    "result_backwards.csv": "time,theta\n0,0\n0.002,0\n0.001,0\n",
 }
 
 
@@ -159,6 +162,22 @@ CASES = [
           "cannot write /proc/self/Pendulum.fmu: no file can be created in /proc/self"),
     _case("output", "sweep --torque 1 --output-dir /proc/self/out", 2,
           "cannot write /proc/self/out: the folder /proc/self/out cannot be created"),
+    _case("judge", "judge {files}/result_no_time.csv --torque 1", 2,
+          "result_no_time.csv:1: no column 'time' (header is t,theta); name the result's time column"),
+    _case("judge", "judge {files}/result_backwards.csv --torque 1", 2,
+          "result_backwards.csv:4: time 0.001 goes backwards (previous row: 0.002)"),
+    _case("judge", "judge {files}/result.csv --torque 1 --map theta=phi", 2,
+          "result.csv:1: no column 'phi', which --map names for theta (header is time,theta)"),
+    _case("judge", "judge {files}/result.csv --torque 1 --map torque=u", 2,
+          "--map: unknown quantity 'torque'; map any of time, theta, omega, alpha"),
+    _case("judge", "judge {files}/result.csv", 2, "judging a result file needs the run's torque"),
+    _case("judge", "judge {files}/absent.csv --torque 1", 2, "absent.csv: cannot read: No such file"),
+    _case("judge", "judge {files}/result.csv --torque 1 --stop-time 0.0005", 2,
+          "result.csv: time 0.001 is after the run's stop time 0.0005 s; give the run's --stop-time"),
+    _case("judge", "judge {files}", 2, "no scenario settings (NAME.json) in this folder"),
+    _case("judge", "judge {files} --torque 1", 2, "is a folder, judged as a scenario kit whose NAME.json files"),
+    _case("scenarios", "scenarios --output-dir {files}/bad_number.csv/kit", 2,
+          "bad_number.csv is a file, not a folder; choose another output path"),
 ]
 
 
