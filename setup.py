@@ -2,15 +2,17 @@
 
 - build_py also builds the FMI 2.0 and 3.0 FMUs into the wheel's pendulum_fmu/data/, from this
   source tree (a clone or the unpacked sdist), for every platform whose compiler is installed.
-- The native co-simulation loop, pendulum_fmu/_cs_loop.c, is built as a shared library. It is
-  plain C loaded with ctypes (pendulum_fmu/cs_loop.py), not a CPython module, so it exports its
-  own function rather than a PyInit_ one. The FMI headers are fmpy's (a build requirement).
-  Being no CPython module, it has the platform's plain name (_cs_loop.so, _cs_loop.pyd) and
-  the wheel is tagged py3-none-<platform>: one wheel serves every Python 3 on a platform.
+- build_ext builds the native co-simulation loop, pendulum_fmu/_cs_loop.c, through the project's
+  one build description (CMakeLists.txt, driven by pendulum_fmu/build.py) with this machine's
+  compiler. It is plain C loaded with ctypes (pendulum_fmu/cs_loop.py), not a CPython module:
+  it has the platform's plain name (_cs_loop.so, _cs_loop.pyd) and the wheel is tagged
+  py3-none-<platform>, one wheel for every Python 3 on a platform.
 """
 
 import importlib.machinery
+import shutil
 import sys
+import tempfile
 from pathlib import Path
 
 from setuptools import Extension, setup
@@ -20,8 +22,6 @@ from setuptools.command.build_py import build_py
 
 # This tree's pendulum_fmu (not an installed one) knows where the sources are.
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-
-from pendulum_fmu.build import FMI_HEADERS  # noqa: E402
 
 
 class BuildPyWithFmu(build_py):
@@ -41,9 +41,17 @@ class BuildPyWithFmu(build_py):
             print(f"pendulum_fmu {__version__}: built {fmu}")
 
 
-class BuildCLibrary(build_ext):
-    def get_export_symbols(self, extension):
-        return extension.export_symbols
+class BuildNativeLoop(build_ext):
+    """The native loop by CMake, for the platform of this machine."""
+
+    def build_extension(self, extension):
+        from pendulum_fmu.build import PLATFORMS, compile_native_loop
+
+        [platform] = [name for name, platform in PLATFORMS.items() if platform.native]
+        target = Path(self.get_ext_fullpath(extension.name))
+        target.parent.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryDirectory() as out_dir:
+            shutil.copyfile(compile_native_loop(platform, out_dir), target)
 
     def get_ext_filename(self, fullname):
         # The last suffix is the one every CPython of the platform loads: .so, .pyd.
@@ -56,8 +64,8 @@ class PlatformWheel(bdist_wheel):
 
 
 setup(
-    ext_modules=[Extension("pendulum_fmu._cs_loop", sources=["pendulum_fmu/_cs_loop.c"],
-                           include_dirs=[str(FMI_HEADERS)],
-                           export_symbols=["cs_loop_run", "cs_loop_interface"])],
-    cmdclass={"build_py": BuildPyWithFmu, "build_ext": BuildCLibrary, "bdist_wheel": PlatformWheel},
+    # Declared so that setuptools builds it (in place too) and tags the wheel for a platform;
+    # BuildNativeLoop builds it with CMake, not with setuptools' compiler.
+    ext_modules=[Extension("pendulum_fmu._cs_loop", sources=["pendulum_fmu/_cs_loop.c"])],
+    cmdclass={"build_py": BuildPyWithFmu, "build_ext": BuildNativeLoop, "bdist_wheel": PlatformWheel},
 )

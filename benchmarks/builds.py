@@ -12,7 +12,7 @@ from pathlib import Path
 
 from fmpy import extract, read_model_description
 
-from pendulum_fmu.build import FMI_HEADERS, PLATFORMS, build_fmu, compile_library, find_compiler, run_compiler
+from pendulum_fmu.build import FMI_HEADERS, PLATFORMS, build_fmu, cmake_build, check_toolchain, run_tool
 
 HERE = Path(__file__).resolve().parent
 NULL_FMU_SOURCES = HERE / "null_fmu"
@@ -48,10 +48,12 @@ def build_pendulum_fmu(out_dir: Path) -> BuiltFmu:
 
 
 def build_null_fmu(out_dir: Path) -> BuiltFmu:
-    """Compile null_fmu/ with the pendulum's compiler flags and zip it as NullFmu.fmu."""
+    """Build null_fmu/ with the pendulum's compiler flags (its CMakeLists.txt includes
+    cmake/flags.cmake) and zip it as NullFmu.fmu."""
     work = out_dir / "null_fmu_build"
     work.mkdir(parents=True, exist_ok=True)
-    library = compile_library(NULL_FMU_SOURCES, work / "NullFmu.so")
+    [native] = PLATFORMS["linux64"].targets
+    library = cmake_build(native, work, "NullFmu", project=NULL_FMU_SOURCES)
     fmu = out_dir / "NullFmu.fmu"
     with zipfile.ZipFile(fmu, "w", zipfile.ZIP_DEFLATED) as archive:
         archive.write(NULL_FMU_SOURCES / "modelDescription.xml", "modelDescription.xml")
@@ -64,10 +66,17 @@ def build_step_master(out_dir: Path, platform: str = "linux64", fmi_version: int
     """Compile the bare C master of an FMI version (step_master.c, fmi3_step_master.c) for a
     platform of pendulum_fmu.build.PLATFORMS with that platform's compiler (the tests run the win64
     one under wine, the aarch64-linux one under qemu-aarch64)."""
-    target = PLATFORMS[platform]
-    source = STEP_MASTER_SOURCES[fmi_version]
-    master = out_dir / f"{source.stem}_{platform}{'.exe' if target.windows else ''}"
-    command = [*find_compiler(target), "-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", f"-I{FMI_HEADERS}",
-               str(source), *([] if target.windows else ["-ldl"]), "-o", str(master)]
-    run_compiler(command, "the step master")
+    return build_bare_master(out_dir, STEP_MASTER_SOURCES[fmi_version], platform)
+
+
+def build_bare_master(out_dir: Path, source: Path, platform: str = "linux64") -> Path:
+    """Compile a C program over bare_master.h (a step master, tests/c/cs_loop_harness.c) for a
+    platform of pendulum_fmu.build.PLATFORMS with that platform's compiler."""
+    chosen = PLATFORMS[platform]
+    check_toolchain(chosen)
+    [target] = chosen.targets  # the masters run here, where no universal binary is needed
+    master = out_dir / f"{source.stem}_{platform}{'.exe' if chosen.windows else ''}"
+    command = [*target.compiler(), "-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", f"-I{FMI_HEADERS}",
+               f"-I{HERE}", str(source), *([] if chosen.windows else ["-ldl"]), "-o", str(master)]
+    run_tool(command, source.name)
     return master

@@ -1,10 +1,12 @@
 """Build Pendulum.fmu from fmu_src/ and modelDescription.xml, for every platform we can compile for.
 
-The C code takes its value references, names and start values from modelDescription.xml: this
-module generates them (model_variables.h/.c), so the XML stays the single source of truth.
-fmu_src/ holds the FMI plumbing, which knows nothing of pendulums, and the pendulum's model.h and
-model.c; another model (fmu_src/pid_controller/) is built over the same plumbing by naming its
-folder and modelDescription.xml.
+The one build description is CMakeLists.txt (with a toolchain file per cross target in cmake/);
+this module drives it. The C code takes its value references, names and start values from the
+model's modelDescription.xml: this module generates them (model_variables.h/.c), so the XML stays
+the single source of truth. fmu_src/src/ and fmu_src/include/ hold the FMI plumbing, which knows
+nothing of pendulums; each model has its own folder (config.h, model.c), listed in MODELS.
+Per platform, CMake configures and builds in a private temporary folder; llvm-lipo merges the two
+macOS slices into one universal binary; the FMU's zip is renamed into place whole.
 
 Builds only ever run from a source tree (a clone or the sdist): an installed package carries the
 built FMU as package data instead (see pendulum_fmu.default_fmu).
@@ -12,7 +14,6 @@ built FMU as package data instead (see pendulum_fmu.default_fmu).
 
 from __future__ import annotations
 
-import functools
 import html
 import os
 import platform as host
@@ -31,11 +32,15 @@ import fmpy
 from fmpy import read_model_description
 
 from . import FMU_FILES, __version__, fmi3
-from .atomic_files import replacing_path
+from .atomic_files import check_writable, replacing_path
 from .errors import PendulumFmuError
 
 ROOT = Path(__file__).resolve().parent.parent
+CMAKE_LISTS = ROOT / "CMakeLists.txt"
+TOOLCHAINS = ROOT / "cmake"
 SOURCE_DIR = ROOT / "fmu_src"
+PLUMBING_DIR = SOURCE_DIR / "src"
+HEADERS_DIR = SOURCE_DIR / "include"
 MODEL_DESCRIPTION = ROOT / "modelDescription.xml"
 FMI_VERSIONS = tuple(FMU_FILES)
 # FMI version -> the FMU a checkout builds and runs when none is named.
@@ -43,21 +48,69 @@ CHECKOUT_FMUS = {version: ROOT / "dist" / name for version, name in FMU_FILES.it
 DEFAULT_FMU = CHECKOUT_FMUS[2]
 GENERATED_SOURCES = ("model_variables.h", "model_variables.c")
 MODEL_FILES = ("config.h", "model.c")
-PID_CONTROLLER_DIR = SOURCE_DIR / "pid_controller"
 # The FMI headers fmpy ships, rather than a vendored copy.
 FMI_HEADERS = Path(fmpy.__file__).parent / "c-code"
 
 
 @dataclass(frozen=True)
-class Platform:
-    """A platform an FMU can carry a binary for."""
+class Model:
+    """A model built over the FMI plumbing."""
 
-    fmi2_folder: str      # binaries/<folder> in an FMI 2.0 FMU
-    fmi3_folder: str      # binaries/<folder> in an FMI 3.0 FMU
-    cross_compiler: str   # the compiler when this is not the machine we build on
-    package: str          # the Debian package that installs cross_compiler
-    machine: str          # platform.machine() of a Linux host that builds it natively
-    suffix: str           # of the shared library
+    folder: Path          # its config.h and model.c
+    description: Path     # its FMI 2.0 modelDescription.xml
+
+
+# The build's one table of models. The pendulum's description is the project's top-level
+# modelDescription.xml, the single source of truth for its variables.
+MODELS = {
+    "pendulum": Model(SOURCE_DIR / "pendulum", MODEL_DESCRIPTION),
+    "pid_controller": Model(SOURCE_DIR / "pid_controller", SOURCE_DIR / "pid_controller" / "modelDescription.xml"),
+}
+PENDULUM_DIR = MODELS["pendulum"].folder
+PID_CONTROLLER_DIR = MODELS["pid_controller"].folder
+ZIG = "zig"
+LIPO = ("llvm-lipo-14", "llvm-lipo", "lipo")
+
+
+@dataclass(frozen=True)
+class Target:
+    """One binary CMake builds: natively on a machine of its kind, with its toolchain file
+    (cmake/<toolchain>) elsewhere."""
+
+    name: str                  # the FMI 3.0 platform folder
+    system: str                # sys.platform of a machine that builds it natively
+    machines: tuple[str, ...]  # platform.machine() of such a machine (any, for macOS's both slices)
+    toolchain: str             # cmake/<toolchain>: how another machine builds it
+    cross_compiler: str        # the compiler that toolchain file runs
+    package: str               # what installs that compiler
+
+    @property
+    def native(self) -> bool:
+        return sys.platform == self.system and (not self.machines or host.machine() in self.machines)
+
+    def compiler(self) -> list[str]:
+        """The C compiler command: $CC (split as a shell would, so CC="ccache gcc" works) or gcc on
+        a machine of the target's kind, the toolchain file's cross-compiler elsewhere (zig: the
+        ziglang package's `zig cc`)."""
+        if self.native:
+            return shlex.split(os.environ.get("CC") or "gcc")
+        if self.cross_compiler == ZIG:
+            return [find_zig() or ZIG, "cc"]
+        return [self.cross_compiler]
+
+
+@dataclass(frozen=True)
+class Platform:
+    """A platform an FMI 2.0 FMU can carry a binary for, and its FMI 3.0 folders."""
+
+    fmi2_folder: str            # binaries/<folder> in an FMI 2.0 FMU
+    targets: tuple[Target, ...]  # its binaries: one, or the slices of one universal Mach-O
+    suffix: str                 # of the FMU's shared library
+
+    @property
+    def fmi3_folders(self) -> tuple[str, ...]:
+        """binaries/<folder> of each target in an FMI 3.0 FMU."""
+        return tuple(target.name for target in self.targets)
 
     @property
     def windows(self) -> bool:
@@ -65,24 +118,20 @@ class Platform:
 
     @property
     def native(self) -> bool:
-        return not self.windows and sys.platform.startswith("linux") and host.machine() == self.machine
-
-    def compiler(self) -> list[str]:
-        """The compiler command: $CC (split as a shell would, so CC="ccache gcc" works) or gcc on
-        the machine we build on, the cross-compiler elsewhere."""
-        if self.native:
-            return shlex.split(os.environ.get("CC") or "gcc")
-        return [self.cross_compiler]
-
-    def install_hint(self) -> str:
-        return f"apt-get install {'gcc' if self.native else self.package}"
+        return all(target.native for target in self.targets)
 
 
 PLATFORMS = {platform.fmi2_folder: platform for platform in (
-    Platform("linux64", "x86_64-linux", "x86_64-linux-gnu-gcc", "gcc-x86-64-linux-gnu", "x86_64", ".so"),
-    Platform("win64", "x86_64-windows", "x86_64-w64-mingw32-gcc", "gcc-mingw-w64-x86-64", "", ".dll"),
+    Platform("linux64", (Target("x86_64-linux", "linux", ("x86_64",), "x86_64-linux.cmake",
+                                "x86_64-linux-gnu-gcc", "apt-get install gcc-x86-64-linux-gnu"),), ".so"),
+    Platform("win64", (Target("x86_64-windows", "win32", ("AMD64",), "x86_64-windows.cmake",
+                              "x86_64-w64-mingw32-gcc", "apt-get install gcc-mingw-w64-x86-64"),), ".dll"),
     # The folder name fmpy and the Reference FMUs use for Linux on ARM64.
-    Platform("aarch64-linux", "aarch64-linux", "aarch64-linux-gnu-gcc", "gcc-aarch64-linux-gnu", "aarch64", ".so"),
+    Platform("aarch64-linux", (Target("aarch64-linux", "linux", ("aarch64",), "aarch64-linux.cmake",
+                                      "aarch64-linux-gnu-gcc", "apt-get install gcc-aarch64-linux-gnu"),), ".so"),
+    # fmpy loads binaries/darwin64 on Intel and Apple Silicon Macs alike: one universal Mach-O.
+    Platform("darwin64", (Target("x86_64-darwin", "darwin", (), "x86_64-darwin.cmake", ZIG, "pip install ziglang"),
+                          Target("aarch64-darwin", "darwin", (), "aarch64-darwin.cmake", ZIG, "pip install ziglang")), ".dylib"),
 )}
 
 
@@ -90,12 +139,16 @@ class BuildError(PendulumFmuError, RuntimeError):
     """The FMU could not be built; the message says why."""
 
 
+class PlatformSkipped(UserWarning):
+    """A platform left out of a default build because its compiler is missing."""
+
+
 def _check_sources_present() -> None:
     if not is_source_checkout():
         raise BuildError(
-            f"the FMU's sources (fmu_src/, modelDescription.xml) are not beside {Path(__file__).parent}: "
-            "to build, run python build_fmu.py in a clone or the unpacked sdist; an installed "
-            "package uses its packaged FMU (pendulum_fmu.default_fmu())")
+            f"the FMU's sources (fmu_src/, modelDescription.xml, CMakeLists.txt) are not beside "
+            f"{Path(__file__).parent}: to build, run python build_fmu.py in a clone or the unpacked "
+            "sdist; an installed package uses its packaged FMU (pendulum_fmu.default_fmu())")
 
 
 def generate_variables(model_description, out_dir: Path) -> list[Path]:
@@ -160,90 +213,155 @@ def _check_source_files(model_description, xml: Path, sources: Path, fmi_version
             )
 
 
-def assemble_sources(sources: Path, model_dir: Path = SOURCE_DIR,
+def assemble_sources(sources: Path, model_dir: Path = PENDULUM_DIR,
                      model_description_file: Path = MODEL_DESCRIPTION, fmi_version: int = 2) -> Path:
-    """Everything that compiles into the FMU, in one folder: what the FMU's sources/ holds, and
-    what the tests' C driver and fuzzers link."""
+    """Everything that compiles into the FMU, in one flat folder: what the FMU's sources/ holds,
+    which fmpy compile builds, and what the tests' C driver and fuzzers link."""
     _check_sources_present()
-    _assemble_sources(Path(model_dir), read_model_description(str(model_description_file)), Path(sources),
-                      fmi_version)
-    return Path(sources)
-
-
-def _assemble_sources(model_dir: Path, model_description, sources: Path, fmi_version: int = 2) -> None:
-    """The plumbing from fmu_src/ (with the entry points of one FMI version), the model from
-    model_dir, the generated variables."""
+    sources = Path(sources)
     sources.mkdir()
-    left_out = {*MODEL_FILES, fmi3.adapter_left_out(fmi_version)}
-    for path in SOURCE_DIR.iterdir():
-        if path.is_file() and path.name not in left_out:
+    generate_variables(read_model_description(str(model_description_file)), sources)
+    _copy_sources(Path(model_dir), sources, fmi_version)
+    return sources
+
+
+def _copy_sources(model_dir: Path, sources: Path, fmi_version: int) -> None:
+    """The plumbing (with the entry points of one FMI version) and the model, into sources."""
+    left_out = fmi3.adapter_left_out(fmi_version)
+    for path in [*sorted(HEADERS_DIR.glob("*.h")), *sorted(PLUMBING_DIR.glob("*.c")),
+                 *(model_dir / name for name in MODEL_FILES)]:
+        if path.name != left_out:
             shutil.copy2(path, sources)
-    for name in MODEL_FILES:
-        shutil.copy2(model_dir / name, sources)
-    generate_variables(model_description, sources)
 
 
-def run_compiler(command: list[str], what: str) -> None:
-    """Run a compiler command; BuildError with its output when it fails."""
+def find_zig() -> str | None:
+    """zig from the ziglang package (pip install ziglang), else from PATH."""
     try:
-        result = subprocess.run(command, capture_output=True, text=True)
-    except OSError as error:
-        raise BuildError(f"compiling {what} failed: {shlex.join(command[:1])}: {error.strerror}") from None
-    if result.returncode != 0:
-        raise BuildError(f"compiling {what} failed:\n{shlex.join(command)}\n{result.stderr}")
+        import ziglang
+    except ImportError:
+        return shutil.which(ZIG)
+    bundled = Path(ziglang.__file__).parent / ("zig.exe" if os.name == "nt" else "zig")
+    return str(bundled) if bundled.is_file() else shutil.which(ZIG)
 
 
-@functools.lru_cache(maxsize=None)
-def supports_lto(compiler: tuple[str, ...], windows: bool = False) -> bool:
-    """Whether compiler links a shared library with -flto: a gcc without its LTO plug-in
-    (lto-wrapper) accepts the flag and then fails to link, so ask by trying."""
-    with tempfile.TemporaryDirectory(prefix="pendulum_fmu_lto_") as probe:
-        source = Path(probe) / "probe.c"
-        source.write_text("int probe(int x) { return x + 1; }\n")
-        command = [*compiler, "-flto", "-O2", "-shared", *([] if windows else ["-fPIC"]),
-                   str(source), "-o", str(Path(probe) / "probe.so")]
+def _lipo() -> str | None:
+    return next(filter(None, map(shutil.which, LIPO)), None)
+
+
+def _cmake() -> str:
+    """cmake from PATH, else from the PyPI cmake package (which fmpy requires), as in a pip
+    build environment."""
+    found = shutil.which("cmake")
+    if found is None:
         try:
-            return subprocess.run(command, capture_output=True).returncode == 0
-        except OSError:
-            return False
+            import cmake
+        except ImportError:
+            raise BuildError("cmake not found (pip install cmake, or apt-get install cmake)") from None
+        found = str(Path(cmake.CMAKE_BIN_DIR) / "cmake")
+    return found
 
 
-def find_compiler(platform: Platform) -> list[str]:
-    """The platform's compiler command, or BuildError naming the package that installs it."""
-    compiler = platform.compiler()
-    if not compiler or shutil.which(compiler[0]) is None:
-        name = shlex.join(compiler) if compiler else "CC (empty)"
-        raise BuildError(f"{platform.fmi2_folder}: C compiler {name} not found "
-                         f"({platform.install_hint()})")
-    return compiler
+def check_toolchain(platform: Platform, fmi_version: int = 2) -> None:
+    """BuildError naming the package to install unless every tool that builds platform is here:
+    the cross-compiler of each target (or $CC, when set, on a machine of the target's kind: else
+    CMake finds the machine's compiler itself), and llvm-lipo where FMI 2.0 merges slices into
+    one binary."""
+    for target in platform.targets:
+        if target.native and not os.environ.get("CC"):
+            continue
+        compiler = target.compiler()
+        if not compiler or shutil.which(compiler[0]) is None:
+            name = shlex.join(compiler) if compiler else "CC (empty)"
+            hint = "set CC to an installed compiler" if target.native else target.package
+            raise BuildError(f"{platform.fmi2_folder}: C compiler {name} not found ({hint})")
+    if fmi_version == 2 and len(platform.targets) > 1 and _lipo() is None:
+        raise BuildError(f"{platform.fmi2_folder}: {LIPO[0]}, which merges its slices into one binary, "
+                         "not found (apt-get install llvm-14)")
 
 
-def compile_library(source_dir: Path, out_file: Path, platform: str = "linux64", *,
-                    export_prefix: str = "fmi2") -> Path:
-    """Compile every C file in source_dir into the platform's shared library, exporting only the
-    functions named export_prefix* (fmi2 or fmi3).
+def run_tool(command: list, what: str, environment: dict | None = None) -> None:
+    """Run a build command; BuildError with the end of its output when it fails."""
+    command = [str(part) for part in command]
+    try:
+        result = subprocess.run(command, capture_output=True, text=True, env=environment)
+    except OSError as error:
+        raise BuildError(f"building {what} failed: {shlex.join(command[:1])}: {error.strerror}") from None
+    if result.returncode != 0:
+        raise BuildError(f"building {what} failed:\n{shlex.join(command)}\n"
+                         f"{(result.stdout + result.stderr)[-4000:]}")
 
-    On Windows the FMI headers mark those functions __declspec(dllexport), so they are all the DLL
-    exports; elsewhere a version script hides everything else. $CFLAGS (split as a shell would)
-    applies to the native compiler only: a cross-compiler may not take the host's flags.
+
+def cmake_build(target: Target, work: Path, cmake_target: str, definitions: dict | None = None,
+                project: Path = ROOT) -> Path:
+    """Configure, build and install one target of a CMake project (CMakeLists.txt, or another
+    that includes cmake/flags.cmake) for one platform target in the empty folder work; return
+    the binary.
+
+    On a machine of the target's kind the compiler is CMake's choice, $CC with $CFLAGS when set;
+    elsewhere the target's toolchain file (cmake/), without the host's $CFLAGS, which a
+    cross-compiler may not take. The CMake target's install component has its name.
     """
-    target = PLATFORMS[platform]
-    compiler = find_compiler(target)
-    if target.windows:
-        # No dependency on the mingw runtime DLLs: the FMU must load on any Windows machine.
-        linking = ["-static-libgcc", "-s"]
-    else:
-        version_script = out_file.parent / f"{out_file.stem}.exports.map"
-        version_script.write_text(f"{{ global: {export_prefix}*; local: *; }};\n")
-        linking = ["-fPIC", "-fvisibility=hidden", f"-Wl,--version-script={version_script}", "-lm"]
-    # -flto lets the integrator inline the model's right-hand side across files.
-    lto = ["-flto"] if supports_lto(tuple(compiler), target.windows) else []
-    user_flags = shlex.split(os.environ.get("CFLAGS", "")) if target.native else []
-    run_compiler([
-        *compiler, "-std=c99", "-O2", *lto, "-shared", "-Wall", "-Wextra", "-Werror", *user_flags,
-        f"-I{source_dir}", f"-I{FMI_HEADERS}", *sorted(str(p) for p in source_dir.glob("*.c")),
-        *linking, "-o", str(out_file),
-    ], f"{out_file.name} for {platform}")
+    cmake = _cmake()
+    build, installed = work / "build", work / "installed"
+    environment = dict(os.environ)
+    configure = [cmake, "-S", project, "-B", build, f"-DFMI_HEADERS={FMI_HEADERS}",
+                 *(f"-D{name}={value}" for name, value in (definitions or {}).items())]
+    # On a Mac too: its toolchain file sets the architecture and the oldest macOS.
+    if not target.native or target.system == "darwin":
+        configure.append(f"-DCMAKE_TOOLCHAIN_FILE={TOOLCHAINS / target.toolchain}")
+    if not target.native:
+        for name in ("CC", "CFLAGS", "LDFLAGS"):
+            environment.pop(name, None)
+        if target.cross_compiler == ZIG:
+            configure.append(f"-DZIG={find_zig()}")
+    what = f"{cmake_target} for {target.name}"
+    run_tool(configure, what, environment)
+    run_tool([cmake, "--build", build, "--target", cmake_target, "--config", "Release"], what, environment)
+    run_tool([cmake, "--install", build, "--prefix", installed, "--component", cmake_target,
+              "--config", "Release"], what, environment)
+    [binary] = [path for path in installed.iterdir() if path.is_file()]
+    return binary
+
+
+def _merged(slices: list[Path], out_file: Path) -> Path:
+    """One binary of the slices: the slice itself, or a universal Mach-O that llvm-lipo makes."""
+    if len(slices) == 1:
+        return slices[0]
+    run_tool([_lipo(), "-create", *slices, "-output", out_file], f"the universal {out_file.name}")
+    return out_file
+
+
+def compile_native_loop(platform: str, out_dir: str | os.PathLike) -> Path:
+    """Build the native co-simulation loop (pendulum_fmu/_cs_loop.c) for a platform of PLATFORMS
+    into out_dir, named as that platform's Python loads it (_cs_loop.so, or _cs_loop.pyd on
+    Windows); for darwin64 one universal binary.
+
+    Parameters
+    ----------
+    platform : str
+        An FMI 2.0 platform folder name, a key of PLATFORMS.
+    out_dir : str or os.PathLike
+        The folder to write into; the file is renamed into place whole.
+
+    Returns
+    -------
+    Path
+        The native loop's file.
+
+    Raises
+    ------
+    BuildError
+        When the platform is unknown, its compiler is missing or the build fails.
+    """
+    _check_sources_present()
+    check_platforms([platform])
+    check_toolchain(PLATFORMS[platform])
+    with tempfile.TemporaryDirectory(prefix="pendulum_fmu_native_loop_") as tmp:
+        slices = [cmake_build(target, Path(tmp, target.name), "_cs_loop") for target in PLATFORMS[platform].targets]
+        built = _merged(slices, Path(tmp, slices[0].name))
+        out_file = Path(out_dir, built.name)
+        with replacing_path(out_file) as partial:
+            shutil.copyfile(built, partial)
     return out_file
 
 
@@ -294,17 +412,13 @@ def check_platforms(names) -> None:
                          f"among {', '.join(PLATFORMS)}")
 
 
-class PlatformSkipped(UserWarning):
-    """A platform left out of a default build because its compiler is missing."""
-
-
-def available_platforms() -> tuple[str, ...]:
-    """Every platform whose compiler is present; for each missing one, a PlatformSkipped warning
+def available_platforms(fmi_version: int = 2) -> tuple[str, ...]:
+    """Every platform whose tools are present; for each missing one, a PlatformSkipped warning
     naming the package that installs it. The machine's own platform is never skipped."""
     present = []
     for name, platform in PLATFORMS.items():
         try:
-            find_compiler(platform)
+            check_toolchain(platform, fmi_version)
         except BuildError as error:
             if platform.native:
                 raise  # an FMU that cannot run where it was built is no use
@@ -325,30 +439,31 @@ def _stamped_model_description(xml: Path, fmi_version: int = 2) -> str:
     return text
 
 
-def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, *, model_dir: Path = SOURCE_DIR,
+def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, *, model_dir: Path = PENDULUM_DIR,
               model_description_file: Path = MODEL_DESCRIPTION,
               platforms: tuple[str, ...] | None = None, fmi_version: int = 2) -> Path:
-    """Build an FMU (binaries/, sources/, documentation/) and return its path.
+    """Build an FMU (binaries/, sources/, documentation/) of a model over the FMI plumbing.
 
     Everything is compiled in a private temporary folder and the zip is renamed into place
     whole, so builds into the same path at the same time all succeed.
 
     Parameters
     ----------
-    out_file : str or os.PathLike, optional
-        The FMU to write (default: dist/Pendulum.fmu of the checkout).
-    model_dir : Path, optional
-        The model's config.h and model.c, built over the same FMI plumbing.
-    model_description_file : Path, optional
-        The model's FMI 2.0 modelDescription.xml.
+    out_file : str or os.PathLike
+        Where to write the FMU.
+    model_dir : Path
+        The model's folder (config.h, model.c); see MODELS.
+    model_description_file : Path
+        The model's FMI 2.0 modelDescription.xml, the source of its variables.
     platforms : tuple of str, optional
-        FMI 2.0 folder names (see PLATFORMS); None builds every platform whose compiler is
-        present and warns (PlatformSkipped) about the others. A platform named explicitly must
-        build.
-    fmi_version : {2, 3}, optional
-        3 builds the FMI 3.0 FMU from the same sources: its model description and
-        sources/buildDescription.xml are generated from the FMI 2.0 one by fmi3.py, its binaries
-        go into the FMI 3.0 platform folders and export only fmi3* functions.
+        FMI 2.0 platform folder names (keys of PLATFORMS). None builds every platform whose
+        tools are present and warns (PlatformSkipped) about each other one; a platform named
+        here must build.
+    fmi_version : int
+        2, or 3 for the FMI 3.0 FMU from the same sources: its model description and
+        sources/buildDescription.xml are generated from the FMI 2.0 one (fmi3.py), its binaries
+        go into the FMI 3.0 platform folders (darwin64's two slices into x86_64-darwin and
+        aarch64-darwin) and export only fmi3* functions.
 
     Returns
     -------
@@ -358,8 +473,8 @@ def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, *, model_dir: Path = SO
     Raises
     ------
     BuildError
-        The sources are missing, a platform is unknown or its compiler is missing or fails, or
-        the FMI version is not built.
+        When the sources are not beside the package, a platform or FMI version is unknown, a
+        named platform's tools are missing, or a compiler fails.
     CannotWrite
         out_file cannot be written.
     """
@@ -367,25 +482,38 @@ def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, *, model_dir: Path = SO
     if fmi_version not in FMI_VERSIONS:
         raise BuildError(f"FMI version {fmi_version}: choose among {', '.join(map(str, FMI_VERSIONS))}")
     if platforms is None:
-        platforms = available_platforms()
+        platforms = available_platforms(fmi_version)
     check_platforms(platforms)
+    check_writable(out_file)  # before the compilers run
+    for name in platforms:
+        check_toolchain(PLATFORMS[name], fmi_version)
+    model_dir = Path(model_dir)
     model_description = read_model_description(str(model_description_file))
     identifier = model_description.coSimulation.modelIdentifier
     with tempfile.TemporaryDirectory(prefix="pendulum_fmu_build_") as tmp:
         tmp = Path(tmp)
+        generated = tmp / "generated"
+        generate_variables(model_description, generated)
         sources = tmp / "sources"
-        _assemble_sources(Path(model_dir), model_description, sources, fmi_version)
+        sources.mkdir()
+        _copy_sources(model_dir, sources, fmi_version)
+        for path in generated.iterdir():
+            shutil.copy2(path, sources)
         _check_source_files(model_description, model_description_file, sources, fmi_version)
         if fmi_version == 3:
             (sources / "buildDescription.xml").write_text(fmi3.build_description(model_description_file))
+        definitions = {"MODEL_DIR": model_dir.resolve(), "GENERATED_DIR": generated,
+                       "MODEL_IDENTIFIER": identifier, "FMI_VERSION": fmi_version}
         binaries = {}
         for name in platforms:
-            folder = tmp / name
-            folder.mkdir()
-            library = folder / f"{identifier}{PLATFORMS[name].suffix}"
-            platform_folder = name if fmi_version == 2 else PLATFORMS[name].fmi3_folder
-            binaries[f"binaries/{platform_folder}/{library.name}"] = compile_library(
-                sources, library, name, export_prefix=f"fmi{fmi_version}")
+            platform = PLATFORMS[name]
+            slices = {target.name: cmake_build(target, tmp / name / target.name, "fmu", definitions)
+                      for target in platform.targets}
+            if fmi_version == 3:
+                binaries.update({f"binaries/{folder}/{binary.name}": binary for folder, binary in slices.items()})
+            else:
+                binary = _merged(list(slices.values()), tmp / name / f"{identifier}{platform.suffix}")
+                binaries[f"binaries/{name}/{binary.name}"] = binary
         with replacing_path(out_file) as partial, zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as fmu:
             fmu.writestr("modelDescription.xml",
                          _stamped_model_description(Path(model_description_file), fmi_version))
@@ -399,15 +527,15 @@ def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, *, model_dir: Path = SO
 
 def build_pid_controller(out_file: str | os.PathLike) -> Path:
     """The PID controller FMU that closes the loop around the pendulum in co-simulation."""
-    return build_fmu(out_file, model_dir=PID_CONTROLLER_DIR,
-                     model_description_file=PID_CONTROLLER_DIR / "modelDescription.xml")
+    model = MODELS["pid_controller"]
+    return build_fmu(out_file, model_dir=model.folder, model_description_file=model.description)
 
 
 def build_inputs() -> list[Path]:
     """Every file a checkout's FMU is built from: when one is newer than the FMU, it is stale."""
     package = Path(__file__).parent
-    return [MODEL_DESCRIPTION, Path(__file__), package / "__init__.py", Path(fmi3.__file__),
-            *(p for p in SOURCE_DIR.iterdir() if p.is_file())]
+    return [MODEL_DESCRIPTION, CMAKE_LISTS, Path(__file__), package / "__init__.py", Path(fmi3.__file__),
+            *TOOLCHAINS.glob("*.cmake"), *(p for p in SOURCE_DIR.rglob("*") if p.is_file())]
 
 
 def fmu_is_stale(fmu: Path = DEFAULT_FMU) -> bool:
@@ -421,5 +549,4 @@ def fmu_is_stale(fmu: Path = DEFAULT_FMU) -> bool:
 def is_source_checkout() -> bool:
     """Whether this package sits beside the FMU's sources (a clone, an editable install, the
     sdist being built), rather than installed from a wheel."""
-    return SOURCE_DIR.is_dir() and MODEL_DESCRIPTION.is_file()
-
+    return SOURCE_DIR.is_dir() and MODEL_DESCRIPTION.is_file() and CMAKE_LISTS.is_file()

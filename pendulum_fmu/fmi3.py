@@ -3,7 +3,7 @@ modelDescription.xml (the single source of truth for the variables).
 
 What changes between the standards is only how the same facts are written: `guid` becomes
 `instantiationToken`, each `<ScalarVariable><Real/>` a `<Float64>`, the independent variable
-`time` is declared (value reference after the model's, as fmu_src/fmi3_functions.c expects),
+`time` is declared (value reference after the model's, as fmu_src/src/fmi3_functions.c expects),
 references by index (derivative, dependencies) become references by value reference, and the
 capability flags take their FMI 3.0 names. The sources' list moves to sources/buildDescription.xml.
 """

@@ -11,6 +11,7 @@ import weakref
 from functools import lru_cache
 from pathlib import Path
 
+import fmpy
 import numpy as np
 from fmpy import extract
 from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
@@ -18,7 +19,8 @@ from fmpy.fmi3 import FMU3Slave
 
 from . import cs_loop, default_fmu, results
 from .errors import InvalidInput, PendulumFmuError
-from .parameters import fmu_file, merged_parameters, model_description, start_value, value_reference
+from .parameters import (fmu_file, merged_parameters, model_description, pendulum_variables, start_value,
+                         value_reference)
 from .torque_schedule import TorqueSignal, TorqueSchedule, schedule
 
 _STATUS = ["OK", "WARNING", "DISCARD", "ERROR", "FATAL", "PENDING"]
@@ -87,14 +89,40 @@ _extracting = threading.Lock()  # threads of one dask worker share the cache
 def _unzipped(fmu_path: Path):
     """(folder, model description) of an FMU file, extracted and parsed once per process; the
     folder is removed at exit."""
+    description = model_description(fmu_path)  # refuses what is no FMU before it is unzipped
     key = (str(fmu_path.resolve()), fmu_path.stat().st_mtime_ns)
     with _extracting:
         if key not in _extracted:
             folder = tempfile.TemporaryDirectory(prefix="pendulum_fmu_")
             extract(str(fmu_path), unzipdir=folder.name)
-            _extracted[key] = folder, model_description(fmu_path)
+            _extracted[key] = folder, description
         folder, description = _extracted[key]
     return folder.name, description
+
+
+def fmi2_library(folder: str, model_identifier: str) -> str | None:
+    """The FMI 2.0 binary for fmpy to load (FMU2Slave's libraryPath), or None to let fmpy choose.
+
+    fmpy 0.3 looks in binaries/linux64 on ARM64 Linux too, where an FMU (this one, the Reference
+    FMUs) keeps its binary in binaries/aarch64-linux: that one, when the FMU has it.
+
+    Parameters
+    ----------
+    folder : str
+        The extracted FMU.
+    model_identifier : str
+        The Co-Simulation model identifier, the binary's file name.
+
+    Returns
+    -------
+    str or None
+        The binary's path on ARM64 Linux when the FMU has binaries/aarch64-linux, else None.
+    """
+    if fmpy.system == "linux" and fmpy.architecture == "aarch64":
+        library = Path(folder, "binaries", "aarch64-linux", f"{model_identifier}.so")
+        if library.is_file():
+            return str(library)
+    return None
 
 
 def open_fmu(fmu_path: str | Path | None = None, *, parameters: dict | None = None,
@@ -105,8 +133,17 @@ def open_fmu(fmu_path: str | Path | None = None, *, parameters: dict | None = No
 
     fmu_path defaults to pendulum_fmu.default_fmu() (FMI 2.0); parameters and value references
     are that FMU's own. The caller frees it with slave.terminate(); slave.freeInstance().
+
+    Raises
+    ------
+    MissingFile, parameters.FmuFileError
+        No file at fmu_path, or none that is a pendulum FMU this machine can run (checked before
+        anything is unzipped or loaded).
+    FmuError
+        The FMU refused the parameters or start values; the message carries what it logged.
     """
     fmu_path = Path(fmu_path) if fmu_path else default_fmu()
+    pendulum_variables(fmu_path)  # FmuFileError when it is no pendulum FMU this machine runs
     folder, description = _unzipped(fmu_path)
     fmi_version = int(description.fmiVersion[0])
     messages = MessageLog(fmi_version)
@@ -116,7 +153,7 @@ def open_fmu(fmu_path: str | Path | None = None, *, parameters: dict | None = No
         slave = FMU3Slave(**arguments)
         slave.instantiate(logMessage=messages.log_fmi3)
     else:
-        slave = FMU2Slave(**arguments)
+        slave = FMU2Slave(**arguments, libraryPath=fmi2_library(folder, arguments["modelIdentifier"]))
         slave.instantiate(callbacks=messages.callbacks)
     slave.fmi_version = fmi_version
     slave.messages = messages  # keeps the logger callback alive as long as the slave

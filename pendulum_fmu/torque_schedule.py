@@ -31,13 +31,13 @@ from __future__ import annotations
 import inspect
 import math
 import numbers
-import os
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
 from typing import Callable, Sequence, Union
 
 import numpy as np
+import psutil
 
 from .errors import InvalidInput
 
@@ -262,15 +262,8 @@ def _check_times(start_time: float, stop_time: float, step_size: float) -> None:
 
 
 def _available_memory() -> int:
-    """Bytes the machine can still give (MemAvailable), or its physical memory where unknown."""
-    try:
-        with open("/proc/meminfo") as meminfo:
-            for line in meminfo:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except OSError:
-        pass
-    return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    """Bytes the machine can still give: MemAvailable on Linux, psutil's counterpart elsewhere."""
+    return psutil.virtual_memory().available
 
 
 def step_count(start_time: float, stop_time: float, step_size: float,

@@ -86,7 +86,8 @@ def sweeps() -> str:
     return _wrapped(f"A study of more than {DEFAULT_MAX_CASES:,} cases is refused unless "
                     f"`--max-cases` allows it. `sweep.png` draws every case when there are up to "
                     f"{LINES_UP_TO}, else the median and the {bands} bands of the largest and the "
-                    "final theta per swept value.")
+                    "final theta per swept value (where each value has one case, the cases alone), "
+                    "its axes in the FMU's units.")
 
 
 def robustness() -> str:

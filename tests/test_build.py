@@ -1,6 +1,7 @@
-"""Builds that survive a user's toolchain: LTO only where the compiler has it, CC and CFLAGS with
-arguments, eight builds into one path at once, an FMU older than its sources rebuilt; and the
-FMU's own model description, not the repository's, wherever an FMU is passed."""
+"""Builds that survive a user's toolchain: LTO only where the compiler has it (CMake's
+CheckIPOSupported asks), CC and CFLAGS with arguments, eight builds into one path at once, an FMU
+older than its sources rebuilt; and the FMU's own model description, not the repository's,
+wherever an FMU is passed."""
 
 import os
 import shutil
@@ -28,20 +29,19 @@ ENVIRONMENT = {name: value for name, value in os.environ.items() if name != "PYT
 
 def _launcher(folder: Path, refuse_lto: bool) -> Path:
     """A compiler launcher like ccache: logs each command, then runs it; or, like a gcc without
-    its LTO plug-in, fails any command with -flto."""
+    its LTO plug-in, fails any command with -flto (or -flto=...)."""
     script = folder / "launcher"
-    refusal = ('for a in "$@"; do [ "$a" = -flto ] && { echo "lto-wrapper: not found" >&2; exit 1; }; done\n'
+    refusal = ('for a in "$@"; do case "$a" in -flto*) echo "lto-wrapper: not found" >&2; exit 1;; esac; done\n'
                if refuse_lto else "")
     script.write_text(f'#!/bin/sh\necho "$@" >> "{folder}/commands.log"\n{refusal}exec "$@"\n')
     script.chmod(script.stat().st_mode | stat.S_IXUSR)
     return script
 
 
-def _library_command(folder: Path) -> list[str]:
-    """The logged command that compiled the FMU's library (the others are LTO probes)."""
-    [command] = [line.split() for line in (folder / "commands.log").read_text().splitlines()
-                 if "Pendulum.so" in line]
-    return command
+def _logged_commands(folder: Path, output: str) -> list[list[str]]:
+    """The logged commands that wrote output (CMake's checks of the compiler wrote others)."""
+    return [line.split() for line in (folder / "commands.log").read_text().splitlines()
+            if f"-o {output}" in line]
 
 
 def _theta_error(fmu: Path) -> float:
@@ -55,9 +55,11 @@ def test_cc_and_cflags_with_arguments_and_lto_only_where_it_links(tmp_path, monk
     monkeypatch.setenv("CC", f"{launcher} gcc")
     monkeypatch.setenv("CFLAGS", "-g  -fno-omit-frame-pointer")
     fmu = build_fmu(tmp_path / "Pendulum.fmu", platforms=("linux64",))
-    command = _library_command(tmp_path)
-    assert command[0] == "gcc" and "-g" in command and "-fno-omit-frame-pointer" in command
-    assert ("-flto" in command) is not refuse_lto
+    [link] = _logged_commands(tmp_path, "Pendulum.so")
+    [compile_model] = _logged_commands(tmp_path, "CMakeFiles/fmu.dir/fmu_src/pendulum/model.c.o")
+    for command in (link, compile_model):
+        assert command[0] == "gcc" and "-g" in command and "-fno-omit-frame-pointer" in command
+        assert any(argument.startswith("-flto") for argument in command) is not refuse_lto
     assert _theta_error(fmu) < 1e-9
 
 
@@ -76,9 +78,10 @@ def test_eight_builds_into_one_path_at_once_all_succeed(tmp_path):
 
 
 def test_checkout_fmu_is_rebuilt_when_a_source_is_newer(tmp_path):
-    for name in ("pendulum_fmu", "fmu_src"):
+    for name in ("pendulum_fmu", "fmu_src", "cmake"):
         shutil.copytree(ROOT / name, tmp_path / name, ignore=shutil.ignore_patterns("__pycache__"))
     shutil.copy2(MODEL_DESCRIPTION, tmp_path)
+    shutil.copy2(ROOT / "CMakeLists.txt", tmp_path)
     ask = [sys.executable, "-c", "import pendulum_fmu; print(pendulum_fmu.default_fmu())"]
 
     def default_fmu_mtime():
@@ -90,7 +93,7 @@ def test_checkout_fmu_is_rebuilt_when_a_source_is_newer(tmp_path):
     built = default_fmu_mtime()
     assert default_fmu_mtime() == built  # up to date: used as is
     future = time.time() + 60
-    os.utime(tmp_path / "fmu_src" / "model.c", (future, future))
+    os.utime(tmp_path / "fmu_src" / "pendulum" / "model.c", (future, future))
     assert default_fmu_mtime() > built
 
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from pendulum_fmu import compare_tools
-from pendulum_fmu.build import MODEL_DESCRIPTION, SOURCE_DIR, build_fmu
+from pendulum_fmu.build import MODEL_DESCRIPTION, PENDULUM_DIR, SOURCE_DIR, build_fmu
 from pendulum_fmu.cli import main
 from pendulum_fmu.compare import run_tools
 from pendulum_fmu.mapped_fmu import MapError, Mapped, MappedFmu, parse_map
@@ -26,8 +26,8 @@ def renamed_fmu(tmp_path_factory):
     folder = tmp_path_factory.mktemp("renamed")
     model = folder / "model"
     model.mkdir()
-    shutil.copy2(SOURCE_DIR / "config.h", model)
-    code = (SOURCE_DIR / "model.c").read_text()
+    shutil.copy2(PENDULUM_DIR / "config.h", model)
+    code = (PENDULUM_DIR / "model.c").read_text()
     xml = MODEL_DESCRIPTION.read_text().replace('modelIdentifier="Pendulum"', 'modelIdentifier="Renamed"')
     for ours, theirs in RENAMES.items():
         code = code.replace(f"VR_{ours.upper()}", f"VR_{theirs.upper()}")

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from pendulum_fmu.build import FMI_HEADERS, SOURCE_DIR, assemble_sources
+from pendulum_fmu.build import FMI_HEADERS, PLUMBING_DIR, assemble_sources
 
 HARNESSES = Path(__file__).resolve().parent / "fuzz"
 DEFAULT_SECONDS = 15  # per harness, as CI runs it
@@ -22,7 +22,7 @@ pytestmark = pytest.mark.skipif(shutil.which("clang") is None,
 @pytest.fixture(scope="module")
 def sources(tmp_path_factory):
     sources = assemble_sources(tmp_path_factory.mktemp("fuzz") / "sources")
-    shutil.copy2(SOURCE_DIR / "fmi3_functions.c", sources)  # fuzz_calls drives both standards
+    shutil.copy2(PLUMBING_DIR / "fmi3_functions.c", sources)  # fuzz_calls drives both standards
     return sources
 
 

@@ -1,11 +1,16 @@
 """One FMU for every platform, in both FMI versions: the win64 binary (mingw-w64) run under wine
 and the aarch64-linux binary (gcc-aarch64-linux-gnu) run under qemu-aarch64, each by the same bare
-C master that runs the linux64 binary, with the same numbers; and a build that skips a platform
-whose compiler is missing."""
+C master that runs the linux64 binary, with the same numbers; the macOS binaries (zig), which
+nothing here can run, read slice by slice, and zig's builds for Linux run instead to show that
+zig compiles the sources to the same numbers; and a build that skips a platform whose compiler
+is missing."""
 
+import dataclasses
+import hashlib
 import os
 import re
 import shutil
+import struct
 import subprocess
 import zipfile
 from dataclasses import dataclass
@@ -17,7 +22,8 @@ from fmpy import read_model_description
 
 import pendulum_fmu.build
 from benchmarks.builds import build_step_master
-from pendulum_fmu.build import FMI_VERSIONS, PLATFORMS, BuildError, Platform, PlatformSkipped, build_fmu
+from pendulum_fmu.build import (FMI_VERSIONS, PLATFORMS, ZIG, BuildError, PlatformSkipped, Target,
+                                available_platforms, build_fmu, find_zig)
 from pendulum_fmu.cli import main
 from pendulum_fmu.reference import reference
 
@@ -25,8 +31,8 @@ STEPS, STEP_SIZE = 3000, 1e-3  # the tutorial case: 20 N.m, gravity on, 3 s
 # How each platform's master runs here: natively, under wine, under qemu with the cross libc.
 RUNNERS = {"linux64": [], "win64": ["wine"], "aarch64-linux": ["qemu-aarch64", "-L", "/usr/aarch64-linux-gnu"]}
 CROSS = [pytest.param(platform, marks=pytest.mark.skipif(
-    shutil.which(PLATFORMS[platform].cross_compiler) is None or shutil.which(RUNNERS[platform][0]) is None,
-    reason=f"needs Debian's {PLATFORMS[platform].package} and {RUNNERS[platform][0]} (.ci/run installs them)"))
+    shutil.which(PLATFORMS[platform].targets[0].cross_compiler) is None or shutil.which(RUNNERS[platform][0]) is None,
+    reason=f"needs {PLATFORMS[platform].targets[0].package} and {RUNNERS[platform][0]} (.ci/run installs them)"))
     for platform in ("win64", "aarch64-linux")]
 EACH_FMI_VERSION = pytest.mark.parametrize("fmi_version", FMI_VERSIONS, ids=lambda version: f"fmi{version}")
 # The value references benchmarks/bare_master.h hard-codes (VR_TORQUE, VR_THETA).
@@ -43,9 +49,22 @@ class UnzippedBuild:
     token: str  # the FMI 2.0 guid, the FMI 3.0 instantiationToken
     value_references: dict
 
-    def library(self, platform):
-        folder = platform if self.fmi_version == 2 else PLATFORMS[platform].fmi3_folder
+    def library(self, platform, fmi3_folder=None):
+        """The binary of an FMI 2.0 platform; in FMI 3.0, of its one folder or of fmi3_folder."""
+        if self.fmi_version == 2:
+            folder = platform
+        else:
+            [folder] = [fmi3_folder] if fmi3_folder else PLATFORMS[platform].fmi3_folders
         return self.work / "unzipped/binaries" / folder / f"Pendulum{PLATFORMS[platform].suffix}"
+
+
+def _unzipped_build(fmu, work):
+    with zipfile.ZipFile(fmu) as archive:
+        archive.extractall(work / "unzipped")
+    description = read_model_description(str(fmu))
+    fmi_version = int(description.fmiVersion[0])
+    return UnzippedBuild(fmi_version, work, description.guid,
+                         {v.name: v.valueReference for v in description.modelVariables})
 
 
 @pytest.fixture(scope="module")
@@ -54,13 +73,8 @@ def every_platform(tmp_path_factory):
     builds = {}
     for fmi_version in FMI_VERSIONS:
         work = tmp_path_factory.mktemp(f"platforms_fmi{fmi_version}")
-        fmu = build_fmu(work / "Pendulum.fmu", fmi_version=fmi_version)
-        with zipfile.ZipFile(fmu) as archive:
-            archive.extractall(work / "unzipped")
-        description = read_model_description(str(fmu))
-        assert description.fmiVersion == f"{fmi_version}.0"
-        builds[fmi_version] = UnzippedBuild(fmi_version, work, description.guid,
-                                            {v.name: v.valueReference for v in description.modelVariables})
+        builds[fmi_version] = _unzipped_build(build_fmu(work / "Pendulum.fmu", fmi_version=fmi_version), work)
+        assert builds[fmi_version].fmi_version == fmi_version
     return builds
 
 
@@ -83,11 +97,11 @@ def _exports(platform, library):
     return _exports_of_so(library, "aarch64-linux-gnu-nm" if platform == "aarch64-linux" else "nm")
 
 
-def _theta_by_step_master(build, platform):
+def _theta_by_step_master(build, platform, master=None):
     """theta at every communication point, from the C master of build's FMI version built for and
-    run on platform."""
+    run on platform (or master, built before)."""
     assert {name: build.value_references[name] for name in MASTER_VALUE_REFERENCES} == MASTER_VALUE_REFERENCES
-    master = build_step_master(build.work, platform, build.fmi_version)
+    master = master or build_step_master(build.work, platform, build.fmi_version)
     trajectory = build.work / f"theta_{platform}.txt"
     # One wine prefix for both FMI versions: making one takes wine seconds.
     environment = {**os.environ, "WINEPREFIX": str(build.work.parent / "wineprefix"), "WINEDEBUG": "-all"}
@@ -120,22 +134,168 @@ def test_binary_on_its_platform_matches_linux64_in_both_fmi_versions(every_platf
     assert np.max(np.abs(run - expected)) < 1e-9
 
 
+# Every Mach-O slice: its FMI 3.0 folder and the oldest macOS it loads on (Apple Silicon began
+# with 11.0; 10.13 is what the Reference FMUs' x86_64 binaries ask for).
+MACOS_SLICES = {"x86_64": ("x86_64-darwin", "10.13"), "arm64": ("aarch64-darwin", "11.0")}
+LLVM_TOOLS = ("llvm-objdump-14", "llvm-lipo-14")
+READS_MACH_O = pytest.mark.skipif(
+    find_zig() is None or not all(map(shutil.which, LLVM_TOOLS)),
+    reason="needs zig (pip install ziglang) and llvm-objdump-14, llvm-lipo-14 (apt-get install llvm-14)")
+CS_ADHOC, CS_HASHTYPE_SHA256 = 0x2, 2
+ZIG_HEADER_SYMBOLS = {"__mh_dylib_header", "___dso_handle"}
+
+
+def _llvm(tool, *arguments):
+    return subprocess.run([f"llvm-{tool}-14", *map(str, arguments)], capture_output=True, text=True,
+                          check=True).stdout
+
+
+def _macho_slices(build, work):
+    """{architecture: the slice as a file of its own}: FMI 2.0's universal darwin64 binary cut
+    into its slices, FMI 3.0's two binaries as they are."""
+    if build.fmi_version == 3:
+        return {architecture: build.library("darwin64", folder) for architecture, (folder, _) in MACOS_SLICES.items()}
+    universal = build.library("darwin64")
+    assert set(_llvm("lipo", "-archs", universal).split()) == set(MACOS_SLICES)
+    slices = {}
+    for architecture in MACOS_SLICES:
+        slices[architecture] = work / f"Pendulum_{architecture}.dylib"
+        _llvm("lipo", universal, "-thin", architecture, "-output", slices[architecture])
+    return slices
+
+
+def _load_commands(slice_):
+    """Each load command as {field: value}, in the order of the file."""
+    commands = []
+    for line in _llvm("objdump", "--macho", "--private-headers", slice_).splitlines():
+        if line.startswith("Load command"):
+            commands.append({})
+        elif commands and line.strip():
+            field, _, value = line.strip().partition(" ")
+            commands[-1].setdefault(field, value.strip())
+    return commands
+
+
+def _check_ad_hoc_signature(slice_, signature):
+    """The code directory of an ad-hoc signature whose page hashes are those of the slice's bytes:
+    what macOS checks, page by page, before it runs code on Apple Silicon."""
+    data = slice_.read_bytes()
+    offset = int(signature["dataoff"])
+    blob = data[offset:offset + int(signature["datasize"])]
+    magic, _, count = struct.unpack_from(">III", blob)
+    assert magic == 0xFADE0CC0  # an embedded signature's super blob
+    [directory] = [blob[at:] for kind, at in (struct.unpack_from(">II", blob, 12 + 8 * i) for i in range(count))
+                   if kind == 0]
+    (magic, _, _, flags, hash_offset, _, _, code_slots, code_limit, hash_size, hash_type, _,
+     page_shift) = struct.unpack_from(">9I4B", directory)
+    assert magic == 0xFADE0C02 and flags & CS_ADHOC and hash_type == CS_HASHTYPE_SHA256
+    assert code_limit == offset  # it covers every byte before it
+    page = 1 << page_shift
+    assert code_slots == -(-code_limit // page)
+    for index in range(code_slots):
+        expected = directory[hash_offset + index * hash_size:hash_offset + (index + 1) * hash_size]
+        assert hashlib.sha256(data[index * page:min((index + 1) * page, code_limit)]).digest() == expected
+
+
+@READS_MACH_O
+@EACH_FMI_VERSION
+def test_every_macos_slice_exports_the_fmi_functions_and_loads_only_libsystem(every_platform, fmi_version, tmp_path):
+    """Read, not run: no Mac is available here."""
+    build = every_platform[fmi_version]
+    linux_exports = _exports_of_so(build.library("linux64"))
+    for architecture, slice_ in _macho_slices(build, tmp_path).items():
+        assert _llvm("lipo", "-archs", slice_).split() == [architecture]
+        exports = {line.split()[-1] for line in _llvm("objdump", "--macho", "--exports-trie", slice_).splitlines()
+                   if line.startswith("0x")}
+        # C names take a _ on Mach-O. zig's Mach-O linker also exports the two symbols it makes
+        # for the image's header (Apple's ld64 and LLVM's keep them private): nothing else may leak.
+        assert exports == {f"_{name}" for name in linux_exports} | ZIG_HEADER_SYMBOLS, architecture
+        commands = _load_commands(slice_)
+        by_kind = {}
+        for command in commands:
+            by_kind.setdefault(command["cmd"], []).append(command)
+        [identity] = by_kind["LC_ID_DYLIB"]
+        assert identity["name"].split(" (")[0] == "Pendulum.dylib"
+        assert [load["name"].split(" (")[0] for load in by_kind["LC_LOAD_DYLIB"]] == ["/usr/lib/libSystem.B.dylib"]
+        assert not {"LC_LOAD_WEAK_DYLIB", "LC_REEXPORT_DYLIB", "LC_RPATH"} & by_kind.keys()
+        # macOS 10.13 binaries say their minimum in LC_VERSION_MIN_MACOSX, 11.0 ones in LC_BUILD_VERSION.
+        [minimum] = ([build_version["minos"] for build_version in by_kind.get("LC_BUILD_VERSION", [])]
+                     or [old["version"] for old in by_kind["LC_VERSION_MIN_MACOSX"]])
+        assert minimum == MACOS_SLICES[architecture][1], architecture
+        if architecture == "arm64":
+            [signature] = by_kind["LC_CODE_SIGNATURE"]
+            _check_ad_hoc_signature(slice_, signature)
+
+
+# The zig targets of the Linux platforms, for the toolchain proof below.
+ZIG_LINUX_TARGETS = {"linux64": "x86_64-linux-gnu", "aarch64-linux": "aarch64-linux-gnu"}
+RUNS_ZIG = [pytest.param(platform, marks=pytest.mark.skipif(
+    find_zig() is None or shutil.which(RUNNERS[platform][0] if RUNNERS[platform] else "true") is None
+    or shutil.which(PLATFORMS[platform].targets[0].compiler()[0]) is None,
+    reason=f"needs zig (pip install ziglang) and {PLATFORMS[platform].targets[0].compiler()[0]}, "
+           f"{(RUNNERS[platform] or ['nothing'])[0]} to build and run the master"))
+    for platform in ZIG_LINUX_TARGETS]
+
+
+def _comment(library):
+    """The ELF .comment section: which compiler and linker made the binary."""
+    return subprocess.run(["readelf", "-p", ".comment", str(library)], capture_output=True, text=True,
+                          check=True).stdout
+
+
+@pytest.mark.parametrize("platform", RUNS_ZIG)
+@EACH_FMI_VERSION
+def test_zig_builds_the_sources_to_the_gcc_builds_theta_bit_for_bit(every_platform, tmp_path, monkeypatch,
+                                                                     fmi_version, platform):
+    """The macOS binaries come from zig's C compiler, and nothing here can run them: the same zig,
+    through the same CMake description and cmake/zig.cmake, builds the same sources for Linux,
+    whose binaries the bare C masters run here (qemu for arm64). Their theta is the gcc build's
+    at every point, bit for bit: without FMA contraction (cmake/flags.cmake) clang and gcc round
+    every operation alike, and the Linux binaries call the same libm. A Mac's libm is another
+    one, which this cannot show."""
+    master = build_step_master(tmp_path, platform, fmi_version)  # by gcc, before zig takes the platform
+    monkeypatch.setenv("ZIG_TARGET", ZIG_LINUX_TARGETS[platform])
+    [gcc_target] = PLATFORMS[platform].targets
+    zig = Target(gcc_target.name, "zig", (), "zig.cmake", ZIG, "pip install ziglang")
+    monkeypatch.setitem(PLATFORMS, platform, dataclasses.replace(PLATFORMS[platform], targets=(zig,)))
+    build = _unzipped_build(build_fmu(tmp_path / "Pendulum.fmu", platforms=(platform,), fmi_version=fmi_version),
+                            tmp_path)
+    comment = _comment(build.library(platform))
+    assert "clang" in comment and "GCC" not in comment, comment  # zig's clang built it, not gcc
+    run = _theta_by_step_master(build, platform, master)
+    assert len(run) == STEPS + 1
+    gcc = _theta_by_step_master(every_platform[fmi_version], "linux64")
+    assert np.array_equal(run, gcc), np.max(np.abs(run - gcc))
+
+
 def _without_compiler(monkeypatch, platform):
-    missing = Platform(**{**PLATFORMS[platform].__dict__, "cross_compiler": "no-such-cross-gcc"})
-    monkeypatch.setitem(pendulum_fmu.build.PLATFORMS, platform, missing)
+    targets = tuple(dataclasses.replace(target, cross_compiler="no-such-cross-gcc")
+                    for target in PLATFORMS[platform].targets)
+    monkeypatch.setitem(pendulum_fmu.build.PLATFORMS, platform, dataclasses.replace(PLATFORMS[platform], targets=targets))
 
 
-@pytest.mark.parametrize("platform", ["win64", "aarch64-linux"])
-def test_default_build_skips_a_platform_without_its_compiler_in_one_line(tmp_path, monkeypatch, platform):
+@pytest.mark.parametrize("platform, package", [("win64", "apt-get install gcc-mingw-w64-x86-64"),
+                                               ("aarch64-linux", "apt-get install gcc-aarch64-linux-gnu"),
+                                               ("darwin64", "pip install ziglang")])
+def test_default_build_skips_a_platform_without_its_compiler_in_one_line(tmp_path, monkeypatch, platform, package):
     _without_compiler(monkeypatch, platform)
     with pytest.warns(PlatformSkipped) as skipped:
         fmu = build_fmu(tmp_path / "Pendulum.fmu")
     [message] = [str(warning.message) for warning in skipped if platform in str(warning.message)]
-    assert message == (f"{platform}: C compiler no-such-cross-gcc not found "
-                       f"(apt-get install {PLATFORMS[platform].package}); skipped")
+    assert message == f"{platform}: C compiler no-such-cross-gcc not found ({package}); skipped"
     with zipfile.ZipFile(fmu) as archive:
         folders = {name.split("/")[1] for name in archive.namelist() if name.startswith("binaries/")}
     assert "linux64" in folders and platform not in folders
+
+
+@pytest.mark.skipif(find_zig() is None, reason="needs zig (pip install ziglang)")
+def test_default_build_skips_the_universal_macos_binary_without_lipo_in_one_line(monkeypatch):
+    monkeypatch.setattr(pendulum_fmu.build, "LIPO", ("no-such-lipo",))
+    with pytest.warns(PlatformSkipped) as skipped:
+        assert "darwin64" not in available_platforms(fmi_version=2)
+    assert "darwin64" in available_platforms(fmi_version=3)  # whose two folders need no merging
+    assert [str(warning.message) for warning in skipped if "darwin64" in str(warning.message)] == [
+        "darwin64: no-such-lipo, which merges its slices into one binary, not found (apt-get install llvm-14); skipped"]
 
 
 def test_a_platform_named_explicitly_must_build(tmp_path, monkeypatch):

@@ -36,6 +36,8 @@ EXCLUDED = {
     r"^sudo apt-get ": "installs system packages as root; .ci/run installs the same list",
     r"^\.venv/bin/pip install ": "changes the environment this test suite runs in",
     r"^ssh ": "runs on other machines (head, node1, ...)",
+    r"^\.venv/bin/python build_wheels\.py$": "builds every OS's wheel, longer than a README command "
+                                              "may take; tests/test_wheels.py runs the same build",
     r"^(helm|kubectl) ": "needs a Kubernetes cluster",
     r"--scheduler tcp://(head|localhost):8786": "needs the cluster's dask scheduler started above",
     r"jupyter notebook": "starts a server that runs until stopped; tests/test_notebook.py runs "

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from pendulum_fmu.build import FMI_HEADERS, SOURCE_DIR, assemble_sources
+from pendulum_fmu.build import FMI_HEADERS, PLUMBING_DIR, assemble_sources
 
 DRIVER = Path(__file__).resolve().parent / "c" / "driver.c"
 # The loads, and the bounds the native runs must keep (tests/readme_figures.py shows them).
@@ -32,7 +32,7 @@ def _compile(sources, out, flags):
 def drivers(tmp_path_factory):
     work = tmp_path_factory.mktemp("driver")
     sources = assemble_sources(work / "sources")
-    shutil.copy2(SOURCE_DIR / "fmi3_functions.c", sources)  # both adapters over one core
+    shutil.copy2(PLUMBING_DIR / "fmi3_functions.c", sources)  # both adapters over one core
     return {"asan": _compile(sources, work / "driver_asan",
                              ["-O1", "-fno-omit-frame-pointer", "-fsanitize=address,undefined",
                               "-fno-sanitize-recover=all"]),
@@ -45,9 +45,10 @@ def _run(command, **kwargs):
     return result.stdout
 
 
-@pytest.mark.parametrize("case", [["bad-calls"], ["bad-calls-fmi3"], ["instances", str(INSTANCES)],
-                                  ["threads", str(THREADS)], ["energy", "100000"],
-                                  ["churn", str(SANITIZED_CYCLES)], ["churn-fmi3", str(SANITIZED_CYCLES)]])
+@pytest.mark.parametrize("case", [["bad-calls"], ["bad-calls-fmi3"], ["foreign-states"],
+                                  ["instances", str(INSTANCES)], ["threads", str(THREADS)],
+                                  ["energy", "100000"], ["churn", str(SANITIZED_CYCLES)],
+                                  ["churn-fmi3", str(SANITIZED_CYCLES)]])
 def test_under_address_and_undefined_behavior_sanitizers(drivers, case):
     environment = {**os.environ, "ASAN_OPTIONS": "detect_leaks=1:abort_on_error=0",
                    "UBSAN_OPTIONS": "print_stacktrace=1"}
@@ -56,8 +57,8 @@ def test_under_address_and_undefined_behavior_sanitizers(drivers, case):
 
 
 @pytest.mark.skipif(shutil.which("valgrind") is None, reason="needs valgrind")
-@pytest.mark.parametrize("case", [["bad-calls"], ["bad-calls-fmi3"], ["instances", "100"], ["threads", "8"],
-                                  ["churn", "2000"], ["churn-fmi3", "2000"]])
+@pytest.mark.parametrize("case", [["bad-calls"], ["bad-calls-fmi3"], ["foreign-states"], ["instances", "100"],
+                                  ["threads", "8"], ["churn", "2000"], ["churn-fmi3", "2000"]])
 def test_under_valgrind_memcheck(drivers, case):
     _run(["valgrind", "-q", "--leak-check=full", "--errors-for-leak-kinds=all", "--error-exitcode=1",
           str(drivers["plain"]), *case])

@@ -1,9 +1,13 @@
 """Torque signals: schedules from constants, callables and CSVs; clear errors for bad files."""
 
+import re
+from pathlib import Path
+
 import numpy as np
 import pytest
 
-from pendulum_fmu.torque_schedule import TorqueFileError, read_torque_csv, schedule, write_torque_csv
+from pendulum_fmu.torque_schedule import (BYTES_PER_STEP, TorqueFileError, read_torque_csv, schedule,
+                                          step_count, write_torque_csv)
 
 
 def test_csv_jumps_become_communication_points(tmp_path):
@@ -95,3 +99,15 @@ def test_errors_after_blank_lines_name_the_file_line(tmp_path):
     csv.write_text("time,torque\n0,1\n\n\n2,1\n1,1\n")
     with pytest.raises(TorqueFileError, match="t.csv:6: time 1 goes backwards"):
         read_torque_csv(csv)
+
+
+@pytest.mark.skipif(not Path("/proc/meminfo").is_file(), reason="needs Linux's /proc/meminfo as the reference")
+def test_a_run_larger_than_the_free_memory_is_refused():
+    # The kernel's own figure, read without psutil, which the package now asks on every OS.
+    free_kib = next(int(line.split()[1]) for line in Path("/proc/meminfo").read_text().splitlines()
+                    if line.startswith("MemAvailable:"))
+    steps = 2 * free_kib * 1024 // BYTES_PER_STEP
+    with pytest.raises(ValueError, match=r"needs [\d.]+ GiB and the machine has ([\d.]+) GiB free") as refused:
+        step_count(0.0, float(steps), 1.0, max_steps=steps)
+    said = float(re.search(r"has ([\d.]+) GiB free", str(refused.value)).group(1))
+    assert said == pytest.approx(free_kib / 2**20, rel=0.1)  # other jobs allocate in between

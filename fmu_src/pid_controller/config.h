@@ -1,8 +1,11 @@
 #ifndef CONFIG_H
 #define CONFIG_H
 
-/* The controller's one state is the integral of the angle error. */
+/* The model's traits, which the FMI plumbing (fmu_src/src/) reads: the controller's one state is
+   the integral of the angle error, it has no events and all its variables are Float64. */
 #define N_STATES 1
+#define HAS_EVENTS 0
+#define FLOAT64_ONLY 1
 
 typedef struct {
     double setpoint;

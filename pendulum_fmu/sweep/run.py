@@ -12,7 +12,7 @@ import numpy as np
 
 from .. import default_fmu
 from ..errors import InvalidInput, MissingDependency, WrongType
-from ..parameters import model_description
+from ..parameters import pendulum_variables
 from .client import dask_client, progress_bar, run_chunks
 from .figure import draw
 from .grid import columns
@@ -77,6 +77,8 @@ def run_sweep(study: Study, *, output_dir: str | os.PathLike, resume: bool = Fal
     StudyExists
         output_dir holds a study and neither resume (for the same study) nor overwrite was
         given; before anything starts.
+    MissingFile, parameters.FmuFileError
+        No file at the study's FMU, or none that is a pendulum FMU this machine can run.
     InUse
         Another run is writing into the same local output_dir.
     CannotWrite
@@ -96,7 +98,7 @@ def run_sweep(study: Study, *, output_dir: str | os.PathLike, resume: bool = Fal
     url = str(output_dir)
     target = Store(*_file_system(url), format=study.format)
     fmu = str(Path(study.fmu_path).resolve() if study.fmu_path else default_fmu())
-    model_description(fmu)  # a missing or unreadable FMU refused here, before anything starts
+    pendulum_variables(fmu)  # a missing file, or none that is a pendulum FMU, refused before anything starts
     definition = study.definition(fmu)
     # The folder taken first, so that a second run is refused before it starts a cluster; then
     # connected, so that a scheduler that does not answer leaves the study untouched.
@@ -126,7 +128,7 @@ def run_sweep(study: Study, *, output_dir: str | os.PathLike, resume: bool = Fal
                 store.remove_unfinished()
             drawing = time.perf_counter()
             table = store.read_cases(study.names)
-            draw(store, table, study.names, study.outputs, f"{store.root}/sweep.png")
+            draw(store, table, study.names, study.outputs, fmu, f"{store.root}/sweep.png")
             drawn = time.perf_counter()
             if store is not target:
                 target.replace_with(store)

@@ -177,14 +177,17 @@ class Store:
         lock = FileLock(path, timeout=0)
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
+        except OSError as error:
+            raise CannotWrite(f"cannot write {output_dir}: the folder {error.filename} cannot be created "
+                              f"({error.strerror}); choose another output directory") from None
+        try:
             lock.acquire()
         except Timeout:
             raise InUse(f"output directory {output_dir} is in use by another run (it holds {path}); "
                         "wait for that run to end, or choose another output") from None
         except OSError as error:
-            reason = "it is a file, not a folder" if path.parent.is_file() else error.strerror or error
-            raise CannotWrite(f"cannot write {output_dir}: {reason}; choose another output "
-                              "directory") from None
+            raise CannotWrite(f"cannot write {output_dir}: {error.strerror or error}; choose "
+                              "another output directory") from None
         try:
             yield
         finally:

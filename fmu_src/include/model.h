@@ -3,10 +3,15 @@
 
 /* The interface between the FMI plumbing and a model. The plumbing stores every variable in one
    array indexed by value reference (values[]) and never looks at what the numbers mean. Each
-   model brings config.h (N_STATES and its ModelCoefficients) and model.c. */
+   model brings, in its own folder, config.h (its traits N_STATES, HAS_EVENTS and FLOAT64_ONLY, and
+   its ModelCoefficients) and model.c. */
 
 #include "config.h"
 #include "model_variables.h"
+
+#if !defined(N_STATES) || !defined(HAS_EVENTS) || !defined(FLOAT64_ONLY)
+#error "the model's config.h must define N_STATES, HAS_EVENTS and FLOAT64_ONLY"
+#endif
 
 /* What a master said of how its inputs move over a step: first and second time derivatives at
    the step's start (FMI 2.0's input derivatives; all zero holds the inputs). */

@@ -123,7 +123,7 @@ fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nC
 
 fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
                                fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime) {
-    (void)stopTimeDefined; /* the pendulum can run for ever */
+    (void)stopTimeDefined; /* a model without events has no end of its own */
     (void)stopTime;
     ENTER(fmi2SetupExperiment)
     return STATUS(instance_setup_experiment(instance, function, toleranceDefined, tolerance, startTime));
@@ -292,7 +292,7 @@ fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boo
     if (instance_null_argument(instance, function, "value", value)) return fmi2Error;
     if (s != fmi2Terminated)
         return STATUS(instance_error(instance, function, "only fmi2Terminated is available"));
-    *value = fmi2False; /* the pendulum never asks to stop */
+    *value = fmi2False; /* a model without events never asks to stop */
     return fmi2OK;
 }
 
@@ -303,7 +303,11 @@ fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2Stri
     return STATUS(instance_error(instance, function, "no string status is available"));
 }
 
-/* Model exchange. The pendulum has no events: event mode only passes through. */
+/* Model exchange, for a model without events (HAS_EVENTS 0 in its config.h): event mode only
+   passes through. */
+#if HAS_EVENTS
+#error "HAS_EVENTS 1: the FMI plumbing has no event indicators or discrete states yet"
+#endif
 
 fmi2Status fmi2EnterEventMode(fmi2Component c) {
     ENTER(fmi2EnterEventMode)

@@ -1,8 +1,9 @@
 /* The FMI 3.0 entry points, co-simulation and model exchange: state machine, argument checks,
    then one call into instance.c, as fmi2_functions.c does for FMI 2.0. Which states each function
    is allowed in is data: one mask per function (FMI 3.0, sections 3.2 and 4.2; the core's
-   STEP_COMPLETE is step mode, STEP_FAILED step discarded). Everything FMI 3.0 offers that the
-   pendulum has no use for (clocks, scheduled execution, configuration mode, event mode in
+   STEP_COMPLETE is step mode, STEP_FAILED step discarded). Everything FMI 3.0 offers that a
+   model without events and with Float64 variables only (HAS_EVENTS 0, FLOAT64_ONLY 1 in its
+   config.h) has no use for (clocks, scheduled execution, configuration mode, event mode in
    co-simulation, variables other than Float64) answers fmi3Error with a line saying why. */
 
 #include <stddef.h>
@@ -197,7 +198,7 @@ void fmi3FreeInstance(fmi3Instance c) {
 fmi3Status fmi3EnterInitializationMode(fmi3Instance c, fmi3Boolean toleranceDefined,
                                        fmi3Float64 tolerance, fmi3Float64 startTime,
                                        fmi3Boolean stopTimeDefined, fmi3Float64 stopTime) {
-    (void)stopTimeDefined; /* the pendulum can run for ever */
+    (void)stopTimeDefined; /* a model without events has no end of its own */
     (void)stopTime;
     ENTER(fmi3EnterInitializationMode)
     const Status status = instance_setup_experiment(instance, function, toleranceDefined, tolerance,
@@ -260,7 +261,11 @@ fmi3Status fmi3SetFloat64(fmi3Instance c, const fmi3ValueReference valueReferenc
     return STATUS(instance_set_real(instance, function, valueReferences, nValueReferences, values));
 }
 
-/* The model has Float64 variables only: any reference of another type is unknown. */
+/* The model has Float64 variables only (FLOAT64_ONLY 1 in its config.h): any reference of
+   another type is unknown. */
+#if !FLOAT64_ONLY
+#error "FLOAT64_ONLY 0: the FMI plumbing has getters and setters for Float64 variables only"
+#endif
 #define NO_VARIABLES_OF_TYPE(name, values_type)                                                \
     fmi3Status name(fmi3Instance c, const fmi3ValueReference valueReferences[],                 \
                     size_t nValueReferences, values_type values, size_t nValues) {              \
@@ -485,7 +490,11 @@ fmi3Status fmi3SetShiftFraction(fmi3Instance c, const fmi3ValueReference valueRe
     NOT_SUPPORTED(NO_CLOCKS);
 }
 
-/* The pendulum has no discrete states and no events: event mode only passes through. */
+/* A model without events (HAS_EVENTS 0 in its config.h) has no discrete states: event mode only
+   passes through. */
+#if HAS_EVENTS
+#error "HAS_EVENTS 1: the FMI plumbing has no event indicators or discrete states yet"
+#endif
 
 fmi3Status fmi3EvaluateDiscreteStates(fmi3Instance c) {
     ENTER(fmi3EvaluateDiscreteStates)

@@ -112,6 +112,8 @@ Instance *instance_create(const char *function, const char *name, const char *to
 }
 
 void instance_free(Instance *instance) {
+    if (!instance) return; /* both standards: freeing NULL is ignored */
+    instance_free_states(instance);
     free(instance);
 }
 
@@ -295,8 +297,9 @@ Status instance_get_output_derivatives(Instance *instance, const char *function,
             !model_output_derivative(&instance->coefficients, instance->data.values,
                                      &instance->data.inputs, vr[i], order[i], &value[i]))
             return instance_error(instance, function,
-                                  "no derivative of order %d for vr %u (outputs theta, omega, alpha; "
-                                  "orders 1 and 2)", order[i], vr[i]);
+                                  "no derivative of order %d for vr %u (the model description's "
+                                  "outputs and maxOutputDerivativeOrder say which there are)",
+                                  order[i], vr[i]);
     }
     return STATUS_OK;
 }
