@@ -16,12 +16,25 @@ def fmu3(tmp_path_factory):
 
 
 @pytest.fixture
-def other_package_installed(tmp_path):
-    """The environment of a process in which another pendulum_fmu (the main job's non-editable
-    install, say) comes first on the path: a script that imports it instead of the clone's fails."""
+def generated_by_script(tmp_path):
+    """What a generator script of tests/ writes when run as the README has it, `python
+    tests/NAME.py OUT`, where another pendulum_fmu (the main job's non-editable install, say)
+    comes first on the path: a script that imported it instead of the clone's would fail."""
     import os
+    import subprocess
+    import sys
+    from pathlib import Path
 
     decoy = tmp_path / "site-packages" / "pendulum_fmu"
     decoy.mkdir(parents=True)
     (decoy / "__init__.py").write_text('raise ImportError("the installed pendulum_fmu, not the clone\'s")\n')
-    return {**os.environ, "PYTHONPATH": str(decoy.parent)}
+
+    def generate(script: str) -> str:
+        out = tmp_path / "generated.md"
+        done = subprocess.run([sys.executable, str(Path(__file__).parent / script), str(out)], cwd=tmp_path,
+                              env={**os.environ, "PYTHONPATH": str(decoy.parent)}, capture_output=True,
+                              text=True, timeout=600)
+        assert done.returncode == 0, done.stderr
+        return out.read_text()
+
+    return generate
