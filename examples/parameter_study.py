@@ -5,6 +5,7 @@ import argparse
 
 import pyarrow.parquet as pq
 
+from pendulum_fmu.errors import PendulumFmuError
 from pendulum_fmu.sweep import Study, run_sweep, sweep_grid
 
 
@@ -33,7 +34,10 @@ def main(argv=None):
     parser.add_argument("--overwrite", action="store_true",
                         help="replace the study --output-dir holds (else such a folder is refused)")
     args = parser.parse_args(argv)
-    run(args.torque, args.stop_time, args.output_dir, args.scheduler, args.overwrite)
+    try:
+        run(args.torque, args.stop_time, args.output_dir, args.scheduler, args.overwrite)
+    except PendulumFmuError as error:  # a study already there, say: one line, as pendulum-fmu says it
+        parser.exit(2, f"{parser.prog}: error: {error}\n")
 
 
 if __name__ == "__main__":
