@@ -185,12 +185,19 @@ def cmd_sweep(args) -> int:
                   format=args.format, fmu_path=args.fmu)
     try:
         result = run_sweep(study, output_dir=args.output_dir, resume=args.resume,
-                           scheduler=args.scheduler, workers=args.workers,
-                           connect_timeout=args.connect_timeout, max_cases=args.max_cases)
+                           overwrite=args.overwrite, scheduler=args.scheduler,
+                           workers=args.workers, connect_timeout=args.connect_timeout,
+                           max_cases=args.max_cases)
     except Stopped as stopped:
         what = STOPPING_SIGNALS[stopped.signal_number]
-        print(f"pendulum-fmu sweep: {what}; the chunks that finished are kept in {args.output_dir}: "
-              "run the same command with --resume to run the rest", file=sys.stderr)
+        if args.overwrite:
+            print(f"pendulum-fmu sweep: {what}; {args.output_dir} holds what it held before (the "
+                  "new study was not finished and is not kept): run the same command again to "
+                  "start over", file=sys.stderr)
+        else:
+            print(f"pendulum-fmu sweep: {what}; the chunks that finished are kept in "
+                  f"{args.output_dir}: run the same command with --resume to run the rest",
+                  file=sys.stderr)
         return 128 + stopped.signal_number
     resumed = result.chunks_run < result.chunks
     print(f"{result.cases} cases in {result.seconds:.1f} s"
@@ -354,11 +361,16 @@ def _add_sweep(commands) -> argparse.ArgumentParser:
                             "every step)")
     sweep.add_argument("--format", choices=("parquet", "csv"), default="parquet",
                        help="file format of the tables (default: %(default)s; csv for small studies)")
-    sweep.add_argument("--resume", action="store_true",
+    again = sweep.add_mutually_exclusive_group()
+    again.add_argument("--resume", action="store_true",
                        help="run only the chunks a previous run of the same study did not write")
+    again.add_argument("--overwrite", action="store_true",
+                       help="replace the study --output-dir holds, once the new one is whole "
+                            "(without --resume or --overwrite, a folder holding a study is refused)")
     sweep.add_argument("--scheduler", help="address of a running dask.distributed scheduler")
     sweep.add_argument("--connect-timeout", type=_float, default=10.0,
-                       help="seconds to wait for --scheduler to answer (default: %(default)s)")
+                       help="seconds --scheduler has to answer dask's handshake, all told "
+                            "(default: %(default)s)")
     sweep.add_argument("--workers", type=int, default=None, help="local cluster workers (default: 2)")
     sweep.add_argument("--max-cases", type=_positive_int, default=DEFAULT_MAX_CASES,
                        help=f"refuse studies of more cases than this (default: {DEFAULT_MAX_CASES:,})")

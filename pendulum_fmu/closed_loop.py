@@ -9,6 +9,9 @@ is the same sampled loop computed with scipy, the oracle for any master that run
 from __future__ import annotations
 
 import copy
+import math
+import numbers
+import shutil
 import tempfile
 from pathlib import Path
 
@@ -19,7 +22,9 @@ from fmpy.container_fmu.config import Component, Configuration, Connection
 from fmpy.model_description import CoSimulation, DefaultExperiment, ModelDescription, ModelVariable
 from scipy.integrate import solve_ivp
 
+from .atomic_files import replacing
 from .build import PID_CONTROLLER_DIR, build_fmu, build_pid_controller
+from .errors import InvalidInput
 from .parameters import total_inertia
 from .simulate import resolve_parameters
 
@@ -61,9 +66,15 @@ def create_closed_loop_fmu(out_file: str | Path, *, step_size: float = 1e-3) -> 
 
     Raises
     ------
+    InvalidInput
+        A step size that is not a positive number.
+    CannotWrite
+        out_file cannot be written.
     BuildError
         The pendulum or the controller cannot be built here.
     """
+    if not (isinstance(step_size, numbers.Real) and 0 < step_size < math.inf):
+        raise InvalidInput(f"step size {step_size!r} must be a positive number of seconds")
     out_file = Path(out_file)
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
@@ -91,7 +102,11 @@ def create_closed_loop_fmu(out_file: str | Path, *, step_size: float = 1e-3) -> 
                               exported["torque"]: [(components["controller"], variables["controller"]["torque"])]})
         work = tmp / "container"
         work.mkdir()
-        create_container_fmu(configuration, work, out_file)
+        # fmpy renames its zip to the name given: made here, then copied into place whole (the
+        # target may be on another file system than the temporary folder).
+        create_container_fmu(configuration, work, tmp / "ClosedLoop.fmu")
+        with replacing(out_file, "wb") as file, open(tmp / "ClosedLoop.fmu", "rb") as made:
+            shutil.copyfileobj(made, file)
     return out_file
 
 

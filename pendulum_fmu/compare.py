@@ -11,6 +11,7 @@ from __future__ import annotations
 import csv
 import itertools
 import math
+import os
 import time as clock
 from dataclasses import dataclass
 from pathlib import Path
@@ -19,7 +20,7 @@ import numpy as np
 
 from .atomic_files import check_writable, replacing
 from .compare_tools import ToolSpecError, parse_tools
-from .errors import InvalidInput
+from .errors import InvalidInput, WrongType
 from .plot import case_title, plot_comparison
 from .reference import reference
 from .simulate import resolve_parameters
@@ -182,6 +183,8 @@ def compare(torque: TorqueSignal, tools=TOOLS, *, output_dir: str | Path, step_s
     CannotWrite
         output_dir cannot be written.
     """
+    if not isinstance(output_dir, str | os.PathLike):
+        raise WrongType(f"output_dir is a folder's path, not {output_dir!r}")
     parsed = parse_tools(tools, mapping=mapping, fmu_path=fmu_path)
     if len(parsed) < 2:
         raise ToolSpecError(f"compare needs at least two tools, got {parsed[0].label}: "

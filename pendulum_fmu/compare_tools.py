@@ -27,7 +27,7 @@ import numpy as np
 
 from . import results
 from .engines import MODES, check_held, check_mode
-from .errors import InvalidInput
+from .errors import InvalidInput, WrongType
 from .reference import reference_schedule
 from .simulate import resolve_parameters, simulate_plan
 from .torque_schedule import TorqueSchedule
@@ -145,7 +145,12 @@ def parse_tools(spec: str | Sequence[str], *, mapping: str | None = None,
 
     mapping is the --map for the tools given as LABEL=PATH; fmu_path the FMU that "fmu" runs.
     """
-    items = [item.strip() for item in (spec.split(",") if isinstance(spec, str) else spec)]
+    if isinstance(spec, str):
+        spec = spec.split(",")
+    if not (isinstance(spec, Sequence) and all(isinstance(item, str) for item in spec)):
+        raise WrongType(f"tools is a comma-separated string or a list of names, e.g. "
+                        f"'fmu,reference'; got {spec!r}")
+    items = [item.strip() for item in spec]
     items = [item for item in items if item]
     if not items:
         raise ToolSpecError("--tools is empty: name at least one of " + ", ".join(KINDS))

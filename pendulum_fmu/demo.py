@@ -72,8 +72,9 @@ def run_demo(output_dir: str | Path, workers: int | None = None) -> bool:
     print(f"\nwrote {overlay}")
     print(f"\nParameter study: torque {', '.join(f'{t:g}' for t in STUDY_TORQUES)} N.m with gravity, "
           "on a local dask cluster")
+    # The demo writes all its outputs anew each run, the study too (once the new one is whole).
     result = run_sweep(Study(sweep_grid(STUDY_TORQUES, [9.81])), output_dir=out / "parameter_study",
-                       workers=workers)
+                       overwrite=True, workers=workers)
     print(f"{result.cases} cases in {result.seconds:.1f} s\nwrote {result.cases_table}\n"
           f"wrote {result.figure}")
     return agree

@@ -15,6 +15,7 @@ OSError for a file, ...). The kinds that belong to one module live there:
     engines.ToolCannotRamp            a ramp given to a tool that holds the torque
     engines.drake.UnequalSteps        unequal steps given to drake:default
     sweep.store.InUse                 an output folder another run holds
+    sweep.store.StudyExists           an output folder holding a study the run was not asked to replace
     sweep.client.SchedulerUnreachable a dask scheduler that does not answer
     build.BuildError                  an FMU that cannot be built
 """
@@ -27,6 +28,11 @@ class PendulumFmuError(Exception):
 class InvalidInput(PendulumFmuError, ValueError):
     """An argument, option, parameter or case the package refuses: a time, a step, a tolerance,
     a parameter's name or value, a sweep's values."""
+
+
+class WrongType(PendulumFmuError, TypeError):
+    """An argument of a kind the function does not take (None for a folder, a list for a Study);
+    the message says what it takes."""
 
 
 class MissingFile(PendulumFmuError, FileNotFoundError):

@@ -10,14 +10,16 @@ variables are asked for.
 from __future__ import annotations
 
 import math
+import numbers
 import zipfile
+from collections.abc import Mapping
 from functools import lru_cache
 from pathlib import Path
 
 import fmpy
 from fmpy import read_model_description
 
-from .errors import InvalidInput, MissingFile
+from .errors import InvalidInput, MissingFile, WrongType
 
 # The start values a user gives, and the FMU's variables they start.
 START_VALUES = {"theta0": "theta", "omega0": "omega"}
@@ -133,14 +135,26 @@ def merged_parameters(overrides: dict[str, float] | None = None,
     """The FMU's defaults with overrides applied; unknown names and non-finite values are refused.
     What the FMU itself refuses is left to it: see simulate.resolve_parameters."""
     parameters = default_parameters(fmu_path)
+    if not isinstance(overrides, Mapping | None):
+        raise WrongType(f"parameters is a dict {{name: value}}, e.g. {{'gravity': 0}}; got a "
+                        f"{type(overrides).__name__}")
     for name, value in (overrides or {}).items():
         if name not in parameters:
             raise InvalidInput(f"unknown parameter {name!r}: the parameters are {', '.join(parameters)}")
+        if not isinstance(value, numbers.Real):
+            raise InvalidInput(f"parameter {name} = {value!r} is not a number")
         value = float(value)
         if not math.isfinite(value):
             raise InvalidInput(f"parameter {name} = {value} must be finite")
         parameters[name] = value
     return parameters
+
+
+def start_value(name: str, value, unit: str) -> float:
+    """theta0 or omega0 as a float; InvalidInput unless it is a finite number."""
+    if not (isinstance(value, numbers.Real) and math.isfinite(value)):
+        raise InvalidInput(f"{name} = {value!r} must be a finite number of {unit}")
+    return float(value)
 
 
 def fmu_file(fmu_path: str | Path | None) -> Path:

@@ -1,9 +1,10 @@
 """The independent oracle: a torque signal as docs/signals.md defines it, through scipy.
 
-`reference()` shares no code with the path that feeds the tools (`torque_schedule.schedule`). It reads a
-CSV with its own small reader, keeps the times as exact fractions of the decimals written in the
-file, and finds the communication points and the torque of each step from the written
-definition. A schedule that does not carry the user's signal to the tools then shows as a
+`reference()` shares no code with the path that feeds the tools (`torque_schedule.schedule`)
+beyond its checks of what it is given (a file that is no signal, a run length, refused in the
+same words), never how it reads or samples a signal. It reads a CSV with its own small reader,
+keeps the times as exact fractions of the decimals written in the file, and finds the
+communication points and the torque of each step from the written definition. A schedule that does not carry the user's signal to the tools then shows as a
 difference between them and this oracle. `reference_schedule()` integrates a given schedule, to
 judge a tool on exactly the torques it was fed.
 
@@ -16,6 +17,7 @@ from __future__ import annotations
 import bisect
 import csv
 import math
+import numbers
 from fractions import Fraction
 from pathlib import Path
 from typing import Callable
@@ -24,9 +26,10 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from . import results
-from .errors import InvalidInput
-from .parameters import total_inertia
+from .errors import InvalidInput, WrongType
+from .parameters import start_value, total_inertia
 from .simulate import resolve_parameters
+from .torque_schedule import TorqueSchedule, read_torque_csv, step_count
 
 # docs/signals.md: an event within max(1e-9 step, 64 ulp of its time) of a communication point
 # is that point. Written again here on purpose: the oracle must not borrow the schedule's code.
@@ -37,6 +40,20 @@ _DEFAULT_STOP_TIME = Fraction(3)
 def _exact(value) -> Fraction:
     """A number as the decimal a person wrote: 0.009 is 9/1000, not the double nearest it."""
     return Fraction(repr(float(value))) if not isinstance(value, (str, Fraction)) else Fraction(value)
+
+
+def _seconds(name: str, value) -> Fraction:
+    """A time argument as the decimal a person wrote; InvalidInput unless a finite number."""
+    if not (isinstance(value, numbers.Real) and math.isfinite(value)):
+        raise InvalidInput(f"{name} {value!r} must be a finite number of seconds")
+    return _exact(value)
+
+
+def _torque(value, where: str) -> float:
+    """A torque value of the signal; InvalidInput unless a finite number."""
+    if not (isinstance(value, numbers.Real) and math.isfinite(value)):
+        raise InvalidInput(f"the torque is {value!r} {where}; it must be a finite number of N.m")
+    return float(value)
 
 
 def _tolerance(time: Fraction, step: Fraction) -> Fraction:
@@ -89,6 +106,9 @@ class _TorqueFile:
 
 def _grid(start: Fraction, stop: Fraction, step: Fraction) -> list[Fraction]:
     """start + k*step up to stop; stop itself ends a shorter last step unless it is on the grid."""
+    # Only checked by the schedule's code, in simulate()'s words (a step that is not positive, a
+    # stop not after the start, a run too long to hold): the grid below is the oracle's own.
+    step_count(float(start), float(stop), float(step))
     points, k, last = [], 0, stop - _tolerance(stop, step)
     point = start
     while point < last:
@@ -122,6 +142,7 @@ class _Pieces:
 
 def _signal_pieces(torque, start: Fraction, stop: Fraction | None, step: Fraction, ramp: bool) -> _Pieces:
     if isinstance(torque, (str, Path)):
+        read_torque_csv(torque)  # a file that is no signal refused where it is wrong; read below anew
         signal = _TorqueFile(Path(torque))
         stop = signal.times[-1] if stop is None else stop
         grid = _grid(start, stop, step)
@@ -137,14 +158,14 @@ def _signal_pieces(torque, start: Fraction, stop: Fraction | None, step: Fractio
         return _Pieces(points[:-1], stop, held, [0.0] * len(held), points, _holding(points, held, step))
 
     if isinstance(torque, (list, tuple, np.ndarray)):
-        values = [float(u) for u in torque]
+        values = [_torque(u, f"at step {k} of the array") for k, u in enumerate(torque)]
         points = _grid(start, start + len(values) * step if stop is None else stop, step)
         if len(points) - 1 != len(values):
             raise InvalidInput(f"the torque array has {len(values)} values for {len(points) - 1} steps")
     else:
         points = _grid(start, _DEFAULT_STOP_TIME if stop is None else stop, step)
-        sample = torque if callable(torque) else (lambda t, u=float(torque): u)
-        values = [float(sample(float(p))) for p in points]
+        sample = torque if callable(torque) else (lambda t, u=torque: u)
+        values = [_torque(sample(float(p)), f"at t = {float(p)}") for p in points]
     if ramp:
         rate = [(b - a) / float(t1 - t0) for a, b, t0, t1 in zip(values, values[1:], points, points[1:])]
     else:
@@ -190,6 +211,10 @@ def equation_of_motion(parameters: dict[str, float]) -> Callable:
 
 def _integrate(pieces: _Pieces, at: np.ndarray, parameters: dict | None, theta0: float, omega0: float,
                rtol: float, atol: float, fmu_path: str | Path | None) -> np.ndarray:
+    theta0, omega0 = start_value("theta0", theta0, "rad"), start_value("omega0", omega0, "rad/s")
+    for name, value in (("rtol", rtol), ("atol", atol)):
+        if not (isinstance(value, numbers.Real) and 0 < value < math.inf):
+            raise InvalidInput(f"{name} {value!r} must be a positive finite number (solve_ivp's tolerance)")
     acceleration = equation_of_motion(resolve_parameters(parameters, fmu_path))
     starts = [float(s) for s in pieces.starts]
     ends = starts[1:] + [float(pieces.stop)]
@@ -270,12 +295,28 @@ def reference(torque=20.0, *, start_time: float = 0.0, stop_time: float | None =
                          f"not a {type(torque).__name__}: it reads the signal itself")
     if isinstance(torque, (list, tuple, np.ndarray)) and ramp:
         raise InvalidInput("a per-step torque array is held over each step; ramp needs a CSV or a callable")
-    step = _exact(step_size)
-    start = _exact(start_time)
-    pieces = _signal_pieces(torque, start, None if stop_time is None else _exact(stop_time), step, ramp)
+    step, start = _seconds("step size", step_size), _seconds("start time", start_time)
+    stop = None if stop_time is None else _seconds("stop time", stop_time)
+    pieces = _signal_pieces(torque, start, stop, step, ramp)
     if at is None:
         at = np.array([float(t) for t in pieces.points])
-    return _integrate(pieces, np.asarray(at, dtype=float), parameters, theta0, omega0, rtol, atol, fmu_path)
+    return _integrate(pieces, _times(at, pieces, step), parameters, theta0, omega0, rtol, atol, fmu_path)
+
+
+def _times(at, pieces: _Pieces, step: Fraction) -> np.ndarray:
+    """The times to report: within the run, or a rounding past its ends."""
+    try:
+        times = np.asarray(at, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidInput(f"at is the times to report, numbers in s; got {at!r}") from None
+    start, stop = pieces.starts[0], pieces.stop
+    earliest, latest = float(start - _tolerance(start, step)), float(stop + _tolerance(stop, step))
+    outside = times.ravel()[~((times.ravel() >= earliest) & (times.ravel() <= latest))]
+    if times.ndim != 1 or len(outside):
+        shown = float(outside[0]) if len(outside) else at
+        raise InvalidInput(f"at: {shown!r} is no time of the run, {float(start):g} to "
+                           f"{float(stop):g} s")
+    return times
 
 
 def reference_schedule(plan, *, parameters: dict | None = None, theta0: float = 0.0,
@@ -306,6 +347,9 @@ def reference_schedule(plan, *, parameters: dict | None = None, theta0: float = 
     RuntimeError
         solve_ivp failed.
     """
+    if not isinstance(plan, TorqueSchedule):
+        raise WrongType(f"plan is a TorqueSchedule (torque_schedule.schedule(...)), not a "
+                        f"{type(plan).__name__}")
     points = [Fraction(float(t)) for t in plan.time]
     u0, rate = plan.torque.tolist(), plan.torque_rate.tolist()
     # The schedule's points are the tools' own: no tolerance beyond rounding.

@@ -19,7 +19,8 @@ from fmpy.fmi3 import FMU3Slave
 
 from . import cs_loop, default_fmu, results
 from .errors import InvalidInput, PendulumFmuError
-from .parameters import fmu_file, merged_parameters, model_description, pendulum_variables, value_reference
+from .parameters import (fmu_file, merged_parameters, model_description, pendulum_variables, start_value,
+                         value_reference)
 from .torque_schedule import TorqueSignal, TorqueSchedule, schedule
 
 _STATUS = ["OK", "WARNING", "DISCARD", "ERROR", "FATAL", "PENDING"]
@@ -171,7 +172,8 @@ def initialize(slave: FMU2Slave | FMU3Slave, *, parameters: dict | None = None, 
     """Set the parameters and start values of an instantiated (or reset) slave from open_fmu and
     leave it in step mode; FmuError says why the FMU refused."""
     # The FMU checks the parameters itself, here as everywhere (resolve_parameters).
-    start = {**merged_parameters(parameters, slave.fmu_path), "theta": float(theta0), "omega": float(omega0)}
+    start = {**merged_parameters(parameters, slave.fmu_path), "theta": start_value("theta0", theta0, "rad"),
+             "omega": start_value("omega0", omega0, "rad/s")}
     references = [value_reference(n, slave.fmu_path) for n in start]
     try:
         if slave.fmi_version == 3:

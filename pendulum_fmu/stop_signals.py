@@ -2,10 +2,13 @@
 
 While the program starts (entry.py) a signal ends it at once, since nothing is being written
 yet. While a command runs (cli.main) it raises Stopped where the program is, so that every file
-being written is cleaned up on the way out, and cli.main prints one line.
+being written is cleaned up on the way out, and cli.main prints one line. A few steps that must
+not be cut in two (moving a study into place) hold the signals off until they are done.
 """
 
+import contextlib
 import signal
+import threading
 
 # The signals that stop the program, and the word its one line says for each.
 STOPPING_SIGNALS = {signal.SIGINT: "interrupted", signal.SIGTERM: "terminated"}
@@ -30,3 +33,24 @@ def stop_on_signals() -> dict:
         raise Stopped(number)
 
     return {name: signal.signal(name, stop) for name in STOPPING_SIGNALS}
+
+
+@contextlib.contextmanager
+def signals_deferred():
+    """Hold SIGINT and SIGTERM off until the block ends, then let the handler they had act on the
+    first that came. Python runs signal handlers in the main thread only, so elsewhere nothing
+    can cut the block and nothing needs holding."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    came = []
+    previous = {number: signal.signal(number, lambda number, frame: came.append(number))
+                for number in STOPPING_SIGNALS}
+    try:
+        yield
+    finally:
+        for number, handler in previous.items():
+            # None: a handler set outside Python, which cannot be set back from here.
+            signal.signal(number, signal.SIG_DFL if handler is None else handler)
+        if came:
+            signal.raise_signal(came[0])

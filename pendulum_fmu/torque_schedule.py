@@ -28,7 +28,9 @@ FMU's linear ramp over each step is the CSV's own piecewise-linear signal, exact
 
 from __future__ import annotations
 
+import inspect
 import math
+import numbers
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -249,6 +251,8 @@ def write_torque_csv(path: str | Path, plan: TorqueSchedule) -> Path:
 
 def _check_times(start_time: float, stop_time: float, step_size: float) -> None:
     for name, value in (("start time", start_time), ("stop time", stop_time), ("step size", step_size)):
+        if not isinstance(value, numbers.Real):
+            raise InvalidInput(f"{name} {value!r} must be a finite number of seconds")
         if not math.isfinite(value):
             raise InvalidInput(f"{name} {value} must be a finite number of seconds")
     if not step_size > 0:
@@ -275,6 +279,8 @@ def step_count(start_time: float, stop_time: float, step_size: float,
         steps += 1
     steps = max(steps, 1)
     limit = DEFAULT_MAX_STEPS if max_steps is None else max_steps
+    if not (isinstance(limit, numbers.Integral) and limit >= 1):
+        raise InvalidInput(f"max steps {limit!r} must be a whole number of steps, at least 1")
     what = f"{start_time:g} to {stop_time:g} s in steps of {step_size:g} s is {steps:,} steps"
     if steps > limit:
         raise InvalidInput(f"{what}, over the limit of {limit:,}: use a coarser step size or a shorter "
@@ -309,7 +315,11 @@ def _with_events(grid: np.ndarray, events: np.ndarray | None, step_size: float) 
 
 def _array_schedule(values, start_time: float, stop_time: float | None, step_size: float,
                     ramp: bool, max_steps: int | None) -> TorqueSchedule:
-    torque = np.asarray(values, dtype=float)
+    try:
+        torque = np.asarray(values, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidInput(f"a torque array needs one value per step, each a number in N.m; got "
+                           f"{_shortened(values)}") from None
     if torque.ndim != 1 or len(torque) == 0:
         raise InvalidInput(f"a torque array needs one value per step (a flat list of numbers); got shape {torque.shape}")
     if ramp:
@@ -326,6 +336,31 @@ def _array_schedule(values, start_time: float, stop_time: float | None, step_siz
     if len(bad):
         raise InvalidInput(f"the torque array's value {bad[0]} is {torque[bad[0]]}; values must be finite")
     return TorqueSchedule(time=time, torque=torque, torque_rate=np.zeros(len(torque)))
+
+
+def _shortened(values) -> str:
+    text = repr(values)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _takes_time(function: Callable, times: list[float]) -> list[float]:
+    """times, once the function is known to take one argument, the time in s."""
+    try:
+        inspect.signature(function).bind(times[0])
+    except TypeError as error:
+        raise InvalidInput(f"a torque callable takes the time in s and returns N.m; "
+                           f"{getattr(function, '__name__', 'it')} cannot: {error}") from None
+    except ValueError:  # no signature to read (some builtins): calling it will tell
+        pass
+    return times
+
+
+def _sample(function: Callable, t: float) -> float:
+    value = function(t)
+    if not isinstance(value, numbers.Real):
+        raise InvalidInput(f"the torque callable returned {_shortened(value)} at t = {t}; it must "
+                           "return a number in N.m")
+    return float(value)
 
 
 def schedule(torque: TorqueSignal, *, start_time: float = 0.0, stop_time: float | None = None,
@@ -352,7 +387,7 @@ def schedule(torque: TorqueSignal, *, start_time: float = 0.0, stop_time: float 
         time = communication_points(start_time, DEFAULT_STOP_TIME if stop_time is None else stop_time,
                                     step_size, max_steps=max_steps)
         if callable(torque):
-            samples = np.array([float(torque(t)) for t in time.tolist()])
+            samples = np.array([_sample(torque, t) for t in _takes_time(torque, time.tolist())])
         else:
             try:
                 samples = np.full(len(time), float(torque))

@@ -13,6 +13,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
+if __name__ == "__main__":  # a script documents the clone it is in, whatever package is installed
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
 from fmpy.fmi2 import fmi2CallbackFunctions
 from fmpy.fmi3 import fmi3LogMessageCallback
 
@@ -650,8 +653,10 @@ def main(argv=None):
             harness = harness_type(Path(tmp) / str(version) / f"binaries/{folder}/Pendulum.so",
                                    read_model_description(str(fmu)).guid)
             tables.append([(case, *run_case(harness, case)) for case in cases])
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(markdown(*tables))
+    from pendulum_fmu.atomic_files import replacing
+
+    with replacing(out) as file:
+        file.write(markdown(*tables))
     print(f"wrote {out}: {sum(map(len, tables))} cases")
 
 

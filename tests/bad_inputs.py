@@ -1,8 +1,11 @@
-"""Every bad input a user can give the command line, as data: run by tests/test_bad_inputs.py,
-and written as the table in docs/bad_inputs.md by `python tests/bad_inputs.py docs/bad_inputs.md`.
+"""Every bad input a user can give the command line and the Python API, as data: run by
+tests/test_bad_inputs.py, and written as the tables in docs/bad_inputs.md by
+`python tests/bad_inputs.py docs/bad_inputs.md`.
 
 Each case is a `pendulum-fmu` command line, with `{files}` standing for a folder of the input
-files below, the exit code it must give and a part of the one line it must print."""
+files below, the exit code it must give and a part of the one line it must print. Each call is a
+Python expression a user of the API writes (with API_IMPORTS done), the PendulumFmuError subclass
+it must raise and a part of its one-line message."""
 
 from __future__ import annotations
 
@@ -12,6 +15,9 @@ import sys
 import zipfile
 from dataclasses import dataclass
 from pathlib import Path
+
+if __name__ == "__main__":  # a script documents the clone it is in, whatever package is installed
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 
 def _zip(members: dict[str, str]) -> bytes:
@@ -64,6 +70,8 @@ FILES = {
     "result.csv": "time,theta\n0,0\n0.001,0\n",
     "result_no_time.csv": "t,theta\n0,0\n0.001,0\n",
     "result_backwards.csv": "time,theta\n0,0\n0.002,0\n0.001,0\n",
+    # A folder with a study's entry that no sweep wrote.
+    "not_a_study/study.json": "{}\n",
 }
 
 
@@ -178,12 +186,113 @@ CASES = [
     _case("judge", "judge {files} --torque 1", 2, "is a folder, judged as a scenario kit whose NAME.json files"),
     _case("scenarios", "scenarios --output-dir {files}/bad_number.csv/kit", 2,
           "bad_number.csv is a file, not a folder; choose another output path"),
+    # A sweep into a folder that holds a study (issue 23, item 1).
+    _case("sweep", "sweep --torque 5 --output-dir {files}/not_a_study", 2,
+          "holds study.json but no study.json of a sweep: choose another output directory, or add --overwrite"),
+    _case("sweep", "sweep --torque 5 --resume --overwrite --output-dir {files}/out", 2,
+          "argument --overwrite: not allowed with argument --resume"),
+]
+
+# What the calls below have in scope.
+API_IMPORTS = """\
+from pendulum_fmu import default_fmu
+from pendulum_fmu.closed_loop import create_closed_loop_fmu
+from pendulum_fmu.compare import compare
+from pendulum_fmu.reference import reference, reference_schedule
+from pendulum_fmu.simulate import simulate
+from pendulum_fmu.sweep import Study, run_sweep, sweep_grid"""
+
+
+@dataclass(frozen=True)
+class Call:
+    group: str
+    code: str
+    error: str  # the name of the PendulumFmuError subclass it raises
+    message: str
+
+
+ONE = 'Study([{"torque": 1.0}])'
+OUT = 'output_dir="{files}/out"'
+
+CALLS = [
+    Call("simulate", 'simulate(20.0, stop_time=float("inf"))', "InvalidInput",
+         "stop time inf must be a finite number of seconds"),
+    Call("simulate", 'simulate(20.0, stop_time="3")', "InvalidInput", "stop time '3' must be a finite number of seconds"),
+    Call("simulate", "simulate(20.0, step_size=0)", "InvalidInput", "step size 0 must be positive"),
+    Call("simulate", "simulate(20.0, step_size=1e-9, stop_time=100)", "InvalidInput",
+         "is 100,000,000,000 steps, over the limit of 10,000,000"),
+    Call("simulate", "simulate(20.0, max_steps=1.5)", "InvalidInput", "max steps 1.5 must be a whole number of steps, at least 1"),
+    Call("simulate", "simulate(None)", "InvalidInput",
+         "a torque is a number, a callable of time, a per-step array or a CSV path; got NoneType"),
+    Call("simulate", 'simulate(float("nan"))', "InvalidInput", "the torque is nan at t = 0.0; it must be finite"),
+    Call("simulate", 'simulate(["a", "b"], stop_time=0.002)', "InvalidInput",
+         "a torque array needs one value per step, each a number in N.m"),
+    Call("simulate", "simulate([1.0, 2.0, 3.0], stop_time=1.0)", "InvalidInput",
+         "the torque array has 3 values but 0 to 1 s in steps of 0.001 s is 1000 steps"),
+    Call("simulate", 'simulate(lambda t: "x", stop_time=0.01)', "InvalidInput", "the torque callable returned 'x' at t = 0.0"),
+    Call("simulate", "simulate(lambda: 1.0)", "InvalidInput", "a torque callable takes the time in s and returns N.m"),
+    Call("simulate", 'simulate("{files}/absent.csv")', "TorqueFileError", "absent.csv: cannot read: No such file"),
+    Call("simulate", 'simulate("{files}/no_torque.csv")', "TorqueFileError", "no_torque.csv:1: missing column 'torque'"),
+    Call("simulate", 'simulate(20.0, parameters={"mas": 2})', "InvalidInput", "unknown parameter 'mas'"),
+    Call("simulate", 'simulate(20.0, parameters={"mass": "heavy"})', "InvalidInput", "parameter mass = 'heavy' is not a number"),
+    Call("simulate", 'simulate(20.0, parameters={"mass": -1})', "InvalidInput", "the FMU refuses the parameters: mass must be > 0"),
+    Call("simulate", 'simulate(20.0, parameters=[("mass", 2)])', "WrongType", "parameters is a dict {name: value}"),
+    Call("simulate", 'simulate(20.0, theta0="a")', "InvalidInput", "theta0 = 'a' must be a finite number of rad"),
+    Call("simulate", 'simulate(20.0, omega0=float("inf"))', "InvalidInput", "omega0 = inf must be a finite number of rad/s"),
+    Call("simulate", "simulate(20.0, tolerance=2.0)", "FmuError", "tolerance 2 must be in (0, 1)"),
+    Call("simulate", 'simulate(20.0, fmu_path="{files}/absent.fmu")', "MissingFile", "absent.fmu: No such file or directory"),
+    Call("reference", "reference(20.0, step_size=0)", "InvalidInput", "step size 0.0 must be positive"),
+    Call("reference", "reference(20.0, step_size=1e-9, stop_time=100)", "InvalidInput",
+         "is 100,000,000,000 steps, over the limit of 10,000,000"),
+    Call("reference", 'reference(20.0, rtol=float("nan"))', "InvalidInput", "rtol nan must be a positive finite number"),
+    Call("reference", "reference(20.0, at=[5.0])", "InvalidInput", "at: 5.0 is no time of the run, 0 to 3 s"),
+    Call("reference", 'reference(lambda t: "x", stop_time=0.01)', "InvalidInput", "the torque is 'x' at t = 0.0"),
+    Call("reference", 'reference("{files}/no_torque.csv")', "TorqueFileError", "no_torque.csv:1: missing column 'torque'"),
+    Call("reference", 'reference(20.0, theta0=float("nan"))', "InvalidInput", "theta0 = nan must be a finite number of rad"),
+    Call("reference", "reference_schedule(None)", "WrongType", "plan is a TorqueSchedule"),
+    Call("compare", f'compare(20.0, "fmu", {OUT})', "ToolSpecError", "compare needs at least two tools, got fmu"),
+    Call("compare", f'compare(20.0, ["fmu", "matlab"], {OUT})', "ToolSpecError", "unknown tool(s) matlab"),
+    Call("compare", f"compare(20.0, 42, {OUT})", "WrongType", "tools is a comma-separated string or a list of names"),
+    Call("compare", 'compare(20.0, "fmu,reference", output_dir=None)', "WrongType", "output_dir is a folder's path, not None"),
+    Call("compare", f'compare(20.0, "fmu,reference", tolerance=-1, {OUT})', "InvalidInput",
+         "the tolerance -1 must be a positive finite number"),
+    Call("compare", f'compare(20.0, "fmu,reference", mapping="torque=u", {OUT})', "ToolSpecError",
+         "--map applies to FMUs given as LABEL=path/to/Their.fmu in --tools, and there is none"),
+    Call("compare", 'compare(20.0, "fmu,reference", stop_time=0.01, output_dir="{files}/bad_number.csv/out")',
+         "CannotWrite", "bad_number.csv is a file, not a folder; choose another output path"),
+    Call("sweep", "sweep_grid([1.0, 1.0])", "InvalidInput", "torque values repeat: [1.0, 1.0]"),
+    Call("sweep", 'sweep_grid([1.0], extra={"colour": [1.0]})', "InvalidInput", "cannot sweep 'colour'"),
+    Call("sweep", 'sweep_grid([1.0], extra=[("damping", [0.0])])', "WrongType", "extra is a dict {name: [values, ...]}"),
+    Call("sweep", "Study([])", "InvalidInput", "no cases to run"),
+    Call("sweep", "Study([1.0, 2.0])", "WrongType", "case 0 is 1.0, not a dict"),
+    Call("sweep", 'Study([{"torque": 1.0}, {"torque": 1.0}])', "InvalidInput", "case 1 repeats case 0"),
+    Call("sweep", 'Study([{"torque": 1.0}], outputs="theta")', "WrongType", "outputs is a list of names"),
+    Call("sweep", 'Study([{"torque": 1.0}], output_interval=0.0015)', "InvalidInput",
+         "output interval 0.0015 s must be a whole number of steps of 0.001 s"),
+    Call("sweep", 'Study([{"torque": 1.0}], format="xlsx")', "InvalidInput", "format 'xlsx': choose parquet or csv"),
+    Call("sweep", f'run_sweep([{{"torque": 1.0}}], {OUT})', "WrongType", "run_sweep takes a Study(cases, ...), not a list"),
+    Call("sweep", f"run_sweep({ONE}, output_dir=None)", "WrongType",
+         "output_dir is a folder's path or an fsspec URL, not None"),
+    Call("sweep", f"run_sweep({ONE}, {OUT}, workers=0)", "InvalidInput", "workers must be a positive integer"),
+    Call("sweep", f"run_sweep({ONE}, {OUT}, resume=True, overwrite=True)", "InvalidInput",
+         "and overwrite replaces it: choose one"),
+    Call("sweep", f'run_sweep({ONE}, {OUT}, scheduler="tcp://127.0.0.1:9", connect_timeout=1)',
+         "SchedulerUnreachable", "no dask scheduler answered at tcp://127.0.0.1:9 within 1 s"),
+    Call("sweep", f'run_sweep({ONE}, output_dir="{{files}}/bad_number.csv")', "CannotWrite",
+         "cannot write {files}/bad_number.csv: the folder {files}/bad_number.csv cannot be created"),
+    Call("sweep", f'run_sweep({ONE}, output_dir="nosuch://study")', "InvalidInput", "Protocol not known: nosuch"),
+    Call("sweep", f'run_sweep({ONE}, output_dir="{{files}}/not_a_study")', "StudyExists",
+         "holds study.json but no study.json of a sweep"),
+    Call("other", "default_fmu(fmi_version=4)", "InvalidInput", "no FMI 4 FMU: the FMI versions are 2, 3"),
+    Call("other", 'create_closed_loop_fmu("{files}/loop.fmu", step_size=0)', "InvalidInput",
+         "step size 0 must be a positive number of seconds"),
 ]
 
 
 def write_files(folder: Path) -> None:
     for name, content in FILES.items():
         path = folder / name
+        path.parent.mkdir(exist_ok=True)
         path.write_bytes(content) if isinstance(content, bytes) else path.write_text(content)
 
 
@@ -201,8 +310,28 @@ def run_case(case: Case, folder: Path) -> tuple[int, str]:
     return code, stderr.getvalue().replace(str(folder), "{files}")
 
 
-def markdown(rows: list[tuple[Case, int, str]]) -> str:
-    lines = ["# What the command line answers to bad input", "",
+def run_call(call: Call, folder: Path) -> BaseException | None:
+    """What the call raises, run in-process (None when it raises nothing)."""
+    namespace: dict = {}
+    exec(API_IMPORTS, namespace)
+    code = call.code.replace("{files}", str(folder))
+    with contextlib.redirect_stderr(io.StringIO()), contextlib.redirect_stdout(io.StringIO()):
+        try:
+            eval(code, namespace)
+        except Exception as error:
+            return error
+    return None
+
+
+def raised(error: BaseException | None, folder: Path) -> tuple[str, str]:
+    """The error's type and message as the table shows them."""
+    if error is None:
+        return "nothing", ""
+    return type(error).__name__, str(error).replace(str(folder), "{files}")
+
+
+def markdown(rows: list[tuple[Case, int, str]], calls: list[tuple[Call, str, str]]) -> str:
+    lines = ["# What the command line and the Python API answer to bad input", "",
              "Generated by `python tests/bad_inputs.py docs/bad_inputs.md` from the cases that "
              "`tests/test_bad_inputs.py` asserts; do not edit by hand. Every answer is one line on "
              "stderr (argparse's own refusals add the usage line before it), never a traceback; "
@@ -211,6 +340,16 @@ def markdown(rows: list[tuple[Case, int, str]]) -> str:
     for case, code, printed in rows:
         answer = printed.strip().splitlines()[-1].replace("|", "\\|")
         lines.append(f"| {case.group} | `pendulum-fmu {' '.join(case.argv)}` | {code} | {answer} |")
+    lines += ["", "## The Python API", "",
+              "Each call runs after", "", "```python", API_IMPORTS, "```", "",
+              "and raises a subclass of `pendulum_fmu.errors.PendulumFmuError` (each also derives "
+              "from the built-in exception a caller expects: `ValueError`, `TypeError`, `OSError`, "
+              "...) whose message is one line; no numpy, scipy or fmpy error gets through. "
+              "Nothing is written when a call is refused.", "",
+              "| group | call | raises | message |", "|---|---|---|---|"]
+    for call, error, message in calls:
+        message = message.replace("|", "\\|")
+        lines.append(f"| {call.group} | `{call.code}` | {error} | {message} |")
     return "\n".join(lines) + "\n"
 
 
@@ -221,11 +360,12 @@ def main(argv=None):
     with tempfile.TemporaryDirectory() as folder:
         write_files(Path(folder))
         rows = [(case, *run_case(case, Path(folder))) for case in CASES]
+        calls = [(call, *raised(run_call(call, Path(folder)), Path(folder))) for call in CALLS]
     from pendulum_fmu.atomic_files import replacing
 
     with replacing(out) as file:
-        file.write(markdown(rows))
-    print(f"wrote {out}: {len(rows)} cases")
+        file.write(markdown(rows, calls))
+    print(f"wrote {out}: {len(rows)} command lines, {len(calls)} calls")
 
 
 if __name__ == "__main__":

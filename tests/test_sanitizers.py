@@ -13,6 +13,10 @@ import pytest
 from pendulum_fmu.build import FMI_HEADERS, PLUMBING_DIR, assemble_sources
 
 DRIVER = Path(__file__).resolve().parent / "c" / "driver.c"
+# The loads, and the bounds the native runs must keep (tests/readme_figures.py shows them).
+INSTANCES, THREADS, SANITIZED_CYCLES = 1000, 8, 20_000
+ENERGY_STEPS, ENERGY_DRIFT_BOUND = 10_000_000, 1e-9
+CYCLES, GROWTH_BOUND_KIB = 100_000, 256
 pytestmark = pytest.mark.skipif(shutil.which("gcc") is None, reason="needs gcc")
 
 
@@ -41,9 +45,10 @@ def _run(command, **kwargs):
     return result.stdout
 
 
-@pytest.mark.parametrize("case", [["bad-calls"], ["bad-calls-fmi3"], ["foreign-states"], ["instances", "1000"],
-                                  ["threads", "8"], ["energy", "100000"], ["churn", "20000"],
-                                  ["churn-fmi3", "20000"]])
+@pytest.mark.parametrize("case", [["bad-calls"], ["bad-calls-fmi3"], ["foreign-states"],
+                                  ["instances", str(INSTANCES)], ["threads", str(THREADS)],
+                                  ["energy", "100000"], ["churn", str(SANITIZED_CYCLES)],
+                                  ["churn-fmi3", str(SANITIZED_CYCLES)]])
 def test_under_address_and_undefined_behavior_sanitizers(drivers, case):
     environment = {**os.environ, "ASAN_OPTIONS": "detect_leaks=1:abort_on_error=0",
                    "UBSAN_OPTIONS": "print_stacktrace=1"}
@@ -60,12 +65,13 @@ def test_under_valgrind_memcheck(drivers, case):
 
 
 def test_energy_is_conserved_over_ten_million_steps(drivers):
-    out = _run([str(drivers["plain"]), "energy", "10000000"])
+    out = _run([str(drivers["plain"]), "energy", str(ENERGY_STEPS)])
     drift = float(re.search(r"drift ([0-9.e+-]+)", out).group(1))
     # The tolerance allows 1e-10 per internal step, 1e-3 over 1e7 steps; 1 ms steps do far better.
-    assert drift < 1e-9, out
+    assert drift < ENERGY_DRIFT_BOUND, out
 
 
 def test_no_memory_growth_over_100000_instances(drivers):
-    out = _run([str(drivers["plain"]), "churn", "100000", "256"])
+    # The driver fails when resident memory grows by more than the bound.
+    out = _run([str(drivers["plain"]), "churn", str(CYCLES), str(GROWTH_BOUND_KIB)])
     assert "resident memory grew" in out

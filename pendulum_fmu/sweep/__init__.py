@@ -16,8 +16,13 @@ A study goes to an output directory, a local path or any fsspec URL every worker
     sweep.png                         the figure
     .sweep.lock                       there while a run writes a local folder: a second run is refused
 
-With format "csv" the same files are CSV. One line of pandas, pyarrow, dask or DuckDB reads
-either table, e.g. pandas.read_parquet("out/trajectories").
+With format "csv" the same files are CSV. One line of pyarrow reads either table, e.g.
+pyarrow.parquet.read_table("out/trajectories"); pandas, dask.dataframe and DuckDB read the same
+folders where they are installed (the package does not bring them).
+
+A folder that holds a study is refused unless the run continues it (resume) or replaces it
+(overwrite): the replacing study is written into .overwrite.<id>.partial/ inside the folder and
+moved into place once whole.
 
 The package, in the order a run goes through it:
 

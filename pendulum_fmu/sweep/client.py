@@ -10,7 +10,9 @@ from __future__ import annotations
 import contextlib
 import logging
 import queue
+import signal
 import sys
+import threading
 from collections.abc import Iterable
 from dataclasses import dataclass
 
@@ -29,24 +31,104 @@ def dask_client(scheduler: str | None, workers: int | None, connect_timeout: flo
     from dask.distributed import Client, LocalCluster
 
     if scheduler is None:
-        # Port 0 for the scheduler's HTTP server: another cluster may hold dask's usual 8787.
-        with LocalCluster(n_workers=workers or 2, threads_per_worker=1, processes=True,
-                          dashboard_address=":0", silence_logs=logging.CRITICAL) as cluster, \
-                Client(cluster) as client:
-            yield client
+        with contextlib.ExitStack() as stack:
+            with _ctrl_c_held():
+                # Port 0 for the scheduler's HTTP server: another cluster may hold dask's usual 8787.
+                cluster = stack.enter_context(LocalCluster(
+                    n_workers=workers or 2, threads_per_worker=1, processes=True,
+                    dashboard_address=":0", silence_logs=logging.CRITICAL))
+            # A Ctrl-C held while the cluster started is raised here, and the stack closes it.
+            yield stack.enter_context(Client(cluster))
         return
-    try:
-        # A port that answers but is no dask scheduler would otherwise be waited on for ever, or
-        # have its bytes read as a message length.
-        client = Client(scheduler, timeout=connect_timeout)
-    except Exception as error:
-        reason = str(error).splitlines()[0] if str(error) else type(error).__name__
+    reason = _why_no_scheduler(scheduler, connect_timeout)
+    if reason is None:
+        try:
+            client = Client(scheduler, timeout=connect_timeout)
+        except Exception as error:
+            reason = _first_line(error)
+    if reason is not None:
         raise SchedulerUnreachable(
-            f"no dask scheduler answered at {scheduler} within {connect_timeout:g} s ({reason}); "
-            "check the address (start one with `dask scheduler`), raise --connect-timeout, or "
-            "leave out --scheduler for a local cluster") from None
+            f"no dask scheduler answered at {scheduler} within {connect_timeout:g} s"
+            f"{f' ({reason})' if reason else ''}; check the address (start one with `dask "
+            "scheduler`), raise --connect-timeout, or leave out --scheduler for a local cluster")
     with client:
         yield client
+
+
+def _first_line(error: BaseException) -> str:
+    return str(error).splitlines()[0] if str(error) else type(error).__name__
+
+
+def _why_no_scheduler(scheduler: str, timeout: float) -> str | None:
+    """Why the address does not answer dask's handshake and an identity request as a scheduler
+    within timeout seconds, all told: "" when nothing answered in time (nothing listens there,
+    or it never answers), else what answered; None when a scheduler did.
+
+    dask's Client bounds only the TCP connection by its timeout and then waits for the handshake
+    for ever: a port that accepts and never answers (a wrong port, a firewall's tarpit) would hold
+    it until the far end closes, and one that answers something else has its bytes read as a
+    message length. Asked in a thread of its own, so that it runs where an event loop already
+    runs (a notebook) too, and a Ctrl-C still stops the waiting here.
+    """
+    import asyncio
+
+    from distributed.comm import connect
+
+    async def identity() -> dict:
+        comm = await connect(scheduler, timeout=timeout)
+        try:
+            await comm.write({"op": "identity", "reply": True})
+            return await comm.read()
+        finally:
+            comm.abort()
+
+    answers: list = []
+
+    def ask() -> None:
+        try:
+            answers.append(asyncio.run(asyncio.wait_for(identity(), timeout)))
+        except (asyncio.TimeoutError, OSError):
+            # Which of the two comes first, dask's connect giving up or the bound here, is chance.
+            answers.append("")
+        except Exception as error:  # an address dask cannot parse
+            answers.append(_first_line(error))
+
+    asking = threading.Thread(target=ask, name="pendulum_fmu scheduler handshake", daemon=True)
+    asking.start()
+    asking.join(timeout + 5.0)  # wait_for ends it by then: the margin is for a loaded machine
+    if not answers:
+        return ""
+    answer = answers[0]
+    if isinstance(answer, str):
+        return answer
+    kind = answer.get("type") if isinstance(answer, dict) else None
+    if kind != "Scheduler":
+        return f"it answers as {kind!r}, not as a dask scheduler"
+    return None
+
+
+@contextlib.contextmanager
+def _ctrl_c_held():
+    """SIGINT blocked in this thread while the local cluster starts, so that the threads the
+    cluster starts, and the worker processes they spawn, inherit it blocked for good.
+
+    A terminal's Ctrl-C goes to every process of its process group, the workers too, where each
+    would print a KeyboardInterrupt traceback. So the workers never receive it: the client alone
+    stops the study, and closing the cluster stops them. A Ctrl-C meanwhile is held pending and
+    raised here as soon as the cluster has started.
+    """
+    if not hasattr(signal, "pthread_sigmask"):  # Windows: Ctrl-C reaches the console's processes alike
+        yield
+        return
+    from multiprocessing import resource_tracker
+
+    # Started first, as its start unblocks SIGINT in the thread that starts it (CPython 3.11).
+    resource_tracker.ensure_running()
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
 class _Lines:

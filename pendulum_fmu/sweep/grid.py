@@ -8,11 +8,11 @@ from __future__ import annotations
 
 import math
 import numbers
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from ..errors import InvalidInput
+from ..errors import InvalidInput, WrongType
 from ..parameters import START_VALUES, default_parameters
 
 
@@ -90,6 +90,9 @@ def sweep_grid(torques, gravities=(9.81,), extra: dict | None = None) -> Grid:
     InvalidInput
         A name that cannot be swept, or values that are no flat list of distinct finite numbers.
     """
+    if not isinstance(extra, Mapping | None):
+        raise WrongType(f"extra is a dict {{name: [values, ...]}}, e.g. {{'damping': [0, 0.5]}}; got "
+                        f"a {type(extra).__name__}")
     extra = dict(extra or {})
     extra_names = _extra_names()
     for name in extra:
@@ -110,6 +113,13 @@ def check_cases(cases, fmu_path=None) -> list[str]:
         return list(cases.axes)  # checked when the grid was made
     if not cases:
         raise InvalidInput("no cases to run")
+    if isinstance(cases, str | Mapping) or not isinstance(cases, Sequence):
+        raise WrongType(f"cases are sweep_grid(...) or a list of dicts {{'torque': ..}}; got a "
+                        f"{type(cases).__name__}")
+    for number, case in enumerate(cases):
+        if not isinstance(case, Mapping):
+            raise WrongType(f"case {number} is {case!r}, not a dict {{'torque': .., <parameter or "
+                            "start value>: ..}")
     names = list(cases[0])
     if "torque" not in names:
         raise InvalidInput("every case needs a 'torque'")

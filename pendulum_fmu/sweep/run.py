@@ -11,12 +11,12 @@ from pathlib import Path
 import numpy as np
 
 from .. import default_fmu
-from ..errors import InvalidInput, MissingDependency
+from ..errors import InvalidInput, MissingDependency, WrongType
 from ..parameters import pendulum_variables
 from .client import dask_client, progress_bar, run_chunks
 from .figure import draw
 from .grid import columns
-from .store import Store
+from .store import Held, Store, StudyExists
 from .study import Study, SweepResult
 from .worker import Task
 
@@ -27,7 +27,7 @@ DEFAULT_MAX_CASES = 1_000_000
 
 
 def run_sweep(study: Study, *, output_dir: str | os.PathLike, resume: bool = False,
-              scheduler: str | None = None, workers: int | None = None,
+              overwrite: bool = False, scheduler: str | None = None, workers: int | None = None,
               connect_timeout: float = 10.0, progress: bool = True,
               max_cases: int = DEFAULT_MAX_CASES) -> SweepResult:
     """Run every case of a study on dask; the workers write it into output_dir.
@@ -45,7 +45,11 @@ def run_sweep(study: Study, *, output_dir: str | os.PathLike, resume: bool = Fal
         write to.
     resume : bool, optional
         Run only the chunks a previous run of the same study into output_dir did not finish.
-        Without it, a new study replaces whatever study output_dir held.
+    overwrite : bool, optional
+        Replace the study output_dir holds. The new study is written beside it, inside
+        output_dir, and takes its place only once it is whole: until then, and if the run stops,
+        the old study stays as it was. Without resume or overwrite, a folder that holds a study,
+        finished or not, is refused.
     scheduler : str, optional
         The address of a running dask.distributed scheduler. Without one a local cluster of
         `workers` processes runs for this call; its workers are spawned, so a script calling
@@ -69,8 +73,10 @@ def run_sweep(study: Study, *, output_dir: str | os.PathLike, resume: bool = Fal
     ------
     InvalidInput
         More cases than max_cases, workers with a scheduler, a bad workers count or connect
-        timeout, or an output_dir that holds a different study on resume; all before anything
-        starts.
+        timeout, or resume and overwrite together; all before anything starts.
+    StudyExists
+        output_dir holds a study and neither resume (for the same study) nor overwrite was
+        given; before anything starts.
     MissingFile, parameters.FmuFileError
         No file at the study's FMU, or none that is a pendulum FMU this machine can run.
     InUse
@@ -84,54 +90,99 @@ def run_sweep(study: Study, *, output_dir: str | os.PathLike, resume: bool = Fal
 
     started = time.perf_counter()
     if not isinstance(study, Study):
-        raise TypeError(f"run_sweep takes a Study(cases, ...), not a {type(study).__name__}")
+        raise WrongType(f"run_sweep takes a Study(cases, ...), not a {type(study).__name__}")
+    if not isinstance(output_dir, str | os.PathLike):
+        raise WrongType(f"output_dir is a folder's path or an fsspec URL, not {output_dir!r}")
     cases = study.cases
-    _check_options(len(cases), max_cases, scheduler, workers, connect_timeout)
+    _check_options(len(cases), max_cases, scheduler, workers, connect_timeout, resume, overwrite)
     url = str(output_dir)
-    store = Store(*_file_system(url), format=study.format)
+    target = Store(*_file_system(url), format=study.format)
     fmu = str(Path(study.fmu_path).resolve() if study.fmu_path else default_fmu())
     pendulum_variables(fmu)  # a missing file, or none that is a pendulum FMU, refused before anything starts
-    task = Task(fmu=fmu, store=store, stop_time=float(study.stop_time),
-                step_size=float(study.step_size), outputs=study.outputs, stride=study.stride)
+    definition = study.definition(fmu)
     # The folder taken first, so that a second run is refused before it starts a cluster; then
     # connected, so that a scheduler that does not answer leaves the study untouched.
-    with store.only_run(url):
+    with target.only_run(url):
+        chunk_cases = _chunk_cases(target.held(), definition, study, resume, overwrite, url)
+        # A study that replaces another is written apart and moved into place once whole.
+        store = target.staging() if overwrite else target
+        task = Task(fmu=fmu, store=store, stop_time=float(study.stop_time),
+                    step_size=float(study.step_size), outputs=study.outputs, stride=study.stride)
         try:
-            with dask_client(scheduler, workers, connect_timeout) as client:
-                chunk_cases = store.prepare(study.definition(fmu), resume, study.chunk_cases(), url)
-                chunks = range(math.ceil(len(cases) / chunk_cases))
-                done = store.done_chunks()
-                pending = [index for index in chunks if index not in done]
-                finished = sum(min(chunk_cases, len(cases) - i * chunk_cases) for i in done)
-                with progress_bar(len(cases), finished, progress) as bar:
-                    totals = run_chunks(client, task, (
-                        (index, index * chunk_cases,
-                         columns(cases, study.names, index * chunk_cases,
-                                 min(len(cases), (index + 1) * chunk_cases)))
-                        for index in pending), bar)
-        finally:
-            # After a local cluster closed, so that none of its workers writes any more (a remote
-            # cluster's may still finish the chunk they were running).
-            store.remove_unfinished()
-    drawing = time.perf_counter()
-    table = store.read_cases(study.names)
-    draw(store, table, study.names, study.outputs, fmu, f"{store.root}/sweep.png")
-    drawn = time.perf_counter()
+            try:
+                with dask_client(scheduler, workers, connect_timeout) as client:
+                    store.start(definition, chunk_cases)
+                    chunks = range(math.ceil(len(cases) / chunk_cases))
+                    done = store.done_chunks()
+                    pending = [index for index in chunks if index not in done]
+                    finished = sum(min(chunk_cases, len(cases) - i * chunk_cases) for i in done)
+                    with progress_bar(len(cases), finished, progress) as bar:
+                        totals = run_chunks(client, task, (
+                            (index, index * chunk_cases,
+                             columns(cases, study.names, index * chunk_cases,
+                                     min(len(cases), (index + 1) * chunk_cases)))
+                            for index in pending), bar)
+            finally:
+                # After a local cluster closed, so that none of its workers writes any more (a
+                # remote cluster's may still finish the chunk they were running).
+                store.remove_unfinished()
+            drawing = time.perf_counter()
+            table = store.read_cases(study.names)
+            draw(store, table, study.names, study.outputs, fmu, f"{store.root}/sweep.png")
+            drawn = time.perf_counter()
+            if store is not target:
+                target.replace_with(store)
+        except BaseException:
+            if store is not target:
+                store.discard()
+            raise
     # Paths on the local file system, URLs elsewhere.
-    where = (Path(store.root).joinpath if isinstance(store.filesystem, LocalFileSystem)
+    where = (Path(target.root).joinpath if isinstance(target.filesystem, LocalFileSystem)
              else f"{url.rstrip('/')}/".__add__)
     return SweepResult(
         output_dir=where(""), trajectories=where("trajectories"), cases_table=where("cases"),
         figure=where("sweep.png"), cases=len(cases),
         failed=int(np.sum(table["status"].to_numpy(zero_copy_only=False) == "failed")),
         chunks=len(chunks), chunks_run=len(pending), bytes=totals.bytes,
-        seconds=drawn - started, figure_seconds=drawn - drawing,
+        seconds=time.perf_counter() - started, figure_seconds=drawn - drawing,
         worker_cpu_seconds=totals.worker_cpu_seconds,
         worker_stepping_seconds=totals.worker_stepping_seconds)
 
 
+def _chunk_cases(held: Held, definition: dict, study: Study, resume: bool, overwrite: bool,
+                 output_dir: str) -> int:
+    """The cases per chunk of this run: the study's own, or on resume those of the run it
+    continues. StudyExists where the run would replace a study without being asked to."""
+    if overwrite or not held.entries:
+        return study.chunk_cases()
+    if held.manifest is None:
+        raise StudyExists(
+            f"{output_dir} holds {', '.join(held.entries)} but no study.json of a sweep: choose "
+            "another output directory, or add --overwrite to replace them (--resume continues "
+            "only a study a sweep wrote)")
+    previous = held.manifest["study"]
+    differences = [key for key in definition if previous.get(key) != definition[key]]
+    progress = f"{held.done_chunks} of {held.chunks()} chunks written"
+    if differences:
+        raise StudyExists(
+            f"{output_dir} holds another study ({', '.join(differences)} differ; {progress}): "
+            "choose another output directory, or add --overwrite to replace it once the new one "
+            "is whole (--resume continues only the same study)")
+    if not resume and held.done_chunks == held.chunks():
+        raise StudyExists(
+            f"{output_dir} already holds this study, finished ({progress}): nothing to run; add "
+            "--overwrite to run it again and replace it once the new one is whole (--resume only "
+            "draws its figure again)")
+    if not resume:
+        raise StudyExists(
+            f"{output_dir} already holds this study, unfinished ({progress}): add --resume to run "
+            "only the chunks not written, or --overwrite to run it all again and replace it once "
+            "the new one is whole")
+    return held.manifest["chunk_cases"]
+
+
 def _check_options(count: int, max_cases: int, scheduler: str | None, workers: int | None,
-                   connect_timeout: float) -> None:
+                   connect_timeout: float, resume: bool, overwrite: bool) -> None:
     if count > max_cases:
         raise InvalidInput(f"{count:,} cases is over the limit of {max_cases:,}: give fewer "
                            "values, or raise the limit (--max-cases) if the study is meant to be "
@@ -142,6 +193,9 @@ def _check_options(count: int, max_cases: int, scheduler: str | None, workers: i
         raise InvalidInput(f"workers must be a positive integer, got {workers!r}")
     if not (isinstance(connect_timeout, numbers.Real) and 0 < connect_timeout < math.inf):
         raise InvalidInput(f"connect timeout {connect_timeout} must be a positive number of seconds")
+    if resume and overwrite:
+        raise InvalidInput("resume continues the study the output directory holds and overwrite "
+                           "replaces it: choose one")
 
 
 def _file_system(url: str) -> tuple[object, str]:

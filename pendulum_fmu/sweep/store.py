@@ -4,6 +4,10 @@ table read back.
 A local path or any fsspec URL every worker can write to. A chunk is done when its cases part
 exists: its worker writes the trajectories part first. What an interrupted run leaves of the
 chunks it did not finish is removed, so only whole chunks stay.
+
+A study that a run replaces (overwrite) stays whole until the new one is: the new study is
+written into a hidden folder inside the output folder and moved into place at the end, with
+Ctrl-C held off while it moves.
 """
 
 from __future__ import annotations
@@ -11,19 +15,43 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import uuid
 from dataclasses import dataclass
 from pathlib import Path
 
 from ..atomic_files import TEMPORARY_GLOB, replacing_on
-from ..errors import CannotWrite, InvalidInput, PendulumFmuError
+from ..errors import CannotWrite, PendulumFmuError
+from ..stop_signals import signals_deferred
 
 SUMMARIES = ("final_theta", "final_omega", "final_alpha", "max_abs_theta")
+# What a study is made of in its folder: study.json first, so that what a study holds is known
+# before any part of it is written.
+ENTRIES = ("study.json", "trajectories", "cases", "sweep.png")
 # There while a run writes the study (see Store.only_run); hidden, and never part of a table.
 LOCK_FILE = ".sweep.lock"
 
 
 class InUse(PendulumFmuError, OSError):
     """Another run holds the output folder; the message says which folder and what to do."""
+
+
+class StudyExists(PendulumFmuError, FileExistsError):
+    """The output folder holds a study (or what looks like one) that the run would replace
+    without being asked to; the message says what it holds, and names --resume and --overwrite."""
+
+
+@dataclass(frozen=True)
+class Held:
+    """What an output folder holds: its study.json's content (None when there is none that a
+    sweep wrote), the study's entries present, and the chunks done."""
+
+    manifest: dict | None
+    entries: tuple[str, ...]
+    done_chunks: int
+
+    def chunks(self) -> int:
+        study = self.manifest["study"]
+        return -(-study["cases"] // self.manifest["chunk_cases"])
 
 
 @dataclass(frozen=True)
@@ -75,7 +103,7 @@ class Store:
         for pattern in patterns:
             for path in self.filesystem.glob(f"{self.root}/{pattern}"):
                 with contextlib.suppress(FileNotFoundError):
-                    self.filesystem.rm(path)
+                    self.filesystem.rm(path, recursive=True)
 
     def remove_unfinished(self) -> None:
         """What interrupted chunks leave: the temporaries of writes cut short (a killed worker, see
@@ -87,24 +115,50 @@ class Store:
                 with contextlib.suppress(FileNotFoundError):
                     self.filesystem.rm(path)
 
-    def prepare(self, definition: dict, resume: bool, chunk_cases: int, output_dir) -> int:
-        """Write study.json with the cases per chunk (or check it, on resume, and keep the
-        earlier run's chunks); returns the cases per chunk."""
-        fs, manifest = self.filesystem, f"{self.root}/study.json"
-        if resume and fs.exists(manifest):
-            with fs.open(manifest, "r") as file:
-                previous = json.load(file)
-            differences = [key for key in definition if previous["study"].get(key) != definition[key]]
-            if differences:
-                raise InvalidInput(
-                    f"{output_dir} holds a different study ({', '.join(differences)} differ); leave "
-                    "out --resume to replace it, or choose another output directory")
-            return previous["chunk_cases"]
-        # A new study replaces whatever study was there.
-        self.remove(("study.json", "sweep.png", "trajectories/part-*", "cases/part-*"))
-        with replacing_on(fs, manifest) as file:
+    def held(self) -> Held:
+        """What the folder holds of a study."""
+        fs, manifest = self.filesystem, None
+        with contextlib.suppress(OSError, ValueError):
+            with fs.open(f"{self.root}/study.json", "r") as file:
+                content = json.load(file)
+            if isinstance(content, dict) and isinstance(content.get("study"), dict) and \
+                    isinstance(content.get("chunk_cases"), int):
+                manifest = content
+        entries = tuple(name for name in ENTRIES if fs.exists(f"{self.root}/{name}"))
+        return Held(manifest, entries, len(self.done_chunks()) if entries else 0)
+
+    def start(self, definition: dict, chunk_cases: int) -> None:
+        """Write study.json: what the study is, and its cases per chunk."""
+        with replacing_on(self.filesystem, f"{self.root}/study.json") as file:
             file.write(json.dumps({"study": definition, "chunk_cases": chunk_cases}, indent=1).encode())
-        return chunk_cases
+
+    def staging(self) -> Store:
+        """A new hidden folder inside this one, where a study that replaces this one is written."""
+        return Store(self.filesystem, f"{self.root}/.overwrite.{uuid.uuid4().hex}.partial", self.format)
+
+    def replace_with(self, staged: Store) -> None:
+        """Move the staged study into this folder in place of the one it holds, which goes. Ctrl-C
+        and SIGTERM wait until the move is done, so they find the old study or the new one; the
+        old study.json goes first and the new one comes last, so that even a killed move leaves
+        no study.json over a mix of the two."""
+        fs = self.filesystem
+        aside = f"{self.root}/.replaced.{uuid.uuid4().hex}.partial"
+        with signals_deferred():
+            fs.makedirs(aside, exist_ok=True)
+            for name in ENTRIES:
+                if fs.exists(f"{self.root}/{name}"):
+                    fs.mv(f"{self.root}/{name}", f"{aside}/{name}", recursive=True)
+            for name in (*ENTRIES[1:], ENTRIES[0]):
+                if fs.exists(f"{staged.root}/{name}"):
+                    fs.mv(f"{staged.root}/{name}", f"{self.root}/{name}", recursive=True)
+            for folder in (aside, staged.root):
+                with contextlib.suppress(FileNotFoundError):
+                    fs.rm(folder, recursive=True)
+
+    def discard(self) -> None:
+        """Remove this folder and everything in it (a staged study that did not finish)."""
+        with contextlib.suppress(FileNotFoundError):
+            self.filesystem.rm(self.root, recursive=True)
 
     @contextlib.contextmanager
     def only_run(self, output_dir):

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import results
-from ..errors import InvalidInput
+from ..errors import InvalidInput, WrongType
 from ..torque_schedule import communication_points
 from .grid import Grid, check_cases, columns
 
@@ -78,10 +78,10 @@ class Study:
 
     def __post_init__(self):
         derived = {"names": check_cases(self.cases, self.fmu_path)}
-        if not (isinstance(self.stop_time, numbers.Real) and math.isfinite(self.stop_time)):
-            raise InvalidInput(f"stop time {self.stop_time} must be a finite number")
         # Refuses a bad stop time or step size with simulate()'s words.
         derived["points"] = len(communication_points(0.0, self.stop_time, self.step_size))
+        if isinstance(self.outputs, str):
+            raise WrongType(f"outputs is a list of names, e.g. ['theta'], not the string {self.outputs!r}")
         derived["outputs"] = outputs = tuple(self.outputs)
         for name in outputs:
             if name not in OUTPUTS or outputs.count(name) > 1:
@@ -116,6 +116,8 @@ class Study:
 def _stride(output_interval: float | None, step_size: float) -> int:
     if output_interval is None:
         return 1
+    if not isinstance(output_interval, numbers.Real):
+        raise InvalidInput(f"output interval {output_interval!r} must be a number of seconds")
     stride = round(output_interval / step_size) if math.isfinite(output_interval) else 0
     if stride < 1 or abs(stride * step_size - output_interval) > 1e-9 * output_interval:
         raise InvalidInput(f"output interval {output_interval} s must be a whole number of steps "
