@@ -6,7 +6,9 @@ model's modelDescription.xml: this module generates them (model_variables.h/.c),
 the single source of truth. fmu_src/src/ and fmu_src/include/ hold the FMI plumbing, which knows
 nothing of pendulums; each model has its own folder (config.h, model.c), listed in MODELS.
 Per platform, CMake configures and builds in a private temporary folder; llvm-lipo merges the two
-macOS slices into one universal binary; the FMU's zip is renamed into place whole.
+macOS slices into one universal binary; the FMU's zip is renamed into place whole. With a glibc
+floor (linux_glibc, CMake's LINUX_GLIBC) zig builds the Linux binaries to load on that glibc and
+every later one, as the manylinux wheels need.
 
 Builds only ever run from a source tree (a clone or the sdist): an installed package carries the
 built FMU as package data instead (see pendulum_fmu.default_fmu).

@@ -21,7 +21,7 @@ import pytest
 from fmpy import read_model_description
 
 import pendulum_fmu.build
-from benchmarks.builds import build_step_master
+from benchmarks.builds import build_bare_master, build_step_master
 from build_wheels import MANYLINUX_GLIBC
 from pendulum_fmu.build import (FMI_VERSIONS, PLATFORMS, BuildError, PlatformSkipped, available_platforms,
                                 build_fmu, find_zig)
@@ -29,12 +29,14 @@ from pendulum_fmu.cli import main
 from pendulum_fmu.reference import reference
 
 STEPS, STEP_SIZE = 3000, 1e-3  # the tutorial case: 20 N.m, gravity on, 3 s
+POW_INPUTS = 1_000_000
 # How each platform's master runs here: natively, under wine, under qemu with the cross libc.
 RUNNERS = {"linux64": [], "win64": ["wine"], "aarch64-linux": ["qemu-aarch64", "-L", "/usr/aarch64-linux-gnu"]}
 CROSS = [pytest.param(platform, marks=pytest.mark.skipif(
     shutil.which(PLATFORMS[platform].targets[0].cross_compiler) is None or shutil.which(RUNNERS[platform][0]) is None,
     reason=f"needs {PLATFORMS[platform].targets[0].package} and {RUNNERS[platform][0]} (.ci/run installs them)"))
     for platform in ("win64", "aarch64-linux")]
+POW_VERSIONS = Path(__file__).parent / "c/pow_versions.c"
 EACH_FMI_VERSION = pytest.mark.parametrize("fmi_version", FMI_VERSIONS, ids=lambda version: f"fmi{version}")
 # The value references benchmarks/bare_master.h hard-codes (VR_TORQUE, VR_THETA).
 MASTER_VALUE_REFERENCES = {"torque": 0, "theta": 1}
@@ -259,8 +261,9 @@ def test_zig_builds_for_the_wheels_glibc_give_the_gcc_builds_theta_bit_for_bit(e
     machine's libm, zig's build through the older symbol versions (pow@GLIBC_2.2.5 on x86_64,
     pow@GLIBC_2.17 on arm64, where gcc's build against Debian 12's glibc binds pow@GLIBC_2.29):
     glibc keeps those as a wrapper around the same pow that only reports errors the old way
-    (math/w_pow_compat.c), so a finite result is the same bits. What this cannot show is another
-    libm: an old glibc's own (its sin, cos and pow predate glibc 2.28's rewrite) or a Mac's."""
+    (math/w_pow_compat.c), so a finite result is the same bits, which tests/c/pow_versions.c
+    checks on a million inputs here. What this cannot show is another libm: an old glibc's own
+    (its sin, cos and pow predate glibc 2.28's rewrite) or a Mac's."""
     master = build_step_master(tmp_path, platform, fmi_version)  # by gcc
     build = _unzipped_build(build_fmu(tmp_path / "Pendulum.fmu", platforms=(platform,), fmi_version=fmi_version,
                                       linux_glibc=MANYLINUX_GLIBC), tmp_path)
@@ -269,10 +272,31 @@ def test_zig_builds_for_the_wheels_glibc_give_the_gcc_builds_theta_bit_for_bit(e
     assert "clang" in comment and "GCC" not in comment, comment  # zig's clang built it, not gcc
     versions = _glibc_versions(library)
     assert "pow" in versions and max(versions.values()) <= tuple(map(int, MANYLINUX_GLIBC.split("."))), versions
+    # This machine's libm: the pow zig's build binds gives pow@GLIBC_2.29's bits.
+    pow_version = "GLIBC_" + ".".join(map(str, versions["pow"]))
+    compared = subprocess.run([*RUNNERS[platform], build_bare_master(tmp_path, POW_VERSIONS, platform), pow_version,
+                               str(POW_INPUTS)], capture_output=True, text=True, check=True, timeout=300).stdout
+    assert compared.splitlines()[-1] == f"0 of {POW_INPUTS} differ", compared
     run = _theta_by_step_master(build, platform, master)
     assert len(run) == STEPS + 1
     gcc = _theta_by_step_master(every_platform[fmi_version], "linux64")
     assert np.array_equal(run, gcc), np.max(np.abs(run - gcc))
+
+
+@pytest.mark.skipif(find_zig() is None, reason="needs zig (pip install ziglang)")
+def test_build_command_builds_for_any_glibc_floor_and_refuses_a_malformed_one_in_one_line(tmp_path, capsys):
+    # Older than the wheels' 2.17: then x86-64's memcpy binds GLIBC_2.2.5, not GLIBC_2.14.
+    fmu = tmp_path / "Pendulum.fmu"
+    assert main(["build", "--platforms", "linux64", "--linux-glibc", "2.12", "--output", str(fmu)]) == 0
+    build = _unzipped_build(fmu, tmp_path)
+    versions = _glibc_versions(build.library("linux64"))
+    assert "clang" in _readelf(build.library("linux64"), "-p", ".comment")
+    assert {"pow", "memcpy"} <= versions.keys() and max(versions.values()) <= (2, 12), versions
+    capsys.readouterr()
+    assert main(["build", "--linux-glibc", "17", "--output", str(tmp_path / "Other.fmu")]) == 2
+    assert capsys.readouterr().err.splitlines() == [
+        "pendulum-fmu build: error: glibc floor '17': give a glibc version such as 2.17"]
+    assert not (tmp_path / "Other.fmu").exists()
 
 
 def _without_compiler(monkeypatch, platform):
