@@ -24,7 +24,7 @@ def run(torque=20.0, stop_time=3.0, step_size=1e-3, output_dir="out/constant_tor
             print(f"  against theta = tau t^2 / (2 I): {np.max(np.abs(fmu['theta'] - parabola)):.2e} rad")
         figure = plot_overlay({"FMU": fmu, "Rigid-body ODE (scipy)": oracle},
                               f"{output_dir}/{title.lower().replace(' ', '_')}.png",
-                              rf"Constant Torque $\tau = {torque:g}$ Nm — {title}")
+                              rf"Constant Torque $\tau = {torque:g}$ N.m — {title}")
         print(f"  wrote {figure}")
         runs[gravity] = fmu, oracle
     return runs

@@ -43,15 +43,50 @@ def _temporary_beside(path: Path, suffix: str) -> tuple[int, str]:
                               "choose another output path")
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise CannotWrite(f"cannot write {path}: the folder {error.filename} cannot be created "
+                          f"({error.strerror}); choose another output path") from None
+    try:
         descriptor, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
     except OSError as error:
-        raise _cannot_write(path, error) from None
+        raise CannotWrite(f"cannot write {path}: no file can be created in {path.parent} "
+                          f"({error.strerror}); choose another output path") from None
     os.chmod(temporary, 0o666 & ~_UMASK)
     return descriptor, temporary
 
 
 def _cannot_write(path: Path, error: OSError) -> CannotWrite:
     return CannotWrite(f"cannot write {path}: {error.strerror or error}; choose another output path")
+
+
+def check_writable(*paths: str | os.PathLike) -> None:
+    """Refuse, before a long run, an output path that `replacing` could not write after it.
+
+    The unique temporary `replacing` would write is created beside each path and removed again,
+    with the folders made for it, so the check leaves nothing behind.
+
+    Parameters
+    ----------
+    *paths : str or os.PathLike
+        The files the run will write.
+
+    Raises
+    ------
+    CannotWrite
+        A path is a folder, a folder on the way is a file, or no file can be created beside it.
+    """
+    for path in map(Path, paths):
+        if path.is_dir():
+            raise CannotWrite(f"cannot write {path}: it is a folder; give a file name")
+        made = [folder for folder in (path.parent, *path.parent.parents) if not folder.exists()]
+        try:
+            descriptor, temporary = _temporary_beside(path, f".partial{path.suffix}")
+            os.close(descriptor)
+            os.unlink(temporary)
+        finally:
+            for folder in made:  # deepest first
+                with contextlib.suppress(OSError):
+                    folder.rmdir()
 
 
 @contextlib.contextmanager

@@ -34,7 +34,7 @@ import fmpy
 from fmpy import read_model_description
 
 from . import FMU_FILES, __version__, fmi3
-from .atomic_files import replacing_path
+from .atomic_files import check_writable, replacing_path
 from .errors import PendulumFmuError
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -515,6 +515,7 @@ def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, *, model_dir: Path = PE
     if platforms is None:
         platforms = available_platforms(fmi_version, linux_glibc)
     check_platforms(platforms)
+    check_writable(out_file)  # before the compilers run
     for name in platforms:
         check_toolchain(PLATFORMS[name], fmi_version, linux_glibc)
     model_dir = Path(model_dir)

@@ -64,8 +64,8 @@ def _torque_signal(args):
     return args.torque_file if args.torque_file is not None else args.torque
 
 
-def _add_signal_arguments(parser) -> None:
-    group = parser.add_mutually_exclusive_group(required=True)
+def _add_signal_arguments(parser, required: bool = True) -> None:
+    group = parser.add_mutually_exclusive_group(required=required)
     group.add_argument("--torque", type=_float, help="constant torque in N.m")
     group.add_argument("--torque-file", type=Path,
                        help="CSV with columns time,torque in fmpy's convention: linear between "
@@ -123,8 +123,10 @@ def cmd_cross_check(args) -> int:
 
 def cmd_simulate(args) -> int:
     from . import results
+    from .atomic_files import check_writable
     from .simulate import simulate
 
+    check_writable(*(path for path in (args.output, args.plot) if path))
     run = simulate(_torque_signal(args), stop_time=args.stop_time, step_size=args.step_size,
                    ramp=args.ramp, parameters=_parameters(args.assignments), theta0=args.theta0,
                    omega0=args.omega0, tolerance=args.tolerance, max_steps=args.max_steps,
@@ -138,9 +140,11 @@ def cmd_simulate(args) -> int:
         print(f"wrote {args.output} ({','.join(results.FIELDS)}; units "
               f"{', '.join(results.UNITS.values())})")
     if args.plot:
-        from .plot import plot_overlay
+        from .plot import case_title, plot_overlay
 
-        print(f"wrote {plot_overlay({'FMU': run}, args.plot, 'Torque-driven pendulum')}")
+        title = case_title(_torque_signal(args), _parameters(args.assignments), args.theta0, args.omega0,
+                           args.fmu)
+        print(f"wrote {plot_overlay({'FMU': run}, args.plot, title)}")
     return 0
 
 
@@ -206,6 +210,46 @@ def cmd_demo(args) -> int:
     from .demo import run_demo
 
     return 0 if run_demo(args.output_dir, workers=args.workers) else 1
+
+
+def cmd_judge(args) -> int:
+    from .judge import format_judgement, format_kit, judge, judge_kit, write_json
+    from .plot import plot_judgement
+
+    signal = _torque_signal(args)
+    if args.result.is_dir():
+        if signal is not None:
+            raise InvalidInput(f"{args.result} is a folder, judged as a scenario kit whose NAME.json "
+                               "files define the runs: leave out --torque and --torque-file")
+        verdicts = judge_kit(args.result, tolerance=args.tol, mapping=args.mapping, fmu_path=args.fmu)
+        print(format_kit(verdicts))
+        judged = {name: judgement for name, judgement in verdicts.items() if judgement is not None}
+        figures = {name: args.plot / f"{name}.png" for name in judged} if args.plot else {}
+    else:
+        if signal is None:
+            raise InvalidInput("judging a result file needs the run's torque: give --torque N.m or "
+                               "--torque-file F.csv (or judge a scenario kit's folder)")
+        verdicts = judge(args.result, signal, start_time=args.start_time, stop_time=args.stop_time,
+                         step_size=args.step_size, ramp=args.ramp,
+                         parameters=_parameters(args.assignments), theta0=args.theta0,
+                         omega0=args.omega0, tolerance=args.tol, mapping=args.mapping,
+                         fmu_path=args.fmu, max_steps=args.max_steps)
+        print(format_judgement(verdicts))
+        judged = {args.result.name: verdicts}
+        figures = {args.result.name: args.plot} if args.plot else {}
+    for title, path in figures.items():
+        print(f"wrote {plot_judgement(judged[title], path, title)}")
+    if args.json:
+        print(f"wrote {write_json(verdicts, args.json)}")
+    return 0 if all(judgement.passed for judgement in judged.values()) else 1
+
+
+def cmd_scenarios(args) -> int:
+    from .scenarios import write_scenarios
+
+    for path in write_scenarios(args.output_dir, args.fmu):
+        print(f"wrote {path}")
+    return 0
 
 
 # --- the parser: one function per command ---------------------------------------------------
@@ -340,6 +384,52 @@ def _add_demo(commands) -> argparse.ArgumentParser:
     return demo
 
 
+def _add_judge(commands) -> argparse.ArgumentParser:
+    judge = commands.add_parser(
+        "judge", help="judge a result file from any tool, and name the mistake",
+        description="Compare a result file from any tool (a CSV with time and theta, optionally "
+                    "omega and alpha) with the independent reference at its own times: pass when "
+                    "max |dtheta| <= --tol (exit 0), else fail (exit 1) with the mistake that "
+                    "explains the difference (input one step late or early, interpolated, held, "
+                    "time grid drift, state not restored, integration error, or unexplained). "
+                    "Given a scenario kit's folder, judges every NAME_out.csv in it.")
+    judge.add_argument("result", type=Path,
+                       help="the result CSV, or a folder written by pendulum-fmu scenarios holding "
+                            "NAME_out.csv files")
+    _add_signal_arguments(judge, required=False)
+    judge.add_argument("--start-time", type=_float, default=0.0,
+                       help="start of the run in s (default: %(default)s)")
+    judge.add_argument("--ramp", action="store_true",
+                       help="the run ramped the torque along the CSV's line (input derivatives)")
+    judge.add_argument("--tol", type=_float, default=None,
+                       help="largest |dtheta| in rad that passes (default: 1e-9, or for a kit each "
+                            "scenario's own)")
+    judge.add_argument("--map", dest="mapping", default=None, metavar="QUANTITY=COLUMN[*FACTOR],...",
+                       help="the result's column names for time, theta, omega and alpha, with a factor "
+                            "to SI where it uses other units, e.g. theta=phi*0.0174532925")
+    judge.add_argument("--json", type=Path, default=None,
+                       help="write the verdict, diagnosis, max |dtheta|, worst time and every "
+                            "candidate's residual (rad) as JSON")
+    judge.add_argument("--plot", type=Path, default=None,
+                       help="write a PNG of the torque, theta and |dtheta| (for a kit: a folder, one "
+                            "NAME.png per scenario)")
+    judge.set_defaults(run=cmd_judge)
+    return judge
+
+
+def _add_scenarios(commands) -> argparse.ArgumentParser:
+    scenarios = commands.add_parser(
+        "scenarios", help="write a kit of scenarios for testing a master with this FMU",
+        description="Write the FMU (carrying the kit as FMI-LS-REF related files) and, per scenario, "
+                    "its torque (NAME_in.csv), settings (NAME.json) and reference (NAME_ref.csv), "
+                    "with a ReadMe.md: run each in your master, write NAME_out.csv beside it, then "
+                    "pendulum-fmu judge FOLDER.")
+    scenarios.add_argument("--output-dir", type=Path, required=True, help="the kit's folder")
+    _add_fmu_argument(scenarios)
+    scenarios.set_defaults(run=cmd_scenarios)
+    return scenarios
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="pendulum-fmu",
@@ -349,7 +439,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--debug", action="store_true", default=False,
                         help="show the Python traceback of an error instead of one line")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for add in (_add_build, _add_cross_check, _add_simulate, _add_compare, _add_sweep, _add_demo):
+    for add in (_add_build, _add_cross_check, _add_simulate, _add_compare, _add_sweep, _add_demo,
+                _add_judge, _add_scenarios):
         # Also after the command's name; SUPPRESS keeps it from hiding one given before it.
         add(commands).add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
                                    help="show the Python traceback of an error instead of one line")

@@ -17,10 +17,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .atomic_files import replacing
+from .atomic_files import check_writable, replacing
 from .compare_tools import ToolSpecError, parse_tools
 from .errors import InvalidInput
-from .plot import plot_comparison
+from .plot import case_title, plot_comparison
 from .reference import reference
 from .simulate import resolve_parameters
 from .torque_schedule import TorqueSchedule, TorqueSignal, schedule
@@ -187,11 +187,15 @@ def compare(torque: TorqueSignal, tools=TOOLS, *, output_dir: str | Path, step_s
         raise ToolSpecError(f"compare needs at least two tools, got {parsed[0].label}: "
                             f"e.g. --tools fmu,{REFERENCE}")
     tolerance = check_tolerance(tolerance)
+    shown = case_title(torque, parameters, theta0, omega0, fmu_path)  # the user's own parameters
     # Refused here before any tool runs; and every tool gets the whole set, so the defaults are
     # fmu_path's for all of them.
     parameters = resolve_parameters(parameters, fmu_path)
     plan = schedule(torque, start_time=start_time, stop_time=stop_time, step_size=step_size, ramp=ramp,
                     max_steps=max_steps)
+    output_dir = Path(output_dir)
+    outputs = {name: output_dir / name for name in ("trajectories.csv", "differences.csv", "comparison.png")}
+    check_writable(*outputs.values())
     steps = len(plan.time) - 1
     runs, seconds = {}, {}
     runs[REFERENCE] = reference(torque, start_time=start_time, stop_time=stop_time, step_size=step_size,
@@ -208,13 +212,11 @@ def compare(torque: TorqueSignal, tools=TOOLS, *, output_dir: str | Path, step_s
              "seconds_per_step": seconds[tool]} for tool in others]
     rows += [{"tool": a, "against": b, **differences(runs[a], runs[b]), "seconds_per_step": None}
              for a, b in itertools.combinations(others, 2)]
-    output_dir = Path(output_dir)
     return Comparison(
         runs=runs, differences=rows, tolerance=tolerance,
-        trajectories=write_trajectories(runs, output_dir / "trajectories.csv"),
-        table=write_differences(rows, output_dir / "differences.csv"),
-        figure=plot_comparison(runs, output_dir / "comparison.png",
-                               title or f"Torque-driven pendulum: {', '.join(runs)}"),
+        trajectories=write_trajectories(runs, outputs["trajectories.csv"]),
+        table=write_differences(rows, outputs["differences.csv"]),
+        figure=plot_comparison(runs, outputs["comparison.png"], title or f"{shown}; tools {', '.join(runs)}"),
     )
 
 

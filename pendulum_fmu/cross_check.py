@@ -18,10 +18,9 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__, default_fmu
-from .atomic_files import replacing, replacing_path
+from .atomic_files import check_writable, replacing, replacing_path
 from .build import PLATFORMS
-from .errors import InvalidInput
-from .parameters import model_description
+from .parameters import model_description, pendulum_variables
 from .simulate import simulate
 from .torque_schedule import TorqueTable
 
@@ -68,13 +67,15 @@ A rigid pendulum driven by a torque at its pivot (FMI 2.0 Co-Simulation).
 def write_cross_check(output_dir: str | Path, fmu_path: str | Path | None = None) -> list[Path]:
     """Write the cross-check folders for every platform the FMU has a binary for; returns them."""
     fmu = Path(fmu_path) if fmu_path else default_fmu()
+    pendulum_variables(fmu)  # a pendulum FMU with this platform's binary, to compute the reference
     description = model_description(fmu)
     model_name = description.coSimulation.modelIdentifier
     with zipfile.ZipFile(fmu) as archive:
         platforms = sorted({name.split("/")[1] for name in archive.namelist()
                             if name.startswith("binaries/") and name.count("/") == 2 and not name.endswith("/")})
-    if not platforms:
-        raise InvalidInput(f"{fmu} carries no binaries: a cross-check needs one to run")
+    folders = [Path(output_dir, "fmus", description.fmiVersion, "cs", platform, TOOL, __version__, model_name)
+               for platform in platforms]
+    check_writable(*(folder / f"{model_name}.fmu" for folder in folders))  # before the run
     rows = _input_rows()
     torque = TorqueTable(np.array([t for t, _ in rows]), np.array([u for _, u in rows]))
     run = simulate(torque, start_time=START_TIME, stop_time=STOP_TIME, step_size=STEP_SIZE,
@@ -82,10 +83,8 @@ def write_cross_check(output_dir: str | Path, fmu_path: str | Path | None = None
     reference_rows = [[repr(float(t)), *(repr(float(v)) for v in values)]
                       for t, *values in zip(run["time"], *(run[name] for name in OUTPUTS))]
     computed_on = next((name for name, platform in PLATFORMS.items() if platform.native), "this machine's")
-    folders = []
-    for platform in platforms:
+    for folder in folders:
         # Each write below makes the folder, or says in one line why it cannot.
-        folder = Path(output_dir, "fmus", description.fmiVersion, "cs", platform, TOOL, __version__, model_name)
         with replacing_path(folder / f"{model_name}.fmu") as copy:
             shutil.copyfile(fmu, copy)
         _write_csv(folder / f"{model_name}_in.csv", ("time", "torque"),
@@ -96,5 +95,4 @@ def write_cross_check(output_dir: str | Path, fmu_path: str | Path | None = None
                           f"StepSize, {STEP_SIZE!r}\nRelTol, {RELATIVE_TOLERANCE!r}\n")
         with replacing(folder / "ReadMe.md") as readme:
             readme.write(_readme(computed_on, model_name))
-        folders.append(folder)
     return folders

@@ -55,7 +55,7 @@ def run_demo(output_dir: str | Path, workers: int | None = None) -> bool:
     runs, agree = {}, True
     for label, gravity, folder in (("No Gravity", 0.0, "no_gravity"), ("With Gravity", 9.81, "gravity")):
         comparison = compare(TORQUE, tools, output_dir=out / folder, parameters={"gravity": gravity},
-                             title=rf"Constant Torque $\tau = {TORQUE:g}$ Nm — {label}")
+                             title=rf"Constant Torque $\tau = {TORQUE:g}$ N.m — {label}")
         print(f"\n{label} (gravity = {gravity:g} m/s2)")
         print(format_comparison(comparison))
         fmu = comparison.runs["fmu"]
@@ -66,8 +66,8 @@ def run_demo(output_dir: str | Path, workers: int | None = None) -> bool:
         print(f"wrote {comparison.figure}")
         runs[label] = fmu
         agree &= comparison.agree
-    overlay = plot_overlay({rf"No gravity ($\tau = {TORQUE:g}$ Nm)": runs["No Gravity"],
-                            rf"With gravity ($\tau = {TORQUE:g}$ Nm)": runs["With Gravity"]},
+    overlay = plot_overlay({rf"No gravity ($\tau = {TORQUE:g}$ N.m)": runs["No Gravity"],
+                            rf"With gravity ($\tau = {TORQUE:g}$ N.m)": runs["With Gravity"]},
                            out / "gravity_effect.png", "Effect of Gravity on Torque-Driven Pendulum")
     print(f"\nwrote {overlay}")
     print(f"\nParameter study: torque {', '.join(f'{t:g}' for t in STUDY_TORQUES)} N.m with gravity, "

@@ -31,7 +31,7 @@ from fmpy.fmi3 import FMU3Slave
 
 from .engines import check_held, check_mode, held_results
 from .errors import InvalidInput
-from .parameters import START_VALUES, default_parameters, model_description, variables
+from .parameters import START_VALUES, FmuFileError, default_parameters, model_description, variables
 from .simulate import RECORDED, FmuError, _unzipped, fmi2_library, resolve_parameters
 from .torque_schedule import TorqueSchedule
 
@@ -58,15 +58,17 @@ def quantities() -> tuple[str, ...]:
     return ("torque", *OUTPUTS, *START_VALUES, *default_parameters())
 
 
-def parse_map(text: str | None) -> dict[str, Mapped]:
-    """{quantity: Mapped} from 'torque=u,theta=phi*0.0174532925,...'."""
+def parse_map(text: str | None, allowed: tuple[str, ...] | None = None) -> dict[str, Mapped]:
+    """{quantity: Mapped} from 'torque=u,theta=phi*0.0174532925,...'; allowed: the quantities
+    that may be mapped (default: every quantity of a compared FMU, quantities())."""
+    allowed = quantities() if allowed is None else allowed
     mapping: dict[str, Mapped] = {}
     for item in filter(None, (part.strip() for part in (text or "").split(","))):
         quantity, equals, target = (part.strip() for part in item.partition("="))
         if not equals or not quantity or not target:
             raise MapError(f"--map item {item!r} is not QUANTITY=VARIABLE[*FACTOR]")
-        if quantity not in quantities():
-            raise MapError(f"--map: unknown quantity {quantity!r}; map any of {', '.join(quantities())}")
+        if quantity not in allowed:
+            raise MapError(f"--map: unknown quantity {quantity!r}; map any of {', '.join(allowed)}")
         if quantity in mapping:
             raise MapError(f"--map: {quantity} is mapped twice")
         factor = 1.0
@@ -89,11 +91,8 @@ class MappedFmu:
             raise MapError(f"{label}: no FMU at {self.path}")
         try:
             self.description = model_description(self.path)
-        except InvalidInput as error:  # "FMU ... cannot be read: ..."
+        except FmuFileError as error:  # not a zip, no model description, not FMI 2.0 or 3.0
             raise MapError(f"{label}: {error}") from None
-        if self.description.fmiVersion not in ("2.0", "3.0"):
-            raise MapError(f"{label}: {self.path} is FMI {self.description.fmiVersion}; "
-                           "only FMI 2.0 and 3.0 FMUs can be compared")
         available = [name for name, present in (("CoSimulation", self.description.coSimulation),
                                                  ("ModelExchange", self.description.modelExchange))
                      if present]

@@ -1,27 +1,57 @@
 """The FMU's variables, parameters and their defaults, read from that FMU's modelDescription.xml.
 
 Every function takes the FMU it is about (default: pendulum_fmu.default_fmu()), so another build
-of the pendulum brings its own parameters. Each FMU file is parsed once per modification time.
+of the pendulum brings its own parameters. Each FMU file is parsed once per modification time,
+and this is where every FMU a user names is first opened: a file that is no FMI 2.0 or 3.0 FMU
+is refused here with FmuFileError, and one that is not a pendulum wherever the pendulum's
+variables are asked for.
 """
 
 from __future__ import annotations
 
 import math
+import zipfile
 from functools import lru_cache
 from pathlib import Path
 
+import fmpy
 from fmpy import read_model_description
 
 from .errors import InvalidInput, MissingFile
 
 # The start values a user gives, and the FMU's variables they start.
 START_VALUES = {"theta0": "theta", "omega0": "omega"}
+# What every tool reads from or writes to a pendulum FMU.
+PENDULUM_VARIABLES = ("torque", "theta", "omega", "alpha")
+FMI_VERSIONS = ("2.0", "3.0")
+
+
+class FmuFileError(InvalidInput):
+    """The file given as an FMU is none this package can run: not a zip, no modelDescription.xml,
+    not FMI 2.0 or 3.0, or not a pendulum; the message names the file and what to do."""
 
 
 @lru_cache(maxsize=32)
-def _read(path: str, modified_ns: int):
-    description = read_model_description(path)
-    return description, {v.name: v for v in description.modelVariables}
+def _read(path: str, modified_ns: int, shown: str):
+    """(model description, {name: variable}, the archive's file names) of the FMU at path; shown
+    is the path as the user gave it, for the messages."""
+    try:
+        with zipfile.ZipFile(path) as archive:
+            names = frozenset(archive.namelist())
+    except (zipfile.BadZipFile, OSError):
+        raise FmuFileError(f"{shown} is not an FMU (an FMU is a zip archive with a "
+                           "modelDescription.xml): check the path") from None
+    if "modelDescription.xml" not in names:
+        raise FmuFileError(f"{shown} is not an FMU: the zip archive has no modelDescription.xml"
+                           + ("" if names else " (it is empty)"))
+    try:
+        description = read_model_description(path)
+    except Exception as error:  # lxml's and fmpy's own: the XML is broken or invalid
+        raise FmuFileError(f"{shown}: its modelDescription.xml cannot be read: {error}") from None
+    if description.fmiVersion not in FMI_VERSIONS:
+        raise FmuFileError(f"{shown} is an FMI {description.fmiVersion} FMU; this package runs "
+                           "FMI 2.0 and 3.0 FMUs: export the model as one of those")
+    return description, {v.name: v for v in description.modelVariables}, names
 
 
 def _described(fmu_path: str | Path | None):
@@ -30,30 +60,72 @@ def _described(fmu_path: str | Path | None):
         modified_ns = path.stat().st_mtime_ns
     except OSError as error:
         raise MissingFile(f"FMU {path}: {error.strerror}") from None
-    try:
-        return _read(str(path.resolve()), modified_ns)
-    except Exception as error:  # fmpy's, whatever the file is instead: no zip, no or bad XML
-        raise InvalidInput(f"FMU {path} cannot be read: {error}; pass an FMI 2.0 or 3.0 FMU "
-                           "file") from None
+    return _read(str(path.resolve()), modified_ns, str(path))
+
+
+def pendulum_variables(fmu_path: str | Path | None = None) -> dict:
+    """variables() of a pendulum FMU this machine can run; raises as default_parameters."""
+    description, found, names = _described(fmu_path)
+    path = fmu_file(fmu_path)
+    missing = [name for name in PENDULUM_VARIABLES if name not in found]
+    if missing:
+        raise FmuFileError(f"{path} is not a pendulum FMU: it has no variable {', '.join(missing)} "
+                           f"(it is the model {description.modelName!r}); give the pendulum's FMU, "
+                           "or compare another model with compare --tools LABEL=path --map")
+    if description.coSimulation is None:
+        raise FmuFileError(f"{path} has no Co-Simulation interface, which this package runs: "
+                           "export it for Co-Simulation")
+    folder = fmpy.platform_tuple if description.fmiVersion == "3.0" else fmpy.platform
+    binary = f"binaries/{folder}/{description.coSimulation.modelIdentifier}{fmpy.sharedLibraryExtension}"
+    if binary not in names:
+        raise FmuFileError(f"{path} has no binary for this platform ({binary}): build it here with "
+                           "pendulum-fmu build, or give an FMU built for this platform")
+    return found
 
 
 def model_description(fmu_path: str | Path | None = None):
-    """fmpy's ModelDescription of the FMU."""
+    """fmpy's ModelDescription of the FMU.
+
+    Raises
+    ------
+    MissingFile
+        No file at fmu_path.
+    FmuFileError
+        The file is no FMI 2.0 or 3.0 FMU.
+    """
     return _described(fmu_path)[0]
 
 
 def variables(fmu_path: str | Path | None = None) -> dict:
-    """{name: fmpy ModelVariable} of the FMU (shared: do not modify)."""
+    """{name: fmpy ModelVariable} of any FMI 2.0 or 3.0 FMU (shared: do not modify); raises as
+    model_description."""
     return _described(fmu_path)[1]
 
 
 def value_reference(name: str, fmu_path: str | Path | None = None) -> int:
-    return variables(fmu_path)[name].valueReference
+    """The value reference of a variable of a pendulum FMU; raises as default_parameters."""
+    return pendulum_variables(fmu_path)[name].valueReference
+
+
+def unit(name: str, fmu_path: str | Path | None = None) -> str:
+    """The unit the pendulum FMU declares for a variable, a parameter or a start value (theta0:
+    theta's), '' where it declares none; raises as default_parameters, KeyError for a name it
+    does not have."""
+    return pendulum_variables(fmu_path)[START_VALUES.get(name, name)].unit or ""
 
 
 def default_parameters(fmu_path: str | Path | None = None) -> dict[str, float]:
-    """{name: start value} of every parameter (mass, length, inertia, gravity, damping)."""
-    return {name: float(v.start) for name, v in variables(fmu_path).items() if v.causality == "parameter"}
+    """{name: start value} of every parameter (mass, length, inertia, gravity, damping).
+
+    Raises
+    ------
+    MissingFile
+        No file at fmu_path.
+    FmuFileError
+        The file is no FMI 2.0 or 3.0 FMU, or not a pendulum (no torque, theta, omega or alpha),
+        or has no Co-Simulation binary for this platform.
+    """
+    return {name: float(v.start) for name, v in pendulum_variables(fmu_path).items() if v.causality == "parameter"}
 
 
 def merged_parameters(overrides: dict[str, float] | None = None,

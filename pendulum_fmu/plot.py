@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import numbers
+import os
 from pathlib import Path
 
 import matplotlib
@@ -11,10 +13,30 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from .atomic_files import replacing_path  # noqa: E402
+from .parameters import merged_parameters, unit  # noqa: E402
 
 THETA_LABEL = r"Position $\theta$ in rad"
 OMEGA_LABEL = r"Velocity $\omega$ in rad/s"
 TIME_LABEL = r"Time $t$ in s"
+
+
+def case_title(torque, parameters: dict[str, float] | None = None, theta0: float = 0.0,
+               omega0: float = 0.0, fmu_path: str | Path | None = None) -> str:
+    """'Torque-driven pendulum: torque 20 N.m, gravity 9.81 m/s2', then every parameter the user
+    set and a start value other than 0, each with the unit the FMU declares.
+
+    torque: a constant (its value is shown), a CSV path (its file name) or any other signal.
+    """
+    if isinstance(torque, numbers.Real):
+        shown = [f"torque {torque:g} {unit('torque', fmu_path)}"]
+    elif isinstance(torque, (str, os.PathLike)):
+        shown = [f"torque from {Path(torque).name}"]
+    else:
+        shown = ["a torque signal"]
+    values = {"gravity": merged_parameters(parameters, fmu_path)["gravity"], **(parameters or {}),
+              **{name: value for name, value in (("theta0", theta0), ("omega0", omega0)) if value}}
+    shown += [f"{name} {value:g} {unit(name, fmu_path)}" for name, value in values.items()]
+    return f"Torque-driven pendulum: {', '.join(shown)}"
 
 
 def _finish(fig, axes, title: str, path: str | Path) -> Path:
@@ -46,6 +68,25 @@ def plot_overlay(runs: dict[str, np.ndarray], path: str | Path, title: str) -> P
     return _finish(fig, axes, title, path)
 
 
+def _draw_difference(ax, time: np.ndarray, difference: np.ndarray, label: str, index: int) -> None:
+    """|difference| on a log axis. Exact zeros have no place there: they are left out and the
+    label says how many (a point between two of them is marked, having no line); a difference
+    that is zero everywhere is written into the panel instead of drawn."""
+    ax.set_yscale("log")
+    identical = difference == 0
+    if identical.all():
+        ax.text(0.5, 1 - 0.12 * index, f"{label}: identical at every point", transform=ax.transAxes,
+                ha="center", va="center", fontsize=10)
+        return
+    note = f" ({np.count_nonzero(identical)} of {len(difference)} points identical, not drawn)" \
+        if identical.any() else ""
+    (line,) = ax.plot(time, np.where(identical, np.nan, difference), label=label + note)
+    gap = np.r_[True, identical, True]
+    alone = ~identical & gap[:-2] & gap[2:]
+    if alone.any():
+        ax.plot(time[alone], difference[alone], ".", color=line.get_color())
+
+
 def plot_comparison(runs: dict[str, np.ndarray], path: str | Path, title: str) -> Path:
     """Left: theta and omega of every tool overlaid. Right: |difference| of each tool against
     the first one, on a log scale, where agreement to 1e-10 is visible."""
@@ -58,10 +99,9 @@ def plot_comparison(runs: dict[str, np.ndarray], path: str | Path, title: str) -
         axes[0, 0].plot(run["time"], run["theta"], label=label, **style)
         axes[1, 0].plot(run["time"], run["omega"], label=label, **style)
         if i:
-            # Exact zeros cannot be drawn on a log axis; the floor sits far below any tolerance.
             for row, name in enumerate(("theta", "omega")):
-                difference = np.maximum(np.abs(run[name] - base[name]), 1e-18)
-                axes[row, 1].semilogy(run["time"], difference, label=f"{label} - {labels[0]}")
+                _draw_difference(axes[row, 1], run["time"], np.abs(run[name] - base[name]),
+                                 f"{label} - {labels[0]}", i)
     axes[0, 0].set_ylabel(THETA_LABEL)
     axes[1, 0].set_ylabel(OMEGA_LABEL)
     axes[0, 1].set_ylabel(r"$|\Delta\theta|$ in rad")
@@ -113,29 +153,86 @@ def _quantiles(x: np.ndarray, y: np.ndarray, quantiles) -> tuple[np.ndarray, lis
 
 
 def plot_case_bands(values: dict[str, np.ndarray], summaries: dict[str, np.ndarray],
-                    path: str | Path, title: str) -> Path:
+                    path: str | Path, title: str, units: dict[str, str] | None = None) -> Path:
     """For many cases: each summary (a row of panels) against each swept value (a column), as
-    the median and the 5-95 % and 25-75 % bands over the cases sharing that value. One sort per
-    panel, so 100,000 cases draw about as fast as 100. NaN summaries (failed cases) are left out."""
+    the median and the 5-95 % and 25-75 % bands over the cases sharing that value; where each
+    value has one case there is nothing to spread, and the cases alone are drawn. One sort per
+    panel, so 100,000 cases draw about as fast as 100. NaN summaries (failed cases) are left out.
+    units: {swept name: unit} for the axes."""
     swept = {name: column for name, column in values.items() if len(np.unique(column)) > 1} or values
     fig, axes = plt.subplots(len(summaries), len(swept), figsize=(4.5 * len(swept) + 1, 6),
                              squeeze=False, sharey="row")
+    labelled = set()
+
+    def once(text):  # each legend entry on the first panel that draws it
+        if text in labelled:
+            return None
+        labelled.add(text)
+        return text
+
     for column, (name, x) in enumerate(swept.items()):
         for row, (label, y) in enumerate(summaries.items()):
-            ax, first = axes[row, column], row == column == 0
+            ax = axes[row, column]
             keep = np.isfinite(y)
+            if column == 0:
+                ax.set_ylabel(label)
+            if row == len(summaries) - 1:
+                ax.set_xlabel(f"{name} in {units[name]}" if units and units.get(name) else name)
             if not keep.any():
                 continue
             quantiles = [q for band in QUANTILE_BANDS for q in band] + [0.5]
             levels, (*bands, median) = _quantiles(x[keep], y[keep], quantiles)
+            if len(levels) == np.count_nonzero(keep):  # one case per value: no spread to show
+                ax.plot(levels, median, color="C0", marker=".", label=once("one case per value"))
+                continue
             for (low, high), (q_low, q_high), alpha in zip(QUANTILE_BANDS, zip(bands[::2], bands[1::2]),
                                                            (0.25, 0.45)):
                 ax.fill_between(levels, q_low, q_high, alpha=alpha, color="C0", linewidth=0,
-                                label=f"{low:.0%}-{high:.0%} of cases" if first else None)
+                                label=once(f"{low:.0%}-{high:.0%} of cases"))
             ax.plot(levels, median, color="C0", marker="." if len(levels) < 30 else None,
-                    label="median" if first else None)
-            if column == 0:
-                ax.set_ylabel(label)
-            if row == len(summaries) - 1:
-                ax.set_xlabel(name)
+                    label=once("median"))
     return _finish(fig, axes, title, path)
+
+
+def _log_difference(ax, time: np.ndarray, difference: np.ndarray, label: str, **style) -> int:
+    """|difference| on a log axis, leaving out the points where it is exactly zero (a log axis has
+    no zero, and a floor would draw them as spikes); returns how many were left out."""
+    magnitude = np.abs(difference)
+    zero = magnitude == 0
+    if not zero.all():
+        ax.semilogy(time, np.where(zero, np.nan, magnitude), label=label, **style)
+    return int(zero.sum())
+
+
+def plot_judgement(judgement, path: str | Path, title: str) -> Path:
+    """A judged result (judge.Judgement): the torque the run asks for and, when the diagnosis
+    names a variant, the torque that variant applies (N.m); theta of the result and of the
+    reference (rad); |theta_result - theta_reference| and the variant's own difference from the
+    reference (rad, log), with the tolerance. Exact zeros are said in words, not drawn."""
+    result, reference, variant = judgement.result, judgement.reference, judgement.explanation
+    time = result["time"]
+    fig, axes = plt.subplots(3, 1, figsize=(10, 8), sharex=True)
+    axes[0].step(time, reference["torque"], where="post", linewidth=2, label="the run's torque")
+    if variant is not None and not np.array_equal(variant["torque"], reference["torque"]):
+        axes[0].step(time, variant["torque"], where="post", linestyle="--", linewidth=1.5,
+                     label=f"applied if {judgement.diagnosis}")
+    axes[0].set_ylabel(r"Torque $\tau$ in N.m")
+    axes[1].plot(time, reference["theta"], linewidth=2, label="reference")
+    axes[1].plot(time, result["theta"], linestyle="--", linewidth=1.5, label=judgement.source)
+    axes[1].set_ylabel(THETA_LABEL)
+    zeros = _log_difference(axes[2], time, result["theta"] - reference["theta"],
+                            "|result - reference|", linewidth=1.5)
+    if variant is not None:
+        _log_difference(axes[2], time, variant["theta"] - reference["theta"],
+                        f"|{judgement.diagnosis} - reference|", linestyle="--", linewidth=1.5)
+    axes[2].axhline(judgement.tolerance, color="grey", linestyle=":",
+                    label=f"tolerance {judgement.tolerance:g} rad")
+    axes[2].set_yscale("log")
+    if zeros:
+        note = ("the result equals the reference exactly at every point (difference 0 rad)"
+                if zeros == len(time) else
+                f"difference exactly 0 rad at {zeros:,} of {len(time):,} points (not drawn)")
+        axes[2].text(0.01, 0.04, note, transform=axes[2].transAxes, fontsize=9)
+    axes[2].set_ylabel(r"$|\Delta\theta|$ in rad")
+    axes[2].set_xlabel(TIME_LABEL)
+    return _finish(fig, axes, f"{title}: {judgement.verdict}, {judgement.diagnosis}", path)

@@ -164,15 +164,33 @@ def _holding(points: list[Fraction], values: list[float], step: Fraction) -> Cal
     return value_after
 
 
-def _integrate(pieces: _Pieces, at: np.ndarray, parameters: dict | None, theta0: float, omega0: float,
-               rtol: float, atol: float, fmu_path: str | Path | None) -> np.ndarray:
-    p = resolve_parameters(parameters, fmu_path)
-    inverse_inertia = 1.0 / total_inertia(p)
-    gravity_moment, damping = p["mass"] * p["gravity"] * p["length"], p["damping"]
+def equation_of_motion(parameters: dict[str, float]) -> Callable:
+    """alpha(theta, omega, torque) of the pendulum with these (resolved) parameters, in rad/s2;
+    works on scalars and numpy arrays alike.
+
+    Parameters
+    ----------
+    parameters : dict
+        mass, length, inertia, gravity and damping, as resolve_parameters gives them.
+
+    Returns
+    -------
+    callable
+        acceleration(theta, omega, torque).
+    """
+    inverse_inertia = 1.0 / total_inertia(parameters)
+    gravity_moment = parameters["mass"] * parameters["gravity"] * parameters["length"]
+    damping = parameters["damping"]
 
     def acceleration(theta, omega, u):
         return (u - gravity_moment * np.sin(theta) - damping * omega) * inverse_inertia
 
+    return acceleration
+
+
+def _integrate(pieces: _Pieces, at: np.ndarray, parameters: dict | None, theta0: float, omega0: float,
+               rtol: float, atol: float, fmu_path: str | Path | None) -> np.ndarray:
+    acceleration = equation_of_motion(resolve_parameters(parameters, fmu_path))
     starts = [float(s) for s in pieces.starts]
     ends = starts[1:] + [float(pieces.stop)]
     # Each reported time belongs to the first piece that reaches it (a time a rounding past the
@@ -261,10 +279,11 @@ def reference(torque=20.0, *, start_time: float = 0.0, stop_time: float | None =
 
 
 def reference_schedule(plan, *, parameters: dict | None = None, theta0: float = 0.0,
-                       omega0: float = 0.0, rtol: float = 1e-12, atol: float = 1e-12,
-                       fmu_path: str | Path | None = None) -> np.ndarray:
-    """Integrate exactly the torques of a schedule, reported at its communication points: the
-    judge of a tool that was fed that schedule.
+                       omega0: float = 0.0, at: np.ndarray | None = None, rtol: float = 1e-12,
+                       atol: float = 1e-12, fmu_path: str | Path | None = None) -> np.ndarray:
+    """Integrate exactly the torques of a schedule, reported at its communication points (or at
+    the times `at`): the judge of a tool that was fed that schedule, and the judge's variants of
+    a run with a mistake made (judge.py).
 
     Parameters
     ----------
@@ -272,6 +291,8 @@ def reference_schedule(plan, *, parameters: dict | None = None, theta0: float = 
         time (N + 1 points, s), torque (N start values, N.m) and torque_rate (N, N.m/s).
     parameters, theta0, omega0, rtol, atol, fmu_path
         As reference() takes them.
+    at : numpy.ndarray, optional
+        The times to report, in s (default: the schedule's communication points).
 
     Returns
     -------
@@ -289,5 +310,5 @@ def reference_schedule(plan, *, parameters: dict | None = None, theta0: float = 
     u0, rate = plan.torque.tolist(), plan.torque_rate.tolist()
     # The schedule's points are the tools' own: no tolerance beyond rounding.
     pieces = _Pieces(points[:-1], points[-1], u0, rate, points, _holding(points, u0, Fraction(0)))
-    return _integrate(pieces, np.asarray(plan.time, dtype=float), parameters, theta0, omega0, rtol, atol,
-                      fmu_path)
+    return _integrate(pieces, np.asarray(plan.time if at is None else at, dtype=float), parameters,
+                      theta0, omega0, rtol, atol, fmu_path)

@@ -19,7 +19,7 @@ from fmpy.fmi3 import FMU3Slave
 
 from . import cs_loop, default_fmu, results
 from .errors import InvalidInput, PendulumFmuError
-from .parameters import fmu_file, merged_parameters, model_description, value_reference
+from .parameters import fmu_file, merged_parameters, model_description, pendulum_variables, value_reference
 from .torque_schedule import TorqueSignal, TorqueSchedule, schedule
 
 _STATUS = ["OK", "WARNING", "DISCARD", "ERROR", "FATAL", "PENDING"]
@@ -88,12 +88,13 @@ _extracting = threading.Lock()  # threads of one dask worker share the cache
 def _unzipped(fmu_path: Path):
     """(folder, model description) of an FMU file, extracted and parsed once per process; the
     folder is removed at exit."""
+    description = model_description(fmu_path)  # refuses what is no FMU before it is unzipped
     key = (str(fmu_path.resolve()), fmu_path.stat().st_mtime_ns)
     with _extracting:
         if key not in _extracted:
             folder = tempfile.TemporaryDirectory(prefix="pendulum_fmu_")
             extract(str(fmu_path), unzipdir=folder.name)
-            _extracted[key] = folder, model_description(fmu_path)
+            _extracted[key] = folder, description
         folder, description = _extracted[key]
     return folder.name, description
 
@@ -131,8 +132,17 @@ def open_fmu(fmu_path: str | Path | None = None, *, parameters: dict | None = No
 
     fmu_path defaults to pendulum_fmu.default_fmu() (FMI 2.0); parameters and value references
     are that FMU's own. The caller frees it with slave.terminate(); slave.freeInstance().
+
+    Raises
+    ------
+    MissingFile, parameters.FmuFileError
+        No file at fmu_path, or none that is a pendulum FMU this machine can run (checked before
+        anything is unzipped or loaded).
+    FmuError
+        The FMU refused the parameters or start values; the message carries what it logged.
     """
     fmu_path = Path(fmu_path) if fmu_path else default_fmu()
+    pendulum_variables(fmu_path)  # FmuFileError when it is no pendulum FMU this machine runs
     folder, description = _unzipped(fmu_path)
     fmi_version = int(description.fmiVersion[0])
     messages = MessageLog(fmi_version)

@@ -41,8 +41,9 @@ class Harness:
     """The FMU's library through ctypes, with a logger that keeps what the FMU says."""
 
     prefix = "fmi2"
-    state_calls = {"get": "fmi2GetFMUstate", "size": "fmi2SerializedFMUstateSize", "serialize": "fmi2SerializeFMUstate",
-                   "free": "fmi2FreeFMUstate", "deserialize": "fmi2DeSerializeFMUstate"}
+    state_calls = {"get": "fmi2GetFMUstate", "set": "fmi2SetFMUstate", "size": "fmi2SerializedFMUstateSize",
+                   "serialize": "fmi2SerializeFMUstate", "free": "fmi2FreeFMUstate",
+                   "deserialize": "fmi2DeSerializeFMUstate"}
 
     def __init__(self, library: Path, guid: str):
         self.lib = ctypes.CDLL(str(library))
@@ -110,8 +111,9 @@ class Harness3(Harness):
     """The same for an FMI 3.0 binary: fmi3 entry points, FMI 3.0's logger."""
 
     prefix = "fmi3"
-    state_calls = {"get": "fmi3GetFMUState", "size": "fmi3SerializedFMUStateSize", "serialize": "fmi3SerializeFMUState",
-                   "free": "fmi3FreeFMUState", "deserialize": "fmi3DeserializeFMUState"}
+    state_calls = {"get": "fmi3GetFMUState", "set": "fmi3SetFMUState", "size": "fmi3SerializedFMUStateSize",
+                   "serialize": "fmi3SerializeFMUState", "free": "fmi3FreeFMUState",
+                   "deserialize": "fmi3DeserializeFMUState"}
 
     def __init__(self, library: Path, token: str):
         self.lib = ctypes.CDLL(str(library))
@@ -265,6 +267,80 @@ def _flip(index):
     return mangle
 
 
+FOREIGN = "is not a state this instance handed out"
+
+
+def _steps_on_after(bad_call):
+    """The bad call on an instance 0.5 s into a swing under 20 N.m; the instance must then step
+    to the theta of an instance that never saw the call, and its own state must still restore."""
+    def run(h):
+        call = {name: getattr(h, function) for name, function in h.state_calls.items()}
+        component, untouched = h.ready(), h.ready()
+        for instance in (component, untouched):
+            assert h.set(instance, TORQUE, 20.0) == OK and h.step(instance, 0.0, 0.5) == OK
+        theta_half, state = h.get(component, THETA), ctypes.c_void_p()
+        assert call["get"](component, ctypes.byref(state)) == OK
+        status = bad_call(h, call, component, state)
+        for instance in (component, untouched):
+            assert h.step(instance, 0.5, 0.5) == OK
+        assert h.get(component, THETA) == h.get(untouched, THETA) != theta_half, "the instance goes on"
+        assert call["set"](component, state) == OK and h.get(component, THETA) == theta_half
+        assert call["free"](component, ctypes.byref(state)) == OK and not state
+        return status
+    return run
+
+
+def _not_a_state():
+    return (ctypes.c_double * 64)()
+
+
+def _another_instances_state(h, call):
+    state = ctypes.c_void_p()
+    assert call["get"](h.ready(), ctypes.byref(state)) == OK
+    return state
+
+
+def _freed_state(h, call, component):
+    """A copy of a state's address, taken before the state was freed."""
+    state = ctypes.c_void_p()
+    assert call["get"](component, ctypes.byref(state)) == OK
+    stale = ctypes.c_void_p(state.value)
+    assert call["free"](component, ctypes.byref(state)) == OK
+    return stale
+
+
+def _overwrite_foreign(h, call, component, state):
+    buffer = _not_a_state()
+    pointer = ctypes.c_void_p(ctypes.addressof(buffer))
+    status = call["get"](component, ctypes.byref(pointer))
+    assert pointer.value == ctypes.addressof(buffer), "a refused pointer is left as it was"
+    return status
+
+
+FOREIGN_STATE_CASES = [
+    # (bad input, call, expected status, expected message, bad call)
+    ("the state where the address of its variable belongs (fmusim 0.0.39)", "free", ERROR, "is a state itself",
+     lambda h, call, c, state: call["free"](c, state)),
+    ("memory that is no FMU state", "set", ERROR, FOREIGN, lambda h, call, c, state: call["set"](c, _not_a_state())),
+    ("a state of another instance", "set", ERROR, FOREIGN,
+     lambda h, call, c, state: call["set"](c, _another_instances_state(h, call))),
+    ("a state freed already", "set", ERROR, FOREIGN, lambda h, call, c, state: call["set"](c, _freed_state(h, call, c))),
+    ("a state freed twice", "free", ERROR, FOREIGN,
+     lambda h, call, c, state: call["free"](c, ctypes.byref(_freed_state(h, call, c)))),
+    ("memory that is no FMU state, to be overwritten", "get", ERROR, FOREIGN, _overwrite_foreign),
+    ("memory that is no FMU state, serialized", "serialize", ERROR, FOREIGN,
+     lambda h, call, c, state: call["serialize"](c, _not_a_state(), (ctypes.c_char * 1024)(), ctypes.c_size_t(1024))),
+    ("a NULL state freed (allowed: nothing happens)", "free", OK, "",
+     lambda h, call, c, state: call["free"](c, ctypes.byref(ctypes.c_void_p()))),
+]
+
+
+def _foreign_state_cases(harness_type):
+    return [Case("FMU state pointers", bad_input, harness_type.state_calls[call], status, message,
+                 _steps_on_after(bad_call))
+            for bad_input, call, status, message, bad_call in FOREIGN_STATE_CASES]
+
+
 def _illegal(call, *arguments, state="instantiated"):
     def run(h):
         component = h.instantiate() if state == "instantiated" else h.ready()
@@ -396,6 +472,7 @@ CASES = [
     Case("FMU state blobs", "one payload bit flipped", "fmi2DeSerializeFMUstate", ERROR, "checksum mismatch", _deserialize(_flip(40))),
     Case("FMU state blobs", "a state of another FMU (payload size differs)", "fmi2DeSerializeFMUstate", ERROR,
          "truncated, or from another build", _deserialize(lambda blob: blob[:8] + (len(blob) - 28).to_bytes(4, "little") + blob[12:-8])),
+    *_foreign_state_cases(Harness),
 ]
 
 
@@ -518,6 +595,7 @@ CASES_FMI3 = [
          _deserialize(lambda blob: blob[:-1])),
     Case("FMU state blobs", "one payload bit flipped", "fmi3DeserializeFMUState", ERROR, "checksum mismatch",
          _deserialize(_flip(40))),
+    *_foreign_state_cases(Harness3),
 ]
 
 

@@ -9,8 +9,40 @@ from __future__ import annotations
 import contextlib
 import io
 import sys
+import zipfile
 from dataclasses import dataclass
 from pathlib import Path
+
+
+def _zip(members: dict[str, str]) -> bytes:
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w") as archive:
+        for name, text in members.items():
+            archive.writestr(name, text)
+    return buffer.getvalue()
+
+
+# A valid FMI 2.0 model description of another model: a spring, no torque and no theta.
+SPRING = """<?xml version="1.0" encoding="UTF-8"?>
+<fmiModelDescription fmiVersion="2.0" modelName="Spring" guid="{5b8e0d1c-0000-4000-8000-000000000001}">
+  <CoSimulation modelIdentifier="Spring"/>
+  <ModelVariables>
+    <ScalarVariable name="force" valueReference="0" causality="input" variability="continuous"><Real start="0"/></ScalarVariable>
+    <ScalarVariable name="x" valueReference="1" causality="output" variability="continuous"><Real/></ScalarVariable>
+    <ScalarVariable name="k" valueReference="2" causality="parameter" variability="fixed" initial="exact"><Real start="1"/></ScalarVariable>
+  </ModelVariables>
+  <ModelStructure><Outputs><Unknown index="2"/></Outputs></ModelStructure>
+</fmiModelDescription>
+"""
+FMI1 = """<?xml version="1.0" encoding="UTF-8"?>
+<fmiModelDescription fmiVersion="1.0" modelName="Pendulum" modelIdentifier="Pendulum"
+  guid="{5b8e0d1c-0000-4000-8000-000000000002}" numberOfContinuousStates="2" numberOfEventIndicators="0">
+  <ModelVariables>
+    <ScalarVariable name="torque" valueReference="0" causality="input"><Real start="0"/></ScalarVariable>
+    <ScalarVariable name="theta" valueReference="1" causality="output"><Real/></ScalarVariable>
+  </ModelVariables>
+</fmiModelDescription>
+"""
 
 # Input files the cases name, written into {files} before they run.
 FILES = {
@@ -25,6 +57,13 @@ FILES = {
     "nan.csv": "time,torque\n0,1\n1,nan\n",
     "one_row.csv": "time,torque\n0,5\n",
     "short_row.csv": "time,torque\n0,1\n1\n",
+    "empty.fmu": _zip({}),
+    "no_model_description.fmu": _zip({"documentation/index.html": "<html></html>"}),
+    "spring.fmu": _zip({"modelDescription.xml": SPRING}),
+    "fmi1.fmu": _zip({"modelDescription.xml": FMI1}),
+    "result.csv": "time,theta\n0,0\n0.001,0\n",
+    "result_no_time.csv": "t,theta\n0,0\n0.001,0\n",
+    "result_backwards.csv": "time,theta\n0,0\n0.002,0\n0.001,0\n",
 }
 
 
@@ -81,6 +120,25 @@ CASES = [
     _case("compare", "compare --torque 1 --tools fmu,reference --tol -1 --output-dir {files}/out", 2,
           "the tolerance -1.0 must be a positive finite number"),
     _case("fmu", "simulate --torque 1 --fmu {files}/absent.fmu", 2, "FMU {files}/absent.fmu: No such file or directory"),
+    _case("fmu", "simulate --torque 1 --fmu {files}/one_row.csv", 2,
+          "{files}/one_row.csv is not an FMU (an FMU is a zip archive with a modelDescription.xml): check the path"),
+    _case("fmu", "simulate --torque 1 --fmu {files}/empty.fmu", 2,
+          "{files}/empty.fmu is not an FMU: the zip archive has no modelDescription.xml (it is empty)"),
+    _case("fmu", "simulate --torque 1 --fmu {files}/no_model_description.fmu", 2,
+          "no_model_description.fmu is not an FMU: the zip archive has no modelDescription.xml"),
+    _case("fmu", "simulate --torque 1 --fmu {files}/spring.fmu", 2,
+          "spring.fmu is not a pendulum FMU: it has no variable torque, theta, omega, alpha (it is the model 'Spring')"),
+    _case("fmu", "simulate --torque 1 --fmu {files}/fmi1.fmu", 2,
+          "fmi1.fmu is an FMI 1.0 FMU; this package runs FMI 2.0 and 3.0 FMUs"),
+    _case("fmu", "compare --torque 1 --tools fmu,reference --fmu {files}/one_row.csv --output-dir {files}/out", 2,
+          "one_row.csv is not an FMU"),
+    _case("fmu", "compare --torque 1 --tools fmu,other={files}/fmi1.fmu --output-dir {files}/out", 2,
+          "other: {files}/fmi1.fmu is an FMI 1.0 FMU"),
+    _case("fmu", "sweep --torque 1 --fmu {files}/spring.fmu --output-dir {files}/out", 2,
+          "spring.fmu is not a pendulum FMU"),
+    _case("fmu", "sweep --torque 1 --fmu {files}/empty.fmu --output-dir {files}/out", 2,
+          "empty.fmu is not an FMU"),
+    _case("fmu", "cross-check --fmu {files}/fmi1.fmu --output-dir {files}/out", 2, "fmi1.fmu is an FMI 1.0 FMU"),
     _case("sweep", "sweep --torque 5 --scheduler tcp://127.0.0.1:9 --connect-timeout 1 --output-dir {files}/out", 2,
           "no dask scheduler answered at tcp://127.0.0.1:9 within 1 s"),
     _case("sweep", "sweep --torque 5 --set mass=heavy --output-dir {files}/out", 2,
@@ -90,6 +148,35 @@ CASES = [
                    "--set length=1,2,3,4,5,6,7,8,9,10 --max-cases 999 --output-dir {files}/out", 2,
           "1,000 cases is over the limit of 999: give fewer values"),
     _case("output", "simulate --torque 1 --stop-time 0.01 --output {files}/bad_number.csv/out.csv", 2,
+          "bad_number.csv is a file, not a folder; choose another output path"),
+    # /proc/self: a folder in which nothing can be created, whoever runs (Linux).
+    _case("output", "simulate --torque 1 --stop-time 0.01 --output /proc/self/out.csv", 2,
+          "cannot write /proc/self/out.csv: no file can be created in /proc/self (No such file or directory)"),
+    _case("output", "simulate --torque 1 --stop-time 0.01 --plot /proc/self/out.png", 2,
+          "cannot write /proc/self/out.png: no file can be created in /proc/self"),
+    _case("output", "simulate --torque 1 --stop-time 0.01 --output {files}", 2,
+          "cannot write {files}: it is a folder; give a file name"),
+    _case("output", "compare --torque 1 --tools fmu,reference --output-dir /proc/self/out", 2,
+          "cannot write /proc/self/out/trajectories.csv: the folder /proc/self/out cannot be created"),
+    _case("output", "build --output /proc/self/Pendulum.fmu --platforms linux64", 2,
+          "cannot write /proc/self/Pendulum.fmu: no file can be created in /proc/self"),
+    _case("output", "sweep --torque 1 --output-dir /proc/self/out", 2,
+          "cannot write /proc/self/out: the folder /proc/self/out cannot be created"),
+    _case("judge", "judge {files}/result_no_time.csv --torque 1", 2,
+          "result_no_time.csv:1: no column 'time' (header is t,theta); name the result's time column"),
+    _case("judge", "judge {files}/result_backwards.csv --torque 1", 2,
+          "result_backwards.csv:4: time 0.001 goes backwards (previous row: 0.002)"),
+    _case("judge", "judge {files}/result.csv --torque 1 --map theta=phi", 2,
+          "result.csv:1: no column 'phi', which --map names for theta (header is time,theta)"),
+    _case("judge", "judge {files}/result.csv --torque 1 --map torque=u", 2,
+          "--map: unknown quantity 'torque'; map any of time, theta, omega, alpha"),
+    _case("judge", "judge {files}/result.csv", 2, "judging a result file needs the run's torque"),
+    _case("judge", "judge {files}/absent.csv --torque 1", 2, "absent.csv: cannot read: No such file"),
+    _case("judge", "judge {files}/result.csv --torque 1 --stop-time 0.0005", 2,
+          "result.csv: time 0.001 is after the run's stop time 0.0005 s; give the run's --stop-time"),
+    _case("judge", "judge {files}", 2, "no scenario settings (NAME.json) in this folder"),
+    _case("judge", "judge {files} --torque 1", 2, "is a folder, judged as a scenario kit whose NAME.json files"),
+    _case("scenarios", "scenarios --output-dir {files}/bad_number.csv/kit", 2,
           "bad_number.csv is a file, not a folder; choose another output path"),
 ]
 

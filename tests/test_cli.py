@@ -16,7 +16,8 @@ I_TOTAL = 30.0
 def test_every_command_has_help():
     parser = build_parser()
     commands = parser._subparsers._group_actions[0].choices
-    assert set(commands) == {"build", "cross-check", "simulate", "compare", "sweep", "demo"}
+    assert set(commands) == {"build", "cross-check", "simulate", "compare", "sweep", "demo", "judge",
+                             "scenarios"}
     for name, command in commands.items():
         assert command.description, name
         for action in command._actions:
@@ -110,3 +111,16 @@ def test_sweep_with_a_refused_case_runs_the_rest_and_exits_1(tmp_path, capsys):
     assert "1 of 2 cases failed" in capsys.readouterr().err
     cases = pq.read_table(tmp_path / "cases").to_pydict()
     assert sorted(zip(cases["mass"], cases["status"])) == [(0.0, "failed"), (40.0, "ok")]
+
+
+def test_an_output_nothing_can_be_written_to_is_refused_before_the_run(tmp_path, capsys):
+    """/proc/self: a folder in which nothing can be created. The error names the user's path, not
+    the temporary beside it, and comes before the run (no summary line)."""
+    for argv in (["simulate", "--torque", "1", "--output", "/proc/self/out.csv"],
+                 ["simulate", "--torque", "1", "--output", str(tmp_path / "fine.csv"), "--plot", "/proc/self/out.png"],
+                 ["compare", "--torque", "1", "--tools", "fmu,reference", "--output-dir", "/proc/self/out"],
+                 ["build", "--output", "/proc/self/Pendulum.fmu", "--platforms", "linux64"]):
+        assert main(argv) == 2, argv
+        out, err = capsys.readouterr()
+        assert out == "" and err.count("\n") == 1 and "/proc/self/" in err and "partial" not in err, (argv, err)
+    assert list(tmp_path.iterdir()) == []

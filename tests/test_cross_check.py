@@ -64,3 +64,11 @@ def test_reference_results_agree_with_fmpy_and_scipy_and_pass_fmpys_validator(re
     fmu_count, result_count, problems = validate_repo(str(repository))
     assert problems == [] and result_count == 1 and fmu_count >= 1
     shutil.rmtree(repository / "results")
+
+
+def test_an_output_folder_nothing_can_be_written_to_is_refused_before_the_run(fmu, capsys):
+    """/proc/self: a folder in which nothing can be created; one line, exit 2, no reference computed."""
+    assert main(["cross-check", "--output-dir", "/proc/self/out", "--fmu", str(fmu)]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("\n") == 1
+    assert "cannot write /proc/self/out/fmus/2.0/cs/" in err and "the folder /proc/self/out cannot be created" in err

@@ -1,18 +1,129 @@
-"""The figures' quantile bands against numpy's own quantiles."""
+"""plot.py: what each figure draws and says, read back from the matplotlib figure."""
 
 import numpy as np
+import pytest
 
-from pendulum_fmu.plot import BAND_LEVELS, _quantiles
+from pendulum_fmu import plot, results
+from pendulum_fmu.cli import main
+from pendulum_fmu.reference import reference
+
+
+@pytest.fixture
+def drawn(monkeypatch):
+    """Every figure plot.py finishes, as (figure, its axes, title), and still written."""
+    figures = []
+    finish = plot._finish
+
+    def keep(fig, axes, title, path):
+        figures.append((fig, list(np.ravel(axes)), title))
+        return finish(fig, axes, title, path)
+
+    monkeypatch.setattr(plot, "_finish", keep)
+    return figures
 
 
 def test_band_quantiles_are_numpys_per_value():
     rng = np.random.default_rng(7)
     x, y = rng.integers(0, 9, 2000).astype(float), rng.normal(size=2000)
-    levels, values = _quantiles(x, y, [0.05, 0.5, 0.75])
+    levels, values = plot._quantiles(x, y, [0.05, 0.5, 0.75])
     assert levels.tolist() == sorted(set(x.tolist()))
     for i, level in enumerate(levels):
         assert np.allclose([v[i] for v in values], np.quantile(y[x == level], [0.05, 0.5, 0.75]),
                            rtol=0, atol=1e-12)
     many = rng.uniform(0.0, 1.0, 5000)  # more distinct values than levels: pooled into bins
-    levels, (median,) = _quantiles(many, many, [0.5])
-    assert len(levels) == BAND_LEVELS and np.max(np.abs(median - levels)) < 0.5 / BAND_LEVELS
+    levels, (median,) = plot._quantiles(many, many, [0.5])
+    assert len(levels) == plot.BAND_LEVELS and np.max(np.abs(median - levels)) < 0.5 / plot.BAND_LEVELS
+
+
+def _legend(ax) -> list[str]:
+    return ax.get_legend_handles_labels()[1]
+
+
+def test_one_case_per_value_draws_the_cases_not_bands(drawn, tmp_path):
+    torque = np.array([40.0, 5.0, 20.0, 10.0])
+    summaries = {"max |theta| in rad": torque / 100, "final theta in rad": torque / 200}
+    plot.plot_case_bands({"torque": torque}, summaries, tmp_path / "one.png", "t", units={"torque": "N.m"})
+    _, axes, _ = drawn[0]
+    for ax, y in zip(axes, summaries.values()):
+        assert len(ax.collections) == 0, "no band where each value has one case"
+        (line,) = ax.get_lines()
+        assert line.get_xdata().tolist() == [5.0, 10.0, 20.0, 40.0]
+        assert line.get_ydata().tolist() == sorted(y.tolist())
+    assert _legend(axes[0]) == ["one case per value"]
+    assert axes[-1].get_xlabel() == "torque in N.m"
+
+
+def test_several_cases_per_value_draw_the_median_and_two_bands(drawn, tmp_path):
+    rng = np.random.default_rng(3)
+    gravity = np.repeat([0.0, 9.81], 20)
+    y = rng.normal(size=40)
+    plot.plot_case_bands({"gravity": gravity}, {"final theta in rad": y}, tmp_path / "bands.png", "t",
+                         units={"gravity": "m/s2"})
+    (_, (ax,), _) = drawn[0]
+    assert len(ax.collections) == 2
+    (median,) = ax.get_lines()
+    assert np.allclose(median.get_ydata(), [np.median(y[:20]), np.median(y[20:])], rtol=0, atol=1e-15)
+    assert _legend(ax) == ["5%-95% of cases", "25%-75% of cases", "median"]
+    assert ax.get_xlabel() == "gravity in m/s2"
+
+
+def _run(theta, omega=None):
+    run = results.empty(len(theta))
+    run["time"] = np.arange(len(theta)) * 1e-3
+    run["theta"], run["omega"] = theta, theta if omega is None else omega
+    return run
+
+
+def test_exact_zeros_are_left_out_of_the_log_axis_and_counted(drawn, tmp_path):
+    base = _run(np.array([0.1, 0.2, 0.3, 0.4, 0.5, 0.6]))
+    difference = np.array([0.0, 1e-12, 0.0, 0.0, 3e-12, 2e-12])
+    plot.plot_comparison({"reference": base, "fmu": _run(base["theta"] + difference)}, tmp_path / "c.png", "t")
+    _, axes, _ = drawn[0]
+    theta_difference = axes[1]  # row 0, right
+    assert theta_difference.get_yscale() == "log"
+    line, alone = theta_difference.get_lines()
+    drawn_values = line.get_ydata()
+    assert np.array_equal(np.isnan(drawn_values), difference == 0)
+    assert np.allclose(drawn_values[difference != 0], difference[difference != 0], rtol=1e-3, atol=0)
+    assert alone.get_xdata().tolist() == [1e-3]  # between two identical points: a marker, no line
+    assert _legend(theta_difference)[0] == "fmu - reference (3 of 6 points identical, not drawn)"
+
+
+def test_a_difference_zero_everywhere_is_written_not_drawn(drawn, tmp_path):
+    base = _run(np.linspace(0.0, 1.0, 5))
+    plot.plot_comparison({"reference": base, "copy": base.copy()}, tmp_path / "same.png", "t")
+    _, axes, _ = drawn[0]
+    for ax in (axes[1], axes[3]):
+        assert len(ax.get_lines()) == 0
+        assert [text.get_text() for text in ax.texts] == ["copy - reference: identical at every point"]
+
+
+def test_titles_name_the_torque_and_the_parameters_with_their_units(tmp_path):
+    assert plot.case_title(20.0) == "Torque-driven pendulum: torque 20 N.m, gravity 9.81 m/s2"
+    assert plot.case_title(tmp_path / "steps.csv", {"gravity": 0.0, "damping": 2.0}, theta0=0.1) == (
+        "Torque-driven pendulum: torque from steps.csv, gravity 0 m/s2, damping 2 N.m.s/rad, theta0 0.1 rad")
+    assert plot.case_title(lambda t: t).startswith("Torque-driven pendulum: a torque signal, gravity 9.81 m/s2")
+
+
+def test_simulate_plot_says_torque_and_gravity_and_draws_the_run(drawn, tmp_path):
+    assert main(["simulate", "--torque", "20", "--set", "gravity=0", "--stop-time", "1",
+                 "--plot", str(tmp_path / "run.png")]) == 0
+    _, axes, title = drawn[0]
+    assert title == "Torque-driven pendulum: torque 20 N.m, gravity 0 m/s2"
+    (theta,) = axes[0].get_lines()
+    expected = reference(20.0, stop_time=1.0, parameters={"gravity": 0.0})["theta"]
+    assert np.max(np.abs(theta.get_ydata() - expected)) < 1e-10
+
+
+def test_a_sweep_of_one_case_per_torque_draws_the_cases_with_units(drawn, tmp_path):
+    from pendulum_fmu.sweep import Study, run_sweep, sweep_grid
+
+    run_sweep(Study(sweep_grid([5.0, 10.0, 20.0, 40.0], [0.0]), stop_time=0.1, outputs=[]),
+              output_dir=tmp_path, workers=1, progress=False)
+    _, axes, _ = drawn[-1]
+    for ax in axes:
+        assert len(ax.collections) == 0
+    assert axes[-1].get_xlabel() == "torque in N.m"
+    # Gravity 0: theta(t) = tau t^2 / (2 I) with I = inertia + mass length^2 = 30 kg.m2.
+    (final,) = axes[-1].get_lines()
+    assert np.allclose(final.get_ydata(), np.array([5.0, 10.0, 20.0, 40.0]) * 0.1**2 / 60, rtol=1e-9, atol=0)

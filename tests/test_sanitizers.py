@@ -41,8 +41,9 @@ def _run(command, **kwargs):
     return result.stdout
 
 
-@pytest.mark.parametrize("case", [["bad-calls"], ["bad-calls-fmi3"], ["instances", "1000"], ["threads", "8"],
-                                  ["energy", "100000"], ["churn", "20000"], ["churn-fmi3", "20000"]])
+@pytest.mark.parametrize("case", [["bad-calls"], ["bad-calls-fmi3"], ["foreign-states"], ["instances", "1000"],
+                                  ["threads", "8"], ["energy", "100000"], ["churn", "20000"],
+                                  ["churn-fmi3", "20000"]])
 def test_under_address_and_undefined_behavior_sanitizers(drivers, case):
     environment = {**os.environ, "ASAN_OPTIONS": "detect_leaks=1:abort_on_error=0",
                    "UBSAN_OPTIONS": "print_stacktrace=1"}
@@ -51,8 +52,8 @@ def test_under_address_and_undefined_behavior_sanitizers(drivers, case):
 
 
 @pytest.mark.skipif(shutil.which("valgrind") is None, reason="needs valgrind")
-@pytest.mark.parametrize("case", [["bad-calls"], ["bad-calls-fmi3"], ["instances", "100"], ["threads", "8"],
-                                  ["churn", "2000"], ["churn-fmi3", "2000"]])
+@pytest.mark.parametrize("case", [["bad-calls"], ["bad-calls-fmi3"], ["foreign-states"], ["instances", "100"],
+                                  ["threads", "8"], ["churn", "2000"], ["churn-fmi3", "2000"]])
 def test_under_valgrind_memcheck(drivers, case):
     _run(["valgrind", "-q", "--leak-check=full", "--errors-for-leak-kinds=all", "--error-exitcode=1",
           str(drivers["plain"]), *case])

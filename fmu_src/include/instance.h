@@ -89,6 +89,9 @@ typedef struct {
     Logger logger;
     int log_categories;                  /* LogCategory bits switched on by the master */
     char name[MAX_INSTANCE_NAME];
+    /* The FMU states this instance handed out and has not freed (fmu_state.c): a state the master
+       passes back is looked up here by its address before anything in it is read. */
+    struct StoredState *states;
 } Instance;
 
 /* Every function below takes `function`, the name of the FMI function the master called, for
@@ -155,7 +158,9 @@ Status instance_get_states(Instance *instance, const char *function, double x[],
 Status instance_get_derivatives(Instance *instance, const char *function, double dx[], size_t nx);
 Status instance_get_nominals(Instance *instance, const char *function, double nominals[], size_t nx);
 
-/* FMU states (fmu_state.c): opaque to the adapters, which pass their fmi*FMUstate through. */
+/* FMU states (fmu_state.c): opaque to the adapters, which pass their fmi*FMUstate through. A
+   state not handed out by this instance (freed, another instance's, or no state at all) is
+   refused with an error, and the instance goes on. */
 Status instance_get_state(Instance *instance, const char *function, void **state);
 Status instance_set_state(Instance *instance, const char *function, const void *state);
 Status instance_free_state(Instance *instance, const char *function, void **state);
@@ -165,6 +170,8 @@ Status instance_serialize_state(Instance *instance, const char *function, const 
                                 unsigned char bytes[], size_t size);
 Status instance_deserialize_state(Instance *instance, const char *function,
                                   const unsigned char bytes[], size_t size, void **state);
+/* Frees the states the master did not free, when the instance goes. */
+void instance_free_states(Instance *instance);
 /* Recomputes what is derived from data after data was replaced wholesale. */
 void instance_data_changed(Instance *instance);
 

@@ -1,5 +1,6 @@
-/* FMU states: in memory a copy of InstanceData; serialized, a versioned blob that is checked to
-   the last byte before anything in it is believed:
+/* FMU states: in memory a copy of InstanceData in its instance's list of the states it handed
+   out, so that a pointer the master passes back is checked before it is read; serialized, a
+   versioned blob that is checked to the last byte before anything in it is believed:
        magic "PNDL" | format version u32 | payload size u32 | payload (InstanceData) | FNV-1a 64 */
 
 #include <math.h>
@@ -53,19 +54,63 @@ static const char *implausible(const InstanceData *data) {
     return NULL;
 }
 
+/* A state as this FMU hands it out, linked into its instance's list. The data comes first: a
+   master that passes the state where the address of its variable belongs (fmusim 0.0.39 calls
+   fmi2FreeFMUstate(c, state)) makes us read a machine state, never the address of a state. */
+typedef struct StoredState {
+    InstanceData data;
+    struct StoredState *next;
+} StoredState;
+
+/* The link that holds state in the instance's list, or NULL when the instance did not hand it
+   out. Addresses are only compared, so a foreign pointer is never read. */
+static StoredState **link_to(Instance *instance, const void *state) {
+    for (StoredState **link = &instance->states; *link; link = &(*link)->next)
+        if ((const void *)*link == state) return link;
+    return NULL;
+}
+
+static Status refuse_foreign(const Instance *instance, const char *function) {
+    return instance_error(instance, function, "FMUstate is not a state this instance handed out "
+                          "(freed already, another instance's, or no state at all): refused, the "
+                          "instance is unchanged");
+}
+
+/* The instance's own state at that address, or NULL after logging why it is refused. */
+static StoredState *own_state(Instance *instance, const char *function, const void *state) {
+    StoredState **link = link_to(instance, state);
+    if (link) return *link;
+    refuse_foreign(instance, function);
+    return NULL;
+}
+
+/* The state the master hands back to be overwritten (*state), or a new one in the list. */
+static StoredState *state_to_fill(Instance *instance, const char *function, void *state) {
+    if (state) return own_state(instance, function, state);
+    StoredState *stored = malloc(sizeof(StoredState));
+    if (!stored) {
+        instance_error(instance, function, "out of memory");
+        return NULL;
+    }
+    stored->next = instance->states;
+    instance->states = stored;
+    return stored;
+}
+
 Status instance_get_state(Instance *instance, const char *function, void **state) {
     if (instance_null_argument(instance, function, "FMUstate", state)) return STATUS_ERROR;
-    /* The master may hand back a state it got before: overwrite it in place. */
-    InstanceData *copy = *state ? (InstanceData *)*state : malloc(sizeof(InstanceData));
-    if (!copy) return instance_error(instance, function, "out of memory");
-    *copy = instance->data;
-    *state = copy;
+    StoredState *stored = state_to_fill(instance, function, *state);
+    if (!stored) return STATUS_ERROR;
+    stored->data = instance->data;
+    *state = stored;
     return STATUS_OK;
 }
 
 Status instance_set_state(Instance *instance, const char *function, const void *state) {
     if (instance_null_argument(instance, function, "FMUstate", state)) return STATUS_ERROR;
-    const InstanceData *data = state;
+    const StoredState *stored = own_state(instance, function, state);
+    if (!stored) return STATUS_ERROR;
+    const InstanceData *data = &stored->data;
     const int own_states = instance->type == INTERFACE_CO_SIMULATION ? CO_SIMULATION_STATES
                                                                        : MODEL_EXCHANGE_STATES;
     if (!(data->machine_state & own_states))
@@ -78,15 +123,33 @@ Status instance_set_state(Instance *instance, const char *function, const void *
 
 Status instance_free_state(Instance *instance, const char *function, void **state) {
     if (instance_null_argument(instance, function, "FMUstate", state)) return STATUS_ERROR;
-    free(*state);
+    if (link_to(instance, state))
+        return instance_error(instance, function, "FMUstate is a state itself, where the address of "
+                              "the variable that holds it belongs (%s(instance, &state)): refused, "
+                              "nothing freed", function);
+    if (!*state) return STATUS_OK; /* both standards: freeing NULL is ignored */
+    StoredState **link = link_to(instance, *state);
+    if (!link) return refuse_foreign(instance, function);
+    StoredState *stored = *link;
+    *link = stored->next;
+    free(stored);
     *state = NULL;
     return STATUS_OK;
+}
+
+void instance_free_states(Instance *instance) {
+    while (instance->states) {
+        StoredState *next = instance->states->next;
+        free(instance->states);
+        instance->states = next;
+    }
 }
 
 Status instance_serialized_state_size(Instance *instance, const char *function, const void *state,
                                       size_t *size) {
     if (instance_null_argument(instance, function, "FMUstate", state) ||
-        instance_null_argument(instance, function, "size", size))
+        instance_null_argument(instance, function, "size", size) ||
+        !own_state(instance, function, state))
         return STATUS_ERROR;
     *size = SERIALIZED_SIZE;
     return STATUS_OK;
@@ -97,6 +160,8 @@ Status instance_serialize_state(Instance *instance, const char *function, const 
     if (instance_null_argument(instance, function, "FMUstate", state) ||
         instance_null_argument(instance, function, "serializedState", bytes))
         return STATUS_ERROR;
+    const StoredState *stored = own_state(instance, function, state);
+    if (!stored) return STATUS_ERROR;
     if (size < SERIALIZED_SIZE)
         return instance_error(instance, function, "size %lu is too small: %lu bytes needed",
                               (unsigned long)size, (unsigned long)SERIALIZED_SIZE);
@@ -104,7 +169,7 @@ Status instance_serialize_state(Instance *instance, const char *function, const 
     memcpy(out, STATE_MAGIC, 4);
     put_u32(out + 4, STATE_FORMAT_VERSION);
     put_u32(out + 8, (uint32_t)sizeof(InstanceData));
-    memcpy(out + HEADER_SIZE, state, sizeof(InstanceData));
+    memcpy(out + HEADER_SIZE, &stored->data, sizeof(InstanceData));
     const uint64_t checksum = fnv1a(out, HEADER_SIZE + sizeof(InstanceData));
     memcpy(out + HEADER_SIZE + sizeof(InstanceData), &checksum, CHECKSUM_SIZE);
     return STATUS_OK;
@@ -136,9 +201,9 @@ Status instance_deserialize_state(Instance *instance, const char *function,
     const char *problem = implausible(&data);
     if (problem) return instance_error(instance, function, "implausible state: %s", problem);
 
-    InstanceData *copy = *state ? (InstanceData *)*state : malloc(sizeof(InstanceData));
-    if (!copy) return instance_error(instance, function, "out of memory");
-    *copy = data;
-    *state = copy;
+    StoredState *stored = state_to_fill(instance, function, *state);
+    if (!stored) return STATUS_ERROR;
+    stored->data = data;
+    *state = stored;
     return STATUS_OK;
 }

@@ -112,6 +112,8 @@ Instance *instance_create(const char *function, const char *name, const char *to
 }
 
 void instance_free(Instance *instance) {
+    if (!instance) return; /* both standards: freeing NULL is ignored */
+    instance_free_states(instance);
     free(instance);
 }
 

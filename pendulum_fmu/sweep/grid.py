@@ -105,6 +105,7 @@ def sweep_grid(torques, gravities=(9.81,), extra: dict | None = None) -> Grid:
 def check_cases(cases, fmu_path=None) -> list[str]:
     """The cases' common keys, which become the cases table's value columns; InvalidInput for
     cases that are not all alike, finite and distinct."""
+    names_allowed, seen = sweepable(fmu_path), {}  # refuses a file that is no pendulum FMU, first
     if isinstance(cases, Grid):
         return list(cases.axes)  # checked when the grid was made
     if not cases:
@@ -112,7 +113,6 @@ def check_cases(cases, fmu_path=None) -> list[str]:
     names = list(cases[0])
     if "torque" not in names:
         raise InvalidInput("every case needs a 'torque'")
-    names_allowed, seen = sweepable(fmu_path), {}
     for number, case in enumerate(cases):
         if list(case) != names:
             raise InvalidInput(f"case {number} has keys {list(case)}; every case needs {names}")

@@ -12,7 +12,7 @@ import numpy as np
 
 from .. import default_fmu
 from ..errors import InvalidInput, MissingDependency
-from ..parameters import model_description
+from ..parameters import pendulum_variables
 from .client import dask_client, progress_bar, run_chunks
 from .figure import draw
 from .grid import columns
@@ -71,6 +71,8 @@ def run_sweep(study: Study, *, output_dir: str | os.PathLike, resume: bool = Fal
         More cases than max_cases, workers with a scheduler, a bad workers count or connect
         timeout, or an output_dir that holds a different study on resume; all before anything
         starts.
+    MissingFile, parameters.FmuFileError
+        No file at the study's FMU, or none that is a pendulum FMU this machine can run.
     InUse
         Another run is writing into the same local output_dir.
     CannotWrite
@@ -88,7 +90,7 @@ def run_sweep(study: Study, *, output_dir: str | os.PathLike, resume: bool = Fal
     url = str(output_dir)
     store = Store(*_file_system(url), format=study.format)
     fmu = str(Path(study.fmu_path).resolve() if study.fmu_path else default_fmu())
-    model_description(fmu)  # a missing or unreadable FMU refused here, before anything starts
+    pendulum_variables(fmu)  # a missing file, or none that is a pendulum FMU, refused before anything starts
     task = Task(fmu=fmu, store=store, stop_time=float(study.stop_time),
                 step_size=float(study.step_size), outputs=study.outputs, stride=study.stride)
     # The folder taken first, so that a second run is refused before it starts a cluster; then
@@ -113,7 +115,7 @@ def run_sweep(study: Study, *, output_dir: str | os.PathLike, resume: bool = Fal
             store.remove_unfinished()
     drawing = time.perf_counter()
     table = store.read_cases(study.names)
-    draw(store, table, study.names, study.outputs, f"{store.root}/sweep.png")
+    draw(store, table, study.names, study.outputs, fmu, f"{store.root}/sweep.png")
     drawn = time.perf_counter()
     # Paths on the local file system, URLs elsewhere.
     where = (Path(store.root).joinpath if isinstance(store.filesystem, LocalFileSystem)

@@ -123,6 +123,10 @@ class Store:
         lock = FileLock(path, timeout=0)
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
+        except OSError as error:
+            raise CannotWrite(f"cannot write {output_dir}: the folder {error.filename} cannot be created "
+                              f"({error.strerror}); choose another output directory") from None
+        try:
             lock.acquire()
         except Timeout:
             raise InUse(f"output directory {output_dir} is in use by another run (it holds {path}); "

@@ -59,6 +59,8 @@ class Study:
         Cases that are not all alike, finite and distinct; a stop time or step size that makes
         no run; an unknown or repeated output; an interval that is no whole number of steps; an
         unknown format.
+    MissingFile, parameters.FmuFileError
+        No file at fmu_path, or none that is a pendulum FMU this machine can run.
     """
 
     cases: Grid | Sequence[dict]

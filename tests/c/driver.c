@@ -3,8 +3,8 @@
 
    Both adapters are linked in, so the FMI 3.0 entry points get the same treatment.
 
-   usage: driver bad-calls | bad-calls-fmi3 | instances N | threads N | energy STEPS
-                 | churn N [MAX_GROWTH_KIB] | churn-fmi3 N
+   usage: driver bad-calls | bad-calls-fmi3 | foreign-states | instances N | threads N
+                 | energy STEPS | churn N [MAX_GROWTH_KIB] | churn-fmi3 N
    Prints one line of figures per case; exits non-zero on the first failed expectation. */
 
 #include <math.h>
@@ -20,10 +20,13 @@
 #include "model_variables.h"
 
 static int messages_logged;
+/* Only the single-threaded cases log, so one buffer serves. */
+static char last_message[512];
 
 static void logger(fmi2ComponentEnvironment environment, fmi2String instance_name,
                    fmi2Status status, fmi2String category, fmi2String message, ...) {
-    (void)environment, (void)instance_name, (void)status, (void)category, (void)message;
+    (void)environment, (void)instance_name, (void)status, (void)category;
+    snprintf(last_message, sizeof(last_message), "%s", message);
     __atomic_add_fetch(&messages_logged, 1, __ATOMIC_RELAXED);
 }
 
@@ -31,7 +34,8 @@ static const fmi2CallbackFunctions callbacks = {logger, NULL, NULL, NULL, NULL};
 
 static void logger3(fmi3InstanceEnvironment environment, fmi3Status status, fmi3String category,
                     fmi3String message) {
-    (void)environment, (void)status, (void)category, (void)message;
+    (void)environment, (void)status, (void)category;
+    snprintf(last_message, sizeof(last_message), "%s", message);
     __atomic_add_fetch(&messages_logged, 1, __ATOMIC_RELAXED);
 }
 
@@ -54,16 +58,26 @@ static fmi2Component ready(const char *name, double torque_start) {
     return c;
 }
 
-/* theta after `steps` 1 ms steps under a constant torque. */
-static double run(fmi2Component c, double torque, long steps) {
-    const fmi2ValueReference torque_vr = VR_TORQUE, theta_vr = VR_THETA;
+static double theta_of(fmi2Component c) {
+    const fmi2ValueReference theta_vr = VR_THETA;
     double theta = 0;
-    for (long k = 0; k < steps; k++) {
+    EXPECT(fmi2GetReal(c, &theta_vr, 1, &theta) == fmi2OK);
+    return theta;
+}
+
+/* theta after the 1 ms steps first..last-1 (from t = first ms) under a constant torque. */
+static double run_steps(fmi2Component c, double torque, long first, long last) {
+    const fmi2ValueReference torque_vr = VR_TORQUE;
+    for (long k = first; k < last; k++) {
         EXPECT(fmi2SetReal(c, &torque_vr, 1, &torque) == fmi2OK);
         EXPECT(fmi2DoStep(c, k * 1e-3, 1e-3, fmi2True) == fmi2OK);
     }
-    EXPECT(fmi2GetReal(c, &theta_vr, 1, &theta) == fmi2OK);
-    return theta;
+    return theta_of(c);
+}
+
+/* theta after `steps` 1 ms steps under a constant torque. */
+static double run(fmi2Component c, double torque, long steps) {
+    return run_steps(c, torque, 0, steps);
 }
 
 /* 1 when the deserializer of one standard refuses the bytes and yields no state. */
@@ -239,6 +253,82 @@ static void bad_calls_fmi3(void) {
 #undef REFUSED
 }
 
+/* 1 when the last message logged contains text. */
+static int logged(const char *text) {
+    return strstr(last_message, text) != NULL;
+}
+
+#define FOREIGN "not a state this instance handed out"
+
+/* A master's bugs with FMU states, each refused with an error and a message before the pointer
+   is read; the instance steps on to the numbers of an instance that never saw them. */
+static void foreign_states(void) {
+    const double torque = 20.0;
+    double not_a_state[64] = {0};
+    int refused = 0;
+#define REFUSED(call, text) do { last_message[0] = 0; EXPECT((call) == fmi2Error && logged(text)); refused++; } \
+                            while (0)
+    fmi2Component c = ready("master with bugs", 0.0), untouched = ready("untouched", 0.0);
+    fmi2Component other = ready("other", 0.0);
+    run(c, torque, 500);
+    fmi2FMUstate state = NULL, other_state = NULL, stale, fake = not_a_state;
+    EXPECT(fmi2GetFMUstate(c, &state) == fmi2OK && state != NULL);
+    EXPECT(fmi2GetFMUstate(other, &other_state) == fmi2OK);
+
+    /* fmusim 0.0.39's call: the state where &state belongs. */
+    REFUSED(fmi2FreeFMUstate(c, state), "is a state itself");
+    REFUSED(fmi2SetFMUstate(c, not_a_state), FOREIGN);
+    REFUSED(fmi2FreeFMUstate(c, &fake), FOREIGN);
+    EXPECT(fake == not_a_state);                          /* left as it was */
+    REFUSED(fmi2GetFMUstate(c, &fake), FOREIGN);          /* not a state to overwrite */
+    REFUSED(fmi2SetFMUstate(c, other_state), FOREIGN);    /* another instance's */
+    REFUSED(fmi2FreeFMUstate(c, &other_state), FOREIGN);
+    EXPECT(other_state != NULL);
+    size_t size = 0;
+    fmi2Byte blob[1024];
+    REFUSED(fmi2SerializedFMUstateSize(c, other_state, &size), FOREIGN);
+    REFUSED(fmi2SerializeFMUstate(c, not_a_state, blob, sizeof(blob)), FOREIGN);
+    fmi2FMUstate none = NULL;
+    EXPECT(fmi2FreeFMUstate(c, &none) == fmi2OK);         /* freeing NULL is ignored */
+
+    /* The state survived the bad free: it still restores, and serializes. */
+    const double theta_500 = theta_of(c);
+    run_steps(c, torque, 500, 700);
+    EXPECT(fmi2SetFMUstate(c, state) == fmi2OK && theta_of(c) == theta_500);
+    EXPECT(fmi2SerializedFMUstateSize(c, state, &size) == fmi2OK && size <= sizeof(blob));
+    EXPECT(fmi2SerializeFMUstate(c, state, blob, size) == fmi2OK);
+    stale = state;
+    EXPECT(fmi2FreeFMUstate(c, &state) == fmi2OK && state == NULL);
+    REFUSED(fmi2SetFMUstate(c, stale), FOREIGN);          /* freed already */
+    REFUSED(fmi2FreeFMUstate(c, &stale), FOREIGN);        /* a double free */
+
+    const double theta = run_steps(c, torque, 500, 3000), expected = run(untouched, torque, 3000);
+    EXPECT(theta == expected);
+
+    /* FMI 3.0: the same core behind the other adapter. */
+    fmi3Instance c3 = ready3("master with bugs 3", 1);
+    fmi3FMUState state3 = NULL;
+    EXPECT(fmi3GetFMUState(c3, &state3) == fmi3OK);
+#undef REFUSED
+#define REFUSED(call, text) do { last_message[0] = 0; EXPECT((call) == fmi3Error && logged(text)); refused++; } \
+                            while (0)
+    REFUSED(fmi3FreeFMUState(c3, state3), "is a state itself");
+    REFUSED(fmi3SetFMUState(c3, not_a_state), FOREIGN);
+    REFUSED(fmi3SetFMUState(c3, other_state), FOREIGN);   /* an FMI 2.0 instance's */
+    REFUSED(fmi3SerializeFMUState(c3, not_a_state, (fmi3Byte *)blob, sizeof(blob)), FOREIGN);
+    EXPECT(fmi3SetFMUState(c3, state3) == fmi3OK);
+    EXPECT(fmi3FreeFMUState(c3, &state3) == fmi3OK && state3 == NULL);
+#undef REFUSED
+
+    /* other_state is left to fmi2FreeInstance, which frees what the master did not. */
+    fmi3FreeInstance(c3);
+    fmi2FreeInstance(other);
+    fmi2FreeInstance(untouched);
+    fmi2FreeInstance(c);
+    printf("foreign-states: %d foreign state pointers refused, theta(3 s) = %.17g rad equal to an "
+           "untouched instance's\n", refused, theta);
+}
+
 static void churn_fmi3(long n) {
     for (long i = 0; i < n; i++) {
         fmi3Instance c = ready3("churn", i % 2);
@@ -381,13 +471,14 @@ static void churn(long n, long max_growth_kib) {
 
 int main(int argc, char **argv) {
     if (argc < 2) {
-        fprintf(stderr, "usage: %s bad-calls | bad-calls-fmi3 | instances N | threads N | energy STEPS "
-                "| churn N [MAX_GROWTH_KIB] | churn-fmi3 N\n", argv[0]);
+        fprintf(stderr, "usage: %s bad-calls | bad-calls-fmi3 | foreign-states | instances N | threads N "
+                "| energy STEPS | churn N [MAX_GROWTH_KIB] | churn-fmi3 N\n", argv[0]);
         return 2;
     }
     const long n = argc > 2 ? atol(argv[2]) : 0;
     if (!strcmp(argv[1], "bad-calls")) bad_calls();
     else if (!strcmp(argv[1], "bad-calls-fmi3")) bad_calls_fmi3();
+    else if (!strcmp(argv[1], "foreign-states")) foreign_states();
     else if (!strcmp(argv[1], "churn-fmi3")) churn_fmi3(n);
     else if (!strcmp(argv[1], "instances")) instances(n);
     else if (!strcmp(argv[1], "threads")) threads((int)n);

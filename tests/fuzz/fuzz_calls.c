@@ -1,9 +1,11 @@
 /* libFuzzer harness for call sequences: the bytes are a program of FMI calls, in any order and
    state, with any arguments, on two instances of either interface of either standard (both
    adapters are linked in over the one core). Nothing may crash, leak or touch memory it does
-   not own. */
+   not own, and a state pointer an instance did not hand out must be refused (a master's bugs:
+   another instance's state, a freed one, any address, fmusim 0.0.39's fmi2FreeFMUstate(c, state)). */
 
 #include <stdint.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "fmi2Functions.h"
@@ -79,21 +81,93 @@ static void fmi3_operation(Program *p, int operation, fmi3Instance c, fmi3FMUSta
     }
 }
 
-static void free_instance(void *instance, int standard, void *states[2]) {
+/* fmi2Status and fmi3Status share their values. */
+#define ERROR 3
+#define REQUIRE(condition) do { if (!(condition)) abort(); } while (0)
+
+static int free_state(int standard, void *instance, void **state) {
+    return standard == 3 ? (int)fmi3FreeFMUState(instance, state) : (int)fmi2FreeFMUstate(instance, state);
+}
+
+static int set_state(int standard, void *instance, void *state) {
+    return standard == 3 ? (int)fmi3SetFMUState(instance, state) : (int)fmi2SetFMUstate(instance, state);
+}
+
+static int get_state(int standard, void *instance, void **state) {
+    return standard == 3 ? (int)fmi3GetFMUState(instance, state) : (int)fmi2GetFMUstate(instance, state);
+}
+
+/* The states in play: states[s] came from instance owner[s]; stale is the address of a state
+   that was freed, which no instance may take for its own (unless the allocator handed it out
+   again to a state in states[]). */
+typedef struct {
+    void *states[2];
+    int owner[2];
+    void *stale;
+} States;
+
+static int live_state_of(const States *st, int i, const void *state) {
+    for (int s = 0; s < 2; s++)
+        if (st->states[s] == state && st->owner[s] == i) return 1;
+    return 0;
+}
+
+/* Frees instance i: the other instance's states are refused, its own freed now or left to
+   fmi*FreeInstance. */
+static void free_instance(Program *p, void *instance, int standard, int i, States *st) {
+    const int free_own = next_byte(p) & 1;
     for (int s = 0; s < 2; s++) {
-        if (!states[s]) continue;
-        if (standard == 3) fmi3FreeFMUState(instance, &states[s]);
-        else fmi2FreeFMUstate(instance, &states[s]);
+        if (!st->states[s]) continue;
+        if (st->owner[s] != i) {
+            void *kept = st->states[s];
+            REQUIRE(free_state(standard, instance, &st->states[s]) == ERROR && st->states[s] == kept);
+            continue;
+        }
+        st->stale = st->states[s];
+        if (free_own) REQUIRE(free_state(standard, instance, &st->states[s]) != ERROR);
+        st->states[s] = NULL;
     }
     if (standard == 3) fmi3FreeInstance(instance);
     else fmi2FreeInstance(instance);
+}
+
+/* A master's bug with states on instance i, which must be refused with an error. */
+static void foreign_state(Program *p, void *c, int standard, int i, int s, States *st) {
+    void *state = st->states[s];
+    switch (next_byte(p) % 4) {
+        case 0: /* fmusim 0.0.39: the state where &state belongs */
+            if (state && st->owner[s] == i) REQUIRE(free_state(standard, c, (void **)state) == ERROR);
+            break;
+        case 1: /* another instance's state */
+            if (state && st->owner[s] != i) {
+                REQUIRE(set_state(standard, c, state) == ERROR);
+                REQUIRE(get_state(standard, c, &st->states[s]) == ERROR && st->states[s] == state);
+                REQUIRE(free_state(standard, c, &st->states[s]) == ERROR && st->states[s] == state);
+            }
+            break;
+        case 2: /* a freed state */
+            state = st->stale;
+            if (state && !live_state_of(st, i, state)) {
+                REQUIRE(set_state(standard, c, state) == ERROR);
+                REQUIRE(free_state(standard, c, &state) == ERROR && state == st->stale);
+            }
+            break;
+        case 3: { /* any address */
+            uintptr_t address = 0;
+            for (size_t k = 0; k < sizeof(address); k++) address = address << 8 | next_byte(p);
+            state = (void *)address;
+            if (state && !live_state_of(st, i, state)) REQUIRE(set_state(standard, c, state) == ERROR);
+            break;
+        }
+    }
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     Program p = {data, size};
     void *instances[2] = {NULL, NULL};
     int standard[2] = {2, 2};
-    void *states[2] = {NULL, NULL};
+    States st = {{NULL, NULL}, {-1, -1}, NULL};
+    void **states = st.states;
     double time[2] = {0, 0};
     for (int count = 0; p.size && count < 256; count++) {
         const uint8_t op = next_byte(&p);
@@ -102,9 +176,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
         fmi2ValueReference vr[2] = {next_byte(&p) % (N_VARIABLES + 2), next_byte(&p) % (N_VARIABLES + 2)};
         double values[2] = {0, 0}, x[2] = {0, 0};
         fmi2Integer orders[2] = {1, 1};
-        const int operation = (op >> 2) % 18;
+        const int operation = (op >> 2) % 19;
+        const void *had = states[s];
+        if (c && operation == 18) {
+            foreign_state(&p, c, standard[i], i, s, &st);
+            continue;
+        }
         if (c && standard[i] == 3 && operation > 1) {
             fmi3_operation(&p, operation, c, &states[s], &time[i], vr);
+            if (!had && states[s]) st.owner[s] = i;
             continue;
         }
         switch (operation) {
@@ -125,7 +205,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
                 break;
             case 1:
                 if (c) {
-                    free_instance(c, standard[i], states);
+                    free_instance(&p, c, standard[i], i, &st);
                     instances[i] = NULL;
                 }
                 break;
@@ -142,7 +222,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
             }
             case 8: fmi2Terminate(c); break;
             case 9: fmi2Reset(c); time[i] = 0; break;
-            case 10: if (c && !states[s]) fmi2GetFMUstate(c, &states[s]); break;
+            case 10: if (c && !states[s] && fmi2GetFMUstate(c, &states[s]) == fmi2OK) st.owner[s] = i; break;
             case 11: if (c && states[s]) fmi2SetFMUstate(c, states[s]); break;
             case 12: values[0] = next_value(&p); orders[0] = next_byte(&p) % 4;
                      fmi2SetRealInputDerivatives(c, vr, 1, orders, values); break;
@@ -159,6 +239,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
         }
     }
     for (int i = 0; i < 2; i++)
-        if (instances[i]) free_instance(instances[i], standard[i], states);
+        if (instances[i]) free_instance(&p, instances[i], standard[i], i, &st);
     return 0;
 }

@@ -1,0 +1,573 @@
+"""Judge a result file from any tool against the independent reference, and name the mistake.
+
+    pendulum-fmu judge RESULT.csv --torque-file torque.csv [--step-size 0.001] [--map ...]
+    pendulum-fmu judge KIT          (every NAME_out.csv beside a scenario kit's inputs)
+
+A result is a CSV with a time column and theta, optionally omega and alpha (any names and units,
+through --map as compare's: theta=phi*0.0174532925). The verdict compares it with the
+independent reference (reference.reference: the signal read by its own reader, scipy DOP853 at
+1e-12) at the result's own times: pass when max |dtheta| <= the tolerance.
+
+A result that fails gets a diagnosis. Each candidate mistake is a variant of the run with that
+mistake made: the schedule a master should feed (torque_schedule.schedule) changed as the mistake changes
+it, integrated exactly (reference.reference_schedule) and compared with the result at the
+result's times. A candidate's residual is max |theta_result - theta_variant|: the mistake that
+explains the result leaves only rounding and solver noise (about 1e-11 rad). The candidates:
+
+- input one step late: step k holds what step k-1 should (the first step holds the signal's first
+  value, or the FMU's start value);
+- input one step early: step k holds what step k+1 should;
+- input interpolated linearly: each step ramps to the next step's value where the signal holds;
+- input held: each step holds where the run asked for a ramp (ramp runs only);
+- time grid drift: the master stepped on the result's own times, off the communication points,
+  sampling the signal there (only when the result's times are off the grid);
+- state not restored: from the last row that agrees, the run restarts from the initial state
+  (a resumed run that did not restore its saved FMU state);
+- integration error: the FMU's equation stepped by explicit or semi-implicit Euler at the
+  communication step (a master that integrates the Model Exchange interface itself).
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from . import results
+from .atomic_files import replacing
+from .errors import InvalidInput
+from .mapped_fmu import parse_map
+from .parameters import variables
+from .reference import equation_of_motion, reference, reference_schedule
+from .scenarios import JUDGE_TOLERANCE as DEFAULT_TOLERANCE, read_settings, settings_files
+from .simulate import resolve_parameters
+from .torque_schedule import TorqueSchedule, TorqueTable, event_tolerance, read_torque_csv, schedule
+
+AGREES = "agrees"
+LATE, EARLY = "input one step late", "input one step early"
+INTERPOLATED, HELD = "input interpolated linearly", "input held"
+DRIFT, NOT_RESTORED = "time grid drift", "state not restored"
+INTEGRATION, UNEXPLAINED = "integration error", "unexplained"
+DIAGNOSES = (AGREES, LATE, EARLY, INTERPOLATED, HELD, DRIFT, NOT_RESTORED, INTEGRATION, UNEXPLAINED)
+# The mistakes in how the input reaches the FMU: a solver's error must be small beside them.
+INPUT_TIMING = (LATE, EARLY, INTERPOLATED, HELD, DRIFT)
+
+# A candidate explains a result when its variant removes nearly all of the difference: its
+# residual is at most EXPLAINS of the raw difference, or below the noise floor of the comparison
+# (NOISE of the tolerance; a correct run leaves 1e-11 rad against the reference). A variant that
+# removes only part of it merely resembles the mistake made: explicit Euler lags like an input half
+# a step late, and with gravity off semi-implicit Euler is close to an input ramped over each step.
+# Measured on the deliberately wrong masters of tests/test_judge.py: the mistake made leaves at most
+# 1.2e-8 of the raw difference; the closest other candidate 3.3e-4 of it (semi-implicit Euler
+# against a ramped input, gravity off), the others 0.37 or more. 1e-5 sits between 1.2e-8 and
+# 3.3e-4, and the smallest residual decides among candidates under it.
+EXPLAINS = 1e-5
+NOISE = 0.1
+# A difference no candidate explains is an integration error when it grows as a solver's does:
+# no larger than explicit Euler's at the communication step (the crudest solver a master would
+# use), and at most INTEGRATION_SMALL of the smallest difference any input-timing mistake makes in
+# this run, so that no such mistake hides in it. Measured: Heun's method at the communication step
+# (second order) is 3.2e-3 and 6.4e-3 of the input-timing effects; an input late at one jump only
+# (no candidate of its own) 0.38. 0.05 sits between, about a decade from either.
+INTEGRATION_SMALL = 0.05
+RESULT_QUANTITIES = ("time", "theta", "omega", "alpha")
+OPTIONAL = ("omega", "alpha")
+
+
+class ResultFileError(InvalidInput):
+    """A result file, or a kit's folder, that cannot be judged; the message names the file, the
+    line and the problem."""
+
+
+@dataclass
+class Judgement:
+    """The verdict on one result and its diagnosis (see the module's docstring)."""
+
+    verdict: str
+    diagnosis: str
+    residual: float
+    max_abs_dtheta: float
+    worst_time: float
+    tolerance: float
+    # Per candidate: the residual of its best variant and how far that variant is from the
+    # reference (rad); None where the candidate does not apply to this run.
+    candidates: dict[str, dict | None]
+    # The smallest difference from the reference an input-timing variant that changes this run
+    # makes (rad; None when none does): an integration error must be small beside it.
+    smallest_input_effect: float | None
+    result: np.ndarray = field(repr=False)
+    reference: np.ndarray = field(repr=False)
+    # The variant the diagnosis names, at the result's times (None for agrees and unexplained).
+    explanation: np.ndarray | None = field(default=None, repr=False)
+    source: str = "result"
+
+    @property
+    def passed(self) -> bool:
+        return self.verdict == "pass"
+
+    def summary(self) -> dict:
+        """What --json writes: plain numbers, rad and s."""
+        worst = {}
+        for name in OPTIONAL:
+            given = self.result[name] if name in self.result.dtype.names else np.nan
+            if np.all(np.isfinite(given)):
+                worst[f"max_abs_d{name}"] = float(np.max(np.abs(given - self.reference[name])))
+        return {"result": self.source, "verdict": self.verdict, "diagnosis": self.diagnosis,
+                "residual": self.residual, "max_abs_dtheta": self.max_abs_dtheta, **worst,
+                "worst_time": self.worst_time, "tolerance": self.tolerance, "points": len(self.result),
+                "candidates": self.candidates, "smallest_input_effect": self.smallest_input_effect,
+                "units": {"residual": "rad", "max_abs_dtheta": "rad", "max_abs_domega": "rad/s",
+                          "max_abs_dalpha": "rad/s2", "worst_time": "s", "tolerance": "rad",
+                          "candidates": "rad", "smallest_input_effect": "rad"}}
+
+
+def read_result(path: str | Path, mapping: str | dict | None = None) -> np.ndarray:
+    """A result CSV as a result array (results.py); omega and alpha are NaN where it has none.
+
+    Parameters
+    ----------
+    path : str or Path
+        A CSV with a header: a time column and theta, optionally omega and alpha.
+    mapping : str or dict, optional
+        Their names and unit factors, as --map gives them: "time=t,theta=phi*0.0174532925".
+
+    Returns
+    -------
+    numpy.ndarray
+        Fields time (s), torque (NaN: not judged), theta (rad), omega (rad/s), alpha (rad/s2).
+
+    Raises
+    ------
+    ResultFileError
+        One line naming the file, the line and the problem: no time column, a mapped column
+        missing, a cell that is not a finite number, times that go backwards, no rows.
+    """
+    path = Path(path)
+    mapped = parse_map(mapping, RESULT_QUANTITIES) if not isinstance(mapping, dict) else mapping
+    try:
+        with open(path, newline="", encoding="utf-8-sig") as file:
+            rows = list(csv.reader(file))
+    except OSError as error:
+        raise ResultFileError(f"{path}: cannot read: {error.strerror}") from None
+    except UnicodeDecodeError:
+        raise ResultFileError(f"{path}: not UTF-8 text; save the result as a UTF-8 CSV") from None
+    numbered = [(number, row) for number, row in enumerate(rows, start=1) if any(c.strip() for c in row)]
+    if not numbered:
+        raise ResultFileError(f"{path}: the file is empty; expected a header such as time,theta")
+    header = [cell.strip() for cell in numbered[0][1]]
+    columns = {}
+    for quantity in RESULT_QUANTITIES:
+        given = mapped.get(quantity)
+        name = given.variable if given else quantity
+        if name in header:
+            columns[quantity] = (header.index(name), given.factor if given else 1.0)
+        elif given:
+            raise ResultFileError(f"{path}:1: no column {name!r}, which --map names for {quantity} "
+                                  f"(header is {','.join(header)})")
+        elif quantity not in OPTIONAL:
+            raise ResultFileError(f"{path}:1: no column {quantity!r} (header is {','.join(header)}); "
+                                  f"name the result's {quantity} column with --map {quantity}=NAME")
+    data = numbered[1:]
+    if not data:
+        raise ResultFileError(f"{path}: no data rows after the header")
+    out = results.empty(len(data))
+    out["torque"] = np.nan
+    for quantity in OPTIONAL:
+        out[quantity] = np.nan
+    for i, (number, row) in enumerate(data):
+        for quantity, (column, factor) in columns.items():
+            cell = row[column].strip() if column < len(row) else ""
+            try:
+                value = float(cell)
+            except ValueError:
+                raise ResultFileError(f"{path}:{number}: {quantity} {cell!r} is not a number") from None
+            if not math.isfinite(value):
+                raise ResultFileError(f"{path}:{number}: {quantity} is {cell}; values must be finite")
+            out[quantity][i] = value * factor
+        if i and out["time"][i] < out["time"][i - 1]:
+            raise ResultFileError(f"{path}:{number}: time {out['time'][i]:.17g} goes backwards (previous "
+                                  f"row: {out['time'][i - 1]:.17g}); a result's times must not decrease")
+    return out
+
+
+def _check_span(result: np.ndarray, plan: TorqueSchedule, step_size: float, source: str) -> None:
+    start, stop = float(plan.time[0]), float(plan.time[-1])
+    slack = float(event_tolerance(max(abs(start), abs(stop)), step_size))
+    if result["time"][0] < start - slack:
+        raise ResultFileError(f"{source}: time {result['time'][0]:.17g} is before the run's start "
+                              f"time {start:g} s; give the run's --start-time")
+    if result["time"][-1] > stop + slack:
+        raise ResultFileError(f"{source}: time {result['time'][-1]:.17g} is after the run's stop "
+                              f"time {stop:g} s; give the run's --stop-time")
+
+
+def _plan_index(plan: TorqueSchedule, times: np.ndarray, step_size: float) -> np.ndarray | None:
+    """For each time, the index of the communication point it is; None when one is off them."""
+    index = np.clip(np.searchsorted(plan.time, times), 1, len(plan.time) - 1)
+    index = np.where(np.abs(plan.time[index] - times) < np.abs(plan.time[index - 1] - times), index, index - 1)
+    on_grid = np.abs(plan.time[index] - times) <= event_tolerance(times, step_size)
+    return index if np.all(on_grid) else None
+
+
+def _changed(plan: TorqueSchedule, torque: np.ndarray, rate: np.ndarray | None = None) -> TorqueSchedule:
+    return TorqueSchedule(time=plan.time, torque=torque, torque_rate=plan.torque_rate if rate is None else rate)
+
+
+def _late(plan: TorqueSchedule, start_torque: float) -> list[TorqueSchedule]:
+    """Step k holds what step k-1 should; the first step the signal's first value or the FMU's
+    start value (whatever the master set before it began)."""
+    variants = []
+    for first in dict.fromkeys((float(plan.torque[0]), start_torque)):
+        first_rate = plan.torque_rate[0] if first == plan.torque[0] else 0.0
+        variants.append(_changed(plan, np.r_[first, plan.torque[:-1]],
+                                 np.r_[first_rate, plan.torque_rate[:-1]]))
+    return variants
+
+
+def _early(plan: TorqueSchedule) -> list[TorqueSchedule]:
+    return [_changed(plan, np.r_[plan.torque[1:], plan.torque[-1]], np.r_[plan.torque_rate[1:], 0.0])]
+
+
+def _interpolated(plan: TorqueSchedule) -> list[TorqueSchedule]:
+    """Each step ramps from its value to the next step's; the last one holds."""
+    return [_changed(plan, plan.torque, np.r_[np.diff(plan.torque) / plan.step_size[:-1], 0.0])]
+
+
+def _signal_values(torque, times: np.ndarray, side: str) -> np.ndarray | None:
+    """The signal just after (side "after") or before each time, sampled as a master would,
+    without the definition's snapping of events onto communication points; None for a per-step
+    array, which has no value between its steps."""
+    if isinstance(torque, (str, Path)):
+        torque = read_torque_csv(torque)
+    if isinstance(torque, TorqueTable):
+        return torque.value_after(times) if side == "after" else torque.value_before(times)
+    if callable(torque):
+        return np.array([float(torque(t)) for t in times.tolist()])
+    if isinstance(torque, (list, tuple, np.ndarray)):
+        return None
+    return np.full(len(times), float(torque))
+
+
+def _drifted(torque, times: np.ndarray, ramp: bool) -> list[TorqueSchedule]:
+    """The master's steps are the result's own times; each samples the signal at its start."""
+    points = np.unique(times)
+    start = _signal_values(torque, points[:-1], "after")
+    if start is None or len(points) < 2:
+        return []
+    rate = ((_signal_values(torque, points[1:], "before") - start) / np.diff(points) if ramp
+            else np.zeros(len(start)))
+    return [TorqueSchedule(time=points, torque=start, torque_rate=rate)]
+
+
+def _euler(plan: TorqueSchedule, acceleration, theta0: float, omega0: float, semi_implicit: bool) -> np.ndarray:
+    """The equation of motion stepped once per communication step, holding each step's start
+    torque: explicit Euler, or semi-implicit (the new omega moves theta)."""
+    out = results.empty(len(plan.time))
+    out["time"] = plan.time
+    theta, omega = theta0, omega0
+    for k, (h, u) in enumerate(zip(plan.step_size.tolist(), plan.torque.tolist())):
+        out["theta"][k], out["omega"][k] = theta, omega
+        alpha = acceleration(theta, omega, u)
+        if semi_implicit:
+            omega += h * alpha
+            theta += h * omega
+        else:
+            theta, omega = theta + h * omega, omega + h * alpha
+    out["theta"][-1], out["omega"][-1] = theta, omega
+    out["torque"][:-1], out["torque"][-1] = plan.torque, plan.torque[-1]
+    return out
+
+
+@dataclass
+class _Run:
+    """What every variant of one run needs."""
+
+    plan: TorqueSchedule
+    times: np.ndarray
+    step_size: float
+    parameters: dict
+    theta0: float
+    omega0: float
+    fmu_path: str | Path | None
+
+    def integrate(self, plan: TorqueSchedule, at: np.ndarray | None = None) -> np.ndarray:
+        """The schedule from the run's initial state, exactly, at the result's times (or at)."""
+        return reference_schedule(plan, parameters=self.parameters, theta0=self.theta0, omega0=self.omega0,
+                                  at=self.times if at is None else at, fmu_path=self.fmu_path)
+
+
+def _not_restored(run: _Run, correct: np.ndarray, first_wrong: int) -> list[np.ndarray]:
+    """Up to a point the reference; from there the run restarts from its initial state, as a
+    resumed run that did not restore its saved FMU state. The restart is where the first row that
+    disagrees is (it shows the initial state), or the row before it (it shows the old instance's
+    state, the next row the new one's)."""
+    variants = []
+    for restart_row in (first_wrong, first_wrong - 1):
+        if restart_row < 1:  # a restart at the very start is no restart
+            continue
+        restart = run.times[restart_row]
+        k = int(np.argmin(np.abs(run.plan.time - restart)))
+        off = abs(run.plan.time[k] - restart) > event_tolerance(restart, run.step_size)
+        if off or k + 1 >= len(run.plan.time):
+            continue
+        tail = TorqueSchedule(time=run.plan.time[k:], torque=run.plan.torque[k:],
+                              torque_rate=run.plan.torque_rate[k:])
+        variant = correct.copy()
+        variant[first_wrong:] = run.integrate(tail, at=run.times[first_wrong:])
+        variants.append(variant)
+    return variants
+
+
+def _integration(run: _Run) -> list[np.ndarray]:
+    index = _plan_index(run.plan, run.times, run.step_size)
+    if index is None:
+        return []
+    acceleration = equation_of_motion(run.parameters)
+    return [_euler(run.plan, acceleration, run.theta0, run.omega0, semi)[index] for semi in (False, True)]
+
+
+def _candidates(run: _Run, torque, held: TorqueSchedule | None, correct: np.ndarray, result: np.ndarray,
+                tolerance: float, start_torque: float) -> dict[str, list[np.ndarray]]:
+    """{candidate: its variants at the result's times}; an empty list where it does not apply.
+    held: for a ramp run, the same signal held over each step (schedule without ramp)."""
+    plan, ramp = run.plan, held is not None
+    off_grid = _plan_index(plan, run.times, run.step_size) is None
+    wrong = np.flatnonzero(np.abs(result["theta"] - correct["theta"]) > tolerance)
+    return {
+        LATE: [run.integrate(p) for p in _late(plan, start_torque)],
+        EARLY: [run.integrate(p) for p in _early(plan)],
+        INTERPOLATED: [] if ramp else [run.integrate(p) for p in _interpolated(plan)],
+        HELD: [run.integrate(held)] if ramp else [],
+        DRIFT: [run.integrate(p) for p in _drifted(torque, run.times, ramp)] if off_grid else [],
+        NOT_RESTORED: _not_restored(run, correct, int(wrong[0])) if len(wrong) else [],
+        INTEGRATION: _integration(run),
+    }
+
+
+def _diagnose(raw: float, tolerance: float, scores: dict[str, dict | None],
+              smallest_input_effect: float | None) -> tuple[str, float]:
+    """The candidate that explains the difference, or integration error, or unexplained."""
+    applicable = {name: score for name, score in scores.items() if score is not None}
+    best = min(applicable, key=lambda name: applicable[name]["residual"], default=None)
+    if best is not None and applicable[best]["residual"] <= max(EXPLAINS * raw, NOISE * tolerance):
+        # Variants the same to the noise are the same run: from rest at an equilibrium, a first step
+        # without torque and a restart from the initial state after it cannot be told apart. The
+        # earlier in DIAGNOSES, the commoner mistake, names it.
+        tied = [name for name in DIAGNOSES if name in applicable
+                and applicable[name]["residual"] <= applicable[best]["residual"] + NOISE * tolerance]
+        return tied[0], applicable[tied[0]]["residual"]
+    euler = applicable.get(INTEGRATION)
+    if (euler is not None and raw <= euler["effect"]
+            and (smallest_input_effect is None or raw <= INTEGRATION_SMALL * smallest_input_effect)):
+        return INTEGRATION, raw
+    return UNEXPLAINED, applicable[best]["residual"] if best is not None else raw
+
+
+def judge(result, torque, *, start_time: float = 0.0, stop_time: float | None = None,
+          step_size: float = 1e-3, ramp: bool = False, parameters: dict | None = None,
+          theta0: float = 0.0, omega0: float = 0.0, tolerance: float | None = None,
+          mapping: str | dict | None = None, fmu_path: str | Path | None = None,
+          max_steps: int | None = None) -> Judgement:
+    """Judge a result from any tool against the independent reference, and diagnose a failure.
+
+    Parameters
+    ----------
+    result : str, Path or numpy.ndarray
+        A result CSV (read_result) or an array with fields time and theta (omega, alpha: optional).
+    torque : float, callable, str or Path
+        The run's signal, as simulate() takes it: a constant (N.m), a callable of time or a
+        time,torque CSV (docs/signals.md).
+    start_time, stop_time, step_size, ramp, parameters, theta0, omega0, max_steps, fmu_path
+        The run's definition, as simulate() takes it.
+    tolerance : float, optional
+        The largest |dtheta| (rad) that passes (default: DEFAULT_TOLERANCE, 1e-9 rad).
+    mapping : str or dict, optional
+        The result's column names and unit factors (--map), for a CSV.
+
+    Returns
+    -------
+    Judgement
+        The verdict, the diagnosis and its residual, max |dtheta| and where, every candidate's
+        residual and effect.
+
+    Raises
+    ------
+    ResultFileError
+        A result file that cannot be read, or whose times fall outside the run.
+    InvalidInput
+        A tolerance that is not positive and finite, or a run definition simulate() would refuse.
+    """
+    tolerance = DEFAULT_TOLERANCE if tolerance is None else tolerance
+    if not (math.isfinite(tolerance) and tolerance > 0):
+        raise InvalidInput(f"the tolerance {tolerance} must be a positive finite number (rad)")
+    source = str(result) if isinstance(result, (str, Path)) else "result"
+    result = read_result(result, mapping) if isinstance(result, (str, Path)) else result
+    parameters = resolve_parameters(parameters, fmu_path)
+    plan = schedule(torque, start_time=start_time, stop_time=stop_time, step_size=step_size, ramp=ramp,
+                    max_steps=max_steps)
+    _check_span(result, plan, step_size, source)
+    times = np.asarray(result["time"], dtype=float)
+    correct = reference(torque, start_time=start_time, stop_time=stop_time, step_size=step_size, ramp=ramp,
+                        parameters=parameters, theta0=theta0, omega0=omega0, at=times, fmu_path=fmu_path)
+    difference = np.abs(result["theta"] - correct["theta"])
+    raw = float(np.max(difference))
+    worst_time = float(times[int(np.argmax(difference))])
+    run = _Run(plan, times, step_size, parameters, theta0, omega0, fmu_path)
+    start_torque = float(variables(fmu_path)["torque"].start or 0.0)
+    held = schedule(torque, start_time=start_time, stop_time=stop_time, step_size=step_size) if ramp else None
+    variants = _candidates(run, torque, held, correct, result, tolerance, start_torque)
+    scores, best_variant, timing_effects = {}, {}, []
+    for name, made in variants.items():
+        if not made:
+            scores[name] = None
+            continue
+        residuals = [float(np.max(np.abs(result["theta"] - v["theta"]))) for v in made]
+        effects = [float(np.max(np.abs(v["theta"] - correct["theta"]))) for v in made]
+        if name in INPUT_TIMING:
+            timing_effects += [effect for effect in effects if effect > tolerance]
+        i = int(np.argmin(residuals))
+        best_variant[name] = made[i]
+        scores[name] = {"residual": residuals[i], "effect": effects[i]}
+    smallest_input_effect = min(timing_effects, default=None)
+    if raw <= tolerance:
+        diagnosis, residual = AGREES, raw
+    else:
+        diagnosis, residual = _diagnose(raw, tolerance, scores, smallest_input_effect)
+    return Judgement(verdict="pass" if raw <= tolerance else "fail", diagnosis=diagnosis, residual=residual,
+                     max_abs_dtheta=raw, worst_time=worst_time, tolerance=tolerance, candidates=scores,
+                     smallest_input_effect=smallest_input_effect, result=result, reference=correct,
+                     explanation=best_variant.get(diagnosis) if diagnosis != AGREES else None, source=source)
+
+
+def format_judgement(judgement: Judgement) -> str:
+    """The lines the command prints for one result: verdict and diagnosis, max |dtheta| and
+    where, and every candidate's residual and effect.
+
+    Parameters
+    ----------
+    judgement : Judgement
+        What judge() returned.
+
+    Returns
+    -------
+    str
+        The lines, joined.
+    """
+    lines = [f"{judgement.source}: {judgement.verdict}: {judgement.diagnosis} (residual "
+             f"{judgement.residual:.2e} rad)",
+             f"max |dtheta| = {judgement.max_abs_dtheta:.3e} rad at t = {judgement.worst_time!r} s "
+             f"(tolerance {judgement.tolerance:g} rad; {len(judgement.result)} points)",
+             f"{'candidate':<28} {'residual rad':>12} {'effect rad':>11}"]
+    for name, score in judgement.candidates.items():
+        if score is None:
+            lines.append(f"{name:<28} {'does not apply to this run':>24}")
+        else:
+            lines.append(f"{name:<28} {score['residual']:>12.2e} {score['effect']:>11.2e}")
+    return "\n".join(lines)
+
+
+def format_kit(verdicts: dict[str, Judgement | None]) -> str:
+    """The lines the command prints for a kit: one per scenario, then how many pass.
+
+    Parameters
+    ----------
+    verdicts : dict
+        What judge_kit() returned: {scenario: Judgement, or None where it was not run}.
+
+    Returns
+    -------
+    str
+        The lines, joined.
+    """
+    lines = []
+    for name, judgement in verdicts.items():
+        if judgement is None:
+            lines.append(f"{name:<18} not run: no {name}_out.csv")
+        else:
+            lines.append(f"{name:<18} {judgement.verdict:<4}  {judgement.diagnosis:<28} max|dtheta| "
+                         f"{judgement.max_abs_dtheta:.2e} rad at t = {judgement.worst_time:.6g} s, "
+                         f"residual {judgement.residual:.1e} rad")
+    judged = [judgement for judgement in verdicts.values() if judgement is not None]
+    not_run = len(verdicts) - len(judged)
+    lines.append(f"{sum(j.passed for j in judged)} of {len(judged)} results pass"
+                 + (f"; {not_run} scenarios not run" if not_run else ""))
+    return "\n".join(lines)
+
+
+def judge_kit(folder: str | Path, *, tolerance: float | None = None, mapping: str | None = None,
+              fmu_path: str | Path | None = None) -> dict[str, Judgement | None]:
+    """Judge every NAME_out.csv beside the settings NAME.json of a scenario kit (scenarios.py).
+
+    Parameters
+    ----------
+    folder : str or Path
+        The kit's folder, as `pendulum-fmu scenarios` wrote it.
+    tolerance : float, optional
+        Overrides each scenario's own tolerance (rad).
+    mapping, fmu_path
+        As judge() takes them.
+
+    Returns
+    -------
+    dict
+        {scenario: Judgement, or None where the folder has no NAME_out.csv}, in the kit's order.
+
+    Raises
+    ------
+    ResultFileError
+        A folder that holds no scenario, or none with a result.
+    """
+    folder = Path(folder)
+    found = settings_files(folder)
+    if not found:
+        raise ResultFileError(f"{folder}: no scenario settings (NAME.json) in this folder; write a kit "
+                              "with pendulum-fmu scenarios --output-dir FOLDER")
+    verdicts = {}
+    for name, settings_path in found.items():
+        settings = read_settings(settings_path)
+        output = folder / settings.pop("output")
+        if not output.is_file():
+            verdicts[name] = None
+            continue
+        if tolerance is not None:
+            settings["tolerance"] = tolerance
+        verdicts[name] = judge(output, mapping=mapping, fmu_path=fmu_path, **settings)
+    if all(v is None for v in verdicts.values()):
+        raise ResultFileError(f"{folder}: no result to judge: run each scenario and write NAME_out.csv "
+                              f"(time,theta[,omega,alpha]) beside its NAME_in.csv, e.g. "
+                              f"{next(iter(found))}_out.csv")
+    return verdicts
+
+
+def write_json(verdicts: dict[str, Judgement | None] | Judgement, path: str | Path) -> Path:
+    """Write --json whole or not at all: one judgement's summary (Judgement.summary), or
+    {"scenarios": {name: summary or null}} for a kit.
+
+    Parameters
+    ----------
+    verdicts : Judgement or dict
+        What judge() or judge_kit() returned.
+    path : str or Path
+        The JSON file.
+
+    Returns
+    -------
+    Path
+        path.
+    """
+    if isinstance(verdicts, Judgement):
+        content = verdicts.summary()
+    else:
+        content = {"scenarios": {name: j.summary() if j else None for name, j in verdicts.items()}}
+    with replacing(path) as file:
+        json.dump(content, file, indent=2)
+        file.write("\n")
+    return Path(path)
+
+
+__all__ = ["DIAGNOSES", "Judgement", "ResultFileError", "format_judgement", "format_kit",
+           "judge", "judge_kit", "read_result", "write_json"]

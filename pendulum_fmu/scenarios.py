@@ -1,0 +1,376 @@
+"""A kit for testing a master with this FMU: scenarios with their input, settings and reference.
+
+    pendulum-fmu scenarios --output-dir kit
+
+writes into kit/:
+- Pendulum.fmu: the FMU, carrying the kit as FMI-LS-REF related files (below);
+- per scenario NAME: NAME_in.csv, the torque (time,torque in fmpy's convention, docs/signals.md);
+  NAME.json, the settings (start, stop, communication step, every parameter, the initial state,
+  whether the torque ramps, where a run resumes from a saved state); NAME_ref.csv, the independent
+  reference (reference.reference) at every communication point: time,torque,theta,omega,alpha;
+- ReadMe.md: what a master's vendor does with it.
+
+A master runs each scenario and writes NAME_out.csv beside its input; `pendulum-fmu judge kit`
+judges each one (judge.py).
+
+FMI-LS-REF, the layered standard for related files in an FMU, followed as of its v1.0.0-beta.1
+(github.com/modelica/fmi-ls-ref, tag v1.0.0-beta.1, 2026-07-01): the FMU carries
+extra/org.fmi-standard.fmi-ls-ref/fmi-ls-manifest.xml, whose Related elements name the
+experiments file (role experiment/validation), each scenario's parameter set (role parameter, an
+SSV file of SSP 1.0 that also sets the start values of theta and omega), settings (role
+configuration) and reference (role result), each labelled scenario:NAME; and
+documentation/fmi-ls-ref.txt, as the standard recommends. Where it departs:
+- The experiments file's format is now MA-HS-Experiments (application/x-ma-hs-experiments), a
+  separate specification this project could not obtain; the file follows the format FMI-LS-REF
+  itself defined until it moved out (its appendix A, removed in commit cd7d904, 2026-06-17):
+  Experiments/Experiment with startTime, stopTime, stepSize, tolerance and Parameters, Stimuli
+  and References sources.
+- That format has no place for what the judge needs besides: whether the torque ramps (input
+  derivatives) and where a run is stopped and resumed. NAME.json carries them (and everything
+  else), and each experiment's description says them in words.
+- The standard's own table gives fmi-ls-version as 1.0.0-alpha.1 even in the beta.1 text; the
+  manifest says 1.0.0-beta.1, the version followed.
+"""
+
+from __future__ import annotations
+
+import json
+import zipfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from xml.etree import ElementTree
+
+import numpy as np
+
+from . import __version__, results
+from .atomic_files import replacing, replacing_path
+from .errors import InvalidInput
+from .parameters import START_VALUES, fmu_file, model_description
+from .reference import reference
+from .simulate import resolve_parameters
+
+LS_REF_NAME = "org.fmi-standard.fmi-ls-ref"
+LS_REF_VERSION = "1.0.0-beta.1"
+LS_REF_FOLDER = f"extra/{LS_REF_NAME}/"
+LS_REF_DOCUMENTATION = "documentation/fmi-ls-ref.txt"
+EXPERIMENTS_FILE = "scenarios.exp"
+EXPERIMENTS_TYPE = "application/x-ma-hs-experiments"
+SSV_NAMESPACE = "http://ssp-standard.org/SSP1/SystemStructureParameterValues"
+# The tolerance the kit's FMU is run at (its own default); the judge's, in rad.
+RELATIVE_TOLERANCE, JUDGE_TOLERANCE = 1e-10, 1e-9
+KIT_FMU = "Pendulum.fmu"
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """One run of the kit: its torque rows (s, N.m) and the rest of its definition."""
+
+    name: str
+    description: str
+    rows: tuple[tuple[float, float], ...]
+    stop_time: float
+    step_size: float
+    parameters: dict = field(default_factory=dict)  # overrides of the FMU's defaults
+    theta0: float = 0.0
+    omega0: float = 0.0
+    ramp: bool = False
+    resume_time: float | None = None
+    start_time: float = 0.0
+
+
+def _random_steps(seed: int, stop_time: float, amplitude: float) -> tuple[tuple[float, float], ...]:
+    """Levels in -amplitude..amplitude N.m (to the mN.m), jumping at random times on the ms grid
+    50 to 400 ms apart."""
+    rng = np.random.default_rng(seed)
+    jumps_ms = np.cumsum(rng.integers(50, 400, size=int(stop_time * 20) + 1))
+    jumps = [int(ms) / 1000 for ms in jumps_ms if ms < stop_time * 1000]
+    levels = [round(float(level), 3) for level in rng.uniform(-amplitude, amplitude, len(jumps) + 1)]
+    rows = [(0.0, levels[0])]
+    for t, before, after in zip(jumps, levels, levels[1:]):
+        rows += [(t, before), (t, after)]
+    return tuple(rows + [(stop_time, levels[-1])])
+
+
+SCENARIOS = (
+    Scenario("constant_torque", "The OpenSim tutorial's case: 20 N.m from rest, gravity on, 3 s in 1 ms "
+             "steps.", ((0.0, 20.0), (3.0, 20.0)), stop_time=3.0, step_size=1e-3),
+    Scenario("steps_on_grid", "Jumps on communication points (0, 40 N.m from 0.5 s, -40 from 1.5 s, 10 "
+             "from 2.5 s), gravity off so theta is a parabola between jumps, from theta = 0.2 rad and "
+             "omega = -0.5 rad/s; 1 ms steps. At a jump, the step that starts there holds the value "
+             "after it.",
+             ((0.0, 0.0), (0.5, 0.0), (0.5, 40.0), (1.5, 40.0), (1.5, -40.0), (2.5, -40.0), (2.5, 10.0),
+              (3.0, 10.0)), stop_time=3.0, step_size=1e-3, parameters={"gravity": 0.0}, theta0=0.2,
+             omega0=-0.5),
+    Scenario("random_steps", "A random level in -40..40 N.m, jumping every 50 to 400 ms on the ms grid, "
+             "4 s in 1 ms steps, with damping 0.5 N.m.s/rad, from theta = 0.3 rad and omega = -0.5 "
+             "rad/s.", _random_steps(25, 4.0, 40.0), stop_time=4.0, step_size=1e-3,
+             parameters={"damping": 0.5}, theta0=0.3, omega0=-0.5),
+    Scenario("decimal_steps", "9 ms steps with jumps at 0.027, 0.333 and 0.45 s: decimals that are no "
+             "binary fractions (3 x 0.009 is 0.026999999999999996 in binary), so a master that "
+             "compares times for equality or sums its steps misses them; 0.9 s.",
+             ((0.0, 10.0), (0.027, 10.0), (0.027, -20.0), (0.333, -20.0), (0.333, 30.0), (0.45, 30.0),
+              (0.45, 5.0), (0.9, 5.0)), stop_time=0.9, step_size=0.009),
+    Scenario("ramp", "The torque is the CSV's own line, kinks on communication points: each 10 ms step "
+             "ramps, so a master sends the slope with fmi2SetRealInputDerivatives (order 1) before "
+             "each fmi2DoStep; 3 s.",
+             ((0.0, 0.0), (0.5, 40.0), (1.5, -40.0), (2.5, 20.0), (3.0, 20.0)), stop_time=3.0,
+             step_size=0.01, ramp=True),
+    Scenario("resume", "Stopped at 1.5 s and resumed through a saved FMU state: take the state there "
+             "(fmi2GetFMUstate, and fmi2SerializeFMUstate to keep it), free the instance, restore the "
+             "state into a new one (fmi2DeSerializeFMUstate, fmi2SetFMUstate) and go on to 3 s, setting "
+             "the torque again: it jumps from 20 to -20 N.m at 1.5 s. From theta = -0.2 rad and omega = 1 "
+             "rad/s, 1 ms steps. The result equals an uninterrupted run.",
+             ((0.0, 20.0), (1.5, 20.0), (1.5, -20.0), (3.0, -20.0)), stop_time=3.0, step_size=1e-3,
+             theta0=-0.2, omega0=1.0, resume_time=1.5),
+)
+
+
+def _csv_text(header: tuple[str, ...], rows) -> str:
+    return ",".join(header) + "\n" + "".join(",".join(repr(float(v)) for v in row) + "\n" for row in rows)
+
+
+def _settings(scenario: Scenario, parameters: dict) -> dict:
+    name = scenario.name
+    return {"name": name, "description": scenario.description, "fmu": KIT_FMU,
+            "input": f"{name}_in.csv", "reference": f"{name}_ref.csv", "output": f"{name}_out.csv",
+            "start_time": scenario.start_time, "stop_time": scenario.stop_time,
+            "step_size": scenario.step_size, "ramp": scenario.ramp, "resume_time": scenario.resume_time,
+            "parameters": parameters, "theta0": scenario.theta0, "omega0": scenario.omega0,
+            "relative_tolerance": RELATIVE_TOLERANCE, "tolerance": JUDGE_TOLERANCE,
+            "units": {**results.UNITS, "step_size": "s", "tolerance": "rad"}}
+
+
+def read_settings(path: str | Path) -> dict:
+    """A scenario's settings as judge()'s keyword arguments.
+
+    Parameters
+    ----------
+    path : str or Path
+        The scenario's NAME.json.
+
+    Returns
+    -------
+    dict
+        torque (the input's path), start_time, stop_time, step_size, ramp, parameters, theta0,
+        omega0, tolerance; and output, the name of the result file a master writes.
+
+    Raises
+    ------
+    InvalidInput
+        One line naming the file and what is wrong with it.
+    """
+    path = Path(path)
+    try:
+        settings = json.loads(path.read_text(encoding="utf-8"))
+        return {"torque": path.parent / settings["input"], "output": settings["output"],
+                **{key: settings[key] for key in ("start_time", "stop_time", "step_size", "ramp",
+                                                  "parameters", "theta0", "omega0", "tolerance")}}
+    except (json.JSONDecodeError, UnicodeDecodeError) as error:
+        raise InvalidInput(f"{path}: not a scenario's settings: {error}") from None
+    except OSError as error:
+        raise InvalidInput(f"{path}: cannot read: {error.strerror}") from None
+    except (KeyError, TypeError) as error:
+        raise InvalidInput(f"{path}: not a scenario's settings: no {error}; write the kit again with "
+                           "pendulum-fmu scenarios") from None
+
+
+def settings_files(folder: str | Path) -> dict[str, Path]:
+    """The scenarios in a folder: each NAME.json with a NAME_in.csv beside it.
+
+    Parameters
+    ----------
+    folder : str or Path
+        A kit's folder.
+
+    Returns
+    -------
+    dict
+        {scenario: its NAME.json}, by name.
+    """
+    folder = Path(folder)
+    return {path.stem: path for path in sorted(folder.glob("*.json"))
+            if (folder / f"{path.stem}_in.csv").is_file()}
+
+
+def _ssv(scenario: Scenario, parameters: dict) -> bytes:
+    """The parameter set and initial state as an SSV file (SSP 1.0); theta and omega are the
+    FMU's own variables, so the set applies as-is."""
+    ElementTree.register_namespace("ssv", SSV_NAMESPACE)
+    tag = lambda name: f"{{{SSV_NAMESPACE}}}{name}"  # noqa: E731
+    root = ElementTree.Element(tag("ParameterSet"), {"version": "1.0", "name": scenario.name})
+    listed = ElementTree.SubElement(root, tag("Parameters"))
+    values = {**parameters, START_VALUES["theta0"]: scenario.theta0, START_VALUES["omega0"]: scenario.omega0}
+    for name, value in values.items():
+        parameter = ElementTree.SubElement(listed, tag("Parameter"), {"name": name})
+        ElementTree.SubElement(parameter, tag("Real"), {"value": repr(float(value))})
+    return _xml(root)
+
+
+def _xml(root: ElementTree.Element) -> bytes:
+    ElementTree.indent(root)
+    return ElementTree.tostring(root, encoding="UTF-8", xml_declaration=True) + b"\n"
+
+
+def _description(scenario: Scenario) -> str:
+    how = "ramped with first-order input derivatives" if scenario.ramp else "held over each step"
+    resume = (f"; stop at {scenario.resume_time:g} s and resume from the saved FMU state"
+              if scenario.resume_time is not None else "")
+    return f"{scenario.description} Torque {how}{resume}; settings in {scenario.name}.json."
+
+
+def _experiments() -> bytes:
+    root = ElementTree.Element("Experiments", {
+        "name": "pendulum-fmu scenarios",
+        "description": f"Runs that test a master with this FMU (pendulum_fmu {__version__}): judge a "
+                       "result with pendulum-fmu judge"})
+    for scenario in SCENARIOS:
+        experiment = ElementTree.SubElement(root, "Experiment", {
+            "name": scenario.name, "description": _description(scenario),
+            "startTime": repr(scenario.start_time), "stopTime": repr(scenario.stop_time),
+            "stepSize": repr(scenario.step_size), "tolerance": repr(RELATIVE_TOLERANCE)})
+        ElementTree.SubElement(experiment, "Parameters", {"source": f"{scenario.name}.ssv"})
+        ElementTree.SubElement(experiment, "Stimuli", {"source": f"{scenario.name}_in.csv"})
+        ElementTree.SubElement(experiment, "References", {"source": f"{scenario.name}_ref.csv"})
+    return _xml(root)
+
+
+def _manifest() -> bytes:
+    namespace = "http://fmi-standard.org/fmi-ls-manifest"
+    ElementTree.register_namespace("fmi-ls", namespace)
+    root = ElementTree.Element("fmiReferences", {
+        f"{{{namespace}}}fmi-ls-name": LS_REF_NAME, f"{{{namespace}}}fmi-ls-version": LS_REF_VERSION,
+        f"{{{namespace}}}fmi-ls-description": "Layered Standard providing information on related files "
+                                               "included in an FMU."})
+    ElementTree.SubElement(root, "Related", {
+        "type": EXPERIMENTS_TYPE, "source": EXPERIMENTS_FILE, "role": "experiment/validation",
+        "description": "Scenarios that test a master with this FMU, each with its stimuli and reference"})
+    for scenario in SCENARIOS:
+        for suffix, kind, role, what in ((".ssv", "application/x-ssp-parameter-set", "parameter",
+                                          "parameters and initial state"),
+                                         (".json", "application/json", "configuration", "settings"),
+                                         ("_ref.csv", "text/csv", "result", "reference result")):
+            related = ElementTree.SubElement(root, "Related", {
+                "type": kind, "source": f"{scenario.name}{suffix}", "role": role,
+                "description": f"{scenario.name}: {what}"})
+            ElementTree.SubElement(related, "Label", {"name": f"scenario:{scenario.name}"})
+    return _xml(root)
+
+
+def _readme(steps: dict[str, int]) -> str:
+    rows = "\n".join(f"| `{s.name}` | {s.description} | {steps[s.name]:,} | {'ramp' if s.ramp else 'held'} |"
+                     for s in SCENARIOS)
+    return f"""# Scenarios for a master running the pendulum FMU (pendulum_fmu {__version__})
+
+Each scenario is a run of `{KIT_FMU}` (FMI 2.0, Co-Simulation or Model Exchange) under a torque
+signal. Run it in your master, write what it gives, and let `pendulum-fmu judge` say whether your
+master handed the FMU the signal that was meant and, when not, what it did.
+
+| scenario | what it tests | steps | torque |
+|---|---|---|---|
+{rows}
+
+For each scenario NAME:
+
+1. Read `NAME.json`: `start_time`, `stop_time` and `step_size` (s, the communication step),
+   `parameters` (set them before initialization, or apply `NAME.ssv` from the FMU's
+   `{LS_REF_FOLDER}`), `theta0` and `omega0` (the start values of `theta` and `omega`),
+   `relative_tolerance` for `fmi2SetupExperiment`, `ramp`, and `resume_time`.
+2. Feed `torque` from `NAME_in.csv`: columns time (s), torque (N.m), linear between rows, a jump
+   where a time repeats (the step that starts at the jump holds the value after it), held before
+   the first row and after the last. Communication points are start + k * step_size (a product,
+   not a running sum); a time in the file within a billionth of a step of one is that point.
+   With `"ramp": false` each step holds the value just after its start. With `"ramp": true` each
+   step ramps: set the value at its start with `fmi2SetReal` and the slope with
+   `fmi2SetRealInputDerivatives` (order 1) before `fmi2DoStep`.
+3. With a `resume_time`, stop there, keep the FMU state (`fmi2GetFMUstate`, and
+   `fmi2SerializeFMUstate` to store it), free the instance, restore the state into a new one
+   (`fmi2DeSerializeFMUstate`, `fmi2SetFMUstate`) and go on, setting the torque again.
+4. Write `NAME_out.csv` beside `NAME_in.csv`: a header `time,theta` (omega and alpha may follow),
+   a row per communication point from the start, every number with 17 significant digits. Other
+   names or units: tell the judge with `--map time=t,theta=phi*0.0174532925`.
+
+Then, in this folder:
+
+    pendulum-fmu judge .
+
+prints one line per scenario: pass or fail (max |theta - reference| against `tolerance`, 1e-9 rad),
+and for a failure the mistake that explains it (input one step late or early, interpolated where
+it holds, held where it ramps, time grid drift, state not restored, integration error), with its
+residual. `pendulum-fmu judge NAME_out.csv` with the scenario's options (`--torque-file
+NAME_in.csv --step-size ... --set ...`) gives the full table, `--plot` a figure, `--json` the
+numbers. `NAME_ref.csv` holds the reference itself: time (s), torque (N.m), theta (rad), omega
+(rad/s), alpha (rad/s2) at every communication point, from scipy (DOP853, tolerance 1e-12).
+
+`{KIT_FMU}` carries the same files under `{LS_REF_FOLDER}` as related files of the FMI layered
+standard FMI-LS-REF {LS_REF_VERSION}: `fmi-ls-manifest.xml`, the experiments file
+`{EXPERIMENTS_FILE}`, and per scenario its parameter set, settings, input and reference.
+"""
+
+
+def _write(path: Path, text: str) -> None:
+    with replacing(path, newline="") as file:
+        file.write(text)
+
+
+def write_scenarios(output_dir: str | Path, fmu_path: str | Path | None = None) -> list[Path]:
+    """Write the scenario kit (see the module's docstring).
+
+    Parameters
+    ----------
+    output_dir : str or Path
+        The kit's folder; results a user put there (NAME_out.csv) are left alone.
+    fmu_path : str or Path, optional
+        The FMI 2.0 FMU to carry and whose parameters apply (default: pendulum_fmu.default_fmu()).
+
+    Returns
+    -------
+    list of Path
+        The files written.
+
+    Raises
+    ------
+    InvalidInput
+        An FMU that is not FMI 2.0 (the ramp scenario needs input derivatives).
+    """
+    fmu = fmu_file(fmu_path)
+    version = model_description(fmu).fmiVersion
+    if version != "2.0":
+        raise InvalidInput(f"{fmu} is FMI {version}: the kit is for the FMI 2.0 FMU (its ramp scenario "
+                           "needs input derivatives)")
+    folder = Path(output_dir)
+    written, carried, steps = [], {}, {}
+    for scenario in SCENARIOS:
+        name = scenario.name
+        parameters = resolve_parameters(scenario.parameters, fmu)
+        signal = folder / f"{name}_in.csv"
+        files = {signal.name: _csv_text(("time", "torque"), scenario.rows)}
+        _write(signal, files[signal.name])
+        # The reference reads the input file itself, as a master does.
+        solution = reference(signal, start_time=scenario.start_time,
+                             stop_time=scenario.stop_time, step_size=scenario.step_size,
+                             ramp=scenario.ramp, parameters=parameters, theta0=scenario.theta0,
+                             omega0=scenario.omega0, fmu_path=fmu)
+        steps[name] = len(solution) - 1
+        files[f"{name}_ref.csv"] = _csv_text(results.FIELDS, (tuple(row) for row in solution.tolist()))
+        files[f"{name}.json"] = json.dumps(_settings(scenario, parameters), indent=2) + "\n"
+        for file_name, text in files.items():
+            if file_name != signal.name:
+                _write(folder / file_name, text)
+            written.append(folder / file_name)
+            carried[LS_REF_FOLDER + file_name] = text.encode()
+        carried[f"{LS_REF_FOLDER}{name}.ssv"] = _ssv(scenario, parameters)
+    readme = _readme(steps)
+    carried.update({f"{LS_REF_FOLDER}fmi-ls-manifest.xml": _manifest(),
+                    LS_REF_FOLDER + EXPERIMENTS_FILE: _experiments(), LS_REF_DOCUMENTATION: readme.encode()})
+    _write(folder / "ReadMe.md", readme)
+    written.append(folder / "ReadMe.md")
+    kit_fmu = folder / KIT_FMU
+    with zipfile.ZipFile(fmu) as original, replacing_path(kit_fmu) as partial:
+        with zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as archive:
+            for item in original.infolist():
+                # A kit FMU given as the source: its old kit files give way to the new ones.
+                if not (item.filename.startswith(LS_REF_FOLDER) or item.filename == LS_REF_DOCUMENTATION):
+                    archive.writestr(item, original.read(item))
+            for name, content in carried.items():
+                archive.writestr(name, content)
+    return [kit_fmu, *written]

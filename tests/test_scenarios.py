@@ -1,0 +1,198 @@
+"""The scenario kit: its files, its FMI-LS-REF layout, its references against the analytic
+solution, and every scenario run through fmpy (a master on FMU2Slave, benchmarks/masters.py, and
+simulate_fmu) and through this package's own native loop, each judged a pass."""
+
+import json
+import re
+import shutil
+import zipfile
+from fractions import Fraction
+from xml.etree import ElementTree
+
+import numpy as np
+import pytest
+from fmpy import simulate_fmu
+from fmpy.validation import validate_fmu
+
+from benchmarks.masters import run
+from pendulum_fmu import cs_loop
+from pendulum_fmu.cli import main
+from pendulum_fmu.judge import AGREES, judge, judge_kit
+from pendulum_fmu.parameters import default_parameters, total_inertia
+from pendulum_fmu.scenarios import (KIT_FMU, LS_REF_FOLDER, LS_REF_VERSION, SCENARIOS, read_settings,
+                                    write_scenarios)
+from pendulum_fmu.simulate import open_fmu, run_schedule
+from pendulum_fmu.torque_schedule import TorqueSchedule, schedule
+
+NAMES = [s.name for s in SCENARIOS]
+# The role values of the FMI-LS-REF 1.0.0-beta.1 schema (fmi3LayeredStandardReferenceManifest.xsd).
+ROLE = re.compile(r"(document|requirement|specification|model|parameter|system|testcase|"
+                  r"experiment(/(smoke-test|validation|uncertainty-analysis))?|result|method|rationale|"
+                  r"report|request|delivery|configuration|signature|serialized-state(/.*)?|meta-data|other)")
+LS = "{http://fmi-standard.org/fmi-ls-manifest}"
+SSV = "{http://ssp-standard.org/SSP1/SystemStructureParameterValues}"
+
+
+@pytest.fixture(scope="module")
+def kit(tmp_path_factory, fmu):
+    folder = tmp_path_factory.mktemp("kit")
+    write_scenarios(folder, fmu)
+    return folder
+
+
+def _judged(kit, name):
+    settings = read_settings(kit / f"{name}.json")
+    return judge(kit / settings.pop("output"), **settings)
+
+
+def test_the_kit_has_every_scenario_the_issue_asks_for(kit):
+    assert set(NAMES) == {"constant_torque", "steps_on_grid", "random_steps", "decimal_steps", "ramp", "resume"}
+    for name in NAMES:
+        settings = json.loads((kit / f"{name}.json").read_text())
+        for key in ("start_time", "stop_time", "step_size", "parameters", "theta0", "omega0", "ramp"):
+            assert key in settings
+        assert set(settings["parameters"]) == set(default_parameters())
+        reference = np.genfromtxt(kit / f"{name}_ref.csv", delimiter=",", names=True)
+        assert reference.dtype.names == ("time", "torque", "theta", "omega", "alpha")
+        steps = round((settings["stop_time"] - settings["start_time"]) / settings["step_size"])
+        assert len(reference) == steps + 1 and reference["time"][-1] == settings["stop_time"]
+    assert json.loads((kit / "ramp.json").read_text())["ramp"] is True
+    assert json.loads((kit / "resume.json").read_text())["resume_time"] == 1.5
+    # Decimal jump times that no binary fraction is: 0.027 is not 3 * 0.009 in doubles.
+    assert 3 * 0.009 != 0.027 and "0.027," in (kit / "decimal_steps_in.csv").read_text()
+
+
+def test_steps_on_grid_reference_is_the_analytic_solution(kit):
+    """Gravity off: theta is theta0 + omega0 t + the double integral of the held torque / I."""
+    settings = json.loads((kit / "steps_on_grid.json").read_text())
+    rows = [line.split(",") for line in (kit / "steps_on_grid_in.csv").read_text().split()[1:]]
+    jumps = [(Fraction(t), float(u)) for (t, _), (t2, u) in zip(rows, rows[1:]) if t == t2]
+    inertia = total_inertia(settings["parameters"])
+    alphas = [float(rows[0][1]) / inertia] + [u / inertia for _, u in jumps]
+    reference = np.genfromtxt(kit / "steps_on_grid_ref.csv", delimiter=",", names=True)
+    for t, theta in zip(reference["time"][::97], reference["theta"][::97]):
+        exact = settings["theta0"] + settings["omega0"] * t + alphas[0] * t ** 2 / 2
+        for (when, _), before, after in zip(jumps, alphas, alphas[1:]):
+            if float(when) <= t:  # from a jump on, the change of alpha adds its own parabola
+                exact += (after - before) * (t - float(when)) ** 2 / 2
+        assert abs(theta - exact) < 1e-12, t
+
+
+def test_the_fmu_carries_the_kit_as_fmi_ls_ref(kit):
+    with zipfile.ZipFile(kit / KIT_FMU) as fmu:
+        names = set(fmu.namelist())
+        manifest = ElementTree.fromstring(fmu.read(LS_REF_FOLDER + "fmi-ls-manifest.xml"))
+        experiments = ElementTree.fromstring(fmu.read(LS_REF_FOLDER + "scenarios.exp"))
+        ssv = ElementTree.fromstring(fmu.read(LS_REF_FOLDER + "resume.ssv"))
+        for name in NAMES:  # the files beside the FMU, byte for byte
+            for suffix in ("_in.csv", ".json", "_ref.csv"):
+                assert fmu.read(f"{LS_REF_FOLDER}{name}{suffix}") == (kit / f"{name}{suffix}").read_bytes()
+    assert "documentation/fmi-ls-ref.txt" in names and "modelDescription.xml" in names
+    assert manifest.tag == "fmiReferences"
+    assert manifest.get(f"{LS}fmi-ls-name") == "org.fmi-standard.fmi-ls-ref"
+    assert manifest.get(f"{LS}fmi-ls-version") == LS_REF_VERSION == "1.0.0-beta.1"
+    related = manifest.findall("Related")
+    assert {r.get("role") for r in related} == {"experiment/validation", "parameter", "configuration", "result"}
+    for item in related:
+        assert ROLE.fullmatch(item.get("role")) and LS_REF_FOLDER + item.get("source") in names
+    experiment = {e.get("name"): e for e in experiments.findall("Experiment")}
+    assert list(experiment) == NAMES
+    for name in NAMES:
+        settings = json.loads((kit / f"{name}.json").read_text())
+        assert float(experiment[name].get("stepSize")) == settings["step_size"]
+        assert float(experiment[name].get("stopTime")) == settings["stop_time"]
+        for element, suffix in (("Parameters", ".ssv"), ("Stimuli", "_in.csv"), ("References", "_ref.csv")):
+            assert experiment[name].find(element).get("source") == f"{name}{suffix}"
+    values = {p.get("name"): float(p.find(f"{SSV}Real").get("value")) for p in ssv.iter(f"{SSV}Parameter")}
+    assert values == {**default_parameters(), "theta": -0.2, "omega": 1.0}
+    assert validate_fmu(str(kit / KIT_FMU)) == []
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_an_fmpy_master_passes_every_scenario(kit, name):
+    run(kit, name)
+    judgement = _judged(kit, name)
+    assert judgement.passed and judgement.diagnosis == AGREES
+    assert judgement.max_abs_dtheta < 1e-10
+
+
+@pytest.mark.parametrize("name", ["constant_torque", "steps_on_grid", "random_steps", "decimal_steps"])
+def test_fmpy_simulate_fmu_passes_the_held_scenarios(kit, name):
+    settings = json.loads((kit / f"{name}.json").read_text())
+    signal = np.genfromtxt(kit / settings["input"], delimiter=",", names=True)
+    run = simulate_fmu(str(kit / KIT_FMU), start_time=settings["start_time"], stop_time=settings["stop_time"],
+                       step_size=settings["step_size"], output_interval=settings["step_size"],
+                       relative_tolerance=settings["relative_tolerance"], input=signal,
+                       start_values={**settings["parameters"], "theta": settings["theta0"],
+                                     "omega": settings["omega0"]}, output=["theta", "omega"])
+    np.savetxt(kit / settings["output"], np.column_stack([run["time"], run["theta"], run["omega"]]),
+               delimiter=",", header="time,theta,omega", comments="", fmt="%.17g")
+    judgement = _judged(kit, name)
+    assert judgement.passed and judgement.max_abs_dtheta < 1e-10
+
+
+def _native(kit, name):
+    """The scenario through this package's schedule and native loop; resume through a serialized
+    FMU state restored into a new instance."""
+    s = read_settings(kit / f"{name}.json")
+    plan = schedule(s["torque"], start_time=s["start_time"], stop_time=s["stop_time"],
+                    step_size=s["step_size"], ramp=s["ramp"])
+    resume = json.loads((kit / f"{name}.json").read_text())["resume_time"]
+    cut = len(plan.time) - 1 if resume is None else int(np.argmin(np.abs(plan.time - resume)))
+    start = dict(parameters=s["parameters"], theta0=s["theta0"], omega0=s["omega0"], fmu_path=kit / KIT_FMU)
+    slave = open_fmu(**start)
+    assert cs_loop.drives(slave), "build the native loop: pip install -e ."
+    parts = [run_schedule(slave, _part(plan, 0, cut))]
+    if resume is not None:
+        blob = slave.serializeFMUstate(slave.getFMUstate())
+        slave.terminate()
+        slave.freeInstance()
+        slave = open_fmu(**start, start_time=resume)
+        slave.setFMUstate(slave.deSerializeFMUstate(blob))
+        parts.append(run_schedule(slave, _part(plan, cut, len(plan.time) - 1))[1:])
+    slave.terminate()
+    slave.freeInstance()
+    result = np.concatenate(parts)
+    columns = [result["time"], result["theta"], result["omega"], result["alpha"]]
+    np.savetxt(kit / f"{name}_out.csv", np.column_stack(columns),
+               delimiter=",", header="time,theta,omega,alpha", comments="", fmt="%.17g")
+
+
+def _part(plan, first, last):
+    return TorqueSchedule(time=plan.time[first:last + 1], torque=plan.torque[first:last],
+                      torque_rate=plan.torque_rate[first:last])
+
+
+def test_the_native_loop_passes_every_scenario_and_judge_says_so_per_line(kit, capsys, tmp_path):
+    own = tmp_path / "kit"
+    shutil.copytree(kit, own)
+    for path in own.glob("*_out.csv"):
+        path.unlink()
+    for name in NAMES:
+        _native(own, name)
+    verdicts = judge_kit(own)
+    assert all(j.passed and j.max_abs_dtheta < 1e-10 for j in verdicts.values())
+    assert main(["judge", str(own), "--json", str(tmp_path / "kit.json")]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert [line.split()[:3] for line in lines[:len(NAMES)]] == [[n, "pass", AGREES] for n in sorted(NAMES)]
+    assert lines[len(NAMES)] == f"{len(NAMES)} of {len(NAMES)} results pass"
+    assert json.loads((tmp_path / "kit.json").read_text())["scenarios"]["resume"]["verdict"] == "pass"
+
+
+def test_writing_the_kit_again_keeps_the_results(kit, tmp_path, capsys):
+    folder = tmp_path / "kit"
+    assert main(["scenarios", "--output-dir", str(folder)]) == 0
+    assert capsys.readouterr().out.count("wrote") == 2 + 3 * len(NAMES)
+    (folder / "ramp_out.csv").write_text("time,theta\n0,0\n")
+    assert main(["scenarios", "--output-dir", str(folder)]) == 0
+    assert (folder / "ramp_out.csv").read_text() == "time,theta\n0,0\n"
+    assert not list(folder.glob(".*"))  # no temporary left
+
+
+def test_a_kit_without_results_and_an_fmi3_fmu_are_refused(kit, fmu3, tmp_path, capsys):
+    empty = tmp_path / "empty"
+    write_scenarios(empty)
+    assert main(["judge", str(empty)]) == 2
+    assert "no result to judge" in capsys.readouterr().err
+    assert main(["scenarios", "--output-dir", str(tmp_path / "k3"), "--fmu", str(fmu3)]) == 2
+    assert "is FMI 3.0: the kit is for the FMI 2.0 FMU" in capsys.readouterr().err
