@@ -5,15 +5,17 @@ arm64), Windows amd64, all from this Linux machine.
 
 One build makes the FMUs (FMI 2.0 and 3.0, a binary for every platform) and every wheel carries
 them; each wheel adds the native co-simulation loop built for its own platform
-(pendulum_fmu.build.compile_native_loop). The steps, with the wheel package's own tools:
+(pendulum_fmu.build.compile_native_loop). Every Linux binary, the FMUs' and the native loops, is
+built by zig for glibc MANYLINUX_GLIBC (pendulum_fmu.build's linux_glibc), so that the Linux
+wheels load on that glibc and every later one. The steps, with the wheel package's own tools:
 1. `python -m build --wheel` builds this machine's wheel, the FMUs inside;
 2. per platform, `wheel unpack`, its native loop in place of this machine's, `wheel pack`
    (which writes the RECORD), `wheel tags --platform-tag`;
 3. the tag is the lowest that holds for every binary the wheel loads on that platform: on Linux
-   what `auditwheel show` finds for the native loop, raised to the newest glibc symbol version
-   that the FMUs' Linux binary needs (auditwheel does not look inside an .fmu); on macOS the
-   newest minimum macOS of the x86_64 slices (the arm64 slices' 11.0 is every Apple Silicon
-   Mac's).
+   the manylinux policy `auditwheel show` finds for the native loop and the FMUs' binaries for
+   the wheel's machine together (shown to it beside the loop, since it does not look inside an
+   .fmu); on macOS the newest minimum macOS of the x86_64 slices (the arm64 slices' 11.0 is
+   every Apple Silicon Mac's).
 Each wheel is written to a temporary beside its target and renamed into place; a wheel of the
 same name from an earlier run is replaced. A missing tool stops the command before anything is
 built, with one line naming what installs it.
@@ -39,6 +41,9 @@ from pendulum_fmu.atomic_files import replacing_path
 
 ROOT = Path(__file__).resolve().parent
 OBJDUMP = "llvm-objdump-14"
+# The oldest glibc the Linux wheels load on: manylinux2014's, the first glibc for ARM64 (its
+# aarch64 port began with 2.17) and auditwheel's oldest aarch64 policy.
+MANYLINUX_GLIBC = "2.17"
 # The tags pip before 20.3 knows for the first manylinux_x_y policies.
 LEGACY_MANYLINUX = {(2, 5): "manylinux1", (2, 12): "manylinux2010", (2, 17): "manylinux2014"}
 # Python packages this command runs, and what installs each.
@@ -85,7 +90,7 @@ def check_tools() -> None:
     for wheel in WHEELS:
         try:
             for fmi_version in FMU_FILES:
-                check_toolchain(PLATFORMS[wheel.platform], fmi_version)
+                check_toolchain(PLATFORMS[wheel.platform], fmi_version, MANYLINUX_GLIBC)
         except BuildError as missing:
             raise WheelhouseError(f"the {wheel.system} {wheel.machine} wheel: {missing}") from None
 
@@ -129,14 +134,6 @@ def _objdump(binary: Path, *options: str) -> str:
     return _run([OBJDUMP, *options, binary], f"reading {binary.name}")
 
 
-def glibc_needed(binary: Path) -> tuple[int, int]:
-    """The newest GLIBC_x.y symbol version an ELF library needs ((2, 5), the oldest manylinux's,
-    when it needs none)."""
-    versions = {(int(major), int(minor)) for major, minor in
-                re.findall(r"\(GLIBC_(\d+)\.(\d+)", _objdump(binary, "-T"))}
-    return max(versions, default=(2, 5))
-
-
 def macos_minimums(binary: Path) -> dict[str, tuple[int, int]]:
     """{slice's architecture: its minimum macOS} of a Mach-O, thin or universal."""
     minimums = {}
@@ -148,13 +145,24 @@ def macos_minimums(binary: Path) -> dict[str, tuple[int, int]]:
 
 
 def manylinux_tag(wheel: Path, machine: str, binaries: list[Path]) -> str:
-    """The lowest manylinux tag under which the wheel's own libraries (auditwheel show) and the
-    FMU binaries for its machine all hold, with its legacy alias where it has one."""
-    shown = " ".join(_run([sys.executable, "-m", "auditwheel", "show", wheel], "auditwheel show").split())
+    """The lowest manylinux policy auditwheel finds the wheel's own libraries and the FMU binaries
+    for its machine consistent with, with its legacy alias where it has one. auditwheel reads
+    every library a wheel's RECORD lists but none inside an .fmu: it is shown the wheel packed
+    again with those binaries added."""
+    with tempfile.TemporaryDirectory(prefix="pendulum_fmu_auditwheel_") as tmp:
+        _run([sys.executable, "-m", "wheel", "unpack", "--dest", Path(tmp, "unpacked"), wheel], "wheel unpack")
+        [tree] = Path(tmp, "unpacked").iterdir()
+        for index, binary in enumerate(binaries):
+            Path(tree, "fmu_binaries", str(index)).mkdir(parents=True)
+            shutil.copyfile(binary, Path(tree, "fmu_binaries", str(index), binary.name))
+        _run([sys.executable, "-m", "wheel", "pack", "--dest-dir", tmp, tree], "wheel pack")
+        [shown_wheel] = Path(tmp).glob("*.whl")
+        shown = " ".join(_run([sys.executable, "-m", "auditwheel", "show", shown_wheel], "auditwheel show").split())
     policy = re.search(r'platform tag: "manylinux_(\d+)_(\d+)_', shown)
     if policy is None:
-        raise WheelhouseError(f"auditwheel finds {wheel.name} consistent with no manylinux tag: {shown}")
-    glibc = max([(int(policy[1]), int(policy[2])), *map(glibc_needed, binaries)])
+        raise WheelhouseError(f"auditwheel finds {wheel.name} with its FMU binaries consistent with no "
+                              f"manylinux tag: {shown}")
+    glibc = (int(policy[1]), int(policy[2]))
     tag = f"manylinux_{glibc[0]}_{glibc[1]}_{machine}"
     return f"{tag}.{LEGACY_MANYLINUX[glibc]}_{machine}" if glibc in LEGACY_MANYLINUX else tag
 
@@ -176,7 +184,8 @@ def macos_tag(binaries: list[Path]) -> str:
 
 def _build_base_wheel(out_dir: Path) -> Path:
     """This machine's wheel, the FMUs inside, built as pip would (an isolated environment)."""
-    command = [sys.executable, "-m", "build", "--wheel", "--outdir", out_dir, ROOT]
+    command = [sys.executable, "-m", "build", "--wheel", "--outdir", out_dir,
+               f"--config-setting=--build-option=--linux-glibc={MANYLINUX_GLIBC}", ROOT]
     result = subprocess.run([str(part) for part in command], capture_output=True, text=True, env=_zig_on_path())
     if result.returncode != 0:
         raise WheelhouseError(f"python -m build --wheel failed:\n{result.stdout[-4000:]}{result.stderr[-4000:]}")
@@ -230,7 +239,7 @@ def build_wheels(output_dir: str | os.PathLike = ROOT / "wheelhouse") -> list[Pa
         for built_here in (tree / "pendulum_fmu").glob("_cs_loop*"):
             built_here.unlink()
         for target in WHEELS:
-            native_loop = compile_native_loop(target.platform, tmp / target.platform)
+            native_loop = compile_native_loop(target.platform, tmp / target.platform, MANYLINUX_GLIBC)
             placed = Path(shutil.copyfile(native_loop, tree / "pendulum_fmu" / target.native_loop))
             packed = tmp / "packed" / target.platform
             packed.mkdir(parents=True)

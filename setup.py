@@ -7,6 +7,9 @@
   compiler. It is plain C loaded with ctypes (pendulum_fmu/cs_loop.py), not a CPython module:
   it has the platform's plain name (_cs_loop.so, _cs_loop.pyd) and the wheel is tagged
   py3-none-<platform>, one wheel for every Python 3 on a platform.
+- bdist_wheel --linux-glibc 2.17 has both build the Linux binaries with zig for that oldest glibc
+  (pendulum_fmu.build's linux_glibc); build_wheels.py passes it, through
+  python -m build -C--build-option=--linux-glibc=2.17.
 """
 
 import importlib.machinery
@@ -37,7 +40,7 @@ class BuildPyWithFmu(build_py):
 
         data = Path(self.build_lib, "pendulum_fmu", "data")
         for fmi_version, name in FMU_FILES.items():
-            fmu = build_fmu(data / name, fmi_version=fmi_version)
+            fmu = build_fmu(data / name, fmi_version=fmi_version, linux_glibc=_linux_glibc(self))
             print(f"pendulum_fmu {__version__}: built {fmu}")
 
 
@@ -51,7 +54,7 @@ class BuildNativeLoop(build_ext):
         target = Path(self.get_ext_fullpath(extension.name))
         target.parent.mkdir(parents=True, exist_ok=True)
         with tempfile.TemporaryDirectory() as out_dir:
-            shutil.copyfile(compile_native_loop(platform, out_dir), target)
+            shutil.copyfile(compile_native_loop(platform, out_dir, _linux_glibc(self)), target)
 
     def get_ext_filename(self, fullname):
         # The last suffix is the one every CPython of the platform loads: .so, .pyd.
@@ -59,8 +62,21 @@ class BuildNativeLoop(build_ext):
 
 
 class PlatformWheel(bdist_wheel):
+    user_options = [*bdist_wheel.user_options,
+                    ("linux-glibc=", None, "build the Linux binaries with zig for this oldest glibc, such as 2.17 "
+                                           "(default: with gcc, for the build machine's glibc)")]
+
+    def initialize_options(self):
+        super().initialize_options()
+        self.linux_glibc = None
+
     def get_tag(self):
         return "py3", "none", super().get_tag()[2]
+
+
+def _linux_glibc(command):
+    """The glibc floor the wheel build was given (bdist_wheel --linux-glibc), or None."""
+    return command.distribution.get_command_obj("bdist_wheel").linux_glibc
 
 
 setup(

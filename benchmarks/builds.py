@@ -70,8 +70,8 @@ def build_step_master(out_dir: Path, platform: str = "linux64", fmi_version: int
 
 
 def build_bare_master(out_dir: Path, source: Path, platform: str = "linux64") -> Path:
-    """Compile a C program over bare_master.h (a step master, tests/c/cs_loop_harness.c) for a
-    platform of pendulum_fmu.build.PLATFORMS with that platform's compiler."""
+    """Compile a C program, one file (a step master over bare_master.h, a program of tests/c/),
+    for a platform of pendulum_fmu.build.PLATFORMS with that platform's compiler."""
     chosen = PLATFORMS[platform]
     check_toolchain(chosen)
     [target] = chosen.targets  # the masters run here, where no universal binary is needed

@@ -6,7 +6,9 @@ model's modelDescription.xml: this module generates them (model_variables.h/.c),
 the single source of truth. fmu_src/src/ and fmu_src/include/ hold the FMI plumbing, which knows
 nothing of pendulums; each model has its own folder (config.h, model.c), listed in MODELS.
 Per platform, CMake configures and builds in a private temporary folder; llvm-lipo merges the two
-macOS slices into one universal binary; the FMU's zip is renamed into place whole.
+macOS slices into one universal binary; the FMU's zip is renamed into place whole. With a glibc
+floor (linux_glibc, CMake's LINUX_GLIBC) zig builds the Linux binaries to load on that glibc and
+every later one, as the manylinux wheels need.
 
 Builds only ever run from a source tree (a clone or the sdist): an installed package carries the
 built FMU as package data instead (see pendulum_fmu.default_fmu).
@@ -69,6 +71,7 @@ MODELS = {
 PENDULUM_DIR = MODELS["pendulum"].folder
 PID_CONTROLLER_DIR = MODELS["pid_controller"].folder
 ZIG = "zig"
+ZIG_PACKAGE = "pip install ziglang"
 LIPO = ("llvm-lipo-14", "llvm-lipo", "lipo")
 
 
@@ -88,14 +91,19 @@ class Target:
     def native(self) -> bool:
         return sys.platform == self.system and (not self.machines or host.machine() in self.machines)
 
-    def compiler(self) -> list[str]:
-        """The C compiler command: $CC (split as a shell would, so CC="ccache gcc" works) or gcc on
-        a machine of the target's kind, the toolchain file's cross-compiler elsewhere (zig: the
-        ziglang package's `zig cc`)."""
+    def built_by_zig(self, linux_glibc: str | None = None) -> bool:
+        """Whether zig's C compiler builds it: a macOS target off a Mac, and a Linux target for a
+        glibc floor (cmake/linux.cmake)."""
+        return (self.cross_compiler == ZIG and not self.native) or bool(linux_glibc and self.system == "linux")
+
+    def compiler(self, linux_glibc: str | None = None) -> list[str]:
+        """The C compiler command: zig's (the ziglang package's `zig cc`) where it builds the
+        target, else $CC (split as a shell would, so CC="ccache gcc" works) or gcc on a machine of
+        the target's kind, the toolchain file's cross-compiler elsewhere."""
+        if self.built_by_zig(linux_glibc):
+            return [find_zig() or ZIG, "cc"]
         if self.native:
             return shlex.split(os.environ.get("CC") or "gcc")
-        if self.cross_compiler == ZIG:
-            return [find_zig() or ZIG, "cc"]
         return [self.cross_compiler]
 
 
@@ -130,8 +138,8 @@ PLATFORMS = {platform.fmi2_folder: platform for platform in (
     Platform("aarch64-linux", (Target("aarch64-linux", "linux", ("aarch64",), "aarch64-linux.cmake",
                                       "aarch64-linux-gnu-gcc", "apt-get install gcc-aarch64-linux-gnu"),), ".so"),
     # fmpy loads binaries/darwin64 on Intel and Apple Silicon Macs alike: one universal Mach-O.
-    Platform("darwin64", (Target("x86_64-darwin", "darwin", (), "x86_64-darwin.cmake", ZIG, "pip install ziglang"),
-                          Target("aarch64-darwin", "darwin", (), "aarch64-darwin.cmake", ZIG, "pip install ziglang")), ".dylib"),
+    Platform("darwin64", (Target("x86_64-darwin", "darwin", (), "x86_64-darwin.cmake", ZIG, ZIG_PACKAGE),
+                          Target("aarch64-darwin", "darwin", (), "aarch64-darwin.cmake", ZIG, ZIG_PACKAGE)), ".dylib"),
 )}
 
 
@@ -261,18 +269,22 @@ def _cmake() -> str:
     return found
 
 
-def check_toolchain(platform: Platform, fmi_version: int = 2) -> None:
+def check_toolchain(platform: Platform, fmi_version: int = 2, linux_glibc: str | None = None) -> None:
     """BuildError naming the package to install unless every tool that builds platform is here:
-    the cross-compiler of each target (or $CC, when set, on a machine of the target's kind: else
-    CMake finds the machine's compiler itself), and llvm-lipo where FMI 2.0 merges slices into
-    one binary."""
+    the cross-compiler of each target (zig for a Linux target with linux_glibc; $CC, when set, on
+    a machine of the target's kind: else CMake finds the machine's compiler itself), and
+    llvm-lipo where FMI 2.0 merges slices into one binary. BuildError too when linux_glibc is not
+    a glibc version."""
+    if linux_glibc is not None and not re.fullmatch(r"2\.\d+", linux_glibc):
+        raise BuildError(f"glibc floor {linux_glibc!r}: give a glibc version such as 2.17")
     for target in platform.targets:
-        if target.native and not os.environ.get("CC"):
+        zig = target.built_by_zig(linux_glibc)
+        if target.native and not zig and not os.environ.get("CC"):
             continue
-        compiler = target.compiler()
+        compiler = target.compiler(linux_glibc)
         if not compiler or shutil.which(compiler[0]) is None:
             name = shlex.join(compiler) if compiler else "CC (empty)"
-            hint = "set CC to an installed compiler" if target.native else target.package
+            hint = ZIG_PACKAGE if zig else "set CC to an installed compiler" if target.native else target.package
             raise BuildError(f"{platform.fmi2_folder}: C compiler {name} not found ({hint})")
     if fmi_version == 2 and len(platform.targets) > 1 and _lipo() is None:
         raise BuildError(f"{platform.fmi2_folder}: {LIPO[0]}, which merges its slices into one binary, "
@@ -292,28 +304,33 @@ def run_tool(command: list, what: str, environment: dict | None = None) -> None:
 
 
 def cmake_build(target: Target, work: Path, cmake_target: str, definitions: dict | None = None,
-                project: Path = ROOT) -> Path:
+                project: Path = ROOT, linux_glibc: str | None = None) -> Path:
     """Configure, build and install one target of a CMake project (CMakeLists.txt, or another
     that includes cmake/flags.cmake) for one platform target in the empty folder work; return
     the binary.
 
     On a machine of the target's kind the compiler is CMake's choice, $CC with $CFLAGS when set;
-    elsewhere the target's toolchain file (cmake/), without the host's $CFLAGS, which a
-    cross-compiler may not take. The CMake target's install component has its name.
+    elsewhere, and for a Linux target with linux_glibc (a glibc version such as 2.17: the oldest
+    glibc the binary loads on, cmake/linux.cmake's LINUX_GLIBC) everywhere, the target's toolchain
+    file (cmake/), without the host's $CFLAGS, which a cross-compiler may not take. The CMake
+    target's install component has its name.
     """
     cmake = _cmake()
     build, installed = work / "build", work / "installed"
     environment = dict(os.environ)
     configure = [cmake, "-S", project, "-B", build, f"-DFMI_HEADERS={FMI_HEADERS}",
                  *(f"-D{name}={value}" for name, value in (definitions or {}).items())]
+    cross = not target.native or target.built_by_zig(linux_glibc)
     # On a Mac too: its toolchain file sets the architecture and the oldest macOS.
-    if not target.native or target.system == "darwin":
+    if cross or target.system == "darwin":
         configure.append(f"-DCMAKE_TOOLCHAIN_FILE={TOOLCHAINS / target.toolchain}")
-    if not target.native:
+    if cross:
         for name in ("CC", "CFLAGS", "LDFLAGS"):
             environment.pop(name, None)
-        if target.cross_compiler == ZIG:
-            configure.append(f"-DZIG={find_zig()}")
+    if target.built_by_zig(linux_glibc):
+        configure.append(f"-DZIG={find_zig()}")
+    if linux_glibc and target.system == "linux":
+        configure.append(f"-DLINUX_GLIBC={linux_glibc}")
     what = f"{cmake_target} for {target.name}"
     run_tool(configure, what, environment)
     run_tool([cmake, "--build", build, "--target", cmake_target, "--config", "Release"], what, environment)
@@ -331,7 +348,7 @@ def _merged(slices: list[Path], out_file: Path) -> Path:
     return out_file
 
 
-def compile_native_loop(platform: str, out_dir: str | os.PathLike) -> Path:
+def compile_native_loop(platform: str, out_dir: str | os.PathLike, linux_glibc: str | None = None) -> Path:
     """Build the native co-simulation loop (pendulum_fmu/_cs_loop.c) for a platform of PLATFORMS
     into out_dir, named as that platform's Python loads it (_cs_loop.so, or _cs_loop.pyd on
     Windows); for darwin64 one universal binary.
@@ -342,6 +359,10 @@ def compile_native_loop(platform: str, out_dir: str | os.PathLike) -> Path:
         An FMI 2.0 platform folder name, a key of PLATFORMS.
     out_dir : str or os.PathLike
         The folder to write into; the file is renamed into place whole.
+    linux_glibc : str, optional
+        For a Linux platform, the oldest glibc the loop is to load on, such as "2.17": zig's C
+        compiler builds it against that glibc's symbol versions. None: gcc (or $CC), against
+        the build machine's glibc.
 
     Returns
     -------
@@ -351,13 +372,15 @@ def compile_native_loop(platform: str, out_dir: str | os.PathLike) -> Path:
     Raises
     ------
     BuildError
-        When the platform is unknown, its compiler is missing or the build fails.
+        When the platform is unknown, its compiler is missing, linux_glibc is not a glibc
+        version or the build fails.
     """
     _check_sources_present()
     check_platforms([platform])
-    check_toolchain(PLATFORMS[platform])
+    check_toolchain(PLATFORMS[platform], linux_glibc=linux_glibc)
     with tempfile.TemporaryDirectory(prefix="pendulum_fmu_native_loop_") as tmp:
-        slices = [cmake_build(target, Path(tmp, target.name), "_cs_loop") for target in PLATFORMS[platform].targets]
+        slices = [cmake_build(target, Path(tmp, target.name), "_cs_loop", linux_glibc=linux_glibc)
+                  for target in PLATFORMS[platform].targets]
         built = _merged(slices, Path(tmp, slices[0].name))
         out_file = Path(out_dir, built.name)
         with replacing_path(out_file) as partial:
@@ -412,13 +435,14 @@ def check_platforms(names) -> None:
                          f"among {', '.join(PLATFORMS)}")
 
 
-def available_platforms(fmi_version: int = 2) -> tuple[str, ...]:
-    """Every platform whose tools are present; for each missing one, a PlatformSkipped warning
-    naming the package that installs it. The machine's own platform is never skipped."""
+def available_platforms(fmi_version: int = 2, linux_glibc: str | None = None) -> tuple[str, ...]:
+    """Every platform whose tools are present (zig for the Linux ones with linux_glibc); for each
+    missing one, a PlatformSkipped warning naming the package that installs it. The machine's
+    own platform is never skipped."""
     present = []
     for name, platform in PLATFORMS.items():
         try:
-            check_toolchain(platform, fmi_version)
+            check_toolchain(platform, fmi_version, linux_glibc)
         except BuildError as error:
             if platform.native:
                 raise  # an FMU that cannot run where it was built is no use
@@ -441,7 +465,8 @@ def _stamped_model_description(xml: Path, fmi_version: int = 2) -> str:
 
 def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, *, model_dir: Path = PENDULUM_DIR,
               model_description_file: Path = MODEL_DESCRIPTION,
-              platforms: tuple[str, ...] | None = None, fmi_version: int = 2) -> Path:
+              platforms: tuple[str, ...] | None = None, fmi_version: int = 2,
+              linux_glibc: str | None = None) -> Path:
     """Build an FMU (binaries/, sources/, documentation/) of a model over the FMI plumbing.
 
     Everything is compiled in a private temporary folder and the zip is renamed into place
@@ -464,6 +489,11 @@ def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, *, model_dir: Path = PE
         sources/buildDescription.xml are generated from the FMI 2.0 one (fmi3.py), its binaries
         go into the FMI 3.0 platform folders (darwin64's two slices into x86_64-darwin and
         aarch64-darwin) and export only fmi3* functions.
+    linux_glibc : str, optional
+        The oldest glibc the Linux binaries are to load on, such as "2.17" (manylinux2014's):
+        zig's C compiler builds them against that glibc's symbol versions (cmake/linux.cmake).
+        None: gcc (or $CC) and the cross gcc, against the build machine's glibc and the cross
+        libc.
 
     Returns
     -------
@@ -474,7 +504,8 @@ def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, *, model_dir: Path = PE
     ------
     BuildError
         When the sources are not beside the package, a platform or FMI version is unknown, a
-        named platform's tools are missing, or a compiler fails.
+        named platform's tools are missing, linux_glibc is not a glibc version, or a compiler
+        fails.
     CannotWrite
         out_file cannot be written.
     """
@@ -482,11 +513,11 @@ def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, *, model_dir: Path = PE
     if fmi_version not in FMI_VERSIONS:
         raise BuildError(f"FMI version {fmi_version}: choose among {', '.join(map(str, FMI_VERSIONS))}")
     if platforms is None:
-        platforms = available_platforms(fmi_version)
+        platforms = available_platforms(fmi_version, linux_glibc)
     check_platforms(platforms)
     check_writable(out_file)  # before the compilers run
     for name in platforms:
-        check_toolchain(PLATFORMS[name], fmi_version)
+        check_toolchain(PLATFORMS[name], fmi_version, linux_glibc)
     model_dir = Path(model_dir)
     model_description = read_model_description(str(model_description_file))
     identifier = model_description.coSimulation.modelIdentifier
@@ -507,7 +538,8 @@ def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, *, model_dir: Path = PE
         binaries = {}
         for name in platforms:
             platform = PLATFORMS[name]
-            slices = {target.name: cmake_build(target, tmp / name / target.name, "fmu", definitions)
+            slices = {target.name: cmake_build(target, tmp / name / target.name, "fmu", definitions,
+                                               linux_glibc=linux_glibc)
                       for target in platform.targets}
             if fmi_version == 3:
                 binaries.update({f"binaries/{folder}/{binary.name}": binary for folder, binary in slices.items()})

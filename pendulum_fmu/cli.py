@@ -106,7 +106,7 @@ def cmd_build(args) -> int:
     from .build import build_fmu
 
     output = args.output or CHECKOUT_FMUS[args.fmi_version]
-    path = build_fmu(output, platforms=args.platforms, fmi_version=args.fmi_version)
+    path = build_fmu(output, platforms=args.platforms, fmi_version=args.fmi_version, linux_glibc=args.linux_glibc)
     with zipfile.ZipFile(path) as fmu:
         binaries = [name for name in fmu.namelist() if name.startswith("binaries/")]
     print(f"wrote {path} ({', '.join(binaries)})")
@@ -273,6 +273,10 @@ def _add_build(commands) -> argparse.ArgumentParser:
     build.add_argument("--platforms", type=_platforms, default=None,
                        help=f"comma-separated, among {', '.join(PLATFORMS)} (default: every one "
                             "whose compiler is installed; the others are skipped with a note)")
+    build.add_argument("--linux-glibc", default=None, metavar="VERSION",
+                       help="build the Linux binaries with zig (pip install ziglang) to load on this glibc "
+                            "and every later one, such as 2.17, manylinux2014's (default: with gcc, for "
+                            "this machine's glibc)")
     build.set_defaults(run=cmd_build)
     return build
 

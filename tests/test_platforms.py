@@ -1,9 +1,9 @@
 """One FMU for every platform, in both FMI versions: the win64 binary (mingw-w64) run under wine
 and the aarch64-linux binary (gcc-aarch64-linux-gnu) run under qemu-aarch64, each by the same bare
 C master that runs the linux64 binary, with the same numbers; the macOS binaries (zig), which
-nothing here can run, read slice by slice, and zig's builds for Linux run instead to show that
-zig compiles the sources to the same numbers; and a build that skips a platform whose compiler
-is missing."""
+nothing here can run, read slice by slice; zig's builds for Linux, which the wheels carry (for
+glibc 2.17), run to show that zig compiles the sources to the same numbers; and a build that
+skips a platform whose compiler is missing."""
 
 import dataclasses
 import hashlib
@@ -21,19 +21,22 @@ import pytest
 from fmpy import read_model_description
 
 import pendulum_fmu.build
-from benchmarks.builds import build_step_master
-from pendulum_fmu.build import (FMI_VERSIONS, PLATFORMS, ZIG, BuildError, PlatformSkipped, Target,
-                                available_platforms, build_fmu, find_zig)
+from benchmarks.builds import build_bare_master, build_step_master
+from build_wheels import MANYLINUX_GLIBC
+from pendulum_fmu.build import (FMI_VERSIONS, PLATFORMS, BuildError, PlatformSkipped, available_platforms,
+                                build_fmu, find_zig)
 from pendulum_fmu.cli import main
 from pendulum_fmu.reference import reference
 
 STEPS, STEP_SIZE = 3000, 1e-3  # the tutorial case: 20 N.m, gravity on, 3 s
+POW_INPUTS = 1_000_000
 # How each platform's master runs here: natively, under wine, under qemu with the cross libc.
 RUNNERS = {"linux64": [], "win64": ["wine"], "aarch64-linux": ["qemu-aarch64", "-L", "/usr/aarch64-linux-gnu"]}
 CROSS = [pytest.param(platform, marks=pytest.mark.skipif(
     shutil.which(PLATFORMS[platform].targets[0].cross_compiler) is None or shutil.which(RUNNERS[platform][0]) is None,
     reason=f"needs {PLATFORMS[platform].targets[0].package} and {RUNNERS[platform][0]} (.ci/run installs them)"))
     for platform in ("win64", "aarch64-linux")]
+POW_VERSIONS = Path(__file__).parent / "c/pow_versions.c"
 EACH_FMI_VERSION = pytest.mark.parametrize("fmi_version", FMI_VERSIONS, ids=lambda version: f"fmi{version}")
 # The value references benchmarks/bare_master.h hard-codes (VR_TORQUE, VR_THETA).
 MASTER_VALUE_REFERENCES = {"torque": 0, "theta": 1}
@@ -227,45 +230,73 @@ def test_every_macos_slice_exports_the_fmi_functions_and_loads_only_libsystem(ev
             _check_ad_hoc_signature(slice_, signature)
 
 
-# The zig targets of the Linux platforms, for the toolchain proof below.
-ZIG_LINUX_TARGETS = {"linux64": "x86_64-linux-gnu", "aarch64-linux": "aarch64-linux-gnu"}
 RUNS_ZIG = [pytest.param(platform, marks=pytest.mark.skipif(
     find_zig() is None or shutil.which(RUNNERS[platform][0] if RUNNERS[platform] else "true") is None
     or shutil.which(PLATFORMS[platform].targets[0].compiler()[0]) is None,
     reason=f"needs zig (pip install ziglang) and {PLATFORMS[platform].targets[0].compiler()[0]}, "
            f"{(RUNNERS[platform] or ['nothing'])[0]} to build and run the master"))
-    for platform in ZIG_LINUX_TARGETS]
+    for platform in ("linux64", "aarch64-linux")]
 
 
-def _comment(library):
-    """The ELF .comment section: which compiler and linker made the binary."""
-    return subprocess.run(["readelf", "-p", ".comment", str(library)], capture_output=True, text=True,
-                          check=True).stdout
+def _readelf(library, *options):
+    return subprocess.run(["readelf", *options, str(library)], capture_output=True, text=True, check=True).stdout
+
+
+def _glibc_versions(library):
+    """{symbol: (major, minor[, patch])}: the glibc symbol version each function the ELF library
+    imports is bound to."""
+    return {name: tuple(map(int, version.split("."))) for name, version in
+            re.findall(r" UND (\w+)@GLIBC_([\d.]+)", _readelf(library, "--dyn-syms", "--wide"))}
 
 
 @pytest.mark.parametrize("platform", RUNS_ZIG)
 @EACH_FMI_VERSION
-def test_zig_builds_the_sources_to_the_gcc_builds_theta_bit_for_bit(every_platform, tmp_path, monkeypatch,
-                                                                     fmi_version, platform):
-    """The macOS binaries come from zig's C compiler, and nothing here can run them: the same zig,
-    through the same CMake description and cmake/zig.cmake, builds the same sources for Linux,
-    whose binaries the bare C masters run here (qemu for arm64). Their theta is the gcc build's
-    at every point, bit for bit: without FMA contraction (cmake/flags.cmake) clang and gcc round
-    every operation alike, and the Linux binaries call the same libm. A Mac's libm is another
-    one, which this cannot show."""
-    master = build_step_master(tmp_path, platform, fmi_version)  # by gcc, before zig takes the platform
-    monkeypatch.setenv("ZIG_TARGET", ZIG_LINUX_TARGETS[platform])
-    [gcc_target] = PLATFORMS[platform].targets
-    zig = Target(gcc_target.name, "zig", (), "zig.cmake", ZIG, "pip install ziglang")
-    monkeypatch.setitem(PLATFORMS, platform, dataclasses.replace(PLATFORMS[platform], targets=(zig,)))
-    build = _unzipped_build(build_fmu(tmp_path / "Pendulum.fmu", platforms=(platform,), fmi_version=fmi_version),
-                            tmp_path)
-    comment = _comment(build.library(platform))
+def test_zig_builds_for_the_wheels_glibc_give_the_gcc_builds_theta_bit_for_bit(every_platform, tmp_path,
+                                                                               fmi_version, platform):
+    """The wheels' Linux binaries come from zig's C compiler for glibc 2.17 (build_wheels.py), the
+    macOS ones from the same zig, and nothing here can run those: the same build, through the same
+    CMake description (cmake/linux.cmake, cmake/zig.cmake), whose binaries the bare C masters run
+    here (qemu for arm64). Their theta is the gcc build's at every point, bit for bit. Without FMA
+    contraction (cmake/flags.cmake) clang and gcc round every operation alike. Both call this
+    machine's libm, zig's build through the older symbol versions (pow@GLIBC_2.2.5 on x86_64,
+    pow@GLIBC_2.17 on arm64, where gcc's build against Debian 12's glibc binds pow@GLIBC_2.29):
+    glibc keeps those as a wrapper around the same pow that only reports errors the old way
+    (math/w_pow_compat.c), so a finite result is the same bits, which tests/c/pow_versions.c
+    checks on a million inputs here. What this cannot show is another libm: an old glibc's own
+    (its sin, cos and pow predate glibc 2.28's rewrite) or a Mac's."""
+    master = build_step_master(tmp_path, platform, fmi_version)  # by gcc
+    build = _unzipped_build(build_fmu(tmp_path / "Pendulum.fmu", platforms=(platform,), fmi_version=fmi_version,
+                                      linux_glibc=MANYLINUX_GLIBC), tmp_path)
+    library = build.library(platform)
+    comment = _readelf(library, "-p", ".comment")
     assert "clang" in comment and "GCC" not in comment, comment  # zig's clang built it, not gcc
+    versions = _glibc_versions(library)
+    assert "pow" in versions and max(versions.values()) <= tuple(map(int, MANYLINUX_GLIBC.split("."))), versions
+    # This machine's libm: the pow zig's build binds gives pow@GLIBC_2.29's bits.
+    pow_version = "GLIBC_" + ".".join(map(str, versions["pow"]))
+    compared = subprocess.run([*RUNNERS[platform], build_bare_master(tmp_path, POW_VERSIONS, platform), pow_version,
+                               str(POW_INPUTS)], capture_output=True, text=True, check=True, timeout=300).stdout
+    assert compared.splitlines()[-1] == f"0 of {POW_INPUTS} differ", compared
     run = _theta_by_step_master(build, platform, master)
     assert len(run) == STEPS + 1
     gcc = _theta_by_step_master(every_platform[fmi_version], "linux64")
     assert np.array_equal(run, gcc), np.max(np.abs(run - gcc))
+
+
+@pytest.mark.skipif(find_zig() is None, reason="needs zig (pip install ziglang)")
+def test_build_command_builds_for_any_glibc_floor_and_refuses_a_malformed_one_in_one_line(tmp_path, capsys):
+    # Older than the wheels' 2.17: then x86-64's memcpy binds GLIBC_2.2.5, not GLIBC_2.14.
+    fmu = tmp_path / "Pendulum.fmu"
+    assert main(["build", "--platforms", "linux64", "--linux-glibc", "2.12", "--output", str(fmu)]) == 0
+    build = _unzipped_build(fmu, tmp_path)
+    versions = _glibc_versions(build.library("linux64"))
+    assert "clang" in _readelf(build.library("linux64"), "-p", ".comment")
+    assert {"pow", "memcpy"} <= versions.keys() and max(versions.values()) <= (2, 12), versions
+    capsys.readouterr()
+    assert main(["build", "--linux-glibc", "17", "--output", str(tmp_path / "Other.fmu")]) == 2
+    assert capsys.readouterr().err.splitlines() == [
+        "pendulum-fmu build: error: glibc floor '17': give a glibc version such as 2.17"]
+    assert not (tmp_path / "Other.fmu").exists()
 
 
 def _without_compiler(monkeypatch, platform):

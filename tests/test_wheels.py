@@ -5,6 +5,7 @@ Debian's arm64 Python under qemu (tests/arm64_python.py), the Windows wheel's na
 under wine by a C harness (tests/c/cs_loop_harness.c; no Windows Python here). No Mac runs the
 macOS wheel: its files are only read."""
 
+import json
 import os
 import re
 import shutil
@@ -12,6 +13,7 @@ import subprocess
 import sys
 import sysconfig
 import zipfile
+from importlib import resources
 from pathlib import Path
 
 import numpy as np
@@ -23,7 +25,7 @@ from packaging import tags
 from packaging.utils import parse_wheel_filename
 
 from benchmarks.builds import build_bare_master
-from build_wheels import LEGACY_MANYLINUX, WHEELS, WheelhouseError, build_wheels, check_tools, main
+from build_wheels import LEGACY_MANYLINUX, MANYLINUX_GLIBC, WHEELS, WheelhouseError, build_wheels, check_tools, main
 from pendulum_fmu import FMU_FILES, __version__
 from pendulum_fmu.build import PLATFORMS
 from pendulum_fmu.cli import main as cli
@@ -70,7 +72,8 @@ def _fmu_binary(wheel: Path, fmu_name: str, folder: str) -> bytes:
 
 
 def _glibc_needed(elf: bytes, tmp_path: Path) -> tuple[int, int]:
-    """Read with pyelftools (build_wheels.py reads llvm-objdump's table)."""
+    """The newest GLIBC_x.y version an ELF library needs, read with pyelftools (build_wheels.py
+    asks auditwheel)."""
     path = tmp_path / "elf"
     path.write_bytes(elf)
     with open(path, "rb") as file:
@@ -79,6 +82,13 @@ def _glibc_needed(elf: bytes, tmp_path: Path) -> tuple[int, int]:
                     for _, auxiliaries in section.iter_versions() for auxiliary in auxiliaries
                     if auxiliary.name.startswith("GLIBC_")]
     return max(versions, default=(0, 0))
+
+
+def _manylinux_policies(machine: str) -> list[tuple[int, int]]:
+    """The glibc (x, y) of every manylinux_x_y policy auditwheel has for machine: its own table."""
+    policies = json.loads((resources.files("auditwheel.policy") / "manylinux-policy.json").read_text())
+    return [tuple(map(int, re.fullmatch(r"manylinux_(\d+)_(\d+)", policy["name"]).groups()))
+            for policy in policies if machine in policy["symbol_versions"]]
 
 
 @needs_build
@@ -173,10 +183,14 @@ def test_each_tag_is_the_lowest_that_holds_for_every_binary_of_the_wheel(wheelho
             fmu_binaries = [_fmu_binary(wheel, FMU_FILES[2], target.platform),
                             *(_fmu_binary(wheel, FMU_FILES[3], folder)
                               for folder in PLATFORMS[target.platform].fmi3_folders)]
-            glibc = max(policy, *(_glibc_needed(binary, tmp_path) for binary in fmu_binaries))
+            needed = max(policy, *(_glibc_needed(binary, tmp_path) for binary in fmu_binaries))
+            # The lowest policy that admits every binary: the native loop's, the FMUs' for the machine.
+            glibc = min(version for version in _manylinux_policies(target.machine) if version >= needed)
             legacy = LEGACY_MANYLINUX.get(glibc)
             assert platforms == {f"manylinux_{glibc[0]}_{glibc[1]}_{target.machine}",
-                                 *([f"{legacy}_{target.machine}"] if legacy else [])}, (policy, glibc)
+                                 *([f"{legacy}_{target.machine}"] if legacy else [])}, (policy, needed)
+            # Built by zig for the wheels' glibc floor, the wheel installs on that glibc.
+            assert glibc <= tuple(map(int, MANYLINUX_GLIBC.split("."))), glibc
         elif target.system == "macos":
             [platform] = platforms
             # The native loop and every FMU binary for a Mac, x86_64 slices and arm64 ones.
