@@ -235,11 +235,13 @@ def compile_library(source_dir: Path, out_file: Path, platform: str = "linux64",
         version_script = out_file.parent / f"{out_file.stem}.exports.map"
         version_script.write_text(f"{{ global: {export_prefix}*; local: *; }};\n")
         linking = ["-fPIC", "-fvisibility=hidden", f"-Wl,--version-script={version_script}", "-lm"]
-    # -flto lets the integrator inline the model's right-hand side across files.
+    # -flto lets the integrator inline the model's series and right-hand side across files, and
+    # -O3 unrolls their loops (bounded by the states and the series' order): a 1 ms step takes
+    # about 460 instructions instead of 590 at -O2 (benchmarks/own_cost.py).
     lto = ["-flto"] if supports_lto(tuple(compiler), target.windows) else []
     user_flags = shlex.split(os.environ.get("CFLAGS", "")) if target.native else []
     run_compiler([
-        *compiler, "-std=c99", "-O2", *lto, "-shared", "-Wall", "-Wextra", "-Werror", *user_flags,
+        *compiler, "-std=c99", "-O3", *lto, "-shared", "-Wall", "-Wextra", "-Werror", *user_flags,
         f"-I{source_dir}", f"-I{FMI_HEADERS}", *sorted(str(p) for p in source_dir.glob("*.c")),
         *linking, "-o", str(out_file),
     ], f"{out_file.name} for {platform}")
@@ -268,8 +270,9 @@ table{{border-collapse:collapse}}td,th{{border:1px solid #999;padding:.2em .5em}
 <p>FMI {fmi_version}.0 {interfaces}, model identifier <code>{name}</code>.</p>
 <h2>Inside a communication step</h2>
 <p>Each <code>fmi{fmi_version}DoStep(t, h)</code> integrates exactly [t, t+h] with an error-controlled
-Dormand-Prince 5(4) Runge-Kutta method: internal steps end on t+h and never cross it, and the
-internal step size carries over between calls. Inputs are held over the step (zero-order
+Taylor series method of order 6 (Dormand-Prince 5(4) where the model has no series or the
+method gives up): internal steps end on t+h and never cross it, and the internal step size
+carries over between calls. Inputs are held over the step (zero-order
 hold) or, after <code>fmi2SetRealInputDerivatives</code> (orders 1 and 2; higher orders are
 ignored), follow their Taylor polynomial from their values at t until the derivatives are set
 again. FMI 3.0 has no input derivatives: there inputs are always held. The relative tolerance is
