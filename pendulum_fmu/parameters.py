@@ -1,12 +1,13 @@
 """The FMU's variables, parameters and their defaults, read from that FMU's modelDescription.xml.
 
 Every function takes the FMU it is about (default: pendulum_fmu.default_fmu()), so another build
-of the pendulum brings its own parameters. Each FMU file is parsed once per modification time.
+of the pendulum brings its own parameters. Each FMU file is parsed once per version (file_version).
 """
 
 from __future__ import annotations
 
 import math
+import os
 from functools import lru_cache
 from pathlib import Path
 
@@ -16,19 +17,25 @@ from fmpy import read_model_description
 START_VALUES = {"theta0": "theta", "omega0": "omega"}
 
 
+def file_version(path: str | os.PathLike) -> tuple[int, int, int, int]:
+    """(device, inode, size, modification time in ns) of a file: a file rebuilt, rewritten or
+    replaced has another. FileNotFoundError (with the path) when it is not there."""
+    try:
+        status = os.stat(path)
+    except OSError as error:
+        raise FileNotFoundError(f"FMU {path}: {error.strerror}") from None
+    return status.st_dev, status.st_ino, status.st_size, status.st_mtime_ns
+
+
 @lru_cache(maxsize=32)
-def _read(path: str, modified_ns: int):
+def _read(path: str, version: tuple):
     description = read_model_description(path)
     return description, {v.name: v for v in description.modelVariables}
 
 
 def _described(fmu_path: str | Path | None):
     path = _fmu_file(fmu_path)
-    try:
-        modified_ns = path.stat().st_mtime_ns
-    except OSError as error:
-        raise FileNotFoundError(f"FMU {path}: {error.strerror}") from None
-    return _read(str(path.resolve()), modified_ns)
+    return _read(str(path.resolve()), file_version(path))
 
 
 def model_description(fmu_path: str | Path | None = None):
@@ -54,7 +61,12 @@ def merged_parameters(overrides: dict[str, float] | None = None,
                       fmu_path: str | Path | None = None) -> dict[str, float]:
     """The FMU's defaults with overrides applied; unknown names and non-finite values are refused.
     What the FMU itself refuses is left to it: see resolve_parameters."""
-    parameters = default_parameters(fmu_path)
+    return merged_with(default_parameters(fmu_path), overrides)
+
+
+def merged_with(defaults: dict[str, float], overrides: dict[str, float] | None) -> dict[str, float]:
+    """merged_parameters over given defaults (an FMU's default_parameters)."""
+    parameters = dict(defaults)
     for name, value in (overrides or {}).items():
         if name not in parameters:
             raise ValueError(f"unknown parameter {name!r}: the parameters are {', '.join(parameters)}")
@@ -75,7 +87,7 @@ def resolve_parameters(overrides: dict[str, float] | None = None,
     """
     parameters = merged_parameters(overrides, fmu_path)
     path = _fmu_file(fmu_path)
-    refusal = _refusal(str(path.resolve()), path.stat().st_mtime_ns, tuple(parameters.items()))
+    refusal = _refusal(str(path.resolve()), file_version(path), tuple(parameters.items()))
     if refusal:
         raise ValueError(refusal)
     return parameters
@@ -89,7 +101,7 @@ def _fmu_file(fmu_path: str | Path | None) -> Path:
 
 
 @lru_cache(maxsize=256)
-def _refusal(fmu: str, modified_ns: int, items: tuple) -> str | None:
+def _refusal(fmu: str, version: tuple, items: tuple) -> str | None:
     """What the FMU says when it refuses these parameters at initialization, or None."""
     from .simulate import FmuError, open_fmu
 

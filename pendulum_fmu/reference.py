@@ -163,7 +163,8 @@ def _holding(points: list[Fraction], values: list[float], step: Fraction) -> Cal
 
 
 def _integrate(pieces: _Pieces, at: np.ndarray, parameters: dict | None, theta0: float, omega0: float,
-               rtol: float, atol: float, fmu_path: str | Path | None) -> np.ndarray:
+               rtol: float, atol: float, fmu_path: str | Path | None, method: str = "DOP853",
+               max_step: float = np.inf) -> np.ndarray:
     p = resolve_parameters(parameters, fmu_path)
     inverse_inertia = 1.0 / total_inertia(p)
     gravity_moment, damping = p["mass"] * p["gravity"] * p["length"], p["damping"]
@@ -193,7 +194,8 @@ def _integrate(pieces: _Pieces, at: np.ndarray, parameters: dict | None, theta0:
             report = np.clip(at[mine], t0, t1)
             times = np.unique(np.append(report, t1))  # solve_ivp wants them strictly increasing
             solution = solve_ivp(lambda t, y: (y[1], acceleration(y[0], y[1], u0 + rate * (t - t0))),
-                                 (t0, t1), state, method="DOP853", rtol=rtol, atol=atol, t_eval=times)
+                                 (t0, t1), state, method=method, rtol=rtol, atol=atol, t_eval=times,
+                                 max_step=max_step)
             if not solution.success:
                 raise RuntimeError(f"solve_ivp failed from t = {t0}: {solution.message}")
             row = np.searchsorted(times, report)
@@ -213,13 +215,15 @@ def _integrate(pieces: _Pieces, at: np.ndarray, parameters: dict | None, theta0:
 def reference(torque=20.0, *, start_time: float = 0.0, stop_time: float | None = None,
               step_size: float = 1e-3, ramp: bool = False, parameters: dict | None = None,
               theta0: float = 0.0, omega0: float = 0.0, at: np.ndarray | None = None,
-              rtol: float = 1e-12, atol: float = 1e-12, fmu_path: str | Path | None = None) -> np.ndarray:
-    """The trajectory under a signal as docs/signals.md defines it, through scipy DOP853.
+              rtol: float = 1e-12, atol: float = 1e-12, fmu_path: str | Path | None = None,
+              method: str = "DOP853", max_step: float = np.inf) -> np.ndarray:
+    """The trajectory under a signal as docs/signals.md defines it, through scipy's solve_ivp.
 
     Takes the signal and the arguments of simulate(): a constant, a callable of time, a per-step
     array or a CSV path; parameters override the defaults of the FMU at fmu_path (default:
     pendulum_fmu.default_fmu()). at: the times to report (default: the signal's communication
-    points). Same result format as simulate().
+    points). method, max_step: solve_ivp's (another method to check this one; a bound on its
+    steps takes it below the error its tolerance alone reaches). Same result format as simulate().
     """
     if not (isinstance(torque, (str, Path, list, tuple, np.ndarray, int, float)) or callable(torque)):
         raise ValueError(f"the reference takes a constant, a callable, a per-step array or a CSV path, "
@@ -231,7 +235,8 @@ def reference(torque=20.0, *, start_time: float = 0.0, stop_time: float | None =
     pieces = _signal_pieces(torque, start, None if stop_time is None else _exact(stop_time), step, ramp)
     if at is None:
         at = np.array([float(t) for t in pieces.points])
-    return _integrate(pieces, np.asarray(at, dtype=float), parameters, theta0, omega0, rtol, atol, fmu_path)
+    return _integrate(pieces, np.asarray(at, dtype=float), parameters, theta0, omega0, rtol, atol, fmu_path,
+                      method, max_step)
 
 
 def reference_schedule(plan, *, parameters: dict | None = None, theta0: float = 0.0,

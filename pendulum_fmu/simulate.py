@@ -1,13 +1,21 @@
-"""Run the FMU through fmpy, one communication step at a time."""
+"""Run the FMU through fmpy, one communication step at a time.
+
+simulate() runs each schedule through a Simulator: an FMU instance made once per thread and FMU
+file, and restarted (fmi2Reset, initialized again) for every run, which gives the numbers of a
+fresh instance bit for bit without paying for loading and instantiating again.
+"""
 
 from __future__ import annotations
 
 import array
 import ctypes
 import itertools
+import os
 import tempfile
 import threading
 import weakref
+from collections import OrderedDict
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -16,7 +24,8 @@ from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
 from fmpy.fmi3 import FMU3Slave
 
 from . import cs_loop, default_fmu, results
-from .parameters import merged_parameters, model_description, resolve_parameters, value_reference
+from .parameters import (default_parameters, file_version, merged_parameters, merged_with,
+                         model_description, resolve_parameters, value_reference)
 from .signal import TorqueSignal, TorqueSchedule, schedule
 
 _STATUS = ["OK", "WARNING", "DISCARD", "ERROR", "FATAL", "PENDING"]
@@ -85,7 +94,7 @@ _extracting = threading.Lock()  # threads of one dask worker share the cache
 def _unzipped(fmu_path: Path):
     """(folder, model description) of an FMU file, extracted and parsed once per process; the
     folder is removed at exit."""
-    key = (str(fmu_path.resolve()), fmu_path.stat().st_mtime_ns)
+    key = (str(fmu_path.resolve()), file_version(fmu_path))
     with _extracting:
         if key not in _extracted:
             folder = tempfile.TemporaryDirectory(prefix="pendulum_fmu_")
@@ -104,7 +113,18 @@ def open_fmu(fmu_path: str | Path | None = None, *, parameters: dict | None = No
     fmu_path defaults to pendulum_fmu.default_fmu() (FMI 2.0); parameters and value references
     are that FMU's own. The caller frees it with slave.terminate(); slave.freeInstance().
     """
-    fmu_path = Path(fmu_path) if fmu_path else default_fmu()
+    slave = _instantiated(Path(fmu_path) if fmu_path else default_fmu(), instance_name)
+    try:
+        initialize(slave, parameters=parameters, theta0=theta0, omega0=omega0,
+                   tolerance=tolerance, start_time=start_time)
+    except BaseException:
+        slave.freeInstance()
+        raise
+    return slave
+
+
+def _instantiated(fmu_path: Path, instance_name: str):
+    """An instantiated FMU2Slave or FMU3Slave, not yet initialized (see open_fmu)."""
     folder, description = _unzipped(fmu_path)
     fmi_version = int(description.fmiVersion[0])
     messages = MessageLog(fmi_version)
@@ -119,12 +139,6 @@ def open_fmu(fmu_path: str | Path | None = None, *, parameters: dict | None = No
     slave.fmi_version = fmi_version
     slave.messages = messages  # keeps the logger callback alive as long as the slave
     slave.fmu_path = fmu_path  # whose parameters and value references apply
-    try:
-        initialize(slave, parameters=parameters, theta0=theta0, omega0=omega0,
-                   tolerance=tolerance, start_time=start_time)
-    except BaseException:
-        slave.freeInstance()
-        raise
     return slave
 
 
@@ -157,13 +171,23 @@ def run_schedule(slave: FMU2Slave | FMU3Slave, plan: TorqueSchedule) -> np.ndarr
     """
     if not cs_loop.drives(slave):
         return run_schedule_python(slave, plan)
-    torque_vr = np.array([value_reference("torque", slave.fmu_path)], np.uint32)
-    recorded_vr = np.array([value_reference(n, slave.fmu_path) for n in RECORDED], np.uint32)
+    return _stepped(_stepper(slave), plan)
+
+
+def _stepper(slave, start_names: tuple[str, ...] = ()) -> cs_loop.Stepper:
+    """The native loop bound to a slave: the torque in, RECORDED out, a restart setting
+    start_names."""
+    def references(names):
+        return np.array([value_reference(name, slave.fmu_path) for name in names], np.uint32)
+    return cs_loop.Stepper(slave, references(["torque"]), references(RECORDED), references(start_names))
+
+
+def _stepped(stepper: cs_loop.Stepper, plan: TorqueSchedule, **restart) -> np.ndarray:
+    """The result array of a schedule through the native loop; restart: Stepper.run's
+    start_values and tolerance."""
     recorded = np.empty((len(plan.time), len(RECORDED)))
-    ramped = bool(np.any(plan.torque_rate))
-    cs_loop.Stepper(slave, torque_vr, recorded_vr, plan.time).run(
-        np.ascontiguousarray(plan.torque)[:, None],
-        np.ascontiguousarray(plan.torque_rate)[:, None] if ramped else None, recorded)
+    rates = np.ascontiguousarray(plan.torque_rate)[:, None] if np.count_nonzero(plan.torque_rate) else None
+    stepper.run(plan.time, np.ascontiguousarray(plan.torque)[:, None], rates, recorded, **restart)
     return _result(plan, recorded)
 
 
@@ -250,6 +274,8 @@ def simulate(torque: TorqueSignal = 20.0, *, start_time: float = 0.0, stop_time:
     tolerance: relative tolerance for fmi2SetupExperiment (None: the FMU's 1e-10).
     max_steps: the longest run accepted (default signal.DEFAULT_MAX_STEPS); a longer one, or one
     that would not fit in memory, is refused before anything is allocated.
+    Runs through this thread's instance of the FMU (simulator()), restarted for the run: after the
+    first call in a thread, a call costs tens of microseconds besides its steps.
     Returns a structured array with fields time, torque, theta, omega, alpha (see results.py).
     """
     plan = schedule(torque, start_time=start_time, stop_time=stop_time, step_size=step_size,
@@ -261,16 +287,96 @@ def simulate(torque: TorqueSignal = 20.0, *, start_time: float = 0.0, stop_time:
 def simulate_plan(plan: TorqueSchedule, *, parameters: dict | None = None, theta0: float = 0.0,
                   omega0: float = 0.0, tolerance: float | None = None,
                   fmu_path: str | Path | None = None) -> np.ndarray:
-    """A schedule through a fresh instance of the FMU, freed afterwards (see simulate)."""
-    merged_parameters(parameters, fmu_path)  # names, values and the FMU file, before opening it
+    """A schedule through this thread's Simulator of the FMU (see simulate)."""
+    runner = simulator(fmu_path)
     try:
-        slave = open_fmu(fmu_path, parameters=parameters, theta0=theta0, omega0=omega0,
-                         tolerance=tolerance, start_time=float(plan.time[0]))
+        return runner.run(plan, parameters=parameters, theta0=theta0, omega0=omega0,
+                          tolerance=tolerance)
     except FmuError:
         resolve_parameters(parameters, fmu_path)  # refused with the same words as every other tool
         raise
-    try:
-        return run_schedule(slave, plan)
-    finally:
-        slave.terminate()
-        slave.freeInstance()
+
+
+class Simulator:
+    """An FMU instance that runs schedule after schedule, restarting before each: fmi2Reset, then
+    initialization with the run's parameters, start values and tolerance, which leaves it as a
+    fresh instance would be, so the numbers are a fresh instance's bit for bit.
+
+    One thread at a time: simulator() keeps one per thread and FMU file. The native loop restarts
+    and steps it in one call (FMI 2.0); else (FMI 3.0, or no native loop) fmpy's calls do.
+    """
+
+    # Also names the restart's start values, in this order.
+    START_STATES = ("theta", "omega")
+
+    def __init__(self, fmu_path: Path, version: tuple):
+        self.fmu_path, self.version = fmu_path, version
+        self.slave = _instantiated(fmu_path, "pendulum")
+        self.defaults = default_parameters(fmu_path)
+        self.stepper = (_stepper(self.slave, (*self.defaults, *self.START_STATES))
+                        if cs_loop.drives(self.slave) else None)
+
+    def run(self, plan: TorqueSchedule, *, parameters: dict | None = None, theta0: float = 0.0,
+            omega0: float = 0.0, tolerance: float | None = None) -> np.ndarray:
+        """The result array of a schedule (see simulate); FmuError when the FMU refuses."""
+        start = [*(merged_with(self.defaults, parameters) if parameters else self.defaults).values(),
+                 float(theta0), float(omega0)]
+        self.slave.messages.lines.clear()
+        if self.stepper is None:
+            self.slave.reset()
+            initialize(self.slave, parameters=parameters, theta0=theta0, omega0=omega0,
+                       tolerance=tolerance, start_time=float(plan.time[0]))
+            return run_schedule_python(self.slave, plan)
+        return _stepped(self.stepper, plan, start_values=start, tolerance=tolerance)
+
+    def close(self) -> None:
+        self.slave.freeInstance()
+
+
+# Simulators a thread keeps, the least recently used dropped first (each holds an instance).
+SIMULATORS_PER_THREAD = 8
+_simulators = threading.local()
+
+
+@lru_cache(maxsize=1)
+def _default_fmu() -> Path:
+    """default_fmu(), looked up once per process (in a checkout: rebuilt then if stale)."""
+    return default_fmu()
+
+
+def simulator(fmu_path: str | Path | None = None) -> Simulator:
+    """This thread's Simulator of an FMU file, made on first use and again whenever the file is
+    rebuilt or replaced (its file_version changes).
+
+    Parameters
+    ----------
+    fmu_path
+        The FMU file; None: pendulum_fmu.default_fmu(), looked up once per process.
+
+    Returns
+    -------
+    Simulator
+        The same object for every call of this thread while the file stays as it is.
+
+    Raises
+    ------
+    FileNotFoundError
+        When there is no such file.
+    """
+    path = _default_fmu() if fmu_path is None else fmu_path
+    version = file_version(path)
+    kept = getattr(_simulators, "kept", None)
+    if kept is None:
+        kept = _simulators.kept = OrderedDict()
+    key = os.fspath(path)
+    current = kept.pop(key, None)
+    if current is not None and current.version != version:
+        current.close()
+        current = None
+    if current is None:
+        current = Simulator(Path(path), version)
+        while len(kept) >= SIMULATORS_PER_THREAD:
+            kept.popitem(last=False)[1].close()
+    kept[key] = current
+    return current
+
