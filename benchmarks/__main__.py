@@ -13,6 +13,7 @@ from pathlib import Path
 
 from .accuracy_cost import accuracy_cost_rows
 from .builds import build_null_fmu, build_pendulum_fmu, build_step_master
+from .fixed_cost import fixed_cost_rows
 from .floor import floor_rows
 from .own_cost import own_cost_rows
 from .peers import opensim_rows, pythonfmu_rows
@@ -20,7 +21,7 @@ from .python_loop import python_loop_rows
 from .report import as_markdown, as_text, main_table
 from .scale import scale_rows
 
-PARTS = ("floor", "own-cost", "accuracy", "python-loop", "opensim", "pythonfmu", "scale")
+PARTS = ("floor", "own-cost", "accuracy", "python-loop", "fixed-cost", "opensim", "pythonfmu", "scale")
 DEFAULT_FIGURE = Path(__file__).resolve().parent / "accuracy_cost.png"
 
 
@@ -31,6 +32,8 @@ def parse_arguments(argv):
                         help="5 repetitions instead of 21, and 4 tolerances instead of 10")
     parser.add_argument("--skip", action="append", choices=PARTS, default=[], metavar="PART",
                         help=f"leave a part out (repeatable): {', '.join(PARTS)}")
+    parser.add_argument("--only", action="append", choices=PARTS, default=[], metavar="PART",
+                        help="run only this part (repeatable); the others are left out")
     parser.add_argument("--markdown", type=Path, metavar="FILE",
                         help="also write the tables as markdown to FILE (for the README)")
     parser.add_argument("--figure", type=Path, default=DEFAULT_FIGURE, metavar="FILE",
@@ -45,7 +48,7 @@ def progress(message: str) -> None:
 def main(argv=None) -> int:
     args = parse_arguments(argv)
     repetitions = 5 if args.quick else 21
-    wanted = [part for part in PARTS if part not in args.skip]
+    wanted = [part for part in PARTS if part not in args.skip and (not args.only or part in args.only)]
     rows, grid = [], None
     with tempfile.TemporaryDirectory(prefix="pendulum-benchmarks-") as scratch:
         scratch = Path(scratch)
@@ -63,6 +66,8 @@ def main(argv=None) -> int:
                 rows += accuracy
             elif part == "python-loop":
                 rows += python_loop_rows(pendulum, repetitions)
+            elif part == "fixed-cost":
+                rows += fixed_cost_rows(pendulum, repetitions)
             elif part == "opensim":
                 rows += opensim_rows(pendulum, repetitions)
             elif part == "pythonfmu":

@@ -29,13 +29,13 @@ def valgrind_missing() -> str | None:
 
 
 def count_instructions(master: Path, fmu: BuiltFmu, steps: int, step_size: float,
-                       tolerance: float | None, only_in: str | None) -> int:
-    """Instructions of one master run; with only_in, just those inside that function and what it
-    calls (callgrind's --toggle-collect)."""
+                       tolerance: float | None, only_in: tuple[str, ...]) -> int:
+    """Instructions of one master run; with only_in, just those inside those functions and what
+    they call (callgrind's --toggle-collect)."""
     with tempfile.TemporaryDirectory() as scratch:
         profile = Path(scratch) / "callgrind.out"
         command = ["valgrind", "--tool=callgrind", f"--callgrind-out-file={profile}",
-                   *([f"--toggle-collect={only_in}"] if only_in else []),
+                   *(f"--toggle-collect={function}" for function in only_in),
                    *master_command(master, fmu, steps, step_size, tolerance)]
         run(command)
         totals = re.search(r"^totals:\s*(\d+)", profile.read_text(), re.MULTILINE)
@@ -52,7 +52,7 @@ class StepCost:
 
 def instructions_per_step(master: Path, fmu: BuiltFmu, step_size: float,
                           tolerance: float | None = None,
-                          only_in: str | None = "fmi2DoStep") -> StepCost:
+                          only_in: tuple[str, ...] = ("fmi2DoStep",)) -> StepCost:
     """Steady-state instructions per communication step: (long run - short run) / extra steps."""
     short_steps, long_steps = round(SHORT_RUN / step_size), round(LONG_RUN / step_size)
     short, long = (count_instructions(master, fmu, n, step_size, tolerance, only_in)

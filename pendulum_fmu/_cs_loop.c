@@ -25,7 +25,7 @@
 
 /* Changes whenever cs_loop_run's arguments do, so that Python never calls a stale build with
    the wrong arguments (cs_loop.py checks it). */
-CS_LOOP_EXPORT int cs_loop_interface(void) { return 3; }
+CS_LOOP_EXPORT int cs_loop_interface(void) { return 4; }
 
 /* The FMU's functions, in this order (cs_loop.py passes them as an array of addresses). */
 typedef struct {
@@ -49,8 +49,9 @@ enum { CALL_SET_REAL = 0, CALL_SET_RATE = 1, CALL_GET_REAL = 2, CALL_DO_STEP = 3
 
    start_values[i]                   when not NULL, the instance is first reset and initialized
                                      again, with start_references[i] set to start_values[i] in
-                                     initialization mode, at start time time[0] (no tolerance,
-                                     no stop time); when NULL it must be initialized already
+                                     initialization mode, at start time time[0] with relative
+                                     tolerance *tolerance (none when tolerance is NULL; no stop
+                                     time); when NULL it must be initialized already
    time[0..n_steps]                  communication points
    inputs[k*n_inputs + i]            input i over step k (the value at the step's start)
    input_rates[k*n_inputs + i]       its derivative of order input_orders[i] (1 for a ramp) over
@@ -66,7 +67,7 @@ enum { CALL_SET_REAL = 0, CALL_SET_RATE = 1, CALL_GET_REAL = 2, CALL_DO_STEP = 3
 CS_LOOP_EXPORT int cs_loop_run(
     const CsFunctions *fmi, fmi2Component component,
     const fmi2ValueReference *start_references, size_t n_start, const double *start_values,
-    const fmi2ValueReference *input_references, size_t n_inputs,
+    const double *tolerance, const fmi2ValueReference *input_references, size_t n_inputs,
     const fmi2ValueReference *output_references, size_t n_outputs,
     size_t n_steps, const double *time, const double *inputs,
     const fmi2Integer *input_orders, const double *input_rates,
@@ -85,7 +86,8 @@ CS_LOOP_EXPORT int cs_loop_run(
 
     if (start_values != NULL) {
         CHECK(fmi->reset(component), CALL_RESET);
-        CHECK(fmi->setup_experiment(component, fmi2False, 0.0, time[0], fmi2False, 0.0),
+        CHECK(fmi->setup_experiment(component, tolerance != NULL, tolerance ? *tolerance : 0.0,
+                                    time[0], fmi2False, 0.0),
               CALL_SETUP_EXPERIMENT);
         CHECK(fmi->enter_initialization_mode(component), CALL_ENTER_INITIALIZATION_MODE);
         if (n_start)

@@ -410,8 +410,9 @@ table{{border-collapse:collapse}}td,th{{border:1px solid #999;padding:.2em .5em}
 <p>FMI {fmi_version}.0 {interfaces}, model identifier <code>{name}</code>.</p>
 <h2>Inside a communication step</h2>
 <p>Each <code>fmi{fmi_version}DoStep(t, h)</code> integrates exactly [t, t+h] with an error-controlled
-Dormand-Prince 5(4) Runge-Kutta method: internal steps end on t+h and never cross it, and the
-internal step size carries over between calls. Inputs are held over the step (zero-order
+Taylor series method of order 6 (Dormand-Prince 5(4) where the model has no series or the
+method gives up): internal steps end on t+h and never cross it, and the internal step size
+carries over between calls. Inputs are held over the step (zero-order
 hold) or, after <code>fmi2SetRealInputDerivatives</code> (orders 1 and 2; higher orders are
 ignored), follow their Taylor polynomial from their values at t until the derivatives are set
 again. FMI 3.0 has no input derivatives: there inputs are always held. The relative tolerance is

@@ -15,6 +15,7 @@ import ctypes
 import importlib.machinery
 from functools import lru_cache
 from pathlib import Path
+from typing import Sequence
 
 import numpy as np
 
@@ -32,7 +33,7 @@ _FMI_FUNCTIONS = ("fmi2Reset", "fmi2SetupExperiment", "fmi2EnterInitializationMo
 
 
 # What _cs_loop.c's cs_loop_interface() returns for the arguments this module passes.
-INTERFACE = 3
+INTERFACE = 4
 
 
 @lru_cache(maxsize=1)
@@ -47,7 +48,7 @@ def _library():
         return None
     run = library.cs_loop_run
     pointer, size = ctypes.c_void_p, ctypes.c_size_t
-    run.argtypes = ([pointer] * 3 + [size] + [pointer] * 2 + [size, pointer, size, size]
+    run.argtypes = ([pointer] * 3 + [size] + [pointer] * 3 + [size, pointer, size, size]
                     + [pointer] * 7)
     run.restype = ctypes.c_int
     return run
@@ -73,15 +74,15 @@ def _address(array: np.ndarray | None, shape: tuple[int, ...], dtype, what: str)
 
 class Stepper:
     """The native loop bound to an fmpy FMU2Slave, its input and output value references (uint32
-    arrays), the communication points `time` (N + 1) and the value references of the start values
-    a restart sets (start_references); run() steps it through them. Binding once keeps a case's
-    Python cost to a few microseconds.
+    arrays) and the value references of the start values a restart sets (start_references);
+    run() steps it through a schedule. Binding once keeps a run's Python cost to a few
+    microseconds.
     """
 
     def __init__(self, slave, input_references: np.ndarray, output_references: np.ndarray,
-                 time: np.ndarray, start_references: np.ndarray | None = None):
-        self.steps, self.inputs, self.outputs = len(time) - 1, len(input_references), len(output_references)
-        self.time, self.messages = time, slave.messages
+                 start_references: np.ndarray | None = None):
+        self.inputs, self.outputs = len(input_references), len(output_references)
+        self.messages = slave.messages
         if start_references is None:
             start_references = np.empty(0, np.uint32)
         self.starts = len(start_references)
@@ -91,41 +92,57 @@ class Stepper:
             *[ctypes.cast(slave.dll[name], ctypes.c_void_p) for name in _FMI_FUNCTIONS])
         self._first_order = np.ones(self.inputs, np.int32)  # fmi2Integer is int
         self._failed_step, self._failed_call = ctypes.c_size_t(), ctypes.c_int()
+        self._tolerance = ctypes.c_double()
         self._fmu = (ctypes.addressof(self._functions), slave.component)
-        self._schedule = (
-            _address(input_references, (self.inputs,), np.uint32, "input_references"), self.inputs,
-            _address(output_references, (self.outputs,), np.uint32, "output_references"), self.outputs,
-            self.steps, _address(time, (self.steps + 1,), np.float64, "time"))
+        self._input_references = _address(input_references, (self.inputs,), np.uint32,
+                                          "input_references"), self.inputs
+        self._output_references = _address(output_references, (self.outputs,), np.uint32,
+                                           "output_references"), self.outputs
         self._start_references = (_address(start_references, (self.starts,), np.uint32,
                                            "start_references"), self.starts)
+        # A restart's start values are copied here, whose address is bound once.
+        self._start_values = np.empty(self.starts)
+        self._start_values_address = self._start_values.ctypes.data
         self._reports = ctypes.byref(self._failed_step), ctypes.byref(self._failed_call)
+        self._run = _library()
 
-    def run(self, inputs: np.ndarray, input_rates: np.ndarray | None, outputs: np.ndarray,
-            start_values: np.ndarray | None = None) -> None:
-        """inputs, input_rates: (N, inputs) values and first derivatives of the inputs over each
-        step (input_rates None: held, fmi2SetRealInputDerivatives is not called; inputs None
-        when there are no inputs). outputs:
-        (N + 1, outputs), filled with the outputs at every point, read after the step's inputs
-        were set.
-        start_values: (start_references,) restart the instance first (reset, and initialize at
-        time[0] with these start values), or None when it is initialized already. A failing call
-        raises the slave's MessageLog error, with the FMU's messages and the time of the failing
-        step, or FmuError("initialization failed: ...") as simulate.initialize does.
+    def run(self, time: np.ndarray, inputs: np.ndarray | None, input_rates: np.ndarray | None,
+            outputs: np.ndarray, start_values: Sequence[float] | None = None,
+            tolerance: float | None = None) -> None:
+        """time: the communication points (N + 1). inputs, input_rates: (N, inputs) values and
+        first derivatives of the inputs over each step (input_rates None: held,
+        fmi2SetRealInputDerivatives is not called; inputs None when there are no inputs).
+        outputs: (N + 1, outputs), filled with the outputs at every point, read after the step's
+        inputs were set.
+        start_values: a value per start reference: restart the instance first (reset, and initialize at
+        time[0] with these start values and the relative tolerance, None for the FMU's own), or
+        None when it is initialized already. A failing call raises the slave's MessageLog error,
+        with the FMU's messages and the time of the failing step, or FmuError("initialization
+        failed: ...") as simulate.initialize does.
         """
+        steps = len(time) - 1
         if inputs is None and self.inputs:
             raise ValueError(f"inputs must be given: the stepper has {self.inputs}")
-        status = _library()(
+        if start_values is not None:
+            if len(start_values) != self.starts:
+                raise ValueError(f"start_values must be {self.starts} values, got {len(start_values)}")
+            self._start_values[:] = start_values
+        if tolerance is not None:
+            self._tolerance.value = tolerance
+        status = self._run(
             *self._fmu, *self._start_references,
-            _address(start_values, (self.starts,), np.float64, "start_values"),
-            *self._schedule,
-            _address(inputs, (self.steps, self.inputs), np.float64, "inputs"),
+            None if start_values is None else self._start_values_address,
+            None if tolerance is None else ctypes.addressof(self._tolerance),
+            *self._input_references, *self._output_references,
+            steps, _address(time, (steps + 1,), np.float64, "time"),
+            _address(inputs, (steps, self.inputs), np.float64, "inputs"),
             None if input_rates is None else self._first_order.ctypes.data,
-            _address(input_rates, (self.steps, self.inputs), np.float64, "input_rates"),
-            _address(outputs, (self.steps + 1, self.outputs), np.float64, "outputs"),
+            _address(input_rates, (steps, self.inputs), np.float64, "input_rates"),
+            _address(outputs, (steps + 1, self.outputs), np.float64, "outputs"),
             *self._reports)
         if status > 1:
             call = self._failed_call.value
             if call >= _RESTART:
                 raise self.messages.initialization_error(f"{_CALLS[call]} failed")
-            where = "at the end" if call == _AT_END else f"at t = {self.time[self._failed_step.value]:.17g}"
+            where = "at the end" if call == _AT_END else f"at t = {time[self._failed_step.value]:.17g}"
             raise self.messages.error(status, f"{_CALLS[call]} {where}")

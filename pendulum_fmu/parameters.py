@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 import numbers
+import os
 import zipfile
 from collections.abc import Mapping
 from functools import lru_cache
@@ -31,6 +32,16 @@ FMI_VERSIONS = ("2.0", "3.0")
 class FmuFileError(InvalidInput):
     """The file given as an FMU is none this package can run: not a zip, no modelDescription.xml,
     not FMI 2.0 or 3.0, or not a pendulum; the message names the file and what to do."""
+
+
+def file_version(path: str | os.PathLike) -> tuple[int, int, int, int]:
+    """(device, inode, size, modification time in ns) of a file: a file rebuilt, rewritten or
+    replaced has another. MissingFile (with the path) when it is not there."""
+    try:
+        status = os.stat(path)
+    except OSError as error:
+        raise MissingFile(f"FMU {path}: {error.strerror}") from None
+    return status.st_dev, status.st_ino, status.st_size, status.st_mtime_ns
 
 
 @lru_cache(maxsize=32)
@@ -134,7 +145,12 @@ def merged_parameters(overrides: dict[str, float] | None = None,
                       fmu_path: str | Path | None = None) -> dict[str, float]:
     """The FMU's defaults with overrides applied; unknown names and non-finite values are refused.
     What the FMU itself refuses is left to it: see simulate.resolve_parameters."""
-    parameters = default_parameters(fmu_path)
+    return merged_with(default_parameters(fmu_path), overrides)
+
+
+def merged_with(defaults: dict[str, float], overrides: dict[str, float] | None) -> dict[str, float]:
+    """merged_parameters over given defaults (an FMU's default_parameters)."""
+    parameters = dict(defaults)
     if not isinstance(overrides, Mapping | None):
         raise WrongType(f"parameters is a dict {{name: value}}, e.g. {{'gravity': 0}}; got a "
                         f"{type(overrides).__name__}")

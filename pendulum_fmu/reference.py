@@ -210,7 +210,8 @@ def equation_of_motion(parameters: dict[str, float]) -> Callable:
 
 
 def _integrate(pieces: _Pieces, at: np.ndarray, parameters: dict | None, theta0: float, omega0: float,
-               rtol: float, atol: float, fmu_path: str | Path | None) -> np.ndarray:
+               rtol: float, atol: float, fmu_path: str | Path | None, method: str = "DOP853",
+               max_step: float = np.inf) -> np.ndarray:
     theta0, omega0 = start_value("theta0", theta0, "rad"), start_value("omega0", omega0, "rad/s")
     for name, value in (("rtol", rtol), ("atol", atol)):
         if not (isinstance(value, numbers.Real) and 0 < value < math.inf):
@@ -238,7 +239,8 @@ def _integrate(pieces: _Pieces, at: np.ndarray, parameters: dict | None, theta0:
             report = np.clip(at[mine], t0, t1)
             times = np.unique(np.append(report, t1))  # solve_ivp wants them strictly increasing
             solution = solve_ivp(lambda t, y: (y[1], acceleration(y[0], y[1], u0 + rate * (t - t0))),
-                                 (t0, t1), state, method="DOP853", rtol=rtol, atol=atol, t_eval=times)
+                                 (t0, t1), state, method=method, rtol=rtol, atol=atol, t_eval=times,
+                                 max_step=max_step)
             if not solution.success:
                 raise RuntimeError(f"solve_ivp failed from t = {t0}: {solution.message}")
             row = np.searchsorted(times, report)
@@ -258,9 +260,10 @@ def _integrate(pieces: _Pieces, at: np.ndarray, parameters: dict | None, theta0:
 def reference(torque=20.0, *, start_time: float = 0.0, stop_time: float | None = None,
               step_size: float = 1e-3, ramp: bool = False, parameters: dict | None = None,
               theta0: float = 0.0, omega0: float = 0.0, at: np.ndarray | None = None,
-              rtol: float = 1e-12, atol: float = 1e-12, fmu_path: str | Path | None = None) -> np.ndarray:
-    """The trajectory under a signal as docs/signals.md defines it, through scipy DOP853: the
-    independent oracle, which reads the signal itself.
+              rtol: float = 1e-12, atol: float = 1e-12, fmu_path: str | Path | None = None,
+              method: str = "DOP853", max_step: float = np.inf) -> np.ndarray:
+    """The trajectory under a signal as docs/signals.md defines it, through scipy's solve_ivp
+    (DOP853 by default): the independent oracle, which reads the signal itself.
 
     Parameters
     ----------
@@ -275,6 +278,11 @@ def reference(torque=20.0, *, start_time: float = 0.0, stop_time: float | None =
         The times to report, in s (default: the signal's communication points).
     rtol, atol : float, optional
         solve_ivp's tolerances.
+    method : str, optional
+        solve_ivp's method (another one checks this one).
+    max_step : float, optional
+        solve_ivp's bound on its steps in s, which takes it below the error its tolerance alone
+        reaches.
     fmu_path : str or Path, optional
         The FMU whose parameters and defaults apply (default: pendulum_fmu.default_fmu()).
 
@@ -300,7 +308,8 @@ def reference(torque=20.0, *, start_time: float = 0.0, stop_time: float | None =
     pieces = _signal_pieces(torque, start, stop, step, ramp)
     if at is None:
         at = np.array([float(t) for t in pieces.points])
-    return _integrate(pieces, _times(at, pieces, step), parameters, theta0, omega0, rtol, atol, fmu_path)
+    return _integrate(pieces, _times(at, pieces, step), parameters, theta0, omega0, rtol, atol, fmu_path,
+                      method, max_step)
 
 
 def _times(at, pieces: _Pieces, step: Fraction) -> np.ndarray:

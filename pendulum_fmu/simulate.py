@@ -1,13 +1,20 @@
-"""Run the FMU through fmpy, one communication step at a time."""
+"""Run the FMU through fmpy, one communication step at a time.
+
+simulate() runs each schedule through a Simulator: an FMU instance made once per thread and FMU
+file, and restarted (fmi2Reset, initialized again) for every run, which gives the numbers of a
+fresh instance bit for bit without paying for loading and instantiating again.
+"""
 
 from __future__ import annotations
 
 import array
 import ctypes
 import itertools
+import os
 import tempfile
 import threading
 import weakref
+from collections import OrderedDict
 from functools import lru_cache
 from pathlib import Path
 
@@ -19,8 +26,8 @@ from fmpy.fmi3 import FMU3Slave
 
 from . import cs_loop, default_fmu, results
 from .errors import InvalidInput, PendulumFmuError
-from .parameters import (fmu_file, merged_parameters, model_description, pendulum_variables, start_value,
-                         value_reference)
+from .parameters import (default_parameters, file_version, fmu_file, merged_parameters, merged_with,
+                         model_description, pendulum_variables, start_value, value_reference)
 from .torque_schedule import TorqueSignal, TorqueSchedule, schedule
 
 _STATUS = ["OK", "WARNING", "DISCARD", "ERROR", "FATAL", "PENDING"]
@@ -90,7 +97,7 @@ def _unzipped(fmu_path: Path):
     """(folder, model description) of an FMU file, extracted and parsed once per process; the
     folder is removed at exit."""
     description = model_description(fmu_path)  # refuses what is no FMU before it is unzipped
-    key = (str(fmu_path.resolve()), fmu_path.stat().st_mtime_ns)
+    key = (str(fmu_path.resolve()), file_version(fmu_path))
     with _extracting:
         if key not in _extracted:
             folder = tempfile.TemporaryDirectory(prefix="pendulum_fmu_")
@@ -143,6 +150,18 @@ def open_fmu(fmu_path: str | Path | None = None, *, parameters: dict | None = No
         The FMU refused the parameters or start values; the message carries what it logged.
     """
     fmu_path = Path(fmu_path) if fmu_path else default_fmu()
+    slave = _instantiated(fmu_path, instance_name)
+    try:
+        initialize(slave, parameters=parameters, theta0=theta0, omega0=omega0,
+                   tolerance=tolerance, start_time=start_time)
+    except BaseException:
+        slave.freeInstance()
+        raise
+    return slave
+
+
+def _instantiated(fmu_path: Path, instance_name: str):
+    """An instantiated FMU2Slave or FMU3Slave, not yet initialized (see open_fmu)."""
     pendulum_variables(fmu_path)  # FmuFileError when it is no pendulum FMU this machine runs
     folder, description = _unzipped(fmu_path)
     fmi_version = int(description.fmiVersion[0])
@@ -158,12 +177,6 @@ def open_fmu(fmu_path: str | Path | None = None, *, parameters: dict | None = No
     slave.fmi_version = fmi_version
     slave.messages = messages  # keeps the logger callback alive as long as the slave
     slave.fmu_path = fmu_path  # whose parameters and value references apply
-    try:
-        initialize(slave, parameters=parameters, theta0=theta0, omega0=omega0,
-                   tolerance=tolerance, start_time=start_time)
-    except BaseException:
-        slave.freeInstance()
-        raise
     return slave
 
 
@@ -197,13 +210,23 @@ def run_schedule(slave: FMU2Slave | FMU3Slave, plan: TorqueSchedule) -> np.ndarr
     """
     if not cs_loop.drives(slave):
         return run_schedule_python(slave, plan)
-    torque_vr = np.array([value_reference("torque", slave.fmu_path)], np.uint32)
-    recorded_vr = np.array([value_reference(n, slave.fmu_path) for n in RECORDED], np.uint32)
+    return _stepped(_stepper(slave), plan)
+
+
+def _stepper(slave, start_names: tuple[str, ...] = ()) -> cs_loop.Stepper:
+    """The native loop bound to a slave: the torque in, RECORDED out, a restart setting
+    start_names."""
+    def references(names):
+        return np.array([value_reference(name, slave.fmu_path) for name in names], np.uint32)
+    return cs_loop.Stepper(slave, references(["torque"]), references(RECORDED), references(start_names))
+
+
+def _stepped(stepper: cs_loop.Stepper, plan: TorqueSchedule, **restart) -> np.ndarray:
+    """The result array of a schedule through the native loop; restart: Stepper.run's
+    start_values and tolerance."""
     recorded = np.empty((len(plan.time), len(RECORDED)))
-    ramped = bool(np.any(plan.torque_rate))
-    cs_loop.Stepper(slave, torque_vr, recorded_vr, plan.time).run(
-        np.ascontiguousarray(plan.torque)[:, None],
-        np.ascontiguousarray(plan.torque_rate)[:, None] if ramped else None, recorded)
+    rates = np.ascontiguousarray(plan.torque_rate)[:, None] if np.count_nonzero(plan.torque_rate) else None
+    stepper.run(plan.time, np.ascontiguousarray(plan.torque)[:, None], rates, recorded, **restart)
     return _result(plan, recorded)
 
 
@@ -285,6 +308,8 @@ def simulate(torque: TorqueSignal = 20.0, *, start_time: float = 0.0, stop_time:
 
     The whole schedule runs in one call into the native loop (cs_loop.py) when it was compiled
     and the FMU is FMI 2.0, else in the Python loop; the two give the same numbers bit for bit.
+    It runs through this thread's instance of the FMU (simulator()), restarted for the run: after
+    the first call in a thread, a call costs tens of microseconds besides its steps.
 
     Parameters
     ----------
@@ -337,19 +362,14 @@ def simulate(torque: TorqueSignal = 20.0, *, start_time: float = 0.0, stop_time:
 def simulate_plan(plan: TorqueSchedule, *, parameters: dict | None = None, theta0: float = 0.0,
                   omega0: float = 0.0, tolerance: float | None = None,
                   fmu_path: str | Path | None = None) -> np.ndarray:
-    """A schedule through a fresh instance of the FMU, freed afterwards (see simulate)."""
-    merged_parameters(parameters, fmu_path)  # names, values and the FMU file, before opening it
+    """A schedule through this thread's Simulator of the FMU (see simulate)."""
+    runner = simulator(fmu_path)
     try:
-        slave = open_fmu(fmu_path, parameters=parameters, theta0=theta0, omega0=omega0,
-                         tolerance=tolerance, start_time=float(plan.time[0]))
+        return runner.run(plan, parameters=parameters, theta0=theta0, omega0=omega0,
+                          tolerance=tolerance)
     except FmuError:
         resolve_parameters(parameters, fmu_path)  # refused with the same words as every other tool
         raise
-    try:
-        return run_schedule(slave, plan)
-    finally:
-        slave.terminate()
-        slave.freeInstance()
 
 
 def resolve_parameters(overrides: dict[str, float] | None = None,
@@ -362,14 +382,14 @@ def resolve_parameters(overrides: dict[str, float] | None = None,
     """
     parameters = merged_parameters(overrides, fmu_path)
     path = fmu_file(fmu_path)
-    refusal = _refusal(str(path.resolve()), path.stat().st_mtime_ns, tuple(parameters.items()))
+    refusal = _refusal(str(path.resolve()), file_version(path), tuple(parameters.items()))
     if refusal:
         raise InvalidInput(refusal)
     return parameters
 
 
 @lru_cache(maxsize=256)
-def _refusal(fmu: str, modified_ns: int, items: tuple) -> str | None:
+def _refusal(fmu: str, version: tuple, items: tuple) -> str | None:
     """What the FMU says when it refuses these parameters at initialization, or None."""
     try:
         slave = open_fmu(fmu, parameters=dict(items))
@@ -379,3 +399,88 @@ def _refusal(fmu: str, modified_ns: int, items: tuple) -> str | None:
     slave.terminate()
     slave.freeInstance()
     return None
+
+
+class Simulator:
+    """An FMU instance that runs schedule after schedule, restarting before each: fmi2Reset, then
+    initialization with the run's parameters, start values and tolerance, which leaves it as a
+    fresh instance would be, so the numbers are a fresh instance's bit for bit.
+
+    One thread at a time: simulator() keeps one per thread and FMU file. The native loop restarts
+    and steps it in one call (FMI 2.0); else (FMI 3.0, or no native loop) fmpy's calls do.
+    """
+
+    # Also names the restart's start values, in this order.
+    START_STATES = ("theta", "omega")
+
+    def __init__(self, fmu_path: Path, version: tuple):
+        self.fmu_path, self.version = fmu_path, version
+        self.slave = _instantiated(fmu_path, "pendulum")
+        self.defaults = default_parameters(fmu_path)
+        self.stepper = (_stepper(self.slave, (*self.defaults, *self.START_STATES))
+                        if cs_loop.drives(self.slave) else None)
+
+    def run(self, plan: TorqueSchedule, *, parameters: dict | None = None, theta0: float = 0.0,
+            omega0: float = 0.0, tolerance: float | None = None) -> np.ndarray:
+        """The result array of a schedule (see simulate); FmuError when the FMU refuses."""
+        start = [*(merged_with(self.defaults, parameters) if parameters else self.defaults).values(),
+                 start_value("theta0", theta0, "rad"), start_value("omega0", omega0, "rad/s")]
+        self.slave.messages.lines.clear()
+        if self.stepper is None:
+            self.slave.reset()
+            initialize(self.slave, parameters=parameters, theta0=theta0, omega0=omega0,
+                       tolerance=tolerance, start_time=float(plan.time[0]))
+            return run_schedule_python(self.slave, plan)
+        return _stepped(self.stepper, plan, start_values=start, tolerance=tolerance)
+
+    def close(self) -> None:
+        self.slave.freeInstance()
+
+
+# Simulators a thread keeps, the least recently used dropped first (each holds an instance).
+SIMULATORS_PER_THREAD = 8
+_simulators = threading.local()
+
+
+@lru_cache(maxsize=1)
+def _default_fmu() -> Path:
+    """default_fmu(), looked up once per process (in a checkout: rebuilt then if stale)."""
+    return default_fmu()
+
+
+def simulator(fmu_path: str | Path | None = None) -> Simulator:
+    """This thread's Simulator of an FMU file, made on first use and again whenever the file is
+    rebuilt or replaced (its file_version changes).
+
+    Parameters
+    ----------
+    fmu_path
+        The FMU file; None: pendulum_fmu.default_fmu(), looked up once per process.
+
+    Returns
+    -------
+    Simulator
+        The same object for every call of this thread while the file stays as it is.
+
+    Raises
+    ------
+    MissingFile
+        When there is no such file.
+    """
+    path = _default_fmu() if fmu_path is None else fmu_path
+    version = file_version(path)
+    kept = getattr(_simulators, "kept", None)
+    if kept is None:
+        kept = _simulators.kept = OrderedDict()
+    key = os.fspath(path)
+    current = kept.pop(key, None)
+    if current is not None and current.version != version:
+        current.close()
+        current = None
+    if current is None:
+        current = Simulator(Path(path), version)
+        while len(kept) >= SIMULATORS_PER_THREAD:
+            kept.popitem(last=False)[1].close()
+    kept[key] = current
+    return current
+

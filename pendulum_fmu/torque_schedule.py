@@ -54,6 +54,9 @@ DEFAULT_STOP_TIME = 3.0
 # close to 3 hours of simulated time, and a typo in a time (epoch seconds, 1e-8 s steps) is
 # likelier than a run that long.
 DEFAULT_MAX_STEPS = 10_000_000
+# Runs needing less memory than this are not checked against what the machine has left: reading
+# it (/proc/meminfo) costs more than such a run, which no machine that runs Python lacks.
+MEMORY_CHECKED_FROM = 2**26  # bytes (64 MiB: about 700,000 steps)
 # Memory one step takes in simulate(): the schedule's three doubles, the result's five and the
 # four recorded outputs.
 BYTES_PER_STEP = 8 * (3 + 5 + 4)
@@ -61,6 +64,8 @@ BYTES_PER_STEP = 8 * (3 + 5 + 4)
 
 def event_tolerance(time, step_size: float):
     """How close an event must be to a communication point to be that point (s)."""
+    if isinstance(time, float):  # math.ulp is np.spacing for a scalar, without numpy's overhead
+        return max(EVENT_TOLERANCE_STEPS * step_size, EVENT_TOLERANCE_ULPS * math.ulp(abs(time)))
     return np.maximum(EVENT_TOLERANCE_STEPS * step_size,
                       EVENT_TOLERANCE_ULPS * np.spacing(np.abs(np.asarray(time, dtype=float))))
 
@@ -285,11 +290,18 @@ def step_count(start_time: float, stop_time: float, step_size: float,
     if steps > limit:
         raise InvalidInput(f"{what}, over the limit of {limit:,}: use a coarser step size or a shorter "
                          "stop time, or raise the limit (--max-steps) if the run is meant to be that long")
-    needed, available = steps * BYTES_PER_STEP, _available_memory()
-    if needed > available:
-        raise InvalidInput(f"{what}, which needs {needed / 2**30:.1f} GiB and the machine has "
-                         f"{available / 2**30:.1f} GiB free: use a coarser step size or a shorter stop time")
+    needed = steps * BYTES_PER_STEP
+    if needed > MEMORY_CHECKED_FROM:
+        available = _available_memory()
+        if needed > available:
+            raise InvalidInput(f"{what}, which needs {needed / 2**30:.1f} GiB and the machine has "
+                               f"{available / 2**30:.1f} GiB free: use a coarser step size or a "
+                               "shorter stop time")
     return steps
+
+
+def _run(start_time: float, stop_time: float, step_size: float, steps: int) -> str:
+    return f"{start_time:g} to {stop_time:g} s in steps of {step_size:g} s is {steps:,} steps"
 
 
 def communication_points(start_time: float, stop_time: float, step_size: float, *,
@@ -394,7 +406,7 @@ def schedule(torque: TorqueSignal, *, start_time: float = 0.0, stop_time: float 
             except (TypeError, ValueError):
                 raise InvalidInput(f"a torque is a number, a callable of time, a per-step array or a CSV "
                                  f"path; got {type(torque).__name__}") from None
-        if not np.all(np.isfinite(samples)):
+        if not np.isfinite(samples).all():
             bad = np.flatnonzero(~np.isfinite(samples))[0]
             raise InvalidInput(f"the torque is {samples[bad]} at t = {time[bad]}; it must be finite")
         start_values, end_values = samples[:-1], samples[1:]

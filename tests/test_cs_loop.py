@@ -43,8 +43,8 @@ def test_native_loop_reports_the_failing_step(fmu):
         plan = schedule(1.0, stop_time=0.01, step_size=1e-3)
         wrong = plan.time + 0.5  # fmi2DoStep refuses a step from where the instance is not
         with pytest.raises(simulate.FmuError, match=r"fmi2DoStep at t = 0.5 returned ERROR: .*not where"):
-            stepper = cs_loop.Stepper(slave, np.array([0], np.uint32), np.array([1, 2, 3], np.uint32), wrong)
-            stepper.run(plan.torque[:, None].copy(), None, np.empty((len(wrong), 3)))
+            stepper = cs_loop.Stepper(slave, np.array([0], np.uint32), np.array([1, 2, 3], np.uint32))
+            stepper.run(wrong, plan.torque[:, None].copy(), None, np.empty((len(wrong), 3)))
     finally:
         slave.freeInstance()
 
@@ -58,10 +58,10 @@ def test_native_restart_matches_a_fresh_instance_bit_for_bit(fmu):
     outputs = np.array([value_reference(n, fmu) for n in OUTPUTS], np.uint32)
     slave = simulate.open_fmu(fmu)  # initialized with the defaults, then restarted twice
     try:
-        stepper = cs_loop.Stepper(slave, np.empty(0, np.uint32), outputs, plan.time, references)
+        stepper = cs_loop.Stepper(slave, np.empty(0, np.uint32), outputs, references)
         for mass in (30.0, 55.0):
             restarted = np.empty((len(plan.time), 3))
-            stepper.run(None, None, restarted, start_values=np.array([mass, 2.0, 0.4, 12.0]))
+            stepper.run(plan.time, None, None, restarted, start_values=np.array([mass, 2.0, 0.4, 12.0]))
             fresh = simulate.open_fmu(fmu, parameters={"mass": mass, "damping": 2.0}, theta0=0.4)
             try:
                 expected = simulate.run_schedule_python(fresh, plan)
@@ -70,6 +70,6 @@ def test_native_restart_matches_a_fresh_instance_bit_for_bit(fmu):
             for column, name in enumerate(OUTPUTS):
                 assert np.array_equal(restarted[:, column], expected[name]), (mass, name)
         with pytest.raises(simulate.FmuError, match="initialization failed: .*mass must be > 0"):
-            stepper.run(None, None, restarted, start_values=np.array([-1.0, 0.0, 0.0, 0.0]))
+            stepper.run(plan.time, None, None, restarted, start_values=np.array([-1.0, 0.0, 0.0, 0.0]))
     finally:
         slave.freeInstance()

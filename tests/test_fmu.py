@@ -139,6 +139,17 @@ def test_setup_experiment_tolerance_is_used(fmu):
     assert tight_error < 1e-10 < loose_error < 1e-3
 
 
+def test_a_step_the_taylor_method_gives_up_on_is_taken_by_dopri5(fmu):
+    # Spinning at 1e30 rad/s, sin(theta) turns some 1e26 times in the step: its Taylor series converges
+    # only over steps far below the 1e-12 of the step the Taylor method allows itself, so it gives
+    # up; DOPRI5 takes the step, as omega's change (at most 6.5e-3 rad/s) is far below rounding.
+    slave = open_fmu(fmu, omega0=1e30)
+    slave.doStep(0.0, 1e-3)
+    assert slave.getReal([THETA, OMEGA]) == [1e30 * 1e-3, 1e30]  # theta = omega*t, rounded
+    slave.terminate()
+    slave.freeInstance()
+
+
 def _stepper(fmu, **kwargs):
     slave = open_fmu(fmu, **kwargs)
 

@@ -38,6 +38,14 @@ void model_derivatives(const ModelCoefficients *coefficients, const double value
     dx[0] = coefficients->setpoint - input_at(values, inputs, VR_THETA, offset);
 }
 
+int model_taylor_series(const ModelCoefficients *coefficients, const double values[N_VARIABLES],
+                        const InputDerivatives *inputs, double offset, double h,
+                        double series[TAYLOR_ORDER + 1][N_STATES]) {
+    /* No series: the integrator steps the controller with DOPRI5. */
+    (void)coefficients, (void)values, (void)inputs, (void)offset, (void)h, (void)series;
+    return 0;
+}
+
 void model_update_outputs(const ModelCoefficients *k, double values[N_VARIABLES]) {
     values[VR_TORQUE] = k->proportional_gain * (k->setpoint - values[VR_THETA])
                         + k->integral_gain * values[VR_ERROR_INTEGRAL]

@@ -4,8 +4,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "dopri5.h"
 #include "instance.h"
+#include "integrator.h"
 
 /* A master's time arithmetic (t += h against t = n*h) may differ in the last bits from ours. */
 #define TIME_MATCH_TOLERANCE 1e-9
@@ -193,19 +193,19 @@ int instance_known_references(const Instance *instance, const char *function,
 
 /* Why a variable may not be set in this state, or NULL when it may (FMI 2.0 section 3.2.3, FMI 3.0 section 2.2.4). */
 static const char *why_not_settable(const VariableInfo *variable, int state) {
-    const int input = variable->causality == CAUSALITY_INPUT;
+    /* Inputs first, as they are set every step: in every state a setter is allowed in. */
+    if (variable->causality == CAUSALITY_INPUT) return NULL;
     const int exact = variable->initial == INITIAL_EXACT;
     const int tunable = variable->variability == VARIABILITY_TUNABLE;
     if (variable->variability == VARIABILITY_CONSTANT) return "it is a constant";
     if (variable->initial == INITIAL_CALCULATED) return "it is calculated by the FMU";
     switch (state) {
         case STATE_INSTANTIATED:
-            return input || exact || variable->initial == INITIAL_APPROX ? NULL
-                                                                          : "not before initialization";
+            return exact || variable->initial == INITIAL_APPROX ? NULL : "not before initialization";
         case STATE_INITIALIZATION_MODE:
-            return input || exact ? NULL : "not in initialization mode";
+            return exact ? NULL : "not in initialization mode";
         default:
-            if (input || (variable->causality == CAUSALITY_PARAMETER && tunable)) return NULL;
+            if (variable->causality == CAUSALITY_PARAMETER && tunable) return NULL;
             return variable->causality == CAUSALITY_PARAMETER
                        ? "a fixed parameter cannot change after initialization"
                        : "it can be set only before initialization ends";
@@ -352,6 +352,13 @@ static void derivatives(const void *context, double offset, const double x[N_STA
                       offset, x, dx);
 }
 
+static int taylor_series(const void *context, double offset, double h,
+                         double series[TAYLOR_ORDER + 1][N_STATES]) {
+    const Instance *instance = context;
+    return model_taylor_series(&instance->coefficients, instance->data.values,
+                               &instance->data.inputs, offset, h, series);
+}
+
 Status instance_do_step(Instance *instance, const char *function, double communication_point,
                         double communication_step) {
     InstanceData *data = &instance->data;
@@ -359,7 +366,8 @@ Status instance_do_step(Instance *instance, const char *function, double communi
         return instance_error(instance, function,
                               "communicationStepSize %g must be positive and finite",
                               communication_step);
-    if (!(fabs(communication_point - data->time) <= TIME_MATCH_TOLERANCE * fmax(1.0, fabs(data->time))))
+    const double time_scale = fabs(data->time) > 1.0 ? fabs(data->time) : 1.0;
+    if (!(fabs(communication_point - data->time) <= TIME_MATCH_TOLERANCE * time_scale))
         return instance_error(instance, function,
                               "currentCommunicationPoint %.17g is not where the instance stands "
                               "(%.17g)", communication_point, data->time);
@@ -368,18 +376,19 @@ Status instance_do_step(Instance *instance, const char *function, double communi
     double step_size = data->step_size;
     long steps;
     model_get_states(data->values, x);
-    const Dopri5Result result = dopri5_integrate(derivatives, instance, x, communication_step,
-                                                 data->tolerance, data->tolerance,
-                                                 MAX_INTERNAL_STEPS, &step_size, &steps);
-    if (result != DOPRI5_OK) {
+    const IntegrationResult result = integrate(derivatives, taylor_series, instance, x,
+                                               communication_step, data->tolerance,
+                                               data->tolerance, MAX_INTERNAL_STEPS, &step_size,
+                                               &steps);
+    if (result != INTEGRATION_OK) {
         data->machine_state = STATE_STEP_FAILED;
         instance_log(instance, STATUS_DISCARD, LOG_STATUS_DISCARD,
                      "%s: step from t = %.17g of size %g discarded after %ld internal steps: "
                      "%s at tolerance %g; the instance stays at t = %.17g (restore an FMU state "
                      "or take smaller steps)",
                      function, communication_point, communication_step, steps,
-                     result == DOPRI5_STEP_BUDGET_EXHAUSTED ? "step budget exhausted"
-                                                            : "step size underflow",
+                     result == INTEGRATION_STEP_BUDGET_EXHAUSTED ? "step budget exhausted"
+                                                                 : "step size underflow",
                      data->tolerance, data->time);
         return STATUS_DISCARD;
     }

@@ -1,6 +1,7 @@
 """What a dask worker does with a chunk of cases: simulate each, write the chunk's two parts.
 
-A worker thread steps its cases through one FMU instance that it restarts between cases, each
+A worker thread steps its cases through its thread's FMU instance (simulate.simulator),
+restarted between cases, each
 case in one call into the native loop (cs_loop.py); the FMI 3.0 FMU, or a machine without the
 native loop, runs the same case through fmpy's calls.
 """
@@ -15,8 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import cs_loop
-from ..parameters import START_VALUES, default_parameters, value_reference
-from ..simulate import FmuError, initialize, open_fmu, run_schedule_python
+from ..parameters import START_VALUES, value_reference
+from ..simulate import FmuError, initialize, run_schedule_python, simulator
 from ..torque_schedule import TorqueSchedule, communication_points
 from .store import SUMMARIES, Store
 from .study import OUTPUTS
@@ -35,17 +36,21 @@ class Task:
 
 
 class Runner:
-    """A worker thread's FMU instance, restarted (reset and initialized again) between cases:
-    instantiating costs about a hundred times what a restart costs.
+    """Cases through this thread's Simulator of the FMU (simulate.simulator), whose instance is
+    restarted (reset and initialized again) for each: instantiating costs about a hundred times
+    what a restart costs.
 
     A case is the start values of a restart: the parameters, theta and omega, and the torque,
     which then stays as it was set, so the native loop sets no input per step."""
 
-    def __init__(self, fmu: str):
-        self.fmu, self.slave, self.stepper = fmu, None, None
-        self.defaults = {**default_parameters(fmu), "theta": 0.0, "omega": 0.0, "torque": 0.0}
-        self.start_references = np.array([value_reference(n, fmu) for n in self.defaults], np.uint32)
-        self.outputs = np.array([value_reference(name, fmu) for name in OUTPUTS], np.uint32)
+    def __init__(self, fmu_simulator):
+        self.simulator, fmu = fmu_simulator, fmu_simulator.fmu_path
+        self.defaults = {**fmu_simulator.defaults, "theta": 0.0, "omega": 0.0, "torque": 0.0}
+        start_references = np.array([value_reference(n, fmu) for n in self.defaults], np.uint32)
+        outputs = np.array([value_reference(name, fmu) for name in OUTPUTS], np.uint32)
+        self.stepper = (cs_loop.Stepper(fmu_simulator.slave, np.empty(0, np.uint32), outputs,
+                                        start_references)
+                        if fmu_simulator.stepper is not None else None)
 
     def start_values(self, values: dict[str, np.ndarray], count: int) -> np.ndarray:
         """(count, start values) of the cases given as {name: column}, the defaults elsewhere."""
@@ -55,52 +60,36 @@ class Runner:
 
     def run(self, start_values: np.ndarray, points: np.ndarray, outputs: np.ndarray) -> None:
         """theta, omega and alpha of one case (its row of start_values) at every communication
-        point into outputs (points x 3). FmuError when the FMU refuses the case."""
-        try:
-            if self.slave is None:
-                self.slave = open_fmu(self.fmu, start_time=float(points[0]))
-            self.slave.messages.lines.clear()
-            if cs_loop.drives(self.slave):
-                if self.stepper is None or not np.array_equal(self.stepper.time, points):
-                    self.stepper = cs_loop.Stepper(self.slave, np.empty(0, np.uint32), self.outputs,
-                                                   points, self.start_references)
-                self.stepper.run(None, None, outputs, start_values=start_values)
-            else:
-                self._run_python(dict(zip(self.defaults, start_values.tolist())), points, outputs)
-        except BaseException:
-            # After a refusal the instance is in an error state: the next case starts afresh.
-            self.close()
-            raise
+        point into outputs (points x 3). FmuError when the FMU refuses the case; the next case's
+        restart starts from fmi2Reset, whatever state the refusal left."""
+        self.simulator.slave.messages.lines.clear()
+        if self.stepper is not None:
+            self.stepper.run(points, None, None, outputs, start_values=start_values)
+        else:
+            self._run_python(dict(zip(self.defaults, start_values.tolist())), points, outputs)
 
     def _run_python(self, start: dict[str, float], points: np.ndarray, outputs: np.ndarray) -> None:
         """The same case through fmpy's calls: FMI 3.0 FMUs, or no native loop."""
         torque, theta0, omega0 = start.pop("torque"), start.pop("theta"), start.pop("omega")
-        self.slave.reset()
-        initialize(self.slave, parameters=start, theta0=theta0, omega0=omega0,
-                   start_time=float(points[0]))
+        slave = self.simulator.slave
+        slave.reset()
+        initialize(slave, parameters=start, theta0=theta0, omega0=omega0, start_time=float(points[0]))
         plan = TorqueSchedule(time=points, torque=np.full(len(points) - 1, torque),
                               torque_rate=np.zeros(len(points) - 1))
-        run = run_schedule_python(self.slave, plan)
+        run = run_schedule_python(slave, plan)
         outputs[:] = np.column_stack([run[name] for name in OUTPUTS])
-
-    def close(self) -> None:
-        if self.slave is not None:
-            self.slave.freeInstance()
-            self.slave = self.stepper = None
 
 
 _runners = threading.local()
 
 
 def _runner(fmu: str) -> Runner:
-    """This thread's runner for the FMU file (a new one when the file changed)."""
-    key = (fmu, os.stat(fmu).st_mtime_ns)
+    """This thread's runner for the FMU file, over its Simulator (new when the file changed)."""
+    fmu_simulator = simulator(fmu)
     current = getattr(_runners, "runner", None)
-    if current is None or current[0] != key:
-        if current is not None:
-            current[1].close()
-        current = _runners.runner = key, Runner(fmu)
-    return current[1]
+    if current is None or current.simulator is not fmu_simulator:
+        current = _runners.runner = Runner(fmu_simulator)
+    return current
 
 
 def kept_points(points: int, stride: int) -> np.ndarray:
