@@ -51,6 +51,9 @@ def _seconds(name: str, value) -> Fraction:
 
 def _torque(value, where: str) -> float:
     """A torque value of the signal; InvalidInput unless a finite number."""
+    # A signal written with numpy may return a 0-d array (np.where, np.interp of a scalar).
+    if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
+        value = value.item()
     if not (isinstance(value, numbers.Real) and math.isfinite(value)):
         raise InvalidInput(f"the torque is {value!r} {where}; it must be a finite number of N.m")
     return float(value)
