@@ -18,12 +18,12 @@
 #include "bare_master.h"
 
 /* What cs_loop.py checks too: the arguments below are those of this interface. */
-#define CS_LOOP_INTERFACE 3
+#define CS_LOOP_INTERFACE 4
 
 typedef int CsLoopInterface(void);
 typedef int CsLoopRun(void *const *functions, fmi2Component component,
                       const fmi2ValueReference *start_references, size_t n_start, const double *start_values,
-                      const fmi2ValueReference *input_references, size_t n_inputs,
+                      const double *tolerance, const fmi2ValueReference *input_references, size_t n_inputs,
                       const fmi2ValueReference *output_references, size_t n_outputs,
                       size_t n_steps, const double *time, const double *inputs,
                       const fmi2Integer *input_orders, const double *input_rates,
@@ -48,7 +48,7 @@ static void run_loop(CsLoopRun *run_case, void *const *functions, fmi2Component 
     const double theta0 = 0.0;
     size_t failed_step = 0;
     int failed_call = -1;
-    check(run_case(functions, fmu, &theta_vr, 1, &theta0, &torque_vr, 1, &theta_vr, 1, steps, time, torque,
+    check(run_case(functions, fmu, &theta_vr, 1, &theta0, NULL, &torque_vr, 1, &theta_vr, 1, steps, time, torque,
                    NULL, NULL, theta, &failed_step, &failed_call),
           "cs_loop_run", (long)failed_step);
 }
@@ -73,7 +73,7 @@ int main(int argc, char **argv) {
 
     const MasterRun run = start_master(argc - 1, argv + 1);
     if (run.tolerance != 0) {
-        fprintf(stderr, MASTER_NAME ": the tolerance must be 0: the loop's restart defines none\n");
+        fprintf(stderr, MASTER_NAME ": the tolerance must be 0: this harness restarts with none defined\n");
         return 2;
     }
     LOOK_UP(run.library, fmi2Instantiate);
