@@ -41,11 +41,7 @@ def _temporary_beside(path: Path, suffix: str) -> tuple[int, str]:
         if folder.exists() and not folder.is_dir():
             raise CannotWrite(f"cannot write {path}: {folder} is a file, not a folder; "
                               "choose another output path")
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-    except OSError as error:
-        raise CannotWrite(f"cannot write {path}: the folder {error.filename} cannot be created "
-                          f"({error.strerror}); choose another output path") from None
+    make_folder(path.parent, path)
     try:
         descriptor, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
     except OSError as error:
@@ -53,6 +49,30 @@ def _temporary_beside(path: Path, suffix: str) -> tuple[int, str]:
                           f"({error.strerror}); choose another output path") from None
     os.chmod(temporary, 0o666 & ~_UMASK)
     return descriptor, temporary
+
+
+def make_folder(folder: Path, target, choice: str = "output path") -> None:
+    """Create folder and its parents for writing target; CannotWrite naming target if not.
+
+    Parameters
+    ----------
+    folder : Path
+        The folder to create (nothing happens when it exists).
+    target : str or Path
+        What the user asked to write, named in the message.
+    choice : str, optional
+        What the message asks the user to choose instead.
+
+    Raises
+    ------
+    CannotWrite
+        A folder on the way cannot be created.
+    """
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise CannotWrite(f"cannot write {target}: the folder {error.filename} cannot be created "
+                          f"({error.strerror}); choose another {choice}") from None
 
 
 def _cannot_write(path: Path, error: OSError) -> CannotWrite:

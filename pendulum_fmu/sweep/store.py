@@ -19,7 +19,7 @@ import uuid
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..atomic_files import TEMPORARY_GLOB, replacing_on
+from ..atomic_files import TEMPORARY_GLOB, make_folder, replacing_on
 from ..errors import CannotWrite, PendulumFmuError
 from ..stop_signals import signals_deferred
 
@@ -175,11 +175,7 @@ class Store:
             return
         path = Path(self.root) / LOCK_FILE
         lock = FileLock(path, timeout=0)
-        try:
-            path.parent.mkdir(parents=True, exist_ok=True)
-        except OSError as error:
-            raise CannotWrite(f"cannot write {output_dir}: the folder {error.filename} cannot be created "
-                              f"({error.strerror}); choose another output directory") from None
+        make_folder(path.parent, output_dir, "output directory")
         try:
             lock.acquire()
         except Timeout:
