@@ -21,7 +21,7 @@ import numpy as np
 from . import __version__
 from .build import CHECKOUT_FMUS, FMI_VERSIONS, PLATFORMS, BuildError, PlatformSkipped, check_platforms
 from .errors import InvalidInput, PendulumFmuError
-from .stop_signals import STOPPING_SIGNALS, Stopped, stop_on_signals
+from .stop_signals import STOPPING_SIGNALS, Stopped, restore_signals, stop_on_signals
 from .sweep import DEFAULT_MAX_CASES
 from .torque_schedule import DEFAULT_MAX_STEPS
 
@@ -496,5 +496,5 @@ def main(argv=None) -> int:
               "for the traceback, and report it)", file=sys.stderr)
         return 3
     finally:
-        for number, handler in previous.items():
-            signal.signal(number, handler)
+        if previous:
+            restore_signals(previous)

@@ -8,7 +8,9 @@ not be cut in two (moving a study into place) hold the signals off until they ar
 
 import contextlib
 import signal
+import sys
 import threading
+import time
 
 # The signals that stop the program, and the word its one line says for each.
 STOPPING_SIGNALS = {signal.SIGINT: "interrupted", signal.SIGTERM: "terminated"}
@@ -25,14 +27,53 @@ class Stopped(BaseException):
 
 def stop_on_signals() -> dict:
     """Make SIGINT and SIGTERM raise Stopped once; further ones are ignored so the cleanup that
-    follows (closing the cluster, removing temporaries) runs to its end. Returns the old handlers."""
+    follows (closing the cluster, removing temporaries) runs to its end. Returns the old handlers.
+
+    Python runs a signal's handler wherever the main thread is. Where that is code whose
+    exceptions Python cannot pass on, a garbage collector's callback (dask's client runs one on
+    every collection) or a __del__, it prints Stopped as an ignored exception and goes on, so the
+    program would finish as if no signal had come. sys.unraisablehook catches that Stopped,
+    silently, and the signal is sent again, to land once the main thread is back in the command."""
 
     def stop(number, frame):
         for name in STOPPING_SIGNALS:
             signal.signal(name, signal.SIG_IGN)
         raise Stopped(number)
 
+    unraisable_hook = sys.unraisablehook
+
+    def deliver_again(unraisable):
+        if not isinstance(unraisable.exc_value, Stopped):
+            unraisable_hook(unraisable)
+            return
+        number = unraisable.exc_value.signal_number
+        signal.signal(number, stop)
+        threading.Thread(target=_signal_main_thread, args=(number,), daemon=True).start()
+
+    deliver_again.replaced = unraisable_hook
+    sys.unraisablehook = deliver_again
     return {name: signal.signal(name, stop) for name in STOPPING_SIGNALS}
+
+
+def restore_signals(previous: dict) -> None:
+    """Undo stop_on_signals: the handlers it returned, and Python's own hook for ignored
+    exceptions."""
+    for number, handler in previous.items():
+        signal.signal(number, handler)
+    sys.unraisablehook = getattr(sys.unraisablehook, "replaced", sys.unraisablehook)
+
+
+def _signal_main_thread(number: int) -> None:
+    # Later than the hook's return, so that the handler does not run inside the hook itself; to
+    # the main thread where the platform can aim a signal, so that it also cuts a wait there short.
+    time.sleep(_REDELIVERY_DELAY)
+    if hasattr(signal, "pthread_kill"):
+        signal.pthread_kill(threading.main_thread().ident, number)
+    else:
+        signal.raise_signal(number)
+
+
+_REDELIVERY_DELAY = 0.05  # s
 
 
 @contextlib.contextmanager

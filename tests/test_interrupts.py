@@ -77,3 +77,36 @@ def test_ctrl_c_while_the_program_starts_is_one_line_too(tmp_path, delay):
     assert "Traceback" not in stderr and len(stderr.strip().splitlines()) <= 1, stderr
     assert process.returncode in (0, 130)
     assert [p.name for p in tmp_path.iterdir()] in ([], ["out.csv"])
+
+
+HANDLER_IN_A_GC_CALLBACK = """
+import gc, signal, time
+from pendulum_fmu.stop_signals import Stopped, restore_signals, stop_on_signals
+
+previous = stop_on_signals()
+fired = []
+
+def callback(phase, info):  # as dask's client has one
+    if not fired:
+        fired.append(phase)
+        signal.raise_signal(signal.SIGINT)  # its handler runs here, where Python drops exceptions
+
+gc.callbacks.append(callback)
+try:
+    deadline = time.monotonic() + 10
+    while time.monotonic() < deadline:
+        gc.collect()
+        time.sleep(0.01)
+    print("ran to the end")
+except Stopped as stopped:
+    print("stopped by", stopped.signal_number)
+restore_signals(previous)
+"""
+
+
+def test_a_signal_whose_handler_runs_in_a_gc_callback_still_stops_the_command():
+    # Python prints an exception raised in a garbage collector's callback as "Exception ignored"
+    # and goes on: a Ctrl-C that came there must still stop the command, with nothing printed.
+    run = subprocess.run([sys.executable, "-c", HANDLER_IN_A_GC_CALLBACK], capture_output=True,
+                         text=True, timeout=60)
+    assert (run.stdout, run.stderr) == (f"stopped by {int(signal.SIGINT)}\n", "")
