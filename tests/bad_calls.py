@@ -8,6 +8,7 @@ wrong state reach it exactly as a foreign master would make them (fmpy guards so
 from __future__ import annotations
 
 import ctypes
+import struct
 import sys
 from dataclasses import dataclass
 from pathlib import Path
@@ -270,6 +271,66 @@ def _flip(index):
     return mangle
 
 
+def _fnv1a(data: bytes) -> int:
+    """FNV-1a, 64 bits, as its authors define it: the serialized state's checksum."""
+    hash_value = 0xCBF29CE484222325
+    for byte in data:
+        hash_value = ((hash_value ^ byte) * 0x100000001B3) & 0xFFFFFFFFFFFFFFFF
+    return hash_value
+
+
+def _resealed(offset, replacement):
+    """A blob with bytes at offset replaced and its checksum made anew: what a master forging a
+    state would send, which the checksum cannot catch."""
+    def mangle(blob):
+        blob[offset:offset + len(replacement)] = replacement
+        blob[-8:] = _fnv1a(bytes(blob[:-8])).to_bytes(8, "little")
+        return blob
+    return mangle
+
+
+def _step_past_the_largest_time(h):
+    component, call = h.ready(), {name: getattr(h, function) for name, function in h.state_calls.items()}
+    assert h.step(component, 0.0, 1e308) == OK  # at rest without torque: exact for any step
+    # The state after it is one the FMU reads back (its internal step hint stays finite).
+    state, size = ctypes.c_void_p(), ctypes.c_size_t()
+    assert call["get"](component, ctypes.byref(state)) == OK and call["size"](component, state, ctypes.byref(size)) == OK
+    blob = (ctypes.c_char * size.value)()
+    assert call["serialize"](component, state, blob, size) == OK
+    restored = ctypes.c_void_p()
+    assert call["deserialize"](component, blob, size, ctypes.byref(restored)) == OK, h.last_message()
+    status = h.step(component, 1e308, 1e308)
+    assert h.step(component, 2.0, 1.0) == ERROR, "time stays at 1e308: no other point is accepted"
+    assert h.step(component, 1e308, 1.0) == OK
+    return status
+
+
+def _derivatives_past_the_largest_number(h):
+    component = h.ready()
+    assert h.fmi2SetRealInputDerivatives(component, refs(TORQUE, TORQUE), 2, (ctypes.c_int * 2)(1, 2),
+                                         reals(1e308, 1e308)) == OK
+    status = h.step(component, 0.0, 10.0)
+    # Refused before anything moved: the same instance steps on once the derivatives are sane.
+    assert h.fmi2SetRealInputDerivatives(component, refs(TORQUE, TORQUE), 2, (ctypes.c_int * 2)(1, 2),
+                                         reals(0.0, 0.0)) == OK
+    assert h.set(component, TORQUE, 20.0) == OK and h.step(component, 0.0, 1.0) == OK
+    assert 0 < h.get(component, THETA) < 1
+    return status
+
+
+def _states_never_freed(h):
+    component = h.ready()
+    states = [ctypes.c_void_p() for _ in range(MAX_FMU_STATES)]
+    for state in states:
+        assert h.fmi2GetFMUstate(component, ctypes.byref(state)) == OK
+    extra = ctypes.c_void_p()
+    status = h.fmi2GetFMUstate(component, ctypes.byref(extra))
+    assert not extra, "no state is handed out past the limit"
+    assert h.fmi2FreeFMUstate(component, ctypes.byref(states.pop())) == OK
+    assert h.fmi2GetFMUstate(component, ctypes.byref(extra)) == OK, "freeing one makes room for one"
+    return status
+
+
 FOREIGN = "is not a state this instance handed out"
 
 
@@ -353,6 +414,14 @@ def _illegal(call, *arguments, state="instantiated"):
     return run
 
 
+def _terminated_model_exchange_then(call, *arguments):
+    def run(h):
+        component = h.ready(kind=MODEL_EXCHANGE)
+        assert getattr(h, f"{h.prefix}Terminate")(component) == OK
+        return getattr(h, call)(component, *(a() if callable(a) else a for a in arguments))
+    return run
+
+
 def _no_instance(check):
     def run(h):
         return 0 if check(h) else 3
@@ -360,6 +429,7 @@ def _no_instance(check):
 
 
 NAN, INF = float("nan"), float("inf")
+MAX_FMU_STATES = 10000  # fmu_src/include/instance.h: the FMU states one instance holds at most
 
 CASES = [
     # Non-finite values
@@ -412,9 +482,17 @@ CASES = [
     Case("state machine", "fmi2SetupExperiment after initialization", "fmi2SetupExperiment", ERROR, "not allowed in state",
          _illegal("fmi2SetupExperiment", 0, ctypes.c_double(0), ctypes.c_double(0), 0, ctypes.c_double(0), state="ready")),
     Case("state machine", "model-exchange call on a co-simulation instance", "fmi2SetContinuousStates", ERROR,
-         "not allowed in state 'step complete'", _illegal("fmi2SetContinuousStates", lambda: reals(0.0, 0.0), 2, state="ready")),
-    Case("state machine", "fmi2DoStep on a model-exchange instance", "fmi2DoStep", ERROR, "not allowed in state 'event mode'",
+         "a model-exchange function, and this instance is for co-simulation",
+         _illegal("fmi2SetContinuousStates", lambda: reals(0.0, 0.0), 2, state="ready")),
+    Case("state machine", "model-exchange call on a co-simulation instance in initialization mode (a state both share)",
+         "fmi2GetContinuousStates", ERROR, "a model-exchange function, and this instance is for co-simulation",
+         lambda h: h.fmi2GetContinuousStates(h.initializing(), reals(0.0, 0.0), 2)),
+    Case("state machine", "fmi2DoStep on a model-exchange instance", "fmi2DoStep", ERROR,
+         "a co-simulation function, and this instance is for model exchange",
          lambda h: h.step(h.ready(kind=MODEL_EXCHANGE), 0.0, 0.001)),
+    Case("state machine", "co-simulation call on a terminated model-exchange instance (a state both share)",
+         "fmi2GetRealStatus", ERROR, "a co-simulation function, and this instance is for model exchange",
+         _terminated_model_exchange_then("fmi2GetRealStatus", 2, lambda: reals(0.0))),
     Case("state machine", "fmi2CancelStep (steps are never asynchronous)", "fmi2CancelStep", ERROR, "illegal call sequence",
          _illegal("fmi2CancelStep", state="ready")),
     Case("state machine", "output derivative of order 3", "fmi2GetRealOutputDerivatives", ERROR, "no derivative of order 3",
@@ -434,6 +512,12 @@ CASES = [
          "is not where the instance stands", _step_then(lambda h, c: h.step(c, 0.5, 0.001))),
     Case("fmi2DoStep", "a step of 1e9 s: more than the 100000 internal steps allowed", "fmi2DoStep", DISCARD,
          "step budget exhausted", _discarded_huge_step),
+    Case("fmi2DoStep", "a step of 1e308 s at rest, then one that ends past the largest double", "fmi2DoStep", ERROR,
+         "ends past the largest time a double holds", _step_past_the_largest_time),
+    Case("fmi2DoStep", "input derivatives of 1e308 (orders 1 and 2) over a 10 s step", "fmi2DoStep", ERROR,
+         "take it past the largest number a double holds within this step", _derivatives_past_the_largest_number),
+    Case("FMU states", "a master that never frees its states", "fmi2GetFMUstate", ERROR,
+         f"holds {MAX_FMU_STATES} FMU states, the most it keeps", _states_never_freed),
     # NULL pointers and counts
     Case("NULL and counts", "vr = NULL with nvr = 1", "fmi2GetReal", ERROR, "argument vr must not be NULL",
          lambda h: h.fmi2GetReal(h.ready(), None, 1, reals(0.0))),
@@ -475,6 +559,10 @@ CASES = [
     Case("FMU state blobs", "one payload bit flipped", "fmi2DeSerializeFMUstate", ERROR, "checksum mismatch", _deserialize(_flip(40))),
     Case("FMU state blobs", "a state of another FMU (payload size differs)", "fmi2DeSerializeFMUstate", ERROR,
          "truncated, or from another build", _deserialize(lambda blob: blob[:8] + (len(blob) - 28).to_bytes(4, "little") + blob[12:-8])),
+    Case("FMU state blobs", "mass = -1 written into a state after initialization, checksum made anew", "fmi2DeSerializeFMUstate",
+         ERROR, "implausible state: parameters no initialization would accept", _deserialize(_resealed(84, struct.pack("<d", -1.0)))),
+    Case("FMU state blobs", "a machine state of 2^32 + 4, checksum made anew", "fmi2DeSerializeFMUstate", ERROR,
+         "implausible state: unknown machine state", _deserialize(_resealed(12, struct.pack("<q", (1 << 32) | 4)))),
     *_foreign_state_cases(Harness),
 ]
 
@@ -529,10 +617,16 @@ CASES_FMI3 = [
          lambda h: h.step(h.instantiate(), 0.0, 0.001)),
     Case("state machine", "fmi3DoStep after fmi3Terminate", "fmi3DoStep", ERROR, "not allowed in state 'terminated'",
          lambda h: (lambda c: (h.fmi3Terminate(c), h.step(c, 0.0, 0.001))[-1])(h.ready())),
-    Case("state machine", "fmi3DoStep on a model-exchange instance", "fmi3DoStep", ERROR, "not allowed in state 'event mode'",
+    Case("state machine", "fmi3DoStep on a model-exchange instance", "fmi3DoStep", ERROR,
+         "a co-simulation function, and this instance is for model exchange",
          lambda h: h.step(h.ready(kind=MODEL_EXCHANGE), 0.0, 0.001)),
     Case("state machine", "model-exchange call on a co-simulation instance", "fmi3SetContinuousStates", ERROR,
-         "not allowed in state 'step complete'", _ready_then("fmi3SetContinuousStates", lambda: reals(0.0, 0.0), 2)),
+         "a model-exchange function, and this instance is for co-simulation",
+         _ready_then("fmi3SetContinuousStates", lambda: reals(0.0, 0.0), 2)),
+    Case("state machine", "co-simulation call on a terminated model-exchange instance (a state both share)",
+         "fmi3GetOutputDerivatives", ERROR, "a co-simulation function, and this instance is for model exchange",
+         _terminated_model_exchange_then("fmi3GetOutputDerivatives", refs(THETA), 1, (ctypes.c_int * 1)(1),
+                                         lambda: reals(0.0), 1)),
     Case("state machine", "fmi3EnterEventMode on a co-simulation instance (no event mode)", "fmi3EnterEventMode", ERROR,
          "not allowed in state 'step complete'", _ready_then("fmi3EnterEventMode")),
     Case("state machine", "fixed parameter mass set after initialization", "fmi3SetFloat64", ERROR,

@@ -26,9 +26,7 @@ typedef enum {
 } InterfaceType;
 
 /* The machine states of both standards, as bits so that each function's allowed states are a
-   mask. STEP_COMPLETE is FMI 3.0's step mode and STEP_FAILED its step discarded. Co-simulation
-   instances never reach the model-exchange states and vice versa, so the masks also keep each
-   interface's functions to its own instances. */
+   mask. STEP_COMPLETE is FMI 3.0's step mode and STEP_FAILED its step discarded. */
 typedef enum {
     STATE_INSTANTIATED = 1 << 0,
     STATE_INITIALIZATION_MODE = 1 << 1,
@@ -44,10 +42,20 @@ typedef enum {
 #define MODEL_EXCHANGE_STATES (STATE_INSTANTIATED | STATE_INITIALIZATION_MODE | STATE_EVENT_MODE \
                                | STATE_CONTINUOUS_TIME_MODE | STATE_TERMINATED)
 
+/* Beside the states, the mask of a function that belongs to one interface says which: the two
+   interfaces share the states instantiated, initialization mode and terminated, so the states
+   alone would let the other interface's instances call it there. */
+#define CO_SIMULATION_ONLY (1 << 7)
+#define MODEL_EXCHANGE_ONLY (1 << 8)
+
 #define DEFAULT_TOLERANCE 1e-10
 /* Internal steps one communication step may try before it gives up with a discard. */
 #define MAX_INTERNAL_STEPS 100000L
 #define MAX_INSTANCE_NAME 128
+/* FMU states one instance holds at most: each call that takes a state looks it up in the
+   instance's list, so a master that never frees its states would otherwise slow every such call
+   without end. */
+#define MAX_FMU_STATES 10000
 
 /* The master's logger as an adapter hands it over: its function, cast to a generic function
    pointer, and forward, the adapter's function that casts it back and calls it. */
@@ -92,6 +100,7 @@ typedef struct {
     /* The FMU states this instance handed out and has not freed (fmu_state.c): a state the master
        passes back is looked up here by its address before anything in it is read. */
     struct StoredState *states;
+    size_t n_states;
 } Instance;
 
 /* Every function below takes `function`, the name of the FMI function the master called, for
@@ -113,7 +122,8 @@ void instance_log(const Instance *instance, Status status, LogCategory category,
                   const char *format, ...);
 Status instance_error(const Instance *instance, const char *function, const char *format, ...);
 
-/* 1 when the instance's machine state is in mask, else logs an illegal call sequence. */
+/* 1 when the instance's machine state is in mask and the mask does not keep the function to the
+   other interface, else logs an illegal call. */
 int instance_state_allows(const Instance *instance, int mask, const char *function);
 int instance_null_argument(const Instance *instance, const char *function, const char *argument,
                            const void *pointer);

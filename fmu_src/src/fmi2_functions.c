@@ -34,30 +34,30 @@
 #define MASK_fmi2SerializeFMUstate            ANY_STATE
 #define MASK_fmi2DeSerializeFMUstate          ANY_STATE
 #define MASK_fmi2GetDirectionalDerivative     (STATE_INITIALIZATION_MODE | ANY_INITIALIZED)
-#define MASK_fmi2SetRealInputDerivatives      (STATE_INSTANTIATED | STATE_INITIALIZATION_MODE \
+#define MASK_fmi2SetRealInputDerivatives      (CO_SIMULATION_ONLY | STATE_INSTANTIATED | STATE_INITIALIZATION_MODE \
                                                | STATE_STEP_COMPLETE)
-#define MASK_fmi2GetRealOutputDerivatives     (STATE_STEP_COMPLETE | STATE_STEP_FAILED \
+#define MASK_fmi2GetRealOutputDerivatives     (CO_SIMULATION_ONLY | STATE_STEP_COMPLETE | STATE_STEP_FAILED \
                                                | STATE_TERMINATED)
-#define MASK_fmi2DoStep                       STATE_STEP_COMPLETE
-#define MASK_fmi2CancelStep                   0
-#define MASK_fmi2GetStatus                    (STATE_STEP_COMPLETE | STATE_STEP_FAILED \
+#define MASK_fmi2DoStep                       (CO_SIMULATION_ONLY | STATE_STEP_COMPLETE)
+#define MASK_fmi2CancelStep                   CO_SIMULATION_ONLY
+#define MASK_fmi2GetStatus                    (CO_SIMULATION_ONLY | STATE_STEP_COMPLETE | STATE_STEP_FAILED \
                                                | STATE_TERMINATED)
 #define MASK_fmi2GetRealStatus                MASK_fmi2GetStatus
 #define MASK_fmi2GetIntegerStatus             MASK_fmi2GetStatus
 #define MASK_fmi2GetBooleanStatus             MASK_fmi2GetStatus
 #define MASK_fmi2GetStringStatus              MASK_fmi2GetStatus
-#define MASK_fmi2EnterEventMode               (STATE_EVENT_MODE | STATE_CONTINUOUS_TIME_MODE)
-#define MASK_fmi2NewDiscreteStates            STATE_EVENT_MODE
-#define MASK_fmi2EnterContinuousTimeMode      STATE_EVENT_MODE
-#define MASK_fmi2CompletedIntegratorStep      STATE_CONTINUOUS_TIME_MODE
-#define MASK_fmi2SetTime                      (STATE_EVENT_MODE | STATE_CONTINUOUS_TIME_MODE)
-#define MASK_fmi2SetContinuousStates          STATE_CONTINUOUS_TIME_MODE
-#define MASK_fmi2GetEventIndicators           (STATE_INITIALIZATION_MODE | STATE_EVENT_MODE \
+#define MASK_fmi2EnterEventMode               (MODEL_EXCHANGE_ONLY | STATE_EVENT_MODE | STATE_CONTINUOUS_TIME_MODE)
+#define MASK_fmi2NewDiscreteStates            (MODEL_EXCHANGE_ONLY | STATE_EVENT_MODE)
+#define MASK_fmi2EnterContinuousTimeMode      (MODEL_EXCHANGE_ONLY | STATE_EVENT_MODE)
+#define MASK_fmi2CompletedIntegratorStep      (MODEL_EXCHANGE_ONLY | STATE_CONTINUOUS_TIME_MODE)
+#define MASK_fmi2SetTime                      (MODEL_EXCHANGE_ONLY | STATE_EVENT_MODE | STATE_CONTINUOUS_TIME_MODE)
+#define MASK_fmi2SetContinuousStates          (MODEL_EXCHANGE_ONLY | STATE_CONTINUOUS_TIME_MODE)
+#define MASK_fmi2GetEventIndicators           (MODEL_EXCHANGE_ONLY | STATE_INITIALIZATION_MODE | STATE_EVENT_MODE \
                                                | STATE_CONTINUOUS_TIME_MODE | STATE_TERMINATED)
 #define MASK_fmi2GetContinuousStates          MASK_fmi2GetEventIndicators
-#define MASK_fmi2GetDerivatives               (STATE_EVENT_MODE | STATE_CONTINUOUS_TIME_MODE \
+#define MASK_fmi2GetDerivatives               (MODEL_EXCHANGE_ONLY | STATE_EVENT_MODE | STATE_CONTINUOUS_TIME_MODE \
                                                | STATE_TERMINATED)
-#define MASK_fmi2GetNominalsOfContinuousStates (STATE_INSTANTIATED | STATE_EVENT_MODE \
+#define MASK_fmi2GetNominalsOfContinuousStates (MODEL_EXCHANGE_ONLY | STATE_INSTANTIATED | STATE_EVENT_MODE \
                                                | STATE_CONTINUOUS_TIME_MODE | STATE_TERMINATED)
 
 /* Every function with an instance starts here: NULL instance, then the state mask. Each

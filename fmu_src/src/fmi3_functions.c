@@ -15,7 +15,7 @@
    FMI 3.0 model description (pendulum_fmu/fmi3.py) numbers it so. */
 #define VR_TIME N_VARIABLES
 
-#define ANY_STATE (~0)
+#define ANY_STATE (CO_SIMULATION_STATES | MODEL_EXCHANGE_STATES)
 #define RUNNING (STATE_STEP_COMPLETE | STATE_EVENT_MODE | STATE_CONTINUOUS_TIME_MODE)
 #define ANY_INITIALIZED (RUNNING | STATE_STEP_FAILED | STATE_TERMINATED)
 
@@ -61,20 +61,20 @@
 #define MASK_fmi3GetAdjointDerivative            MASK_fmi3GetDirectionalDerivative
 #define MASK_fmi3EvaluateDiscreteStates          RUNNING
 #define MASK_fmi3UpdateDiscreteStates            STATE_EVENT_MODE
-#define MASK_fmi3EnterContinuousTimeMode         STATE_EVENT_MODE
-#define MASK_fmi3CompletedIntegratorStep         STATE_CONTINUOUS_TIME_MODE
-#define MASK_fmi3SetTime                         (STATE_EVENT_MODE | STATE_CONTINUOUS_TIME_MODE)
-#define MASK_fmi3SetContinuousStates             STATE_CONTINUOUS_TIME_MODE
-#define MASK_fmi3GetContinuousStateDerivatives   (STATE_INITIALIZATION_MODE | STATE_EVENT_MODE \
+#define MASK_fmi3EnterContinuousTimeMode         (MODEL_EXCHANGE_ONLY | STATE_EVENT_MODE)
+#define MASK_fmi3CompletedIntegratorStep         (MODEL_EXCHANGE_ONLY | STATE_CONTINUOUS_TIME_MODE)
+#define MASK_fmi3SetTime                         (MODEL_EXCHANGE_ONLY | STATE_EVENT_MODE | STATE_CONTINUOUS_TIME_MODE)
+#define MASK_fmi3SetContinuousStates             (MODEL_EXCHANGE_ONLY | STATE_CONTINUOUS_TIME_MODE)
+#define MASK_fmi3GetContinuousStateDerivatives   (MODEL_EXCHANGE_ONLY | STATE_INITIALIZATION_MODE | STATE_EVENT_MODE \
                                                   | STATE_CONTINUOUS_TIME_MODE | STATE_TERMINATED)
 #define MASK_fmi3GetEventIndicators              MASK_fmi3GetContinuousStateDerivatives
 #define MASK_fmi3GetContinuousStates             MASK_fmi3GetContinuousStateDerivatives
 #define MASK_fmi3GetNominalsOfContinuousStates   MASK_fmi3GetContinuousStateDerivatives
 #define MASK_fmi3GetNumberOfEventIndicators      ANY_STATE
 #define MASK_fmi3GetNumberOfContinuousStates     ANY_STATE
-#define MASK_fmi3GetOutputDerivatives            (STATE_STEP_COMPLETE | STATE_STEP_FAILED \
+#define MASK_fmi3GetOutputDerivatives            (CO_SIMULATION_ONLY | STATE_STEP_COMPLETE | STATE_STEP_FAILED \
                                                   | STATE_TERMINATED)
-#define MASK_fmi3DoStep                          STATE_STEP_COMPLETE
+#define MASK_fmi3DoStep                          (CO_SIMULATION_ONLY | STATE_STEP_COMPLETE)
 /* Not supported in any state: they answer why after the NULL check. */
 #define MASK_fmi3GetClock                        ANY_STATE
 #define MASK_fmi3SetClock                        ANY_STATE

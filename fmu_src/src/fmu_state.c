@@ -37,10 +37,14 @@ static uint32_t get_u32(const unsigned char *from) {
     return value;
 }
 
+/* States past initialization, where the parameters have passed the model's checks. */
+#define INITIALIZED_STATES (RESTORABLE_STATES & ~(STATE_INSTANTIATED | STATE_INITIALIZATION_MODE))
+
 /* NULL when data could have come from an instance of this FMU, else what is wrong with it. */
 static const char *implausible(const InstanceData *data) {
-    const int state = data->machine_state;
-    if (!(state & RESTORABLE_STATES) || (state & (state - 1))) return "unknown machine state";
+    const int64_t state = data->machine_state;
+    if (!(state & RESTORABLE_STATES) || (state & ~(int64_t)RESTORABLE_STATES) || (state & (state - 1)))
+        return "unknown machine state";
     if (!isfinite(data->time) || !isfinite(data->last_successful_time)) return "non-finite time";
     if (!(data->tolerance > 0 && data->tolerance < 1)) return "tolerance out of range";
     if (!(data->step_size >= 0) || !isfinite(data->step_size)) return "bad internal step size";
@@ -51,6 +55,9 @@ static const char *implausible(const InstanceData *data) {
         if ((first != 0 || second != 0) && model_variables[vr].causality != CAUSALITY_INPUT)
             return "derivative on a variable that is not an input";
     }
+    /* Before initialization ends the parameters are the master's, not checked yet. */
+    if ((state & INITIALIZED_STATES) && model_invalid_parameters(data->values))
+        return "parameters no initialization would accept";
     return NULL;
 }
 
@@ -87,6 +94,11 @@ static StoredState *own_state(Instance *instance, const char *function, const vo
 /* The state the master hands back to be overwritten (*state), or a new one in the list. */
 static StoredState *state_to_fill(Instance *instance, const char *function, void *state) {
     if (state) return own_state(instance, function, state);
+    if (instance->n_states >= MAX_FMU_STATES) {
+        instance_error(instance, function, "this instance holds %d FMU states, the most it keeps: "
+                       "free those no longer needed", MAX_FMU_STATES);
+        return NULL;
+    }
     StoredState *stored = malloc(sizeof(StoredState));
     if (!stored) {
         instance_error(instance, function, "out of memory");
@@ -94,6 +106,7 @@ static StoredState *state_to_fill(Instance *instance, const char *function, void
     }
     stored->next = instance->states;
     instance->states = stored;
+    instance->n_states++;
     return stored;
 }
 
@@ -133,6 +146,7 @@ Status instance_free_state(Instance *instance, const char *function, void **stat
     StoredState *stored = *link;
     *link = stored->next;
     free(stored);
+    instance->n_states--;
     *state = NULL;
     return STATUS_OK;
 }
@@ -143,6 +157,7 @@ void instance_free_states(Instance *instance) {
         free(instance->states);
         instance->states = next;
     }
+    instance->n_states = 0;
 }
 
 Status instance_serialized_state_size(Instance *instance, const char *function, const void *state,

@@ -57,6 +57,13 @@ static const char *state_name(int state) {
 }
 
 int instance_state_allows(const Instance *instance, int mask, const char *function) {
+    const int co_simulation = instance->type == INTERFACE_CO_SIMULATION;
+    if (mask & (co_simulation ? MODEL_EXCHANGE_ONLY : CO_SIMULATION_ONLY)) {
+        instance_error(instance, function, "illegal call: a %s function, and this instance is for %s",
+                       co_simulation ? "model-exchange" : "co-simulation",
+                       co_simulation ? "co-simulation" : "model exchange");
+        return 0;
+    }
     if (instance->data.machine_state & mask) return 1;
     instance_error(instance, function, "illegal call sequence: not allowed in state '%s'",
                    state_name(instance->data.machine_state));
@@ -371,6 +378,20 @@ Status instance_do_step(Instance *instance, const char *function, double communi
         return instance_error(instance, function,
                               "currentCommunicationPoint %.17g is not where the instance stands "
                               "(%.17g)", communication_point, data->time);
+    if (!isfinite(communication_point + communication_step))
+        return instance_error(instance, function,
+                              "a step of %g from t = %.17g ends past the largest time a double holds",
+                              communication_step, communication_point);
+    for (size_t vr = 0; vr < N_VARIABLES; vr++) {
+        if (model_variables[vr].causality != CAUSALITY_INPUT) continue;
+        const double end_value = input_at(data->values, &data->inputs, (int)vr, communication_step);
+        if (!isfinite(end_value) || !isfinite(data->inputs.first[vr] + communication_step * data->inputs.second[vr]))
+            return instance_error(instance, function,
+                                  "the derivatives of %s set with the input derivatives take it past "
+                                  "the largest number a double holds within this step of %g: take "
+                                  "smaller steps or set smaller derivatives",
+                                  model_variables[vr].name, communication_step);
+    }
 
     double x[N_STATES];
     double step_size = data->step_size;
@@ -399,7 +420,9 @@ Status instance_do_step(Instance *instance, const char *function, double communi
         data->values[vr] = input_at(data->values, &data->inputs, (int)vr, communication_step);
         data->inputs.first[vr] += communication_step * data->inputs.second[vr];
     }
-    data->step_size = step_size;
+    /* A hint grown past the largest double (a step near it, at rest) is no hint: the next step
+       starts from its whole length, as the first does. */
+    data->step_size = isfinite(step_size) ? step_size : 0.0;
     data->time = communication_point + communication_step;
     data->last_successful_time = data->time;
     instance->outputs_stale = 1;
