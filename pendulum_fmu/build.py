@@ -169,6 +169,7 @@ def generate_variables(model_description, out_dir: Path) -> list[Path]:
                 f"{index}: the C code indexes one array of Reals by value reference"
             )
     enum = ",\n".join(f"    VR_{v.name.upper()} = {v.valueReference}" for v in variables)
+    inputs = ", ".join(f"VR_{v.name.upper()}" for v in variables if v.causality == "input")
     header = f"""/* Generated from modelDescription.xml by pendulum_fmu/build.py: edit the XML, not this. */
 #ifndef MODEL_VARIABLES_H
 #define MODEL_VARIABLES_H
@@ -177,6 +178,9 @@ def generate_variables(model_description, out_dir: Path) -> list[Path]:
 
 #define MODEL_GUID "{model_description.guid}"
 #define N_VARIABLES {len(variables)}
+/* The inputs' value references: a step updates these, without a pass over every variable. */
+#define N_INPUTS {sum(v.causality == "input" for v in variables)}
+#define INPUT_REFERENCES {{{inputs}}}
 
 typedef enum {{
 {enum}

@@ -122,9 +122,24 @@ void instance_log(const Instance *instance, Status status, LogCategory category,
                   const char *format, ...);
 Status instance_error(const Instance *instance, const char *function, const char *format, ...);
 
+/* Logs why mask does not allow the call (the function is the other interface's, or the machine
+   state is not in it); returns 0. */
+int instance_illegal_call(const Instance *instance, int mask, const char *function);
+
 /* 1 when the instance's machine state is in mask and the mask does not keep the function to the
-   other interface, else logs an illegal call. */
-int instance_state_allows(const Instance *instance, int mask, const char *function);
+   other interface, else logs an illegal call. Inline, so that each entry point's constant mask
+   folds the check to a test or two: the interface is asked only where the mask allows a state
+   both interfaces share. */
+static inline int instance_state_allows(const Instance *instance, int mask, const char *function) {
+    const int shared_states = STATE_INSTANTIATED | STATE_INITIALIZATION_MODE | STATE_TERMINATED;
+    const int interface_only = mask & (CO_SIMULATION_ONLY | MODEL_EXCHANGE_ONLY);
+    if ((instance->data.machine_state & mask)
+        && (!(interface_only && (mask & shared_states))
+            || interface_only == (instance->type == INTERFACE_CO_SIMULATION ? CO_SIMULATION_ONLY
+                                                                            : MODEL_EXCHANGE_ONLY)))
+        return 1;
+    return instance_illegal_call(instance, mask, function);
+}
 int instance_null_argument(const Instance *instance, const char *function, const char *argument,
                            const void *pointer);
 /* 1 when the value references are all variables of this FMU, else logs which is not. */

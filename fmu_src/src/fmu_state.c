@@ -47,7 +47,8 @@ static const char *implausible(const InstanceData *data) {
         return "unknown machine state";
     if (!isfinite(data->time) || !isfinite(data->last_successful_time)) return "non-finite time";
     if (!(data->tolerance > 0 && data->tolerance < 1)) return "tolerance out of range";
-    if (!(data->step_size >= 0) || !isfinite(data->step_size)) return "bad internal step size";
+    /* +inf is a hint like any other: a step near the largest double, at rest, grows it there. */
+    if (!(data->step_size >= 0)) return "bad internal step size";
     for (size_t vr = 0; vr < N_VARIABLES; vr++) {
         const double first = data->inputs.first[vr], second = data->inputs.second[vr];
         if (!isfinite(data->values[vr]) || !isfinite(first) || !isfinite(second))

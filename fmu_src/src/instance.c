@@ -56,7 +56,7 @@ static const char *state_name(int state) {
     }
 }
 
-int instance_state_allows(const Instance *instance, int mask, const char *function) {
+int instance_illegal_call(const Instance *instance, int mask, const char *function) {
     const int co_simulation = instance->type == INTERFACE_CO_SIMULATION;
     if (mask & (co_simulation ? MODEL_EXCHANGE_ONLY : CO_SIMULATION_ONLY)) {
         instance_error(instance, function, "illegal call: a %s function, and this instance is for %s",
@@ -64,7 +64,6 @@ int instance_state_allows(const Instance *instance, int mask, const char *functi
                        co_simulation ? "co-simulation" : "model exchange");
         return 0;
     }
-    if (instance->data.machine_state & mask) return 1;
     instance_error(instance, function, "illegal call sequence: not allowed in state '%s'",
                    state_name(instance->data.machine_state));
     return 0;
@@ -378,20 +377,35 @@ Status instance_do_step(Instance *instance, const char *function, double communi
         return instance_error(instance, function,
                               "currentCommunicationPoint %.17g is not where the instance stands "
                               "(%.17g)", communication_point, data->time);
-    if (!isfinite(communication_point + communication_step))
+    const double end_time = communication_point + communication_step;
+    if (!isfinite(end_time))
         return instance_error(instance, function,
                               "a step of %g from t = %.17g ends past the largest time a double holds",
                               communication_step, communication_point);
-    for (size_t vr = 0; vr < N_VARIABLES; vr++) {
-        if (model_variables[vr].causality != CAUSALITY_INPUT) continue;
-        const double end_value = input_at(data->values, &data->inputs, (int)vr, communication_step);
-        if (!isfinite(end_value) || !isfinite(data->inputs.first[vr] + communication_step * data->inputs.second[vr]))
+
+#if N_INPUTS > 0
+    /* Where the inputs' polynomials take them by the step's end (a held input, the usual case,
+       stays): past the largest double, the step is refused before anything moves. */
+    static const int inputs[N_INPUTS] = INPUT_REFERENCES;
+    double end_values[N_INPUTS], end_first[N_INPUTS];
+    int moving = 0;
+    for (int i = 0; i < N_INPUTS; i++) {
+        const int vr = inputs[i];
+        if (data->inputs.first[vr] == 0 && data->inputs.second[vr] == 0) {
+            end_values[i] = data->values[vr];
+            end_first[i] = 0;
+            continue;
+        }
+        moving = 1;
+        end_values[i] = input_at(data->values, &data->inputs, vr, communication_step);
+        end_first[i] = data->inputs.first[vr] + communication_step * data->inputs.second[vr];
+        if (!isfinite(end_values[i]) || !isfinite(end_first[i]))
             return instance_error(instance, function,
-                                  "the derivatives of %s set with the input derivatives take it past "
-                                  "the largest number a double holds within this step of %g: take "
-                                  "smaller steps or set smaller derivatives",
-                                  model_variables[vr].name, communication_step);
+                                  "the input derivatives take %s past the largest number a double "
+                                  "holds within this step of %g: take smaller steps or set smaller "
+                                  "derivatives", model_variables[vr].name, communication_step);
     }
+#endif
 
     double x[N_STATES];
     double step_size = data->step_size;
@@ -413,17 +427,15 @@ Status instance_do_step(Instance *instance, const char *function, double communi
                      data->tolerance, data->time);
         return STATUS_DISCARD;
     }
-    model_set_states(data->values, x);
-    /* The inputs are where their polynomials have taken them. */
-    for (size_t vr = 0; vr < N_VARIABLES; vr++) {
-        if (model_variables[vr].causality != CAUSALITY_INPUT) continue;
-        data->values[vr] = input_at(data->values, &data->inputs, (int)vr, communication_step);
-        data->inputs.first[vr] += communication_step * data->inputs.second[vr];
+#if N_INPUTS > 0
+    for (int i = 0; moving && i < N_INPUTS; i++) {
+        data->values[inputs[i]] = end_values[i];
+        data->inputs.first[inputs[i]] = end_first[i];
     }
-    /* A hint grown past the largest double (a step near it, at rest) is no hint: the next step
-       starts from its whole length, as the first does. */
-    data->step_size = isfinite(step_size) ? step_size : 0.0;
-    data->time = communication_point + communication_step;
+#endif
+    model_set_states(data->values, x);
+    data->step_size = step_size;
+    data->time = end_time;
     data->last_successful_time = data->time;
     instance->outputs_stale = 1;
     return STATUS_OK;
