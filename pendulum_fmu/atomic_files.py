@@ -3,7 +3,9 @@
 Everything the project writes goes through `replacing`: the content is written to a unique
 temporary beside the target (same folder, so the rename is atomic on one file system) and renamed
 into place only when the writer finished without an exception. An interrupted or failed write
-leaves the old file, or none, and no temporary.
+leaves the old file, or none, and no temporary. A target that is a symbolic link replaces the file
+the link leads to, and keeps the link; a target that is no regular file (a device such as
+/dev/null, a named pipe) has nothing to replace and is written into as it is.
 """
 
 from __future__ import annotations
@@ -11,6 +13,7 @@ from __future__ import annotations
 import contextlib
 import errno
 import os
+import stat
 import tempfile
 import uuid
 from pathlib import Path
@@ -34,20 +37,56 @@ def _read_umask() -> int:
 _UMASK = _read_umask()
 
 
+# Of the target's name, the temporary carries this much: enough to tell whose it is, and short
+# enough that a target whose name the file system just allows still gets a temporary.
+_NAME_IN_TEMPORARY = 64
+
+
+def _streamed(path: Path) -> bool:
+    """Whether path is an existing file that is no regular file or folder (a device, a named
+    pipe, a socket): renaming over it would destroy it, so it is written into as it is."""
+    try:
+        mode = path.stat().st_mode  # through a link, to what it leads to
+    except OSError:
+        return False
+    return not (stat.S_ISREG(mode) or stat.S_ISDIR(mode))
+
+
+def _final(path: Path) -> Path:
+    """The file a write to path replaces: the one a symbolic link leads to (so the link stays a
+    link), else path itself."""
+    return Path(os.path.realpath(path)) if path.is_symlink() else path
+
+
+def _longest_name(folder: Path) -> int:
+    """The longest file name folder's file system allows, in bytes (255 where the platform cannot
+    say, as on Windows, whose file systems allow 255 characters)."""
+    try:
+        return os.pathconf(folder, "PC_NAME_MAX")
+    except (AttributeError, OSError, ValueError):
+        return 255
+
+
 def _temporary_beside(path: Path, suffix: str) -> tuple[int, str]:
-    """A new file beside path with the permissions a plain open() would give (mkstemp's are 0600,
-    which would hide an FMU or a table from the other users of a shared folder)."""
+    """A new file beside path with the permissions of the file it replaces, or those a plain
+    open() would give (mkstemp's are 0600, which would hide an FMU or a table from the other users
+    of a shared folder)."""
     for folder in (path.parent, *path.parent.parents):
         if folder.exists() and not folder.is_dir():
             raise CannotWrite(f"cannot write {path}: {folder} is a file, not a folder; "
                               "choose another output path")
     make_folder(path.parent, path)
     try:
-        descriptor, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
+        descriptor, temporary = tempfile.mkstemp(prefix=f".{path.name[:_NAME_IN_TEMPORARY]}.",
+                                                 suffix=suffix[:_NAME_IN_TEMPORARY], dir=path.parent)
     except OSError as error:
         raise CannotWrite(f"cannot write {path}: no file can be created in {path.parent} "
                           f"({error.strerror}); choose another output path") from None
-    os.chmod(temporary, 0o666 & ~_UMASK)
+    try:
+        permissions = stat.S_IMODE(path.stat().st_mode)
+    except OSError:
+        permissions = 0o666 & ~_UMASK
+    os.chmod(temporary, permissions)
     return descriptor, temporary
 
 
@@ -96,17 +135,36 @@ def check_writable(*paths: str | os.PathLike) -> None:
         A path is a folder, a folder on the way is a file, or no file can be created beside it.
     """
     for path in map(Path, paths):
-        if path.is_dir():
-            raise CannotWrite(f"cannot write {path}: it is a folder; give a file name")
-        made = [folder for folder in (path.parent, *path.parent.parents) if not folder.exists()]
         try:
-            descriptor, temporary = _temporary_beside(path, f".partial{path.suffix}")
-            os.close(descriptor)
-            os.unlink(temporary)
-        finally:
-            for folder in made:  # deepest first
-                with contextlib.suppress(OSError):
-                    folder.rmdir()
+            _check_writable(path)
+        except CannotWrite:
+            raise
+        except OSError as error:  # a name too long, a loop of links: the path itself is wrong
+            raise _cannot_write(path, error) from None
+
+
+def _check_writable(path: Path) -> None:
+    if path.is_dir():
+        raise CannotWrite(f"cannot write {path}: it is a folder; give a file name")
+    if _streamed(path):
+        if not os.access(path, os.W_OK):
+            raise CannotWrite(f"cannot write {path}: permission denied; choose another output path")
+        return
+    path = _final(path)
+    made = [folder for folder in (path.parent, *path.parent.parents) if not folder.exists()]
+    try:
+        descriptor, temporary = _temporary_beside(path, f".partial{path.suffix}")
+        os.close(descriptor)
+        os.unlink(temporary)
+        # The name itself, which the temporary's shorter one did not try.
+        longest = _longest_name(path.parent)
+        if len(os.fsencode(path.name)) > longest:
+            raise CannotWrite(f"cannot write {path}: its name is longer than the {longest} bytes "
+                              "this file system allows; choose a shorter name")
+    finally:
+        for folder in made:  # deepest first
+            with contextlib.suppress(OSError):
+                folder.rmdir()
 
 
 @contextlib.contextmanager
@@ -125,6 +183,10 @@ def replacing_path(path: str | os.PathLike):
     """A unique temporary path beside path, for writers that want a file name (savefig, zip);
     renamed to path on success, removed otherwise."""
     path = Path(path)
+    if _streamed(path):
+        yield path
+        return
+    path = _final(path)
     descriptor, temporary = _temporary_beside(path, f".partial{path.suffix}")
     os.close(descriptor)
     try:

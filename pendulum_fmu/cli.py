@@ -9,6 +9,9 @@ traceback on --debug.
 from __future__ import annotations
 
 import argparse
+import contextlib
+import errno
+import os
 import signal
 import sys
 import threading
@@ -121,12 +124,39 @@ def cmd_cross_check(args) -> int:
     return 0
 
 
+def _check_outputs(outputs: dict, inputs: dict) -> None:
+    """Refuse before the run an output (option -> path) that cannot be written, that another
+    output names too, or that is a file the command reads (option -> path): writing it would
+    destroy the input."""
+    from .atomic_files import check_writable
+    from .plot import check_figure_path
+
+    given = {option: Path(path) for option, path in outputs.items() if path}
+    check_writable(*given.values())
+    if given.get("--plot"):
+        check_figure_path(given["--plot"])
+    read = {option: Path(path) for option, path in inputs.items() if path}
+    for number, (option, path) in enumerate(given.items()):
+        for other, other_path in [*list(given.items())[:number], *read.items()]:
+            if _same_file(path, other_path):
+                raise InvalidInput(f"{option} {path} names the same file as {other}: writing it would "
+                                   f"{'destroy what the command reads' if other in read else 'lose one of the two'}; "
+                                   "choose another path")
+
+
+def _same_file(one: Path, other: Path) -> bool:
+    try:
+        return one.samefile(other)
+    except OSError:  # one of them does not exist yet: the same file only by its name
+        return one.resolve() == other.resolve()
+
+
 def cmd_simulate(args) -> int:
     from . import results
-    from .atomic_files import check_writable
     from .simulate import simulate
 
-    check_writable(*(path for path in (args.output, args.plot) if path))
+    _check_outputs({"--output": args.output, "--plot": args.plot},
+                   {"--torque-file": args.torque_file, "--fmu": args.fmu})
     run = simulate(_torque_signal(args), stop_time=args.stop_time, step_size=args.step_size,
                    ramp=args.ramp, parameters=_parameters(args.assignments), theta0=args.theta0,
                    omega0=args.omega0, tolerance=args.tolerance, max_steps=args.max_steps,
@@ -224,6 +254,10 @@ def cmd_judge(args) -> int:
     from .plot import plot_judgement
 
     signal = _torque_signal(args)
+    kit = sorted(args.result.iterdir()) if args.result.is_dir() else []
+    _check_outputs({"--json": args.json, **({} if kit else {"--plot": args.plot})},
+                   {"the result": args.result, "--torque-file": args.torque_file, "--fmu": args.fmu,
+                    **{f"the kit's {path.name}": path for path in kit if path.is_file()}})
     if args.result.is_dir():
         if signal is not None:
             raise InvalidInput(f"{args.result} is a folder, judged as a scenario kit whose NAME.json "
@@ -459,6 +493,40 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+class _UntilTheReaderIsGone:
+    """stdout that drops what is printed once its reader is gone (piped into `head`, which
+    closed the pipe; a full /dev/full), so that the command still writes its files: what it
+    prints only reports them."""
+
+    def __init__(self, stream):
+        self._stream = stream
+        self._gone = False
+
+    def _guarded(self, write, *arguments):
+        if self._gone:
+            return None
+        try:
+            return write(*arguments)
+        except OSError as error:
+            if not isinstance(error, BrokenPipeError) and error.errno != errno.ENOSPC:
+                raise
+            self._gone = True
+            # What is still buffered goes nowhere too, also when Python flushes it at exit.
+            with contextlib.suppress(OSError, ValueError):
+                os.dup2(os.open(os.devnull, os.O_WRONLY), self._stream.fileno())
+            return None
+
+    def write(self, text: str) -> int:
+        self._guarded(self._stream.write, text)
+        return len(text)
+
+    def flush(self) -> None:
+        self._guarded(self._stream.flush)
+
+    def __getattr__(self, name):
+        return getattr(self._stream, name)
+
+
 def main(argv=None) -> int:
     """Run one command line; returns the exit status (0, 1 when a comparison or a sweep found
     what it reports, 2 for a user's error, 3 for a bug of ours, 128 + n on signal n)."""
@@ -474,6 +542,7 @@ def main(argv=None) -> int:
 
     # Signal handlers can only be set from the main thread; elsewhere Ctrl-C stays Python's.
     previous = stop_on_signals() if threading.current_thread() is threading.main_thread() else {}
+    stdout, sys.stdout = sys.stdout, _UntilTheReaderIsGone(sys.stdout)
     try:
         with warnings.catch_warnings():
             warnings.showwarning = one_line
@@ -496,5 +565,6 @@ def main(argv=None) -> int:
               "for the traceback, and report it)", file=sys.stderr)
         return 3
     finally:
+        sys.stdout = stdout
         if previous:
             restore_signals(previous)

@@ -11,8 +11,10 @@ import matplotlib
 matplotlib.use("Agg")  # files only: works on machines without a display
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.backend_bases import FigureCanvasBase  # noqa: E402
 
 from .atomic_files import replacing_path  # noqa: E402
+from .errors import InvalidInput  # noqa: E402
 from .parameters import merged_parameters, unit  # noqa: E402
 
 THETA_LABEL = r"Position $\theta$ in rad"
@@ -39,6 +41,26 @@ def case_title(torque, parameters: dict[str, float] | None = None, theta0: float
     return f"Torque-driven pendulum: {', '.join(shown)}"
 
 
+def check_figure_path(path: str | Path) -> None:
+    """Refuse, before any work, a figure name whose extension matplotlib writes no format for.
+
+    Parameters
+    ----------
+    path : str or Path
+        The figure to write; without an extension it is a PNG.
+
+    Raises
+    ------
+    InvalidInput
+        An extension such as .csv, which no figure format has.
+    """
+    suffix = Path(path).suffix.lstrip(".").lower()
+    formats = FigureCanvasBase.get_supported_filetypes()
+    if suffix and suffix not in formats:
+        raise InvalidInput(f"{path}: a figure cannot be written as .{suffix}; end its name in .png, "
+                           f".pdf or .svg (or {', '.join('.' + name for name in sorted(formats))})")
+
+
 def _finish(fig, axes, title: str, path: str | Path) -> Path:
     for ax in np.ravel(axes):
         ax.grid(True, alpha=0.4)
@@ -47,6 +69,7 @@ def _finish(fig, axes, title: str, path: str | Path) -> Path:
     fig.suptitle(title, fontsize=13)
     fig.tight_layout()
     path = Path(path)
+    check_figure_path(path)
     try:
         with replacing_path(path) as partial:
             fig.savefig(partial, dpi=120, format=path.suffix.lstrip(".") or "png")

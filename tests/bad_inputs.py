@@ -170,6 +170,18 @@ CASES = [
           "cannot write /proc/self/Pendulum.fmu: no file can be created in /proc/self"),
     _case("output", "sweep --torque 1 --output-dir /proc/self/out", 2,
           "cannot write /proc/self/out: the folder /proc/self/out cannot be created"),
+    _case("output", "simulate --torque 1 --stop-time 0.01 --plot {files}/out.csv", 2,
+          "out.csv: a figure cannot be written as .csv; end its name in .png, .pdf or .svg"),
+    _case("output", "simulate --torque-file {files}/epoch.csv --output {files}/epoch.csv", 2,
+          "--output {files}/epoch.csv names the same file as --torque-file: writing it would destroy what the "
+          "command reads; choose another path"),
+    _case("output", "simulate --torque 1 --stop-time 0.01 --output {files}/out.png --plot {files}/out.png", 2,
+          "--plot {files}/out.png names the same file as --output: writing it would lose one of the two"),
+    _case("output", "simulate --torque 1 --stop-time 0.01 --output {files}/" + "a" * 300 + ".csv", 2,
+          "File name too long; choose another output path"),
+    _case("judge", "judge {files}/result.csv --torque 1 --json {files}/result.csv", 2,
+          "--json {files}/result.csv names the same file as the result: writing it would destroy what the "
+          "command reads"),
     _case("judge", "judge {files}/result_no_time.csv --torque 1", 2,
           "result_no_time.csv:1: no column 'time' (header is t,theta); name the result's time column"),
     _case("judge", "judge {files}/result_backwards.csv --torque 1", 2,

@@ -81,3 +81,52 @@ def test_the_check_leaves_nothing_behind(tmp_path):
     (tmp_path / "kept.csv").write_text("a finished result")
     check_writable(tmp_path / "kept.csv")
     assert os.listdir(tmp_path) == ["kept.csv"] and (tmp_path / "kept.csv").read_text() == "a finished result"
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="named pipes are POSIX")
+def test_a_named_pipe_is_written_into_and_stays_a_pipe(tmp_path):
+    # Renaming a temporary over it would replace it with a regular file (as it did /dev/null).
+    import stat
+    import threading
+
+    pipe = tmp_path / "pipe"
+    os.mkfifo(pipe)
+    received = []
+    reader = threading.Thread(target=lambda: received.append(pipe.read_text()))
+    reader.start()
+    check_writable(pipe)
+    with replacing(pipe) as file:
+        file.write("time,theta\n0,0\n")
+    reader.join(timeout=10)
+    assert received == ["time,theta\n0,0\n"] and stat.S_ISFIFO(os.stat(pipe).st_mode)
+    assert [p.name for p in tmp_path.iterdir()] == ["pipe"]
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="symbolic links need privileges on Windows")
+def test_a_link_keeps_leading_to_the_file_it_names_which_is_replaced(tmp_path):
+    (tmp_path / "results").mkdir()
+    real = tmp_path / "results" / "run.csv"
+    real.write_text("old\n")
+    os.chmod(real, 0o640)
+    link = tmp_path / "latest.csv"
+    link.symlink_to(real)
+    check_writable(link)
+    with replacing(link) as file:
+        file.write("new\n")
+    assert link.is_symlink() and os.readlink(link) == str(real) and real.read_text() == "new\n"
+    assert oct(os.stat(real).st_mode & 0o777) == oct(0o640), "the replaced file keeps its permissions"
+    dangling = tmp_path / "next.csv"
+    dangling.symlink_to(tmp_path / "results" / "next_run.csv")
+    with replacing(dangling) as file:
+        file.write("first\n")
+    assert dangling.is_symlink() and (tmp_path / "results" / "next_run.csv").read_text() == "first\n"
+
+
+def test_a_name_as_long_as_the_file_system_allows_is_written_and_a_longer_one_refused(tmp_path):
+    longest = tmp_path / ("a" * 251 + ".csv")  # 255 bytes: the temporary's name must be shorter
+    check_writable(longest)
+    with replacing(longest) as file:
+        file.write("x\n")
+    assert longest.read_text() == "x\n" and [p.name for p in tmp_path.iterdir()] == [longest.name]
+    with pytest.raises(CannotWrite, match=r"cannot write .*a\.csv: .*; choose"):
+        check_writable(tmp_path / ("a" * 300 + ".csv"))

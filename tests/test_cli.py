@@ -124,3 +124,29 @@ def test_an_output_nothing_can_be_written_to_is_refused_before_the_run(tmp_path,
         out, err = capsys.readouterr()
         assert out == "" and err.count("\n") == 1 and "/proc/self/" in err and "partial" not in err, (argv, err)
     assert list(tmp_path.iterdir()) == []
+
+
+def _simulate_printing_to(stdout, folder):
+    process = subprocess.Popen([sys.executable, "-m", "pendulum_fmu", "simulate", "--torque", "3",
+                                "--set", "gravity=0", "--stop-time", "0.01", "--output", "out.csv"],
+                               cwd=folder, stdout=stdout, stderr=subprocess.PIPE)
+    if stdout is subprocess.PIPE:
+        process.stdout.close()  # the reader is gone before the command prints (`| head -0`)
+    error = process.stderr.read()
+    return process.wait(timeout=120), error
+
+
+def test_a_reader_of_stdout_that_goes_away_does_not_cost_the_files(tmp_path):
+    # What a command prints only reports its files: piped into a reader that closed (BrokenPipe)
+    # or sent to a full device, the command still writes them, says nothing more and succeeds.
+    outputs = [("pipe", subprocess.PIPE)]
+    if sys.platform.startswith("linux"):
+        outputs.append(("/dev/full", open("/dev/full", "w")))
+    for name, stdout in outputs:
+        folder = tmp_path / name.strip("/").replace("/", "_")
+        folder.mkdir()
+        code, error = _simulate_printing_to(stdout, folder)
+        assert (code, error) == (0, b""), name
+        data = np.genfromtxt(folder / "out.csv", delimiter=",", names=True)
+        # From rest with gravity off: theta = torque t^2 / (2 I), I = 20 + 40 * 0.5^2 kg.m2.
+        assert len(data) == 11 and abs(data["theta"][-1] - 3 * 0.01**2 / (2 * 30)) < 1e-15, name
