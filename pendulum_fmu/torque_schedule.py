@@ -32,6 +32,7 @@ import inspect
 import math
 import numbers
 from dataclasses import dataclass
+from fractions import Fraction
 from functools import cached_property
 from pathlib import Path
 from typing import Callable, Sequence, Union
@@ -278,15 +279,21 @@ def step_count(start_time: float, stop_time: float, step_size: float,
     the memory the machine has left, is refused here, before anything is allocated."""
     _check_times(start_time, stop_time, step_size)
     span = stop_time - start_time
-    steps = math.floor(span / step_size)
-    # stop within the event tolerance past a grid point is that point, not a sliver of a step.
-    if span - steps * step_size > event_tolerance(stop_time, step_size):
-        steps += 1
+    ratio = span / step_size
+    if math.isfinite(ratio):
+        steps = math.floor(ratio)
+        # stop within the event tolerance past a grid point is that point, not a sliver of a step.
+        if span - steps * step_size > event_tolerance(stop_time, step_size):
+            steps += 1
+    else:
+        # The span or the count is past the largest double (1e308 s, a 1e-320 s step): count
+        # exactly, so the run is refused below in the same words as any run too long.
+        steps = math.ceil((Fraction(stop_time) - Fraction(start_time)) / Fraction(step_size))
     steps = max(steps, 1)
     limit = DEFAULT_MAX_STEPS if max_steps is None else max_steps
     if not (isinstance(limit, numbers.Integral) and limit >= 1):
         raise InvalidInput(f"max steps {limit!r} must be a whole number of steps, at least 1")
-    what = f"{start_time:g} to {stop_time:g} s in steps of {step_size:g} s is {steps:,} steps"
+    what = f"{start_time:g} to {stop_time:g} s in steps of {step_size:g} s is {_count(steps)} steps"
     if steps > limit:
         raise InvalidInput(f"{what}, over the limit of {limit:,}: use a coarser step size or a shorter "
                          "stop time, or raise the limit (--max-steps) if the run is meant to be that long")
@@ -294,10 +301,27 @@ def step_count(start_time: float, stop_time: float, step_size: float,
     if needed > MEMORY_CHECKED_FROM:
         available = _available_memory()
         if needed > available:
-            raise InvalidInput(f"{what}, which needs {needed / 2**30:.1f} GiB and the machine has "
+            raise InvalidInput(f"{what}, which needs {_gib(needed)} and the machine has "
                                f"{available / 2**30:.1f} GiB free: use a coarser step size or a "
                                "shorter stop time")
     return steps
+
+
+def _count(steps: int) -> str:
+    """A step count as a line can hold it: every digit up to 2**53, then 'about 1.23e+628'. Past
+    2**53 the count came from a float quotient, whose trailing digits are rounding, and past 1e308
+    no float holds it, so it is rounded here in integers."""
+    if steps <= 2**53:
+        return f"{steps:,}"
+    exponent = len(str(steps)) - 1
+    mantissa = round(Fraction(steps, 10**(exponent - 2)))  # three digits, 100 to 1000
+    if mantissa == 1000:
+        mantissa, exponent = 100, exponent + 1
+    return f"about {mantissa / 100:g}e+{exponent}"
+
+
+def _gib(size: int) -> str:
+    return f"{size / 2**30:.1f} GiB" if size < 2**1000 else f"{_count(size >> 30)} GiB"
 
 
 def _run(start_time: float, stop_time: float, step_size: float, steps: int) -> str:

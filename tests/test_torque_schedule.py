@@ -111,3 +111,21 @@ def test_a_run_larger_than_the_free_memory_is_refused():
         step_count(0.0, float(steps), 1.0, max_steps=steps)
     said = float(re.search(r"has ([\d.]+) GiB free", str(refused.value)).group(1))
     assert said == pytest.approx(free_kib / 2**20, rel=0.1)  # other jobs allocate in between
+
+
+@pytest.mark.parametrize("start, stop, step, count", [
+    (0.0, 1e308, 1e-3, "about 1e+311"),
+    (-1e308, 1e308, 1.0, "about 2e+308"),  # the span itself is past the largest double
+    (0.0, 0.01, 1e-320, "about 1e+318"),
+    (0.0, 1e20, 1e-3, "about 1e+23"),  # past 2**53 the trailing digits would be a float's rounding
+    (0.0, 9e12, 1e-3, "9,000,000,000,000,000"),
+])
+def test_a_count_past_the_largest_double_is_refused_like_any_long_run(start, stop, step, count):
+    with pytest.raises(ValueError, match=re.escape(f"is {count} steps, over the limit of 10,000,000")):
+        step_count(start, stop, step)
+
+
+def test_a_count_past_the_largest_double_counts_exactly():
+    # Raising the limit past it shows the count is the exact ceiling, not an overflowed float.
+    with pytest.raises(ValueError, match=r"is about 3e\+320 steps, which needs about 2.68e\+313 GiB"):
+        step_count(0.0, 3.0, 1e-320, max_steps=10**400)
