@@ -12,6 +12,7 @@ from __future__ import annotations
 import contextlib
 import io
 import sys
+import warnings
 import zipfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -132,6 +133,10 @@ CASES = [
     _case("parameters", "simulate --torque 1 --set mass=-1", 2, "mass must be > 0"),
     _case("parameters", "simulate --torque 1 --set damping=inf", 2, "parameter damping = inf must be finite"),
     _case("parameters", "simulate --torque 1 --set mass", 2, "expected name=value, got 'mass'"),
+    # The reference's solve_ivp fails where mass*gravity*length overflows.
+    _case("compare", "compare --torque 1 --tools fmu,reference --set mass=1e308 --stop-time 0.01 "
+                     "--output-dir {files}/out", 2,
+          "the reference cannot integrate the pendulum from t = 0 s with mass = 1e+308, length = 0.5"),
     _case("compare", "compare --torque 1 --tools fmu,matlab --output-dir {files}/out", 2, "unknown tool(s) matlab"),
     _case("compare", "compare --torque 1 --tools fmu,fmu --output-dir {files}/out", 2,
           "--tools names fmu twice"),
@@ -192,6 +197,8 @@ CASES = [
           "result.csv:1: no column 'phi', which --map names for theta (header is time,theta)"),
     _case("judge", "judge {files}/result.csv --torque 1 --map torque=u", 2,
           "--map: unknown quantity 'torque'; map any of time, theta, omega, alpha"),
+    _case("judge", "judge {files}/result.csv --torque 1 --stop-time 0.01 --set mass=1e308", 2,
+          "the reference cannot integrate the pendulum from t = 0 s with mass = 1e+308"),
     _case("judge", "judge {files}/result.csv", 2, "judging a result file needs the run's torque"),
     _case("judge", "judge {files}/absent.csv --torque 1", 2, "absent.csv: cannot read: No such file"),
     _case("judge", "judge {files}/result.csv --torque 1 --stop-time 0.0005", 2,
@@ -267,6 +274,8 @@ CALLS = [
     Call("reference", 'reference(lambda t: "x", stop_time=0.01)', "InvalidInput", "the torque is 'x' at t = 0.0"),
     Call("reference", 'reference("{files}/no_torque.csv")', "TorqueFileError", "no_torque.csv:1: missing column 'torque'"),
     Call("reference", 'reference(20.0, theta0=float("nan"))', "InvalidInput", "theta0 = nan must be a finite number of rad"),
+    Call("reference", 'reference(20.0, stop_time=0.01, parameters={"mass": 1e308})', "InvalidInput",
+         "the reference cannot integrate the pendulum from t = 0 s with mass = 1e+308"),
     Call("reference", "reference_schedule(None)", "WrongType", "plan is a TorqueSchedule"),
     Call("compare", f'compare(20.0, "fmu", {OUT})', "ToolSpecError", "compare needs at least two tools, got fmu"),
     Call("compare", f'compare(20.0, ["fmu", "matlab"], {OUT})', "ToolSpecError", "unknown tool(s) matlab"),
@@ -314,13 +323,22 @@ def write_files(folder: Path) -> None:
         path.write_bytes(content) if isinstance(content, bytes) else path.write_text(content)
 
 
+@contextlib.contextmanager
+def _no_runtime_warnings():
+    """numpy's RuntimeWarnings (overflow, invalid value) raised as errors: printed, each would be
+    lines beside the one line, and pytest would record them instead, unseen."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        yield
+
+
 def run_case(case: Case, folder: Path) -> tuple[int, str]:
     """(exit code, what the command printed on stderr), run in-process."""
     from pendulum_fmu.cli import main
 
     argv = [part.format(files=folder) for part in case.argv]
     stderr = io.StringIO()
-    with contextlib.redirect_stderr(stderr), contextlib.redirect_stdout(io.StringIO()):
+    with contextlib.redirect_stderr(stderr), contextlib.redirect_stdout(io.StringIO()), _no_runtime_warnings():
         try:
             code = main(argv)
         except SystemExit as exit_:  # argparse's own refusals
@@ -333,7 +351,7 @@ def run_call(call: Call, folder: Path) -> BaseException | None:
     namespace: dict = {}
     exec(API_IMPORTS, namespace)
     code = call.code.replace("{files}", str(folder))
-    with contextlib.redirect_stderr(io.StringIO()), contextlib.redirect_stdout(io.StringIO()):
+    with contextlib.redirect_stderr(io.StringIO()), contextlib.redirect_stdout(io.StringIO()), _no_runtime_warnings():
         try:
             eval(code, namespace)
         except Exception as error:
