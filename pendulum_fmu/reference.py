@@ -95,7 +95,10 @@ class _TorqueFile:
 
     def _between(self, j: int, t: Fraction) -> float:
         t0, t1, u0, u1 = self.times[j - 1], self.times[j], self.torques[j - 1], self.torques[j]
-        return u0 + (u1 - u0) * float((t - t0) / (t1 - t0))
+        share = float((t - t0) / (t1 - t0))
+        value = u0 + (u1 - u0) * share
+        # docs/signals.md's form, unless rows near the largest double differ by inf.
+        return value if math.isfinite(value) else u0 * (1 - share) + u1 * share
 
     def jumps(self) -> list[Fraction]:
         return sorted({a for a, b in zip(self.times, self.times[1:]) if a == b})
@@ -250,7 +253,7 @@ def _integrate(pieces: _Pieces, at: np.ndarray, parameters: dict | None, theta0:
                                      (t0, t1), state, method=method, rtol=rtol, atol=atol, t_eval=times,
                                      max_step=max_step)
             if not solution.success:
-                raise _failed(solution.message, t0, parameters, theta0, omega0)
+                raise _failed(solution.message, t0, parameters, theta0, omega0, pieces)
             row = np.searchsorted(times, report)
             out["theta"][mine], out["omega"][mine] = solution.y[0, row], solution.y[1, row]
             state = solution.y[:, -1].copy()
@@ -265,17 +268,20 @@ def _integrate(pieces: _Pieces, at: np.ndarray, parameters: dict | None, theta0:
         out["alpha"] = acceleration(out["theta"], out["omega"], out["torque"])
     if not np.isfinite(out["alpha"]).all():  # the states stayed finite, the acceleration did not
         at_time = float(out["time"][np.flatnonzero(~np.isfinite(out["alpha"]))[0]])
-        raise _failed("the acceleration is not finite", at_time, parameters, theta0, omega0)
+        raise _failed("the acceleration is not finite", at_time, parameters, theta0, omega0, pieces)
     return out
 
 
-def _failed(why: str, t: float, parameters: dict, theta0: float, omega0: float) -> InvalidInput:
+def _failed(why: str, t: float, parameters: dict, theta0: float, omega0: float,
+            pieces: _Pieces) -> InvalidInput:
     """The one-line error for an integration these values break, naming every value."""
     values = ", ".join(f"{name} = {value:g}" for name, value in
                        {**parameters, "theta0": theta0, "omega0": omega0}.items())
-    return InvalidInput(f"the reference cannot integrate the pendulum from t = {t:g} s with {values}: "
-                        f"{why.rstrip('.')}; products such as mass*gravity*length or mass*length^2 "
-                        "must stay finite: give physically meaningful values")
+    torque = max(abs(u) for u in pieces.u0)
+    return InvalidInput(f"the reference cannot integrate the pendulum from t = {t:g} s with {values} "
+                        f"and torques up to {torque:g}: {why.rstrip('.')}; values near the largest "
+                        "double (mass*gravity*length, mass*length^2, the torque over the inertia) "
+                        "break it: give physically meaningful values")
 
 
 def reference(torque=20.0, *, start_time: float = 0.0, stop_time: float | None = None,

@@ -105,8 +105,15 @@ class TorqueTable:
             return np.full(t.shape, torque[0])
         i = np.clip(np.searchsorted(time, t, side=side), 1, len(time) - 1)
         t0, t1, u0, u1 = time[i - 1], time[i], torque[i - 1], torque[i]
-        with np.errstate(invalid="ignore", divide="ignore"):
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
             inside = u0 + (u1 - u0) * (t - t0) / (t1 - t0)
+            # Rows of opposite sign near the largest double (1e308, then -1e308) differ by inf;
+            # weighting each row's value instead stays finite (only there: elsewhere it would
+            # round differently from the form above, which docs/signals.md states).
+            overflowed = ~np.isfinite(inside)
+            if overflowed.any():
+                share = (t - t0) / (t1 - t0)
+                inside = np.where(overflowed, u0 * (1 - share) + u1 * share, inside)
         if side == "right":
             return np.where(t < time[0], torque[0], np.where(t >= time[-1], torque[-1], inside))
         return np.where(t <= time[0], torque[0], np.where(t > time[-1], torque[-1], inside))
@@ -434,5 +441,15 @@ def schedule(torque: TorqueSignal, *, start_time: float = 0.0, stop_time: float 
             bad = np.flatnonzero(~np.isfinite(samples))[0]
             raise InvalidInput(f"the torque is {samples[bad]} at t = {time[bad]}; it must be finite")
         start_values, end_values = samples[:-1], samples[1:]
-    rate = (end_values - start_values) / np.diff(time) if ramp else np.zeros(len(time) - 1)
+    if not ramp:
+        return TorqueSchedule(time=time, torque=start_values, torque_rate=np.zeros(len(time) - 1))
+    with np.errstate(over="ignore", invalid="ignore"):
+        rate = (end_values - start_values) / np.diff(time)
+    steep = np.flatnonzero(~np.isfinite(rate))
+    if len(steep):
+        k = steep[0]
+        raise InvalidInput(f"{source if isinstance(torque, TorqueTable) else 'the torque'} ramps from "
+                           f"{start_values[k]:g} to {end_values[k]:g} N.m between t = {time[k]:g} and "
+                           f"{time[k + 1]:g} s, a rate past the largest double: hold the torque "
+                           "(no ramp) or give values that change less steeply")
     return TorqueSchedule(time=time, torque=start_values, torque_rate=rate)

@@ -129,3 +129,22 @@ def test_a_count_past_the_largest_double_counts_exactly():
     # Raising the limit past it shows the count is the exact ceiling, not an overflowed float.
     with pytest.raises(ValueError, match=r"is about 3e\+320 steps, which needs about 2.68e\+313 GiB"):
         step_count(0.0, 3.0, 1e-320, max_steps=10**400)
+
+
+@pytest.mark.filterwarnings("error")  # numpy's overflow warning was a line on stderr
+def test_rows_near_the_largest_double_interpolate_without_overflow(tmp_path):
+    csv = tmp_path / "t.csv"
+    csv.write_text("time,torque\n0,1e308\n0.01,-1e308\n")
+    plan = schedule(csv, step_size=0.0025)
+    assert plan.torque.tolist() == pytest.approx([1e308, 0.5e308, 0.0, -0.5e308], rel=1e-15, abs=1e293)
+    with pytest.raises(ValueError, match=re.escape(f"{csv} ramps from 1e+308 to 5e+307 N.m between t = 0 "
+                                                   "and 0.0025 s, a rate past the largest double")):
+        schedule(csv, step_size=0.0025, ramp=True)
+
+
+def test_ordinary_rows_keep_the_documented_interpolation(tmp_path):
+    # The overflow fallback weighs the rows differently; it must not touch finite results.
+    csv = tmp_path / "t.csv"
+    csv.write_text("time,torque\n0,0.1\n0.3,0.7\n")
+    t = np.array([0.1, 0.2])
+    assert read_torque_csv(csv).value_after(t).tolist() == (0.1 + (0.7 - 0.1) * (t - 0) / 0.3).tolist()
