@@ -28,6 +28,7 @@ FMU's linear ramp over each step is the CSV's own piecewise-linear signal, exact
 
 from __future__ import annotations
 
+import csv
 import inspect
 import math
 import numbers
@@ -150,19 +151,25 @@ def _decode(path: Path, raw: bytes) -> str:
 
 
 def _first_bad_row(path: Path, lines: list[str], columns: tuple[int, int]) -> TorqueFileError | None:
-    """The one-line error for the first row that is not two finite numbers, or None."""
+    """The one-line error for the first row that is not two finite numbers, or has more
+    columns than the header, or None."""
+    header = len(next(csv.reader([lines[0]])))
     for number, line in enumerate(lines[1:], start=2):
         if not line.strip():
             continue
-        cells = line.split(",")
+        cells = next(csv.reader([line]))  # as pyarrow reads it: "1,5" is one quoted cell
         for column, name in zip(columns, ("time", "torque")):
             cell = cells[column].strip() if column < len(cells) else ""
             try:
-                value = float(cell)
+                # Python's float takes 1_0 and fullwidth digits, which pyarrow refuses.
+                value = float(cell) if cell.isascii() and "_" not in cell else float("")
             except ValueError:
                 return TorqueFileError(f"{path}:{number}: {name} {cell!r} is not a number")
             if not math.isfinite(value):
                 return TorqueFileError(f"{path}:{number}: {name} is {cell}; values must be finite")
+        if len(cells) > header:
+            return TorqueFileError(f"{path}:{number}: {len(cells)} columns, but the header names "
+                                   f"{header}; quote a cell holding a comma")
     return None
 
 
@@ -210,6 +217,9 @@ def read_torque_csv(path: str | Path) -> TorqueTable:
     _decode(path, raw)  # only to refuse another encoding here, with its line
     header_line = raw[:raw.find(b"\n") if b"\n" in raw else len(raw)].decode("utf-8")
     if not header_line.strip():
+        if raw.strip():
+            raise TorqueFileError(f"{path}:1: the line is blank; the header, e.g. time,torque, must be "
+                                  "the first line: remove the blank lines before it")
         raise TorqueFileError(f"{path}: the file is empty; expected a header 'time,torque'")
     header = [name.strip() for name in header_line.split(",")]
     for column in ("time", "torque"):

@@ -48,11 +48,16 @@ def test_written_schedule_reads_back(tmp_path):
     ("time,torque\n0,1\ninf,1\n", "t.csv:3: time is inf"),
     ("time,torque\n0,1\n1,1\n1,2\n1,3\n", "t.csv:5: time 1 appears three times"),
     ("time,torque\n", "no data rows"),
+    ("time,torque\n0,1\n1,1_0\n", "t.csv:3: torque '1_0' is not a number"),  # Python's float takes it
+    ("time,torque\n0,1\n1,\uff11\n", "t.csv:3: torque '\uff11' is not a number"),  # a fullwidth 1
+    ("time,torque\n0,1\n1,2,3\n", "t.csv:3: 3 columns, but the header names 2"),
+    ("\n\ntime,torque\n0,1\n", "t.csv:1: the line is blank; the header, e.g. time,torque, must be the first line"),
+    ('time,torque\n"0","1,5"\n', "t.csv:2: torque '1,5' is not a number"),
 ])
 def test_bad_files_name_file_row_and_problem(tmp_path, content, message):
     csv = tmp_path / "t.csv"
-    csv.write_text(content)
-    with pytest.raises(TorqueFileError, match=message.replace("(", r"\(")) as error:
+    csv.write_text(content, encoding="utf-8")
+    with pytest.raises(TorqueFileError, match=re.escape(message)) as error:
         read_torque_csv(csv)
     assert str(error.value).startswith(str(csv))
     assert "\n" not in str(error.value)
@@ -148,3 +153,9 @@ def test_ordinary_rows_keep_the_documented_interpolation(tmp_path):
     csv.write_text("time,torque\n0,0.1\n0.3,0.7\n")
     t = np.array([0.1, 0.2])
     assert read_torque_csv(csv).value_after(t).tolist() == (0.1 + (0.7 - 0.1) * (t - 0) / 0.3).tolist()
+
+
+def test_quoted_cells_are_numbers(tmp_path):
+    csv = tmp_path / "t.csv"
+    csv.write_text('time,torque\n"0","1"\n1,2\n')
+    assert read_torque_csv(csv).torque.tolist() == [1, 2]
