@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import numbers
 import os
 from pathlib import Path
@@ -12,6 +13,7 @@ matplotlib.use("Agg")  # files only: works on machines without a display
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.backend_bases import FigureCanvasBase  # noqa: E402
+from matplotlib.lines import Line2D  # noqa: E402
 
 from .atomic_files import replacing_path  # noqa: E402
 from .errors import InvalidInput  # noqa: E402
@@ -61,8 +63,66 @@ def check_figure_path(path: str | Path) -> None:
                            f".pdf or .svg (or {', '.join('.' + name for name in sorted(formats))})")
 
 
+# The largest magnitude a figure draws. matplotlib's margins, ticks and log decades overflow near
+# the largest double (1e307 on a log axis already), failing or warning mid-draw; a value this
+# large has long stopped being a pendulum's anyway.
+DRAWABLE = 1e300
+
+
+def _too_large(values) -> float | None:
+    """The first value of magnitude over DRAWABLE, or infinite, or None (NaNs are gaps)."""
+    values = np.asarray(values, dtype=float).ravel()
+    bad = values[np.abs(np.nan_to_num(values, nan=0.0)) > DRAWABLE]
+    return float(bad[0]) if len(bad) else None
+
+
+def _leave_out_undrawable(ax) -> None:
+    """Take out of the panel every line or band reaching past DRAWABLE and write in its place
+    one line saying what and how large, rather than fail or draw a garbage scale."""
+    notes = []
+    for artist in [*ax.lines, *ax.collections]:
+        if isinstance(artist, Line2D):
+            if artist.get_transform() is not ax.transData:  # axhline: its x is the panel's width
+                values = (artist.get_ydata(),)
+            else:
+                values = (artist.get_xdata(), artist.get_ydata())
+        else:
+            values = tuple(path.vertices for path in artist.get_paths())
+        extreme = next((v for v in map(_too_large, values) if v is not None), None)
+        if extreme is not None:
+            label = artist.get_label()
+            notes.append(f"{label if label and not label.startswith('_') else 'a line'} reaches "
+                         f"{extreme:.3g}: too large to draw")
+            artist.remove()
+    for index, note in enumerate(dict.fromkeys(notes)):
+        ax.text(0.5, 0.88 - 0.12 * index, note, transform=ax.transAxes, ha="center", va="center",
+                fontsize=10)
+    if notes:
+        ax.relim()
+        ax.autoscale_view()
+        # With nothing left to scale to, matplotlib keeps the limits the removed data set.
+        for limits, scale, set_limits in ((ax.get_xlim(), ax.get_xscale(), ax.set_xlim),
+                                          (ax.get_ylim(), ax.get_yscale(), ax.set_ylim)):
+            if _too_large(limits) is not None:
+                set_limits((1, 10) if scale == "log" else (0, 1))
+
+
+def _drawing(plot):
+    """plot, with numpy's overflow warnings silenced while it draws: values near the largest
+    double overflow in differences and in matplotlib's autoscaling, which runs as each panel is
+    drawn, before _finish leaves such values out and resets the limits they set."""
+
+    @functools.wraps(plot)
+    def quietly(*args, **kwargs):
+        with np.errstate(over="ignore", invalid="ignore"):
+            return plot(*args, **kwargs)
+
+    return quietly
+
+
 def _finish(fig, axes, title: str, path: str | Path) -> Path:
     for ax in np.ravel(axes):
+        _leave_out_undrawable(ax)
         ax.grid(True, alpha=0.4)
         if ax.get_legend_handles_labels()[0]:
             ax.legend(loc="upper left", fontsize=9, frameon=True)
@@ -78,6 +138,7 @@ def _finish(fig, axes, title: str, path: str | Path) -> Path:
     return path
 
 
+@_drawing
 def plot_overlay(runs: dict[str, np.ndarray], path: str | Path, title: str) -> Path:
     """theta and omega of each run, overlaid (dashed after the first, so coincident lines show)."""
     fig, axes = plt.subplots(2, 1, figsize=(10, 6), sharex=True)
@@ -110,6 +171,7 @@ def _draw_difference(ax, time: np.ndarray, difference: np.ndarray, label: str, i
         ax.plot(time[alone], difference[alone], ".", color=line.get_color())
 
 
+@_drawing
 def plot_comparison(runs: dict[str, np.ndarray], path: str | Path, title: str) -> Path:
     """Left: theta and omega of every tool overlaid. Right: |difference| of each tool against
     the first one, on a log scale, where agreement to 1e-10 is visible."""
@@ -134,6 +196,7 @@ def plot_comparison(runs: dict[str, np.ndarray], path: str | Path, title: str) -
     return _finish(fig, axes, title, path)
 
 
+@_drawing
 def plot_cases(runs: dict[str, np.ndarray], path: str | Path, title: str) -> Path:
     """theta and omega of many cases, coloured along a colormap; labelled when few enough."""
     fig, axes = plt.subplots(2, 1, figsize=(10, 6), sharex=True)
@@ -175,6 +238,7 @@ def _quantiles(x: np.ndarray, y: np.ndarray, quantiles) -> tuple[np.ndarray, lis
     return x[starts], values
 
 
+@_drawing
 def plot_case_bands(values: dict[str, np.ndarray], summaries: dict[str, np.ndarray],
                     path: str | Path, title: str, units: dict[str, str] | None = None) -> Path:
     """For many cases: each summary (a row of panels) against each swept value (a column), as
@@ -227,6 +291,7 @@ def _log_difference(ax, time: np.ndarray, difference: np.ndarray, label: str, **
     return int(zero.sum())
 
 
+@_drawing
 def plot_judgement(judgement, path: str | Path, title: str) -> Path:
     """A judged result (judge.Judgement): the torque the run asks for and, when the diagnosis
     names a variant, the torque that variant applies (N.m); theta of the result and of the

@@ -95,7 +95,10 @@ class _TorqueFile:
 
     def _between(self, j: int, t: Fraction) -> float:
         t0, t1, u0, u1 = self.times[j - 1], self.times[j], self.torques[j - 1], self.torques[j]
-        return u0 + (u1 - u0) * float((t - t0) / (t1 - t0))
+        share = float((t - t0) / (t1 - t0))
+        value = u0 + (u1 - u0) * share
+        # docs/signals.md's form, unless rows near the largest double differ by inf.
+        return value if math.isfinite(value) else u0 * (1 - share) + u1 * share
 
     def jumps(self) -> list[Fraction]:
         return sorted({a for a, b in zip(self.times, self.times[1:]) if a == b})
@@ -219,7 +222,8 @@ def _integrate(pieces: _Pieces, at: np.ndarray, parameters: dict | None, theta0:
     for name, value in (("rtol", rtol), ("atol", atol)):
         if not (isinstance(value, numbers.Real) and 0 < value < math.inf):
             raise InvalidInput(f"{name} {value!r} must be a positive finite number (solve_ivp's tolerance)")
-    acceleration = equation_of_motion(resolve_parameters(parameters, fmu_path))
+    parameters = resolve_parameters(parameters, fmu_path)
+    acceleration = equation_of_motion(parameters)
     starts = [float(s) for s in pieces.starts]
     ends = starts[1:] + [float(pieces.stop)]
     # Each reported time belongs to the first piece that reaches it (a time a rounding past the
@@ -241,11 +245,15 @@ def _integrate(pieces: _Pieces, at: np.ndarray, parameters: dict | None, theta0:
         if t1 > t0:
             report = np.clip(at[mine], t0, t1)
             times = np.unique(np.append(report, t1))  # solve_ivp wants them strictly increasing
-            solution = solve_ivp(lambda t, y: (y[1], acceleration(y[0], y[1], u0 + rate * (t - t0))),
-                                 (t0, t1), state, method=method, rtol=rtol, atol=atol, t_eval=times,
-                                 max_step=max_step)
+            # Values the FMU would refuse (mass*gravity*length past the largest double) make
+            # the derivative inf or NaN: solve_ivp then fails, and that failure is the error to
+            # show, not numpy's warnings on the way to it.
+            with np.errstate(over="ignore", invalid="ignore"):
+                solution = solve_ivp(lambda t, y: (y[1], acceleration(y[0], y[1], u0 + rate * (t - t0))),
+                                     (t0, t1), state, method=method, rtol=rtol, atol=atol, t_eval=times,
+                                     max_step=max_step)
             if not solution.success:
-                raise RuntimeError(f"solve_ivp failed from t = {t0}: {solution.message}")
+                raise _failed(solution.message, t0, parameters, theta0, omega0, pieces)
             row = np.searchsorted(times, report)
             out["theta"][mine], out["omega"][mine] = solution.y[0, row], solution.y[1, row]
             state = solution.y[:, -1].copy()
@@ -256,8 +264,24 @@ def _integrate(pieces: _Pieces, at: np.ndarray, parameters: dict | None, theta0:
     # The end of the run reports the torque the last piece reached, as a master reads it back.
     at_end = at >= ends[-1]
     out["torque"][at_end] = pieces.u0[-1] + pieces.rate[-1] * (ends[-1] - starts[-1])
-    out["alpha"] = acceleration(out["theta"], out["omega"], out["torque"])
+    with np.errstate(over="ignore", invalid="ignore"):
+        out["alpha"] = acceleration(out["theta"], out["omega"], out["torque"])
+    if not np.isfinite(out["alpha"]).all():  # the states stayed finite, the acceleration did not
+        at_time = float(out["time"][np.flatnonzero(~np.isfinite(out["alpha"]))[0]])
+        raise _failed("the acceleration is not finite", at_time, parameters, theta0, omega0, pieces)
     return out
+
+
+def _failed(why: str, t: float, parameters: dict, theta0: float, omega0: float,
+            pieces: _Pieces) -> InvalidInput:
+    """The one-line error for an integration these values break, naming every value."""
+    values = ", ".join(f"{name} = {value:g}" for name, value in
+                       {**parameters, "theta0": theta0, "omega0": omega0}.items())
+    torque = max(abs(u) for u in pieces.u0)
+    return InvalidInput(f"the reference cannot integrate the pendulum from t = {t:g} s with {values} "
+                        f"and torques up to {torque:g}: {why.rstrip('.')}; values near the largest "
+                        "double (mass*gravity*length, mass*length^2, the torque over the inertia) "
+                        "break it: give physically meaningful values")
 
 
 def reference(torque=20.0, *, start_time: float = 0.0, stop_time: float | None = None,
@@ -297,9 +321,8 @@ def reference(torque=20.0, *, start_time: float = 0.0, stop_time: float | None =
     Raises
     ------
     InvalidInput
-        A signal the reference cannot read, or parameters the FMU refuses.
-    RuntimeError
-        solve_ivp failed.
+        A signal the reference cannot read, parameters the FMU refuses, or values with which
+        solve_ivp fails (mass*gravity*length past the largest double, say).
     """
     if not (isinstance(torque, (str, Path, list, tuple, np.ndarray, int, float)) or callable(torque)):
         raise InvalidInput(f"the reference takes a constant, a callable, a per-step array or a CSV path, "
@@ -355,9 +378,7 @@ def reference_schedule(plan, *, parameters: dict | None = None, theta0: float = 
     Raises
     ------
     InvalidInput
-        Parameters the FMU refuses.
-    RuntimeError
-        solve_ivp failed.
+        Parameters the FMU refuses, or values with which solve_ivp fails.
     """
     if not isinstance(plan, TorqueSchedule):
         raise WrongType(f"plan is a TorqueSchedule (torque_schedule.schedule(...)), not a "

@@ -28,10 +28,12 @@ FMU's linear ramp over each step is the CSV's own piecewise-linear signal, exact
 
 from __future__ import annotations
 
+import csv
 import inspect
 import math
 import numbers
 from dataclasses import dataclass
+from fractions import Fraction
 from functools import cached_property
 from pathlib import Path
 from typing import Callable, Sequence, Union
@@ -104,8 +106,15 @@ class TorqueTable:
             return np.full(t.shape, torque[0])
         i = np.clip(np.searchsorted(time, t, side=side), 1, len(time) - 1)
         t0, t1, u0, u1 = time[i - 1], time[i], torque[i - 1], torque[i]
-        with np.errstate(invalid="ignore", divide="ignore"):
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
             inside = u0 + (u1 - u0) * (t - t0) / (t1 - t0)
+            # Rows of opposite sign near the largest double (1e308, then -1e308) differ by inf;
+            # weighting each row's value instead stays finite (only there: elsewhere it would
+            # round differently from the form above, which docs/signals.md states).
+            overflowed = ~np.isfinite(inside)
+            if overflowed.any():
+                share = (t - t0) / (t1 - t0)
+                inside = np.where(overflowed, u0 * (1 - share) + u1 * share, inside)
         if side == "right":
             return np.where(t < time[0], torque[0], np.where(t >= time[-1], torque[-1], inside))
         return np.where(t <= time[0], torque[0], np.where(t > time[-1], torque[-1], inside))
@@ -142,19 +151,25 @@ def _decode(path: Path, raw: bytes) -> str:
 
 
 def _first_bad_row(path: Path, lines: list[str], columns: tuple[int, int]) -> TorqueFileError | None:
-    """The one-line error for the first row that is not two finite numbers, or None."""
+    """The one-line error for the first row that is not two finite numbers, or has more
+    columns than the header, or None."""
+    header = len(next(csv.reader([lines[0]])))
     for number, line in enumerate(lines[1:], start=2):
         if not line.strip():
             continue
-        cells = line.split(",")
+        cells = next(csv.reader([line]))  # as pyarrow reads it: "1,5" is one quoted cell
         for column, name in zip(columns, ("time", "torque")):
             cell = cells[column].strip() if column < len(cells) else ""
             try:
-                value = float(cell)
+                # Python's float takes 1_0 and fullwidth digits, which pyarrow refuses.
+                value = float(cell) if cell.isascii() and "_" not in cell else float("")
             except ValueError:
                 return TorqueFileError(f"{path}:{number}: {name} {cell!r} is not a number")
             if not math.isfinite(value):
                 return TorqueFileError(f"{path}:{number}: {name} is {cell}; values must be finite")
+        if len(cells) > header:
+            return TorqueFileError(f"{path}:{number}: {len(cells)} columns, but the header names "
+                                   f"{header}; quote a cell holding a comma")
     return None
 
 
@@ -202,6 +217,9 @@ def read_torque_csv(path: str | Path) -> TorqueTable:
     _decode(path, raw)  # only to refuse another encoding here, with its line
     header_line = raw[:raw.find(b"\n") if b"\n" in raw else len(raw)].decode("utf-8")
     if not header_line.strip():
+        if raw.strip():
+            raise TorqueFileError(f"{path}:1: the line is blank; the header, e.g. time,torque, must be "
+                                  "the first line: remove the blank lines before it")
         raise TorqueFileError(f"{path}: the file is empty; expected a header 'time,torque'")
     header = [name.strip() for name in header_line.split(",")]
     for column in ("time", "torque"):
@@ -278,15 +296,21 @@ def step_count(start_time: float, stop_time: float, step_size: float,
     the memory the machine has left, is refused here, before anything is allocated."""
     _check_times(start_time, stop_time, step_size)
     span = stop_time - start_time
-    steps = math.floor(span / step_size)
-    # stop within the event tolerance past a grid point is that point, not a sliver of a step.
-    if span - steps * step_size > event_tolerance(stop_time, step_size):
-        steps += 1
+    ratio = span / step_size
+    if math.isfinite(ratio):
+        steps = math.floor(ratio)
+        # stop within the event tolerance past a grid point is that point, not a sliver of a step.
+        if span - steps * step_size > event_tolerance(stop_time, step_size):
+            steps += 1
+    else:
+        # The span or the count is past the largest double (1e308 s, a 1e-320 s step): count
+        # exactly, so the run is refused below in the same words as any run too long.
+        steps = math.ceil((Fraction(stop_time) - Fraction(start_time)) / Fraction(step_size))
     steps = max(steps, 1)
     limit = DEFAULT_MAX_STEPS if max_steps is None else max_steps
     if not (isinstance(limit, numbers.Integral) and limit >= 1):
         raise InvalidInput(f"max steps {limit!r} must be a whole number of steps, at least 1")
-    what = f"{start_time:g} to {stop_time:g} s in steps of {step_size:g} s is {steps:,} steps"
+    what = f"{start_time:g} to {stop_time:g} s in steps of {step_size:g} s is {_count(steps)} steps"
     if steps > limit:
         raise InvalidInput(f"{what}, over the limit of {limit:,}: use a coarser step size or a shorter "
                          "stop time, or raise the limit (--max-steps) if the run is meant to be that long")
@@ -294,14 +318,27 @@ def step_count(start_time: float, stop_time: float, step_size: float,
     if needed > MEMORY_CHECKED_FROM:
         available = _available_memory()
         if needed > available:
-            raise InvalidInput(f"{what}, which needs {needed / 2**30:.1f} GiB and the machine has "
+            raise InvalidInput(f"{what}, which needs {_gib(needed)} and the machine has "
                                f"{available / 2**30:.1f} GiB free: use a coarser step size or a "
                                "shorter stop time")
     return steps
 
 
-def _run(start_time: float, stop_time: float, step_size: float, steps: int) -> str:
-    return f"{start_time:g} to {stop_time:g} s in steps of {step_size:g} s is {steps:,} steps"
+def _count(steps: int) -> str:
+    """A step count as a line can hold it: every digit up to 2**53, then 'about 1.23e+628'. Past
+    2**53 the count came from a float quotient, whose trailing digits are rounding, and past 1e308
+    no float holds it, so it is rounded here in integers."""
+    if steps <= 2**53:
+        return f"{steps:,}"
+    exponent = len(str(steps)) - 1
+    mantissa = round(Fraction(steps, 10**(exponent - 2)))  # three digits, 100 to 1000
+    if mantissa == 1000:
+        mantissa, exponent = 100, exponent + 1
+    return f"about {mantissa / 100:g}e+{exponent}"
+
+
+def _gib(size: int) -> str:
+    return f"{size / 2**30:.1f} GiB" if size < 2**1000 else f"{_count(size >> 30)} GiB"
 
 
 def communication_points(start_time: float, stop_time: float, step_size: float, *,
@@ -410,5 +447,15 @@ def schedule(torque: TorqueSignal, *, start_time: float = 0.0, stop_time: float 
             bad = np.flatnonzero(~np.isfinite(samples))[0]
             raise InvalidInput(f"the torque is {samples[bad]} at t = {time[bad]}; it must be finite")
         start_values, end_values = samples[:-1], samples[1:]
-    rate = (end_values - start_values) / np.diff(time) if ramp else np.zeros(len(time) - 1)
+    if not ramp:
+        return TorqueSchedule(time=time, torque=start_values, torque_rate=np.zeros(len(time) - 1))
+    with np.errstate(over="ignore", invalid="ignore"):
+        rate = (end_values - start_values) / np.diff(time)
+    steep = np.flatnonzero(~np.isfinite(rate))
+    if len(steep):
+        k = steep[0]
+        raise InvalidInput(f"{source if isinstance(torque, TorqueTable) else 'the torque'} ramps from "
+                           f"{start_values[k]:g} to {end_values[k]:g} N.m between t = {time[k]:g} and "
+                           f"{time[k + 1]:g} s, a rate past the largest double: hold the torque "
+                           "(no ramp) or give values that change less steeply")
     return TorqueSchedule(time=time, torque=start_values, torque_rate=rate)

@@ -12,6 +12,7 @@ from __future__ import annotations
 import contextlib
 import io
 import sys
+import warnings
 import zipfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -62,6 +63,11 @@ FILES = {
     "three_times.csv": "time,torque\n0,1\n1,1\n1,2\n1,3\n",
     "nan.csv": "time,torque\n0,1\n1,nan\n",
     "one_row.csv": "time,torque\n0,5\n",
+    "far_end.csv": "time,torque\n0,1\n1e308,3\n",
+    "extra_column.csv": "time,torque\n0,1\n1,2,3\n",
+    "underscore.csv": "time,torque\n0,1\n1,1_0\n",
+    "blank_first.csv": "\ntime,torque\n0,1\n",
+    "huge_torque.csv": "time,torque\n0,1e308\n0.01,-1e308\n",
     "short_row.csv": "time,torque\n0,1\n1\n",
     "empty.fmu": _zip({}),
     "no_model_description.fmu": _zip({"documentation/index.html": "<html></html>"}),
@@ -96,6 +102,19 @@ CASES = [
           "0 to 7200 s in steps of 1e-08 s is 720,000,000,000 steps, over the limit of 10,000,000"),
     _case("run length", "simulate --torque-file {files}/epoch.csv", 2,
           "0 to 1.7e+09 s in steps of 0.001 s is 1,700,000,100,000 steps, over the limit"),
+    # Counts past the largest double (a span of 1e308 s, a 1e-320 s step): the same refusal.
+    _case("run length", "simulate --torque 1 --stop-time 1e308", 2,
+          "0 to 1e+308 s in steps of 0.001 s is about 1e+311 steps, over the limit of 10,000,000"),
+    _case("run length", "simulate --torque 1 --step-size 1e-320 --stop-time 0.01", 2,
+          "is about 1e+318 steps, over the limit of 10,000,000"),
+    _case("run length", "simulate --torque-file {files}/far_end.csv", 2,
+          "0 to 1e+308 s in steps of 0.001 s is about 1e+311 steps, over the limit"),
+    _case("run length", "compare --torque 1 --tools fmu,reference --stop-time 1e308 --output-dir {files}/out", 2,
+          "is about 1e+311 steps, over the limit of 10,000,000"),
+    _case("run length", "sweep --torque 1 --step-size 1e-320 --output-dir {files}/out", 2,
+          "is about 3e+320 steps, over the limit of 10,000,000"),
+    _case("run length", "judge {files}/result.csv --torque 1 --start-time=-1e308 --stop-time 0.01", 2,
+          "-1e+308 to 0.01 s in steps of 0.001 s is about 1e+311 steps, over the limit"),
     _case("run length", "simulate --torque 1 --max-steps 0", 2, "argument --max-steps: 0 must be at least 1"),
     _case("torque file", "simulate --torque-file {files}/absent.csv", 2, "absent.csv: cannot read: No such file"),
     _case("torque file", "simulate --torque-file {files}/bad_number.csv", 2, "bad_number.csv:3: torque 'x' is not a number"),
@@ -109,6 +128,15 @@ CASES = [
           "three_times.csv:5: time 1 appears three times"),
     _case("torque file", "simulate --torque-file {files}/nan.csv", 2, "nan.csv:3: torque is nan; values must be finite"),
     _case("torque file", "simulate --torque-file {files}/short_row.csv", 2, "short_row.csv:3: torque '' is not a number"),
+    _case("torque file", "simulate --torque-file {files}/extra_column.csv", 2,
+          "extra_column.csv:3: 3 columns, but the header names 2; quote a cell holding a comma"),
+    _case("torque file", "simulate --torque-file {files}/underscore.csv", 2, "underscore.csv:3: torque '1_0' is not a number"),
+    _case("torque file", "simulate --torque-file {files}/blank_first.csv", 2,
+          "blank_first.csv:1: the line is blank; the header, e.g. time,torque, must be the first line"),
+    _case("torque file", "simulate --torque-file {files}/huge_torque.csv --ramp", 2,
+          "huge_torque.csv ramps from 1e+308 to 8e+307 N.m between t = 0 and 0.001 s, a rate past the largest double"),
+    _case("torque file", "compare --torque-file {files}/huge_torque.csv --tools fmu,reference --output-dir {files}/out", 2,
+          "the reference cannot integrate the pendulum from t = 0 s with mass = 40"),
     _case("torque file", "simulate --torque-file {files}/one_row.csv", 2,
           "one_row.csv ends at 0 s, not after the start time 0 s; give a stop time"),
     _case("arguments", "simulate --torque abc", 2, "argument --torque: 'abc' is not a number"),
@@ -118,6 +146,10 @@ CASES = [
     _case("parameters", "simulate --torque 1 --set mass=-1", 2, "mass must be > 0"),
     _case("parameters", "simulate --torque 1 --set damping=inf", 2, "parameter damping = inf must be finite"),
     _case("parameters", "simulate --torque 1 --set mass", 2, "expected name=value, got 'mass'"),
+    # The reference's solve_ivp fails where mass*gravity*length overflows.
+    _case("compare", "compare --torque 1 --tools fmu,reference --set mass=1e308 --stop-time 0.01 "
+                     "--output-dir {files}/out", 2,
+          "the reference cannot integrate the pendulum from t = 0 s with mass = 1e+308, length = 0.5"),
     _case("compare", "compare --torque 1 --tools fmu,matlab --output-dir {files}/out", 2, "unknown tool(s) matlab"),
     _case("compare", "compare --torque 1 --tools fmu,fmu --output-dir {files}/out", 2,
           "--tools names fmu twice"),
@@ -190,6 +222,8 @@ CASES = [
           "result.csv:1: no column 'phi', which --map names for theta (header is time,theta)"),
     _case("judge", "judge {files}/result.csv --torque 1 --map torque=u", 2,
           "--map: unknown quantity 'torque'; map any of time, theta, omega, alpha"),
+    _case("judge", "judge {files}/result.csv --torque 1 --stop-time 0.01 --set mass=1e308", 2,
+          "the reference cannot integrate the pendulum from t = 0 s with mass = 1e+308"),
     _case("judge", "judge {files}/result.csv", 2, "judging a result file needs the run's torque"),
     _case("judge", "judge {files}/absent.csv --torque 1", 2, "absent.csv: cannot read: No such file"),
     _case("judge", "judge {files}/result.csv --torque 1 --stop-time 0.0005", 2,
@@ -233,6 +267,8 @@ CALLS = [
     Call("simulate", "simulate(20.0, step_size=0)", "InvalidInput", "step size 0 must be positive"),
     Call("simulate", "simulate(20.0, step_size=1e-9, stop_time=100)", "InvalidInput",
          "is 100,000,000,000 steps, over the limit of 10,000,000"),
+    Call("simulate", "simulate(20.0, step_size=1e-320, stop_time=0.01)", "InvalidInput",
+         "is about 1e+318 steps, over the limit of 10,000,000"),
     Call("simulate", "simulate(20.0, max_steps=1.5)", "InvalidInput", "max steps 1.5 must be a whole number of steps, at least 1"),
     Call("simulate", "simulate(None)", "InvalidInput",
          "a torque is a number, a callable of time, a per-step array or a CSV path; got NoneType"),
@@ -256,11 +292,15 @@ CALLS = [
     Call("reference", "reference(20.0, step_size=0)", "InvalidInput", "step size 0.0 must be positive"),
     Call("reference", "reference(20.0, step_size=1e-9, stop_time=100)", "InvalidInput",
          "is 100,000,000,000 steps, over the limit of 10,000,000"),
+    Call("reference", "reference(20.0, stop_time=1e308)", "InvalidInput",
+         "is about 1e+311 steps, over the limit of 10,000,000"),
     Call("reference", 'reference(20.0, rtol=float("nan"))', "InvalidInput", "rtol nan must be a positive finite number"),
     Call("reference", "reference(20.0, at=[5.0])", "InvalidInput", "at: 5.0 is no time of the run, 0 to 3 s"),
     Call("reference", 'reference(lambda t: "x", stop_time=0.01)', "InvalidInput", "the torque is 'x' at t = 0.0"),
     Call("reference", 'reference("{files}/no_torque.csv")', "TorqueFileError", "no_torque.csv:1: missing column 'torque'"),
     Call("reference", 'reference(20.0, theta0=float("nan"))', "InvalidInput", "theta0 = nan must be a finite number of rad"),
+    Call("reference", 'reference(20.0, stop_time=0.01, parameters={"mass": 1e308})', "InvalidInput",
+         "the reference cannot integrate the pendulum from t = 0 s with mass = 1e+308"),
     Call("reference", "reference_schedule(None)", "WrongType", "plan is a TorqueSchedule"),
     Call("compare", f'compare(20.0, "fmu", {OUT})', "ToolSpecError", "compare needs at least two tools, got fmu"),
     Call("compare", f'compare(20.0, ["fmu", "matlab"], {OUT})', "ToolSpecError", "unknown tool(s) matlab"),
@@ -308,13 +348,22 @@ def write_files(folder: Path) -> None:
         path.write_bytes(content) if isinstance(content, bytes) else path.write_text(content)
 
 
+@contextlib.contextmanager
+def _no_runtime_warnings():
+    """numpy's RuntimeWarnings (overflow, invalid value) raised as errors: printed, each would be
+    lines beside the one line, and pytest would record them instead, unseen."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        yield
+
+
 def run_case(case: Case, folder: Path) -> tuple[int, str]:
     """(exit code, what the command printed on stderr), run in-process."""
     from pendulum_fmu.cli import main
 
     argv = [part.format(files=folder) for part in case.argv]
     stderr = io.StringIO()
-    with contextlib.redirect_stderr(stderr), contextlib.redirect_stdout(io.StringIO()):
+    with contextlib.redirect_stderr(stderr), contextlib.redirect_stdout(io.StringIO()), _no_runtime_warnings():
         try:
             code = main(argv)
         except SystemExit as exit_:  # argparse's own refusals
@@ -327,7 +376,7 @@ def run_call(call: Call, folder: Path) -> BaseException | None:
     namespace: dict = {}
     exec(API_IMPORTS, namespace)
     code = call.code.replace("{files}", str(folder))
-    with contextlib.redirect_stderr(io.StringIO()), contextlib.redirect_stdout(io.StringIO()):
+    with contextlib.redirect_stderr(io.StringIO()), contextlib.redirect_stdout(io.StringIO()), _no_runtime_warnings():
         try:
             eval(code, namespace)
         except Exception as error:

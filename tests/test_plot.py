@@ -1,5 +1,7 @@
 """plot.py: what each figure draws and says, read back from the matplotlib figure."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -127,3 +129,42 @@ def test_a_sweep_of_one_case_per_torque_draws_the_cases_with_units(drawn, tmp_pa
     # Gravity 0: theta(t) = tau t^2 / (2 I) with I = inertia + mass length^2 = 30 kg.m2.
     (final,) = axes[-1].get_lines()
     assert np.allclose(final.get_ydata(), np.array([5.0, 10.0, 20.0, 40.0]) * 0.1**2 / 60, rtol=1e-9, atol=0)
+
+
+@pytest.mark.filterwarnings("error")  # numpy's overflow warnings would be extra lines on stderr
+def test_values_too_large_to_draw_are_left_out_and_said(drawn, tmp_path):
+    base = _run(np.linspace(0.0, 1.0, 5))
+    far = base.copy()
+    far["theta"] = 1e308
+    plot.plot_comparison({"reference": base, "far": far}, tmp_path / "far.png", "t")
+    _, axes, _ = drawn[0]
+    theta, theta_difference, omega, omega_difference = axes
+    assert _legend(theta) == ["reference"]
+    assert [text.get_text() for text in theta.texts] == ["far reaches 1e+308: too large to draw"]
+    assert all(abs(limit) <= 1.1 for limit in theta.get_ylim())  # scaled to what is drawn: 0 to 1
+    assert len(theta_difference.get_lines()) == 0
+    assert [text.get_text() for text in theta_difference.texts] == ["far - reference reaches 1e+308: too large to draw"]
+    assert _legend(omega) == ["reference", "far"]
+    assert (tmp_path / "far.png").stat().st_size > 0
+
+
+@pytest.mark.filterwarnings("error")
+def test_a_run_started_past_drawable_angles_is_written_with_a_note(drawn, tmp_path, capsys):
+    assert main(["simulate", "--torque", "1", "--stop-time", "0.05", "--theta0", "1e308",
+                 "--plot", str(tmp_path / "run.png")]) == 0
+    _, axes, _ = drawn[0]
+    assert [text.get_text() for text in axes[0].texts] == ["FMU reaches 1e+308: too large to draw"]
+    assert len(axes[1].get_lines()) == 1  # omega stays small: drawn
+    assert (tmp_path / "run.png").is_file() and capsys.readouterr().err == ""
+
+
+@pytest.mark.filterwarnings("error")
+def test_a_sweep_started_past_drawable_angles_still_writes_its_figure(drawn, tmp_path):
+    from pendulum_fmu.sweep import Study, run_sweep, sweep_grid
+
+    done = run_sweep(Study(sweep_grid([1.0], extra={"theta0": [1e308]}), stop_time=0.01, format="csv"),
+                     output_dir=tmp_path, workers=1, progress=False)
+    _, axes, _ = drawn[-1]
+    assert [text.get_text() for text in axes[0].texts] == [
+        "torque = 1 N.m, gravity = 9.81 m/s2, theta0 = 1e+308 rad reaches 1e+308: too large to draw"]
+    assert Path(done.figure).is_file()

@@ -48,11 +48,16 @@ def test_written_schedule_reads_back(tmp_path):
     ("time,torque\n0,1\ninf,1\n", "t.csv:3: time is inf"),
     ("time,torque\n0,1\n1,1\n1,2\n1,3\n", "t.csv:5: time 1 appears three times"),
     ("time,torque\n", "no data rows"),
+    ("time,torque\n0,1\n1,1_0\n", "t.csv:3: torque '1_0' is not a number"),  # Python's float takes it
+    ("time,torque\n0,1\n1,\uff11\n", "t.csv:3: torque '\uff11' is not a number"),  # a fullwidth 1
+    ("time,torque\n0,1\n1,2,3\n", "t.csv:3: 3 columns, but the header names 2"),
+    ("\n\ntime,torque\n0,1\n", "t.csv:1: the line is blank; the header, e.g. time,torque, must be the first line"),
+    ('time,torque\n"0","1,5"\n', "t.csv:2: torque '1,5' is not a number"),
 ])
 def test_bad_files_name_file_row_and_problem(tmp_path, content, message):
     csv = tmp_path / "t.csv"
-    csv.write_text(content)
-    with pytest.raises(TorqueFileError, match=message.replace("(", r"\(")) as error:
+    csv.write_text(content, encoding="utf-8")
+    with pytest.raises(TorqueFileError, match=re.escape(message)) as error:
         read_torque_csv(csv)
     assert str(error.value).startswith(str(csv))
     assert "\n" not in str(error.value)
@@ -111,3 +116,46 @@ def test_a_run_larger_than_the_free_memory_is_refused():
         step_count(0.0, float(steps), 1.0, max_steps=steps)
     said = float(re.search(r"has ([\d.]+) GiB free", str(refused.value)).group(1))
     assert said == pytest.approx(free_kib / 2**20, rel=0.1)  # other jobs allocate in between
+
+
+@pytest.mark.parametrize("start, stop, step, count", [
+    (0.0, 1e308, 1e-3, "about 1e+311"),
+    (-1e308, 1e308, 1.0, "about 2e+308"),  # the span itself is past the largest double
+    (0.0, 0.01, 1e-320, "about 1e+318"),
+    (0.0, 1e20, 1e-3, "about 1e+23"),  # past 2**53 the trailing digits would be a float's rounding
+    (0.0, 9e12, 1e-3, "9,000,000,000,000,000"),
+])
+def test_a_count_past_the_largest_double_is_refused_like_any_long_run(start, stop, step, count):
+    with pytest.raises(ValueError, match=re.escape(f"is {count} steps, over the limit of 10,000,000")):
+        step_count(start, stop, step)
+
+
+def test_a_count_past_the_largest_double_counts_exactly():
+    # Raising the limit past it shows the count is the exact ceiling, not an overflowed float.
+    with pytest.raises(ValueError, match=r"is about 3e\+320 steps, which needs about 2.68e\+313 GiB"):
+        step_count(0.0, 3.0, 1e-320, max_steps=10**400)
+
+
+@pytest.mark.filterwarnings("error")  # numpy's overflow warning was a line on stderr
+def test_rows_near_the_largest_double_interpolate_without_overflow(tmp_path):
+    csv = tmp_path / "t.csv"
+    csv.write_text("time,torque\n0,1e308\n0.01,-1e308\n")
+    plan = schedule(csv, step_size=0.0025)
+    assert plan.torque.tolist() == pytest.approx([1e308, 0.5e308, 0.0, -0.5e308], rel=1e-15, abs=1e293)
+    with pytest.raises(ValueError, match=re.escape(f"{csv} ramps from 1e+308 to 5e+307 N.m between t = 0 "
+                                                   "and 0.0025 s, a rate past the largest double")):
+        schedule(csv, step_size=0.0025, ramp=True)
+
+
+def test_ordinary_rows_keep_the_documented_interpolation(tmp_path):
+    # The overflow fallback weighs the rows differently; it must not touch finite results.
+    csv = tmp_path / "t.csv"
+    csv.write_text("time,torque\n0,0.1\n0.3,0.7\n")
+    t = np.array([0.1, 0.2])
+    assert read_torque_csv(csv).value_after(t).tolist() == (0.1 + (0.7 - 0.1) * (t - 0) / 0.3).tolist()
+
+
+def test_quoted_cells_are_numbers(tmp_path):
+    csv = tmp_path / "t.csv"
+    csv.write_text('time,torque\n"0","1"\n1,2\n')
+    assert read_torque_csv(csv).torque.tolist() == [1, 2]
