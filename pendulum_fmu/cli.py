@@ -246,7 +246,7 @@ def cmd_sweep(args) -> int:
 def cmd_demo(args) -> int:
     from .demo import run_demo
 
-    return 0 if run_demo(args.output_dir, workers=args.workers) else 1
+    return 0 if run_demo(args.output_dir, workers=args.workers, overwrite=args.overwrite) else 1
 
 
 def cmd_judge(args) -> int:
@@ -288,7 +288,7 @@ def cmd_judge(args) -> int:
 def cmd_scenarios(args) -> int:
     from .scenarios import write_scenarios
 
-    for path in write_scenarios(args.output_dir, args.fmu):
+    for path in write_scenarios(args.output_dir, args.fmu, overwrite=args.overwrite):
         print(f"wrote {path}")
     return 0
 
@@ -426,6 +426,9 @@ def _add_demo(commands) -> argparse.ArgumentParser:
     demo.add_argument("--output-dir", type=Path, default=Path("demo"),
                       help="folder for the figures and tables (default: %(default)s)")
     demo.add_argument("--workers", type=int, default=None, help="local dask workers (default: 2)")
+    demo.add_argument("--overwrite", action="store_true",
+                      help="replace the outputs of a previous demo --output-dir holds (without it, "
+                           "such a folder is refused)")
     demo.set_defaults(run=cmd_demo)
     return demo
 
@@ -471,6 +474,10 @@ def _add_scenarios(commands) -> argparse.ArgumentParser:
                     "with a ReadMe.md: run each in your master, write NAME_out.csv beside it, then "
                     "pendulum-fmu judge FOLDER.")
     scenarios.add_argument("--output-dir", type=Path, required=True, help="the kit's folder")
+    scenarios.add_argument("--overwrite", action="store_true",
+                           help="replace the kit --output-dir holds, once the new one is whole; "
+                                "results (NAME_out.csv) are kept (without it, a folder holding a "
+                                "kit is refused)")
     _add_fmu_argument(scenarios)
     scenarios.set_defaults(run=cmd_scenarios)
     return scenarios

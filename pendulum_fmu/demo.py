@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from .compare import compare, format_comparison
+from .errors import PendulumFmuError
 from .parameters import default_parameters, total_inertia
 from .plot import plot_overlay
 from .sweep import Study, run_sweep, sweep_grid
@@ -21,9 +22,16 @@ from .sweep import Study, run_sweep, sweep_grid
 TORQUE = 20.0
 # The parameter study's torques, N.m, with gravity.
 STUDY_TORQUES = (5.0, 10.0, 20.0, 40.0)
+# What the demo writes into its folder.
+ENTRIES = ("no_gravity", "gravity", "gravity_effect.png", "parameter_study")
 
 
-def run_demo(output_dir: str | Path, workers: int | None = None) -> bool:
+class DemoExists(PendulumFmuError, FileExistsError):
+    """The output folder holds a previous demo's outputs that the run would replace without being
+    asked to; the message names them and --overwrite."""
+
+
+def run_demo(output_dir: str | Path, workers: int | None = None, overwrite: bool = False) -> bool:
     """Run the tutorial into output_dir, printing each step's findings.
 
     Parameters
@@ -34,6 +42,9 @@ def run_demo(output_dir: str | Path, workers: int | None = None) -> bool:
         parameter_study/ (a sweep).
     workers : int, optional
         Processes of the local dask cluster of the parameter study (default 2).
+    overwrite : bool, optional
+        Replace the outputs of a previous demo the folder holds (ENTRIES); without it such a
+        folder is refused before anything runs. Other files in it are kept either way.
 
     Returns
     -------
@@ -42,10 +53,16 @@ def run_demo(output_dir: str | Path, workers: int | None = None) -> bool:
 
     Raises
     ------
+    DemoExists
+        A folder that holds a previous demo's outputs, without overwrite.
     PendulumFmuError
         An output that cannot be written, or a tool or FMU that fails (see compare, run_sweep).
     """
     out = Path(output_dir)
+    held = [name for name in ENTRIES if (out / name).exists()]
+    if held and not overwrite:
+        raise DemoExists(f"{out} already holds a demo's outputs ({', '.join(held)}): choose another "
+                         "output directory, or add --overwrite to run the demo again in their place")
     tools = ["fmu", "reference"]
     if importlib.util.find_spec("opensim") is not None:
         tools.append("opensim")
@@ -72,9 +89,9 @@ def run_demo(output_dir: str | Path, workers: int | None = None) -> bool:
     print(f"\nwrote {overlay}")
     print(f"\nParameter study: torque {', '.join(f'{t:g}' for t in STUDY_TORQUES)} N.m with gravity, "
           "on a local dask cluster")
-    # The demo writes all its outputs anew each run, the study too (once the new one is whole).
+    # Asked to overwrite, the study too is replaced (once the new one is whole).
     result = run_sweep(Study(sweep_grid(STUDY_TORQUES, [9.81])), output_dir=out / "parameter_study",
-                       overwrite=True, workers=workers)
+                       overwrite=overwrite, workers=workers)
     print(f"{result.cases} cases in {result.seconds:.1f} s\nwrote {result.cases_table}\n"
           f"wrote {result.figure}")
     return agree

@@ -12,6 +12,8 @@ OSError for a file, ...). The kinds that belong to one module live there:
     compare_tools.ToolSpecError       a --tools list that names no runnable tool
     mapped_fmu.MapError               a --map, or an FMU that does not fit it
     judge.ResultFileError             a result file, or a kit's folder, that cannot be judged
+    scenarios.KitExists               an output folder holding a scenario kit the run was not asked to replace
+    demo.DemoExists                   an output folder holding a demo's outputs the run was not asked to replace
     engines.ToolCannotRamp            a ramp given to a tool that holds the torque
     engines.drake.UnequalSteps        unequal steps given to drake:default
     sweep.store.InUse                 an output folder another run holds

@@ -195,14 +195,29 @@ def read_result(path: str | Path, mapping: str | dict | None = None) -> np.ndarr
 
 
 def _check_span(result: np.ndarray, plan: TorqueSchedule, step_size: float, source: str) -> None:
+    """Refuse a result that is not a record of this run: times outside it, or a first or last row
+    that is not the run's start or stop. A result that stops short (a master that crashed, a file
+    cut off, only the t = 0 row) agrees with the reference wherever it has rows, so judged it would
+    pass a run that never happened."""
     start, stop = float(plan.time[0]), float(plan.time[-1])
     slack = float(event_tolerance(max(abs(start), abs(stop)), step_size))
-    if result["time"][0] < start - slack:
-        raise ResultFileError(f"{source}: time {result['time'][0]:.17g} is before the run's start "
+    first, last = float(result["time"][0]), float(result["time"][-1])
+    if first < start - slack:
+        raise ResultFileError(f"{source}: time {first:.17g} is before the run's start "
                               f"time {start:g} s; give the run's --start-time")
-    if result["time"][-1] > stop + slack:
-        raise ResultFileError(f"{source}: time {result['time'][-1]:.17g} is after the run's stop "
+    if last > stop + slack:
+        raise ResultFileError(f"{source}: time {last:.17g} is after the run's stop "
                               f"time {stop:g} s; give the run's --stop-time")
+    # Half the first and the last step: a master's times may drift off the grid (a diagnosis of
+    # its own), but a first or last row nearer another communication point is another run's.
+    if first > start + (plan.time[1] - start) / 2:
+        raise ResultFileError(f"{source}: the result starts at {first:.17g} s, not at the run's start "
+                              f"time {start:g} s: write a row per communication point from the start "
+                              "(judging a file alone, give the run's --start-time)")
+    if last < stop - (stop - plan.time[-2]) / 2:
+        raise ResultFileError(f"{source}: the result ends at {last:.17g} s, before the run's stop "
+                              f"time {stop:g} s, so it covers only part of the run: run it to the stop "
+                              "time (judging a file alone, give the run's --stop-time)")
 
 
 def _plan_index(plan: TorqueSchedule, times: np.ndarray, step_size: float) -> np.ndarray | None:
@@ -397,7 +412,8 @@ def judge(result, torque, *, start_time: float = 0.0, stop_time: float | None = 
     Raises
     ------
     ResultFileError
-        A result file that cannot be read, or whose times fall outside the run.
+        A result file that cannot be read, whose times fall outside the run, or whose first
+        and last rows are not the run's start and stop (a result of part of the run).
     InvalidInput
         A tolerance that is not positive and finite, or a run definition simulate() would refuse.
     """

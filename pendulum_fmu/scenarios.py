@@ -35,6 +35,10 @@ documentation/fmi-ls-ref.txt, as the standard recommends. Where it departs:
 from __future__ import annotations
 
 import json
+import math
+import os
+import shutil
+import uuid
 import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -43,11 +47,12 @@ from xml.etree import ElementTree
 import numpy as np
 
 from . import __version__, results
-from .atomic_files import replacing, replacing_path
-from .errors import InvalidInput
+from .atomic_files import check_writable, make_folder, replacing, replacing_path
+from .errors import InvalidInput, PendulumFmuError
 from .parameters import START_VALUES, fmu_file, model_description
 from .reference import reference
 from .simulate import resolve_parameters
+from .stop_signals import signals_deferred
 
 LS_REF_NAME = "org.fmi-standard.fmi-ls-ref"
 LS_REF_VERSION = "1.0.0-beta.1"
@@ -157,21 +162,94 @@ def read_settings(path: str | Path) -> dict:
     Raises
     ------
     InvalidInput
-        One line naming the file and what is wrong with it.
+        One line naming the file and what is wrong with it: not JSON, not an object, a field
+        missing, or a field of the wrong type or out of its range (a time that is not a finite
+        number, a step size or tolerance that is not positive, stop_time not after start_time).
     """
     path = Path(path)
     try:
         settings = json.loads(path.read_text(encoding="utf-8"))
-        return {"torque": path.parent / settings["input"], "output": settings["output"],
-                **{key: settings[key] for key in ("start_time", "stop_time", "step_size", "ramp",
-                                                  "parameters", "theta0", "omega0", "tolerance")}}
     except (json.JSONDecodeError, UnicodeDecodeError) as error:
         raise InvalidInput(f"{path}: not a scenario's settings: {error}") from None
     except OSError as error:
         raise InvalidInput(f"{path}: cannot read: {error.strerror}") from None
-    except (KeyError, TypeError) as error:
-        raise InvalidInput(f"{path}: not a scenario's settings: no {error}; write the kit again with "
-                           "pendulum-fmu scenarios") from None
+    if not isinstance(settings, dict):
+        raise InvalidInput(f"{path}: not a scenario's settings: it holds a JSON {_json_kind(settings)}, "
+                           f"not an object; {_AGAIN}")
+    missing = [key for key in SETTINGS_READ if key not in settings]
+    if missing:
+        raise InvalidInput(f"{path}: not a scenario's settings: no {', '.join(map(repr, missing))}; {_AGAIN}")
+    field = _FieldChecker(path, settings)
+    start_time = field.number("start_time", "s")
+    stop_time = field.number("stop_time", "s")
+    if not stop_time > start_time:
+        raise InvalidInput(f"{path}: stop_time {stop_time!r} is not after start_time {start_time!r}; "
+                           f"correct it, or {_AGAIN}")
+    return {"torque": path.parent / field.file_name("input"), "output": field.file_name("output"),
+            "start_time": start_time, "stop_time": stop_time,
+            "step_size": field.number("step_size", "s", positive=True), "ramp": field.boolean("ramp"),
+            "parameters": field.parameters("parameters"), "theta0": field.number("theta0", "rad"),
+            "omega0": field.number("omega0", "rad/s"),
+            "tolerance": field.number("tolerance", "rad", positive=True)}
+
+
+# The fields read_settings takes from NAME.json.
+SETTINGS_READ = ("input", "output", "start_time", "stop_time", "step_size", "ramp", "parameters",
+                 "theta0", "omega0", "tolerance")
+_AGAIN = "write the kit again with pendulum-fmu scenarios --output-dir FOLDER --overwrite"
+
+
+def _json_kind(value) -> str:
+    """What a value is called in JSON, for messages about a hand-edited file."""
+    if value is None:
+        return "null"
+    if isinstance(value, bool):
+        return "boolean"
+    if isinstance(value, (int, float)):
+        return "number"
+    return {str: "string", list: "array", dict: "object"}.get(type(value), type(value).__name__)
+
+
+@dataclass(frozen=True)
+class _FieldChecker:
+    """The checks of NAME.json's fields: a hand-edited value of the wrong type or out of range is
+    refused naming the file and the field, before it can reach the judge's arithmetic."""
+
+    path: Path
+    settings: dict
+
+    def _refuse(self, key: str, what: str):
+        value = json.dumps(self.settings[key])
+        raise InvalidInput(f"{self.path}: {key} is {value}; it must be {what}: correct it, or {_AGAIN}")
+
+    def number(self, key: str, unit: str, positive: bool = False) -> float:
+        value = self.settings[key]
+        # bool is an int in Python, but true is no time or angle.
+        if (isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value)
+                or (positive and value <= 0)):
+            self._refuse(key, f"{'a positive' if positive else 'a'} finite number ({unit})")
+        return float(value)
+
+    def boolean(self, key: str) -> bool:
+        if not isinstance(self.settings[key], bool):
+            self._refuse(key, "true or false")
+        return self.settings[key]
+
+    def file_name(self, key: str) -> str:
+        value = self.settings[key]
+        if not (isinstance(value, str) and value.strip()):
+            self._refuse(key, "a file name (a JSON string)")
+        return value
+
+    def parameters(self, key: str) -> dict[str, float]:
+        value = self.settings[key]
+        if not isinstance(value, dict):
+            self._refuse(key, "an object {name: value}")
+        for name, number in value.items():
+            if isinstance(number, bool) or not isinstance(number, (int, float)) or not math.isfinite(number):
+                raise InvalidInput(f"{self.path}: parameters: {name} is {json.dumps(number)}; it must be "
+                                   f"a finite number: correct it, or {_AGAIN}")
+        return {name: float(number) for name, number in value.items()}
 
 
 def settings_files(folder: str | Path) -> dict[str, Path]:
@@ -312,8 +390,39 @@ def _write(path: Path, text: str) -> None:
         file.write(text)
 
 
-def write_scenarios(output_dir: str | Path, fmu_path: str | Path | None = None) -> list[Path]:
+class KitExists(PendulumFmuError, FileExistsError):
+    """The output folder holds files of a scenario kit that writing the kit would replace without
+    being asked to; the message names them and --overwrite."""
+
+
+def kit_files() -> tuple[str, ...]:
+    """The names of the files `pendulum-fmu scenarios` writes into its folder (results a master
+    writes there, NAME_out.csv, are none of them).
+
+    Returns
+    -------
+    tuple of str
+        The FMU, ReadMe.md, and per scenario NAME_in.csv, NAME_ref.csv and NAME.json.
+    """
+    return (KIT_FMU, "ReadMe.md", *(f"{s.name}{suffix}" for s in SCENARIOS
+                                     for suffix in ("_in.csv", "_ref.csv", ".json")))
+
+
+def _check_replaceable(folder: Path, overwrite: bool) -> None:
+    held = [name for name in kit_files() if (folder / name).exists()]
+    if held and not overwrite:
+        shown = ", ".join(held[:3]) + (f" and {len(held) - 3} more" if len(held) > 3 else "")
+        raise KitExists(f"{folder} already holds a scenario kit ({shown}): choose another output "
+                        "directory, or add --overwrite to write the kit again in its place (the "
+                        "results NAME_out.csv beside it are kept)")
+
+
+def write_scenarios(output_dir: str | Path, fmu_path: str | Path | None = None,
+                    overwrite: bool = False) -> list[Path]:
     """Write the scenario kit (see the module's docstring).
+
+    The kit is written into a hidden folder inside output_dir and moved into place once whole, so
+    a run that fails or is stopped leaves the folder as it was.
 
     Parameters
     ----------
@@ -321,6 +430,9 @@ def write_scenarios(output_dir: str | Path, fmu_path: str | Path | None = None) 
         The kit's folder; results a user put there (NAME_out.csv) are left alone.
     fmu_path : str or Path, optional
         The FMI 2.0 FMU to carry and whose parameters apply (default: pendulum_fmu.default_fmu()).
+    overwrite : bool, optional
+        Replace the files of a kit the folder already holds (kit_files()); without it such a
+        folder is refused. Other files in it are kept either way.
 
     Returns
     -------
@@ -331,6 +443,10 @@ def write_scenarios(output_dir: str | Path, fmu_path: str | Path | None = None) 
     ------
     InvalidInput
         An FMU that is not FMI 2.0 (the ramp scenario needs input derivatives).
+    KitExists
+        A folder that holds a kit's files, without overwrite.
+    CannotWrite
+        A folder that cannot be written.
     """
     fmu = fmu_file(fmu_path)
     version = model_description(fmu).fmiVersion
@@ -338,6 +454,23 @@ def write_scenarios(output_dir: str | Path, fmu_path: str | Path | None = None) 
         raise InvalidInput(f"{fmu} is FMI {version}: the kit is for the FMI 2.0 FMU (its ramp scenario "
                            "needs input derivatives)")
     folder = Path(output_dir)
+    _check_replaceable(folder, overwrite)
+    # Refused now, not after the references are computed.
+    check_writable(folder / KIT_FMU)
+    make_folder(folder, folder, "output directory")
+    staging = folder / f".scenarios.{uuid.uuid4().hex}.partial"
+    try:
+        names = _write_kit(staging, fmu)
+        with signals_deferred():
+            for name in names:
+                os.replace(staging / name, folder / name)
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+    return [folder / name for name in names]
+
+
+def _write_kit(folder: Path, fmu: Path) -> list[str]:
+    """Write the kit into folder; returns the names written, the FMU first."""
     written, carried, steps = [], {}, {}
     for scenario in SCENARIOS:
         name = scenario.name
@@ -356,16 +489,15 @@ def write_scenarios(output_dir: str | Path, fmu_path: str | Path | None = None) 
         for file_name, text in files.items():
             if file_name != signal.name:
                 _write(folder / file_name, text)
-            written.append(folder / file_name)
+            written.append(file_name)
             carried[LS_REF_FOLDER + file_name] = text.encode()
         carried[f"{LS_REF_FOLDER}{name}.ssv"] = _ssv(scenario, parameters)
     readme = _readme(steps)
     carried.update({f"{LS_REF_FOLDER}fmi-ls-manifest.xml": _manifest(),
                     LS_REF_FOLDER + EXPERIMENTS_FILE: _experiments(), LS_REF_DOCUMENTATION: readme.encode()})
     _write(folder / "ReadMe.md", readme)
-    written.append(folder / "ReadMe.md")
-    kit_fmu = folder / KIT_FMU
-    with zipfile.ZipFile(fmu) as original, replacing_path(kit_fmu) as partial:
+    written.append("ReadMe.md")
+    with zipfile.ZipFile(fmu) as original, replacing_path(folder / KIT_FMU) as partial:
         with zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as archive:
             for item in original.infolist():
                 # A kit FMU given as the source: its old kit files give way to the new ones.
@@ -373,4 +505,4 @@ def write_scenarios(output_dir: str | Path, fmu_path: str | Path | None = None) 
                     archive.writestr(item, original.read(item))
             for name, content in carried.items():
                 archive.writestr(name, content)
-    return [kit_fmu, *written]
+    return [KIT_FMU, *written]

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import json
 import sys
 import warnings
 import zipfile
@@ -51,6 +52,15 @@ FMI1 = """<?xml version="1.0" encoding="UTF-8"?>
 </fmiModelDescription>
 """
 
+def _settings(**changes) -> str:
+    """A scenario's NAME.json as `pendulum-fmu scenarios` writes it (the fields the judge reads),
+    with fields edited by hand."""
+    settings = {"input": "s_in.csv", "output": "s_out.csv", "start_time": 0.0, "stop_time": 1.0,
+                "step_size": 0.001, "ramp": False, "parameters": {}, "theta0": 0.0, "omega0": 0.0,
+                "tolerance": 1e-9}
+    return json.dumps({**settings, **changes}) + "\n"
+
+
 # Input files the cases name, written into {files} before they run.
 FILES = {
     "bad_number.csv": "time,torque\n0,1\n1,x\n",
@@ -76,8 +86,24 @@ FILES = {
     "result.csv": "time,theta\n0,0\n0.001,0\n",
     "result_no_time.csv": "t,theta\n0,0\n0.001,0\n",
     "result_backwards.csv": "time,theta\n0,0\n0.002,0\n0.001,0\n",
+    "result_t0.csv": "time,theta\n0,0\n",
     # A folder with a study's entry that no sweep wrote.
     "not_a_study/study.json": "{}\n",
+    # Folders holding a file of a scenario kit, and an output of a demo.
+    "old_kit/ReadMe.md": "my notes\n",
+    "old_demo/gravity_effect.png": "old\n",
+    # A kit whose one scenario's settings were edited by hand, and settings edited field by field.
+    "bad_kit/s.json": _settings(stop_time="three"),
+    "bad_kit/s_in.csv": "time,torque\n0,1\n1,1\n",
+    "settings/stop_nan_text.json": _settings(stop_time="NaN"),
+    "settings/stop_nan.json": _settings(stop_time=float("nan")),
+    "settings/tolerance_text.json": _settings(tolerance="x"),
+    "settings/output_null.json": _settings(output=None),
+    "settings/input_null.json": _settings(input=None),
+    "settings/ramp_text.json": _settings(ramp="yes"),
+    "settings/parameters_list.json": _settings(parameters=[]),
+    "settings/stop_before_start.json": _settings(stop_time=-1.0),
+    "settings/list.json": "[]\n",
 }
 
 
@@ -232,6 +258,18 @@ CASES = [
     _case("judge", "judge {files} --torque 1", 2, "is a folder, judged as a scenario kit whose NAME.json files"),
     _case("scenarios", "scenarios --output-dir {files}/bad_number.csv/kit", 2,
           "bad_number.csv is a file, not a folder; choose another output path"),
+    _case("judge", "judge {files}/result_t0.csv --torque 1", 2,
+          "result_t0.csv: the result ends at 0 s, before the run's stop time 3 s, so it covers only part of the run"),
+    _case("judge", "judge {files}/result.csv --torque 1 --start-time=-1 --stop-time 0.001", 2,
+          "result.csv: the result starts at 0 s, not at the run's start time -1 s"),
+    _case("judge", "judge {files}/bad_kit", 2,
+          'bad_kit/s.json: stop_time is "three"; it must be a finite number (s): correct it, or write the kit again'),
+    _case("scenarios", "scenarios --output-dir {files}/old_kit", 2,
+          "{files}/old_kit already holds a scenario kit (ReadMe.md): choose another output directory, or add "
+          "--overwrite"),
+    _case("demo", "demo --output-dir {files}/old_demo", 2,
+          "{files}/old_demo already holds a demo's outputs (gravity_effect.png): choose another output "
+          "directory, or add --overwrite"),
     # A sweep into a folder that holds a study (issue 23, item 1).
     _case("sweep", "sweep --torque 5 --output-dir {files}/not_a_study", 2,
           "holds study.json but no study.json of a sweep: choose another output directory, or add --overwrite"),
@@ -245,6 +283,7 @@ from pendulum_fmu import default_fmu
 from pendulum_fmu.closed_loop import create_closed_loop_fmu
 from pendulum_fmu.compare import compare
 from pendulum_fmu.reference import reference, reference_schedule
+from pendulum_fmu.scenarios import read_settings, write_scenarios
 from pendulum_fmu.simulate import simulate
 from pendulum_fmu.sweep import Study, run_sweep, sweep_grid"""
 
@@ -335,6 +374,27 @@ CALLS = [
     Call("sweep", f'run_sweep({ONE}, output_dir="nosuch://study")', "InvalidInput", "Protocol not known: nosuch"),
     Call("sweep", f'run_sweep({ONE}, output_dir="{{files}}/not_a_study")', "StudyExists",
          "holds study.json but no study.json of a sweep"),
+    Call("scenarios", 'write_scenarios("{files}/old_kit")', "KitExists",
+         "{files}/old_kit already holds a scenario kit (ReadMe.md): choose another output directory, or add "
+         "--overwrite"),
+    Call("scenarios", 'read_settings("{files}/settings/stop_nan_text.json")', "InvalidInput",
+         'stop_nan_text.json: stop_time is "NaN"; it must be a finite number (s)'),
+    Call("scenarios", 'read_settings("{files}/settings/stop_nan.json")', "InvalidInput",
+         "stop_nan.json: stop_time is NaN; it must be a finite number (s)"),
+    Call("scenarios", 'read_settings("{files}/settings/stop_before_start.json")', "InvalidInput",
+         "stop_before_start.json: stop_time -1.0 is not after start_time 0.0"),
+    Call("scenarios", 'read_settings("{files}/settings/tolerance_text.json")', "InvalidInput",
+         'tolerance_text.json: tolerance is "x"; it must be a positive finite number (rad)'),
+    Call("scenarios", 'read_settings("{files}/settings/output_null.json")', "InvalidInput",
+         "output_null.json: output is null; it must be a file name (a JSON string)"),
+    Call("scenarios", 'read_settings("{files}/settings/input_null.json")', "InvalidInput",
+         "input_null.json: input is null; it must be a file name (a JSON string)"),
+    Call("scenarios", 'read_settings("{files}/settings/ramp_text.json")', "InvalidInput",
+         'ramp_text.json: ramp is "yes"; it must be true or false'),
+    Call("scenarios", 'read_settings("{files}/settings/parameters_list.json")', "InvalidInput",
+         "parameters_list.json: parameters is []; it must be an object {name: value}"),
+    Call("scenarios", 'read_settings("{files}/settings/list.json")', "InvalidInput",
+         "list.json: not a scenario's settings: it holds a JSON array, not an object"),
     Call("other", "default_fmu(fmi_version=4)", "InvalidInput", "no FMI 4 FMU: the FMI versions are 2, 3"),
     Call("other", 'create_closed_loop_fmu("{files}/loop.fmu", step_size=0)', "InvalidInput",
          "step size 0 must be a positive number of seconds"),

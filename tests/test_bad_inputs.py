@@ -23,6 +23,10 @@ def _nothing_written(files):
     assert not (files / "out").exists() or not any((files / "out").iterdir())
     assert not (files / "loop.fmu").exists()
     assert [p.name for p in (files / "not_a_study").iterdir()] == ["study.json"]
+    # Refused kits and demos are left as they were, with no staging folder in them.
+    assert [p.name for p in (files / "old_kit").iterdir()] == ["ReadMe.md"]
+    assert (files / "old_kit" / "ReadMe.md").read_text() == "my notes\n"
+    assert [p.name for p in (files / "old_demo").iterdir()] == ["gravity_effect.png"]
 
 
 @pytest.mark.parametrize("case", CASES, ids=[" ".join(c.argv) for c in CASES])

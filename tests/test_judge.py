@@ -3,6 +3,7 @@ kit's scenarios, each mistake must be diagnosed as made; results from the analyt
 other names and units; the command's exit codes, JSON and figure; bad result files."""
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -131,6 +132,38 @@ def test_bad_result_files_get_one_line(tmp_path):
     (tmp_path / "bad.csv").write_text("time,theta\n0,0\n3.5,0\n")
     with pytest.raises(ResultFileError, match="time 3.5 is after the run's stop time 3 s"):
         judge(tmp_path / "bad.csv", 1.0)
+
+
+@pytest.mark.parametrize(("rows", "options", "message"), [
+    ("0,0\n", {}, "the result ends at 0 s, before the run's stop time 3 s, so it covers only part of the run"),
+    ("0,0\n0.001,0\n", {"start_time": -1.0, "stop_time": 0.001},
+     "the result starts at 0 s, not at the run's start time -1 s"),
+    ("0.001,0\n0.002,0\n", {"stop_time": 0.002}, "the result starts at 0.001 s, not at the run's start time 0 s"),
+])
+def test_a_result_of_part_of_the_run_is_refused(tmp_path, rows, options, message):
+    """Wherever it has rows such a result agrees with the reference (theta 0 at t = 0 from rest):
+    judged, it would pass a run that never happened."""
+    (tmp_path / "part.csv").write_text("time,theta\n" + rows)
+    with pytest.raises(ResultFileError, match="^" + re.escape(f"{tmp_path / 'part.csv'}: {message}")):
+        judge(tmp_path / "part.csv", 0.0, **options)
+
+
+def test_a_kit_result_cut_short_is_refused_naming_it(kit, tmp_path, capsys):
+    out = run(kit, "decimal_steps")
+    lines = out.read_text().splitlines()
+    cut = tmp_path / "cut.csv"
+    cut.write_text("\n".join(lines[:51]) + "\n")  # 50 rows of 100, to 0.441 s
+    settings = read_settings(kit / "decimal_steps.json")
+    settings.pop("output")
+    with pytest.raises(ResultFileError, match="ends at 0.44.* s, before the run.s stop time 0.9 s, so it covers"):
+        judge(cut, **settings)
+    # Every row but the last, as a master that forgets to write after its last step.
+    out.write_text("\n".join(lines[:-1]) + "\n")
+    assert main(["judge", str(kit)]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and err[0].startswith(f"pendulum-fmu judge: error: {out}: the result ends at 0.8909")
+    assert "before the run's stop time 0.9 s" in err[0]
+    run(kit, "decimal_steps")
 
 
 def test_fmpy_applying_a_jump_in_the_first_two_rows_late_is_diagnosed(fmu, tmp_path):

@@ -19,8 +19,9 @@ from pendulum_fmu import cs_loop
 from pendulum_fmu.cli import main
 from pendulum_fmu.judge import AGREES, judge, judge_kit
 from pendulum_fmu.parameters import default_parameters, total_inertia
-from pendulum_fmu.scenarios import (KIT_FMU, LS_REF_FOLDER, LS_REF_VERSION, SCENARIOS, read_settings,
-                                    write_scenarios)
+from pendulum_fmu.errors import InvalidInput
+from pendulum_fmu.scenarios import (KIT_FMU, LS_REF_FOLDER, LS_REF_VERSION, SCENARIOS, KitExists, kit_files,
+                                    read_settings, write_scenarios)
 from pendulum_fmu.simulate import open_fmu, run_schedule
 from pendulum_fmu.torque_schedule import TorqueSchedule, schedule
 
@@ -179,14 +180,102 @@ def test_the_native_loop_passes_every_scenario_and_judge_says_so_per_line(kit, c
     assert json.loads((tmp_path / "kit.json").read_text())["scenarios"]["resume"]["verdict"] == "pass"
 
 
-def test_writing_the_kit_again_keeps_the_results(kit, tmp_path, capsys):
+def test_a_kit_is_replaced_only_when_asked_and_the_results_stay(tmp_path, capsys):
     folder = tmp_path / "kit"
     assert main(["scenarios", "--output-dir", str(folder)]) == 0
     assert capsys.readouterr().out.count("wrote") == 2 + 3 * len(NAMES)
     (folder / "ramp_out.csv").write_text("time,theta\n0,0\n")
-    assert main(["scenarios", "--output-dir", str(folder)]) == 0
+    (folder / "ReadMe.md").write_text("my notes\n")
+    (folder / "random_steps_in.csv").write_text("time,torque\n0,1\n4,1\n")
+    assert main(["scenarios", "--output-dir", str(folder)]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert err == [f"pendulum-fmu scenarios: error: {folder} already holds a scenario kit (Pendulum.fmu, "
+                   "ReadMe.md, constant_torque_in.csv and 17 more): choose another output directory, or add "
+                   "--overwrite to write the kit again in its place (the results NAME_out.csv beside it "
+                   "are kept)"]
+    assert (folder / "ReadMe.md").read_text() == "my notes\n"
+    assert (folder / "random_steps_in.csv").read_text() == "time,torque\n0,1\n4,1\n"
+    assert main(["scenarios", "--output-dir", str(folder), "--overwrite"]) == 0
+    assert (folder / "ReadMe.md").read_text().startswith("# Scenarios for a master")
+    assert (folder / "random_steps_in.csv").read_text().count("\n") == len(SCENARIOS[2].rows) + 1
     assert (folder / "ramp_out.csv").read_text() == "time,theta\n0,0\n"
-    assert not list(folder.glob(".*"))  # no temporary left
+    assert not list(folder.glob(".*"))  # no temporary or staging folder left
+
+
+def test_a_folder_without_a_kit_is_written_into(tmp_path):
+    """Only the kit's own files make a folder a kit's: others are neither refused nor touched."""
+    (tmp_path / "notes.txt").write_text("mine\n")
+    written = write_scenarios(tmp_path)
+    assert sorted(path.name for path in written) == sorted(kit_files())
+    assert (tmp_path / "notes.txt").read_text() == "mine\n"
+    with pytest.raises(KitExists, match="already holds a scenario kit"):
+        write_scenarios(tmp_path)
+
+
+def test_a_kit_that_fails_to_write_leaves_the_folder_as_it_was(tmp_path, monkeypatch):
+    from pendulum_fmu import scenarios
+
+    write_scenarios(tmp_path)
+    before = {path.name: path.read_bytes() for path in tmp_path.iterdir()}
+
+    def broken(steps):
+        raise RuntimeError("stopped while writing")
+
+    monkeypatch.setattr(scenarios, "_readme", broken)
+    with pytest.raises(RuntimeError):
+        write_scenarios(tmp_path, overwrite=True)
+    assert {path.name: path.read_bytes() for path in tmp_path.iterdir()} == before
+
+
+# NAME.json as `scenarios` writes it, then edited by hand: each bad field refused naming file and field.
+BAD_SETTINGS = {
+    "stop_time three": ({"stop_time": "three"}, 'stop_time is "three"; it must be a finite number (s)'),
+    "stop_time NaN text": ({"stop_time": "NaN"}, 'stop_time is "NaN"; it must be a finite number (s)'),
+    "stop_time NaN": ({"stop_time": float("nan")}, "stop_time is NaN; it must be a finite number (s)"),
+    "stop_time true": ({"stop_time": True}, "stop_time is true; it must be a finite number (s)"),
+    "stop before start": ({"stop_time": -1.0}, "stop_time -1.0 is not after start_time 0.0"),
+    "step_size 0": ({"step_size": 0}, "step_size is 0; it must be a positive finite number (s)"),
+    "tolerance x": ({"tolerance": "x"}, 'tolerance is "x"; it must be a positive finite number (rad)'),
+    "output null": ({"output": None}, "output is null; it must be a file name (a JSON string)"),
+    "input null": ({"input": None}, "input is null; it must be a file name (a JSON string)"),
+    "ramp text": ({"ramp": "yes"}, 'ramp is "yes"; it must be true or false'),
+    "parameters list": ({"parameters": []}, "parameters is []; it must be an object {name: value}"),
+    "parameter text": ({"parameters": {"mass": "x"}}, 'parameters: mass is "x"; it must be a finite number'),
+    "theta0 null": ({"theta0": None}, "theta0 is null; it must be a finite number (rad)"),
+}
+
+
+@pytest.mark.parametrize("edit", BAD_SETTINGS, ids=list(BAD_SETTINGS))
+def test_hand_edited_settings_are_refused_naming_the_file_and_field(kit, tmp_path, edit):
+    changes, message = BAD_SETTINGS[edit]
+    settings = json.loads((kit / "constant_torque.json").read_text())
+    path = tmp_path / "constant_torque.json"
+    path.write_text(json.dumps({**settings, **changes}))
+    with pytest.raises(InvalidInput) as refused:
+        read_settings(path)
+    assert str(refused.value).startswith(f"{path}: {message}")
+    assert str(refused.value).endswith("write the kit again with pendulum-fmu scenarios --output-dir "
+                                       "FOLDER --overwrite")
+
+
+@pytest.mark.parametrize(("text", "message"), [
+    ("[]", "not a scenario's settings: it holds a JSON array, not an object"),
+    ("null", "not a scenario's settings: it holds a JSON null, not an object"),
+    ('{"input": "a_in.csv"}', "not a scenario's settings: no 'output', 'start_time'"),
+    ("{", "not a scenario's settings: Expecting property name"),
+])
+def test_settings_that_are_no_settings_are_refused(tmp_path, text, message):
+    (tmp_path / "s.json").write_text(text)
+    with pytest.raises(InvalidInput, match=f"^{tmp_path / 's.json'}: {message}"):
+        read_settings(tmp_path / "s.json")
+
+
+def test_settings_as_written_read_back_as_floats(kit):
+    settings = read_settings(kit / "steps_on_grid.json")
+    assert settings["torque"] == kit / "steps_on_grid_in.csv" and settings["output"] == "steps_on_grid_out.csv"
+    assert settings["stop_time"] == 3.0 and settings["step_size"] == 1e-3 and settings["ramp"] is False
+    assert settings["parameters"]["gravity"] == 0.0 and settings["theta0"] == 0.2
+    assert settings["tolerance"] == 1e-9
 
 
 def test_a_kit_without_results_and_an_fmi3_fmu_are_refused(kit, fmu3, tmp_path, capsys):
