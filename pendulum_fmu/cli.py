@@ -36,6 +36,20 @@ def _assignment(text: str) -> tuple[str, str]:
     return name.strip(), value.strip()
 
 
+def _output_path(text: str) -> Path:
+    # An empty path would be the current folder: most likely an unset shell variable ("$OUT").
+    if not text.strip():
+        raise argparse.ArgumentTypeError("an empty path; give a file or folder name (is a shell "
+                                         "variable unset?)")
+    return Path(text)
+
+
+def _output_location(text: str) -> str:
+    """A folder's path or an fsspec URL, not empty."""
+    _output_path(text)
+    return text
+
+
 def _float(text: str) -> float:
     try:
         return float(text)
@@ -224,6 +238,9 @@ def cmd_sweep(args) -> int:
             print(f"pendulum-fmu sweep: {what}; {args.output_dir} holds what it held before (the "
                   "new study was not finished and is not kept): run the same command again to "
                   "start over", file=sys.stderr)
+        elif "://" not in args.output_dir and not any(Path(args.output_dir).glob("*")):
+            print(f"pendulum-fmu sweep: {what} before anything was written: run the same command "
+                  "again to start", file=sys.stderr)
         else:
             print(f"pendulum-fmu sweep: {what}; the chunks that finished are kept in "
                   f"{args.output_dir}: run the same command with --resume to run the rest",
@@ -299,7 +316,7 @@ def _add_build(commands) -> argparse.ArgumentParser:
     build = commands.add_parser("build", help="build the FMU (same as python build_fmu.py)",
                                 description="Build the FMU from fmu_src/ and modelDescription.xml "
                                             "(a source checkout or the unpacked sdist).")
-    build.add_argument("--output", type=Path, default=None,
+    build.add_argument("--output", type=_output_path, default=None,
                        help=f"where to write the FMU (default: {CHECKOUT_FMUS[2]}, or {CHECKOUT_FMUS[3]} "
                             "for FMI 3.0)")
     build.add_argument("--fmi-version", type=int, choices=FMI_VERSIONS, default=2,
@@ -321,7 +338,7 @@ def _add_cross_check(commands) -> argparse.ArgumentParser:
         description="Write fmus/2.0/cs/<platform>/pendulum_fmu/<version>/Pendulum/ (the FMU, "
                     "_in.csv, _ref.csv, _ref.opt, ReadMe.md) for a step-wise torque, one folder "
                     "per platform the FMU has a binary for.")
-    cross_check.add_argument("--output-dir", type=Path, required=True,
+    cross_check.add_argument("--output-dir", type=_output_path, required=True,
                              help="the cross-check repository's root")
     _add_fmu_argument(cross_check)
     cross_check.set_defaults(run=cmd_cross_check)
@@ -337,8 +354,8 @@ def _add_simulate(commands) -> argparse.ArgumentParser:
                           help="ramp the torque linearly over each step (input derivatives)")
     simulate.add_argument("--tolerance", type=_float, default=None,
                           help="relative tolerance of the FMU's integrator (default: 1e-10)")
-    simulate.add_argument("--output", type=Path, help="write time,torque,theta,omega,alpha CSV")
-    simulate.add_argument("--plot", type=Path, help="write a PNG of theta and omega")
+    simulate.add_argument("--output", type=_output_path, help="write time,torque,theta,omega,alpha CSV")
+    simulate.add_argument("--plot", type=_output_path, help="write a PNG of theta and omega")
     simulate.set_defaults(run=cmd_simulate)
     return simulate
 
@@ -365,7 +382,7 @@ def _add_compare(commands) -> argparse.ArgumentParser:
                          help="for LABEL=FMU tools: their variable names for torque, theta, omega, "
                               "alpha and the parameters, with a factor where they use other units, "
                               "e.g. torque=u,theta=phi*0.0174532925 (docs/engines.md)")
-    compare.add_argument("--output-dir", type=Path, required=True,
+    compare.add_argument("--output-dir", type=_output_path, required=True,
                          help="folder for trajectories.csv, differences.csv and comparison.png")
     compare.add_argument("--tol", type=_float, default=1e-9,
                          help="largest allowed |dtheta| (rad) or |domega| (rad/s), positive and "
@@ -387,7 +404,7 @@ def _add_sweep(commands) -> argparse.ArgumentParser:
                        help="end of every case in s (default: %(default)s)")
     sweep.add_argument("--step-size", type=_float, default=1e-3,
                        help="communication step in s (default: %(default)s)")
-    sweep.add_argument("--output-dir", required=True,
+    sweep.add_argument("--output-dir", type=_output_location, required=True,
                        help="local folder or fsspec URL (s3://..., a shared file system) every "
                             "worker can write to: trajectories/ and cases/ (a file per chunk), "
                             "sweep.png")
@@ -423,7 +440,7 @@ def _add_demo(commands) -> argparse.ArgumentParser:
                                            "OpenSim when installed), the overlay and the "
                                            "parameter study; prints the error table and writes "
                                            "the figures.")
-    demo.add_argument("--output-dir", type=Path, default=Path("demo"),
+    demo.add_argument("--output-dir", type=_output_path, default=Path("demo"),
                       help="folder for the figures and tables (default: %(default)s)")
     demo.add_argument("--workers", type=int, default=None, help="local dask workers (default: 2)")
     demo.add_argument("--overwrite", action="store_true",
@@ -456,10 +473,10 @@ def _add_judge(commands) -> argparse.ArgumentParser:
     judge.add_argument("--map", dest="mapping", default=None, metavar="QUANTITY=COLUMN[*FACTOR],...",
                        help="the result's column names for time, theta, omega and alpha, with a factor "
                             "to SI where it uses other units, e.g. theta=phi*0.0174532925")
-    judge.add_argument("--json", type=Path, default=None,
+    judge.add_argument("--json", type=_output_path, default=None,
                        help="write the verdict, diagnosis, max |dtheta|, worst time and every "
                             "candidate's residual (rad) as JSON")
-    judge.add_argument("--plot", type=Path, default=None,
+    judge.add_argument("--plot", type=_output_path, default=None,
                        help="write a PNG of the torque, theta and |dtheta| (for a kit: a folder, one "
                             "NAME.png per scenario)")
     judge.set_defaults(run=cmd_judge)
@@ -473,7 +490,7 @@ def _add_scenarios(commands) -> argparse.ArgumentParser:
                     "its torque (NAME_in.csv), settings (NAME.json) and reference (NAME_ref.csv), "
                     "with a ReadMe.md: run each in your master, write NAME_out.csv beside it, then "
                     "pendulum-fmu judge FOLDER.")
-    scenarios.add_argument("--output-dir", type=Path, required=True, help="the kit's folder")
+    scenarios.add_argument("--output-dir", type=_output_path, required=True, help="the kit's folder")
     scenarios.add_argument("--overwrite", action="store_true",
                            help="replace the kit --output-dir holds, once the new one is whole; "
                                 "results (NAME_out.csv) are kept (without it, a folder holding a "

@@ -137,7 +137,7 @@ def compare(torque: TorqueSignal, tools=TOOLS, *, output_dir: str | Path, step_s
             start_time: float = 0.0, stop_time: float | None = None, ramp: bool = False,
             parameters: dict | None = None, theta0: float = 0.0, omega0: float = 0.0,
             tolerance: float = 1e-9, title: str | None = None, fmu_path: str | Path | None = None,
-            mapping: str | None = None, max_steps: int | None = None) -> Comparison:
+            mapping: str | dict | None = None, max_steps: int | None = None) -> Comparison:
     """Run one signal through each tool and judge each against the reference.
 
     The reference is the independent oracle reading the signal itself; it always runs, as the
@@ -164,8 +164,9 @@ def compare(torque: TorqueSignal, tools=TOOLS, *, output_dir: str | Path, step_s
         The largest difference in theta (rad) or omega (rad/s) for the tools to agree.
     title : str, optional
         The figure's title.
-    mapping : str, optional
-        The --map of the tools given as LABEL=path (mapped_fmu.py).
+    mapping : str or dict, optional
+        The --map of the tools given as LABEL=path, as its text or as a dict such as
+        {"theta": "phi*0.0174532925"} (mapped_fmu.as_map).
 
     Returns
     -------

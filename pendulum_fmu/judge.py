@@ -40,7 +40,7 @@ import numpy as np
 from . import results
 from .atomic_files import replacing
 from .errors import InvalidInput
-from .mapped_fmu import parse_map
+from .mapped_fmu import as_map
 from .parameters import variables
 from .reference import equation_of_motion, reference, reference_schedule
 from .scenarios import JUDGE_TOLERANCE as DEFAULT_TOLERANCE, read_settings, settings_files
@@ -147,7 +147,7 @@ def read_result(path: str | Path, mapping: str | dict | None = None) -> np.ndarr
         missing, a cell that is not a finite number, times that go backwards, no rows.
     """
     path = Path(path)
-    mapped = parse_map(mapping, RESULT_QUANTITIES) if not isinstance(mapping, dict) else mapping
+    mapped = as_map(mapping, RESULT_QUANTITIES)
     try:
         with open(path, newline="", encoding="utf-8-sig") as file:
             rows = list(csv.reader(file))
@@ -421,7 +421,11 @@ def judge(result, torque, *, start_time: float = 0.0, stop_time: float | None = 
     if not (math.isfinite(tolerance) and tolerance > 0):
         raise InvalidInput(f"the tolerance {tolerance} must be a positive finite number (rad)")
     source = str(result) if isinstance(result, (str, Path)) else "result"
-    result = read_result(result, mapping) if isinstance(result, (str, Path)) else result
+    if isinstance(result, (str, Path)):
+        result = read_result(result, mapping)
+    elif mapping:
+        raise InvalidInput("a map renames and scales a result file's columns: an array result is "
+                           "judged as it is, in the fields time and theta (rad); leave out mapping")
     parameters = resolve_parameters(parameters, fmu_path)
     plan = schedule(torque, start_time=start_time, stop_time=stop_time, step_size=step_size, ramp=ramp,
                     max_steps=max_steps)

@@ -24,15 +24,16 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
+import fmpy
 import numpy as np
 from fmpy import simulate_fmu
 from fmpy.fmi2 import FMU2Slave
 from fmpy.fmi3 import FMU3Slave
 
 from .engines import check_held, check_mode, held_results
-from .errors import InvalidInput
+from .errors import InvalidInput, WrongType
 from .parameters import START_VALUES, FmuFileError, default_parameters, model_description, variables
-from .simulate import RECORDED, FmuError, _unzipped, fmi2_library, resolve_parameters
+from .simulate import RECORDED, FmuError, MessageLog, _unzipped, fmi2_library, instantiate, resolve_parameters
 from .torque_schedule import TorqueSchedule
 
 OUTPUTS = RECORDED[1:]  # theta, omega, alpha
@@ -81,6 +82,28 @@ def parse_map(text: str | None, allowed: tuple[str, ...] | None = None) -> dict[
     return mapping
 
 
+def as_map(mapping, allowed: tuple[str, ...] | None = None) -> dict[str, Mapped]:
+    """A map given as --map's text, as a dict of such texts ({"theta": "phi*0.0174532925"}), as
+    parse_map's result, or None (nothing mapped), as parse_map's result.
+
+    Raises
+    ------
+    WrongType
+        Anything else.
+    MapError
+        A text parse_map refuses.
+    """
+    if mapping is None or isinstance(mapping, str):
+        return parse_map(mapping, allowed)
+    if isinstance(mapping, dict) and all(isinstance(value, Mapped) for value in mapping.values()):
+        return dict(mapping)
+    if isinstance(mapping, dict) and all(isinstance(key, str) and isinstance(value, str)
+                                         for key, value in mapping.items()):
+        return parse_map(",".join(f"{key}={value}" for key, value in mapping.items()), allowed)
+    raise WrongType(f"a map is text such as 'time=t,theta=phi*0.0174532925' or a dict such as "
+                    f"{{'theta': 'phi*0.0174532925'}}, not {mapping!r}")
+
+
 class MappedFmu:
     """An FMU and its map, checked once; run() has the runner signature of every tool."""
 
@@ -101,8 +124,7 @@ class MappedFmu:
             raise MapError(f"{label}: {self.path} has no {self.interface} interface "
                            f"(it has {', '.join(available)})")
         self.variables = variables(self.path)  # shared, read only
-        given = parse_map(mapping) if isinstance(mapping, str) or mapping is None else dict(mapping)
-        self.mapping = self._complete(given)
+        self.mapping = self._complete(as_map(mapping))
 
     def _complete(self, given: dict[str, Mapped]) -> dict[str, Mapped]:
         """The map with every quantity the FMU has by name, and every named variable checked."""
@@ -162,8 +184,15 @@ class MappedFmu:
         identifier = self.description.coSimulation.modelIdentifier
         arguments = dict(guid=self.description.guid, unzipDirectory=folder, modelIdentifier=identifier,
                          instanceName=self.label)
-        slave = (FMU3Slave(**arguments) if fmi3
-                 else FMU2Slave(**arguments, libraryPath=fmi2_library(folder, identifier)))
+        try:
+            slave = (FMU3Slave(**arguments) if fmi3
+                     else FMU2Slave(**arguments, libraryPath=fmi2_library(folder, identifier)))
+        except Exception:  # fmpy's own: no binary of that name for this platform
+            folder = fmpy.platform_tuple if fmi3 else fmpy.platform
+            raise FmuFileError(f"{self.label}: {self.path} cannot be loaded here: it has no "
+                               f"binaries/{folder}/{identifier}{fmpy.sharedLibraryExtension} (its "
+                               "modelIdentifier's binary for this platform)") from None
+        messages = MessageLog(3 if fmi3 else 2)
         outputs = self._output_variables()
         vr = {name: self.variables[name].valueReference for name in (*start, *outputs.values())}
         torque = self.mapping["torque"]
@@ -173,8 +202,7 @@ class MappedFmu:
         get_values = slave.getFloat64 if fmi3 else slave.getReal
         recorded = np.full((len(plan.time), len(outputs)), np.nan)
         t0 = float(plan.time[0])
-        call = "instantiate"
-        slave.instantiate()
+        instantiate(slave, messages, f"{self.label}: {self.path}")
         try:
             if not fmi3:
                 call = "fmi2SetupExperiment"

@@ -60,7 +60,9 @@ def _read(path: str, modified_ns: int, shown: str):
     try:
         description = read_model_description(path)
     except Exception as error:  # lxml's and fmpy's own: the XML is broken or invalid
-        raise FmuFileError(f"{shown}: its modelDescription.xml cannot be read: {error}") from None
+        # fmpy lists its validation problems one per line: one line here.
+        problems = "; ".join(line.strip(" -") for line in str(error).splitlines() if line.strip(" -"))
+        raise FmuFileError(f"{shown}: its modelDescription.xml cannot be read: {problems}") from None
     if description.fmiVersion not in FMI_VERSIONS:
         raise FmuFileError(f"{shown} is an FMI {description.fmiVersion} FMU; this package runs "
                            "FMI 2.0 and 3.0 FMUs: export the model as one of those")

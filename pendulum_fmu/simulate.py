@@ -88,6 +88,22 @@ class MessageLog:
     def initialization_error(self, reason: str) -> FmuError:
         return FmuError(f"initialization failed: {'; '.join(self.lines) or reason}")
 
+    def instantiation_error(self, fmu_path) -> FmuError:
+        """An FMU that returned no instance (fmpy raises a bare Exception), with what it logged."""
+        return FmuError(f"{fmu_path}: the FMU refused to instantiate: {'; '.join(self.lines) or 'no message'}")
+
+
+def instantiate(slave: FMU2Slave | FMU3Slave, messages: MessageLog, fmu_path) -> None:
+    """slave.instantiate with messages as its logger; FmuError naming fmu_path and what the FMU
+    logged when it returns no instance."""
+    try:
+        if isinstance(slave, FMU3Slave):
+            slave.instantiate(logMessage=messages.log_fmi3)
+        else:
+            slave.instantiate(callbacks=messages.callbacks)
+    except Exception:  # fmpy's own, for a NULL instance
+        raise messages.instantiation_error(fmu_path) from None
+
 
 _extracted: dict[tuple[str, int], tuple[tempfile.TemporaryDirectory, object]] = {}
 _extracting = threading.Lock()  # threads of one dask worker share the cache
@@ -170,10 +186,9 @@ def _instantiated(fmu_path: Path, instance_name: str):
                      modelIdentifier=description.coSimulation.modelIdentifier)
     if fmi_version == 3:
         slave = FMU3Slave(**arguments)
-        slave.instantiate(logMessage=messages.log_fmi3)
     else:
         slave = FMU2Slave(**arguments, libraryPath=fmi2_library(folder, arguments["modelIdentifier"]))
-        slave.instantiate(callbacks=messages.callbacks)
+    instantiate(slave, messages, fmu_path)
     slave.fmi_version = fmi_version
     slave.messages = messages  # keeps the logger callback alive as long as the slave
     slave.fmu_path = fmu_path  # whose parameters and value references apply

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import re
 import json
 import sys
 import warnings
@@ -228,6 +229,15 @@ CASES = [
           "cannot write /proc/self/Pendulum.fmu: no file can be created in /proc/self"),
     _case("output", "sweep --torque 1 --output-dir /proc/self/out", 2,
           "cannot write /proc/self/out: the folder /proc/self/out cannot be created"),
+    _case("fmu", "simulate --torque 1 --stop-time 0.01 --fmu {files}/other_guid.fmu", 2,
+          "other_guid.fmu: the FMU refused to instantiate: [ERROR] fmi2Instantiate: fmuGUID "
+          "{00000000-0000-0000-0000-000000000000} does not match this FMU's"),
+    _case("fmu", "compare --torque 1 --stop-time 0.01 --tools fmu,x={files}/other_identifier.fmu "
+                 "--output-dir {files}/out", 2, "x: {files}/other_identifier.fmu cannot be loaded here: it has no "
+                                                 "binaries/linux64/Nope.so"),
+    _case("output", "sweep --torque 1 --output-dir=", 2,
+          "argument --output-dir: an empty path; give a file or folder name (is a shell variable unset?)"),
+    _case("output", "simulate --torque 1 --output=", 2, "argument --output: an empty path"),
     _case("output", "simulate --torque 1 --stop-time 0.01 --plot {files}/out.csv", 2,
           "out.csv: a figure cannot be written as .csv; end its name in .png, .pdf or .svg"),
     _case("output", "simulate --torque-file {files}/epoch.csv --output {files}/epoch.csv", 2,
@@ -282,6 +292,7 @@ API_IMPORTS = """\
 from pendulum_fmu import default_fmu
 from pendulum_fmu.closed_loop import create_closed_loop_fmu
 from pendulum_fmu.compare import compare
+from pendulum_fmu.judge import judge
 from pendulum_fmu.reference import reference, reference_schedule
 from pendulum_fmu.scenarios import read_settings, write_scenarios
 from pendulum_fmu.simulate import simulate
@@ -395,14 +406,40 @@ CALLS = [
          "parameters_list.json: parameters is []; it must be an object {name: value}"),
     Call("scenarios", 'read_settings("{files}/settings/list.json")', "InvalidInput",
          "list.json: not a scenario's settings: it holds a JSON array, not an object"),
+    Call("judge", 'judge("{files}/result.csv", 1.0, stop_time=0.001, mapping=3)', "WrongType",
+         "a map is text such as 'time=t,theta=phi*0.0174532925' or a dict such as"),
+    Call("judge", 'judge("{files}/result.csv", 1.0, stop_time=0.001, mapping={"theta": "phi"})', "ResultFileError",
+         "result.csv:1: no column 'phi'"),
+    Call("judge", 'judge(simulate(1.0, stop_time=0.01), 1.0, stop_time=0.01, mapping="theta=theta*2")',
+         "InvalidInput", "a map renames and scales a result file's columns: an array result is judged as it is"),
     Call("other", "default_fmu(fmi_version=4)", "InvalidInput", "no FMI 4 FMU: the FMI versions are 2, 3"),
     Call("other", 'create_closed_loop_fmu("{files}/loop.fmu", step_size=0)', "InvalidInput",
          "step size 0 must be a positive number of seconds"),
 ]
 
 
+# The package's FMU with its modelDescription.xml edited by hand after the build.
+EDITED_FMUS = {
+    "other_guid.fmu": lambda xml: re.sub(r'guid="[^"]*"', 'guid="{00000000-0000-0000-0000-000000000000}"',
+                                         xml, count=1),
+    "other_identifier.fmu": lambda xml: xml.replace('modelIdentifier="Pendulum"', 'modelIdentifier="Nope"'),
+}
+
+
+def _edited_fmu(edit) -> bytes:
+    from pendulum_fmu import default_fmu
+
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(default_fmu()) as original, zipfile.ZipFile(buffer, "w") as copy:
+        for item in original.infolist():
+            data = original.read(item)
+            copy.writestr(item, edit(data.decode()).encode() if item.filename == "modelDescription.xml" else data)
+    return buffer.getvalue()
+
+
 def write_files(folder: Path) -> None:
-    for name, content in FILES.items():
+    files = {**FILES, **{name: _edited_fmu(edit) for name, edit in EDITED_FMUS.items()}}
+    for name, content in files.items():
         path = folder / name
         path.parent.mkdir(exist_ok=True)
         path.write_bytes(content) if isinstance(content, bytes) else path.write_text(content)
