@@ -17,10 +17,10 @@ from pathlib import Path
 
 import numpy as np
 
-from . import __version__, default_fmu
+from . import __version__
 from .atomic_files import check_writable, replacing, replacing_path
 from .build import PLATFORMS
-from .parameters import model_description, pendulum_variables
+from .parameters import fmu_file, model_description, pendulum_variables
 from .simulate import simulate
 from .torque_schedule import TorqueTable
 
@@ -66,7 +66,7 @@ A rigid pendulum driven by a torque at its pivot (FMI 2.0 Co-Simulation).
 
 def write_cross_check(output_dir: str | Path, fmu_path: str | Path | None = None) -> list[Path]:
     """Write the cross-check folders for every platform the FMU has a binary for; returns them."""
-    fmu = Path(fmu_path) if fmu_path else default_fmu()
+    fmu = fmu_file(fmu_path)
     pendulum_variables(fmu)  # a pendulum FMU with this platform's binary, to compute the reference
     description = model_description(fmu)
     model_name = description.coSimulation.modelIdentifier

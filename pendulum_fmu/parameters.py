@@ -180,6 +180,9 @@ def fmu_file(fmu_path: str | Path | None) -> Path:
     if fmu_path is None:
         from . import default_fmu
         return default_fmu()
+    # bool and int would pass for a file descriptor, which is no FMU's path.
+    if not isinstance(fmu_path, (str, os.PathLike)):
+        raise WrongType(f"fmu_path is the FMU file's path (a str or Path), not {fmu_path!r}")
     return Path(fmu_path)
 
 

@@ -165,7 +165,7 @@ def open_fmu(fmu_path: str | Path | None = None, *, parameters: dict | None = No
     FmuError
         The FMU refused the parameters or start values; the message carries what it logged.
     """
-    fmu_path = Path(fmu_path) if fmu_path else default_fmu()
+    fmu_path = fmu_file(fmu_path)
     slave = _instantiated(fmu_path, instance_name)
     try:
         initialize(slave, parameters=parameters, theta0=theta0, omega0=omega0,
@@ -482,7 +482,7 @@ def simulator(fmu_path: str | Path | None = None) -> Simulator:
     MissingFile
         When there is no such file.
     """
-    path = _default_fmu() if fmu_path is None else fmu_path
+    path = _default_fmu() if fmu_path is None else fmu_file(fmu_path)
     version = file_version(path)
     kept = getattr(_simulators, "kept", None)
     if kept is None:

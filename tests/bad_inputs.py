@@ -412,6 +412,8 @@ CALLS = [
          "result.csv:1: no column 'phi'"),
     Call("judge", 'judge(simulate(1.0, stop_time=0.01), 1.0, stop_time=0.01, mapping="theta=theta*2")',
          "InvalidInput", "a map renames and scales a result file's columns: an array result is judged as it is"),
+    Call("simulate", "simulate(1.0, stop_time=0.01, fmu_path=0)", "WrongType",
+         "fmu_path is the FMU file's path (a str or Path), not 0"),
     Call("other", "default_fmu(fmi_version=4)", "InvalidInput", "no FMI 4 FMU: the FMI versions are 2, 3"),
     Call("other", 'create_closed_loop_fmu("{files}/loop.fmu", step_size=0)', "InvalidInput",
          "step size 0 must be a positive number of seconds"),

@@ -10,9 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import default_fmu
 from ..errors import InvalidInput, MissingDependency, WrongType
-from ..parameters import pendulum_variables
+from ..parameters import fmu_file, pendulum_variables
 from .client import dask_client, progress_bar, run_chunks
 from .figure import draw
 from .grid import columns
@@ -97,7 +96,7 @@ def run_sweep(study: Study, *, output_dir: str | os.PathLike, resume: bool = Fal
     _check_options(len(cases), max_cases, scheduler, workers, connect_timeout, resume, overwrite)
     url = str(output_dir)
     target = Store(*_file_system(url), format=study.format)
-    fmu = str(Path(study.fmu_path).resolve() if study.fmu_path else default_fmu())
+    fmu = str(fmu_file(study.fmu_path).resolve())
     pendulum_variables(fmu)  # a missing file, or none that is a pendulum FMU, refused before anything starts
     definition = study.definition(fmu)
     # The folder taken first, so that a second run is refused before it starts a cluster; then

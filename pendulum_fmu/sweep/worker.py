@@ -8,7 +8,6 @@ native loop, runs the same case through fmpy's calls.
 
 from __future__ import annotations
 
-import os
 import threading
 import time
 from dataclasses import dataclass
