@@ -56,7 +56,7 @@ def _exact(case: dict, stride: int = 1) -> np.ndarray:
 @pytest.fixture(autouse=True)
 def _built_fmu(fmu, monkeypatch):
     """Every study here runs the FMU built for this session."""
-    monkeypatch.setattr("pendulum_fmu.sweep.run.default_fmu", lambda: fmu)
+    monkeypatch.setattr("pendulum_fmu.default_fmu", lambda: fmu)
 
 
 # --- studies on a local cluster -------------------------------------------------------------
