@@ -288,13 +288,16 @@ def test_ctrl_c_during_overwrite_leaves_the_old_study_whole(tmp_path):
     assert subprocess.run(_sweep_command(old, "--torque", "1", "2", "--stop-time", "0.1", "--workers", "1"),
                           capture_output=True).returncode == 0
     before = _snapshot(old)
+    # 594 cases of 600 s on one worker: still running after 4 s on any machine (with 60-s cases
+    # one CI run had finished them all in 2.9 s and printed its progress line before the signal).
     for delay in (2.0, 4.0):  # while the cluster starts, while the chunks run
         process = subprocess.Popen(_sweep_command(old, "--overwrite", "--torque", *map(str, range(3, 300)),
-                                                  "--gravity", "0", "9.81", "--stop-time", "60",
+                                                  "--gravity", "0", "9.81", "--stop-time", "600",
                                                   "--outputs", "none", "--workers", "1"),
                                    stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                                    start_new_session=True)
         time.sleep(delay)
+        assert process.poll() is None, process.communicate()
         os.killpg(process.pid, signal.SIGINT)
         _, err = process.communicate(timeout=120)
         assert process.returncode == 130 and err.count("\n") == 1, err
