@@ -271,11 +271,12 @@ def cmd_judge(args) -> int:
     from .plot import plot_judgement
 
     signal = _torque_signal(args)
-    kit = sorted(args.result.iterdir()) if args.result.is_dir() else []
-    _check_outputs({"--json": args.json, **({} if kit else {"--plot": args.plot})},
+    is_kit = args.result.is_dir()
+    kit_files = [path for path in args.result.iterdir() if path.is_file()] if is_kit else []
+    _check_outputs({"--json": args.json, **({} if is_kit else {"--plot": args.plot})},
                    {"the result": args.result, "--torque-file": args.torque_file, "--fmu": args.fmu,
-                    **{f"the kit's {path.name}": path for path in kit if path.is_file()}})
-    if args.result.is_dir():
+                    **{f"the kit's {path.name}": path for path in kit_files}})
+    if is_kit:
         if signal is not None:
             raise InvalidInput(f"{args.result} is a folder, judged as a scenario kit whose NAME.json "
                                "files define the runs: leave out --torque and --torque-file")

@@ -137,13 +137,17 @@ Status instance_set_state(Instance *instance, const char *function, const void *
 
 Status instance_free_state(Instance *instance, const char *function, void **state) {
     if (instance_null_argument(instance, function, "FMUstate", state)) return STATUS_ERROR;
-    if (link_to(instance, state))
-        return instance_error(instance, function, "FMUstate is a state itself, where the address of "
-                              "the variable that holds it belongs (%s(instance, &state)): refused, "
-                              "nothing freed", function);
-    if (!*state) return STATUS_OK; /* both standards: freeing NULL is ignored */
-    StoredState **link = link_to(instance, *state);
-    if (!link) return refuse_foreign(instance, function);
+    /* The usual call first, one pass over the list. Where state is one of ours itself, *state
+       reads its machine state (StoredState's first field), which is no state's address. */
+    StoredState **link = *state ? link_to(instance, *state) : NULL;
+    if (!link) {
+        if (link_to(instance, state))
+            return instance_error(instance, function, "FMUstate is a state itself, where the address "
+                                  "of the variable that holds it belongs (%s(instance, &state)): "
+                                  "refused, nothing freed", function);
+        if (!*state) return STATUS_OK; /* both standards: freeing NULL is ignored */
+        return refuse_foreign(instance, function);
+    }
     StoredState *stored = *link;
     *link = stored->next;
     free(stored);
