@@ -11,7 +11,6 @@ import array
 import ctypes
 import itertools
 import os
-import tempfile
 import threading
 import weakref
 from collections import OrderedDict
@@ -20,12 +19,12 @@ from pathlib import Path
 
 import fmpy
 import numpy as np
-from fmpy import extract
 from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
 from fmpy.fmi3 import FMU3Slave
 
 from . import cs_loop, default_fmu, results
 from .errors import InvalidInput, PendulumFmuError
+from .model import fmu_model
 from .parameters import (default_parameters, file_version, fmu_file, merged_parameters, merged_with,
                          model_description, pendulum_variables, start_value, value_reference)
 from .torque_schedule import TorqueSignal, TorqueSchedule, schedule
@@ -105,22 +104,10 @@ def instantiate(slave: FMU2Slave | FMU3Slave, messages: MessageLog, fmu_path) ->
         raise messages.instantiation_error(fmu_path) from None
 
 
-_extracted: dict[tuple[str, int], tuple[tempfile.TemporaryDirectory, object]] = {}
-_extracting = threading.Lock()  # threads of one dask worker share the cache
-
-
-def _unzipped(fmu_path: Path):
-    """(folder, model description) of an FMU file, extracted and parsed once per process; the
-    folder is removed at exit."""
-    description = model_description(fmu_path)  # refuses what is no FMU before it is unzipped
-    key = (str(fmu_path.resolve()), file_version(fmu_path))
-    with _extracting:
-        if key not in _extracted:
-            folder = tempfile.TemporaryDirectory(prefix="pendulum_fmu_")
-            extract(str(fmu_path), unzipdir=folder.name)
-            _extracted[key] = folder, description
-        folder, description = _extracted[key]
-    return folder.name, description
+def _unzipped(fmu_path):
+    """(folder, model description) of an FMU file, extracted once per model (model.FmuModel)."""
+    model = fmu_model(fmu_path)  # refuses what is no FMU before it is unzipped
+    return model.folder, model.description
 
 
 def fmi2_library(folder: str, model_identifier: str) -> str | None:
@@ -178,9 +165,9 @@ def open_fmu(fmu_path: str | Path | None = None, *, parameters: dict | None = No
 
 def _instantiated(fmu_path: Path, instance_name: str):
     """An instantiated FMU2Slave or FMU3Slave, not yet initialized (see open_fmu)."""
-    pendulum_variables(fmu_path)  # FmuFileError when it is no pendulum FMU this machine runs
-    folder, description = _unzipped(fmu_path)
-    fmi_version = int(description.fmiVersion[0])
+    model = fmu_model(fmu_path)
+    model.pendulum_variables  # FmuFileError when it is no pendulum FMU this machine runs
+    folder, description, fmi_version = model.folder, model.description, model.fmi_version
     messages = MessageLog(fmi_version)
     arguments = dict(guid=description.guid, unzipDirectory=folder, instanceName=instance_name,
                      modelIdentifier=description.coSimulation.modelIdentifier)
@@ -191,7 +178,7 @@ def _instantiated(fmu_path: Path, instance_name: str):
     instantiate(slave, messages, fmu_path)
     slave.fmi_version = fmi_version
     slave.messages = messages  # keeps the logger callback alive as long as the slave
-    slave.fmu_path = fmu_path  # whose parameters and value references apply
+    slave.fmu_path = model  # whose parameters and value references apply, parsed once
     return slave
 
 
@@ -431,7 +418,7 @@ class Simulator:
     def __init__(self, fmu_path: Path, version: tuple):
         self.fmu_path, self.version = fmu_path, version
         self.slave = _instantiated(fmu_path, "pendulum")
-        self.defaults = default_parameters(fmu_path)
+        self.defaults = default_parameters(self.slave.fmu_path)
         self.stepper = (_stepper(self.slave, (*self.defaults, *self.START_STATES))
                         if cs_loop.drives(self.slave) else None)
 
