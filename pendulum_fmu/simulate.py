@@ -187,9 +187,9 @@ def initialize(slave: FMU2Slave | FMU3Slave, *, parameters: dict | None = None, 
     """Set the parameters and start values of an instantiated (or reset) slave from open_fmu and
     leave it in step mode; FmuError says why the FMU refused."""
     # The FMU checks the parameters itself, here as everywhere (resolve_parameters).
-    start = {**merged_parameters(parameters, slave.fmu_path), "theta": start_value("theta0", theta0, "rad"),
+    start = {**merged_with(slave.fmu_path.default_parameters, parameters), "theta": start_value("theta0", theta0, "rad"),
              "omega": start_value("omega0", omega0, "rad/s")}
-    references = [value_reference(n, slave.fmu_path) for n in start]
+    references = [slave.fmu_path.value_reference(n) for n in start]
     try:
         if slave.fmi_version == 3:
             slave.enterInitializationMode(tolerance=tolerance, startTime=start_time)
@@ -219,7 +219,7 @@ def _stepper(slave, start_names: tuple[str, ...] = ()) -> cs_loop.Stepper:
     """The native loop bound to a slave: the torque in, RECORDED out, a restart setting
     start_names."""
     def references(names):
-        return np.array([value_reference(name, slave.fmu_path) for name in names], np.uint32)
+        return np.array([slave.fmu_path.value_reference(name) for name in names], np.uint32)
     return cs_loop.Stepper(slave, references(["torque"]), references(RECORDED), references(start_names))
 
 
@@ -258,8 +258,8 @@ def run_schedule_python(slave: FMU2Slave | FMU3Slave, plan: TorqueSchedule) -> n
              ("fmi2SetReal", "fmi2GetReal", "fmi2SetRealInputDerivatives", "fmi2DoStep"))
     set_real, get_real, set_rate, do_step = (dll[name] if name else None for name in names)
     component = ctypes.c_void_p(slave.component)
-    torque_vr = (ctypes.c_uint * 1)(value_reference("torque", slave.fmu_path))
-    recorded_vr = (ctypes.c_uint * 4)(*(value_reference(n, slave.fmu_path) for n in RECORDED))
+    torque_vr = (ctypes.c_uint * 1)(slave.fmu_path.value_reference("torque"))
+    recorded_vr = (ctypes.c_uint * 4)(*(slave.fmu_path.value_reference(n) for n in RECORDED))
     one, four = ctypes.c_size_t(1), ctypes.c_size_t(4)
     first_order = (ctypes.c_int * 1)(1)
     no_rollback = ctypes.c_int(1)
