@@ -61,12 +61,26 @@
                                                | STATE_CONTINUOUS_TIME_MODE | STATE_TERMINATED)
 
 /* Every function with an instance starts here: NULL instance, then the state mask. Each
-   function's name travels into the core for its messages. */
+   function's name travels into the core for its messages; the instance's time before the call
+   is kept for the call record, which also records a call the state machine refuses. */
 #define ENTER(name)                                                                    \
     static const char function[] = #name;                                             \
     Instance *instance = (Instance *)c;                                                \
-    if (!instance || !instance_state_allows(instance, MASK_##name, function))          \
-        return fmi2Error;
+    if (!instance) return fmi2Error;                                                   \
+    const double time_before = instance->data.time;                                    \
+    (void)time_before;                                                                 \
+    if (!instance_state_allows(instance, MASK_##name, function)) {                     \
+        RECORD(STATUS_ERROR, "refused in this state")                                  \
+        return fmi2Error;                                                              \
+    }
+
+/* The call record's line for this call (instance.h), formatted only when the record is on. */
+#define RECORD(status, ...)                                                            \
+    if (instance_recording(instance))                                                  \
+        instance_record_call(instance, function, time_before, (status), __VA_ARGS__);
+#define RECORD_VALUES(status, vr, order, n, value)                                     \
+    if (instance_recording(instance))                                                  \
+        instance_record_values(instance, function, time_before, (status), (vr), (order), (n), (value));
 
 /* Array arguments may be NULL only when their length is 0. */
 #define REQUIRE_ARRAY(name, length)                                                    \
@@ -112,7 +126,13 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
 }
 
 void fmi2FreeInstance(fmi2Component c) {
-    instance_free((Instance *)c);
+    static const char function[] = "fmi2FreeInstance";
+    Instance *instance = (Instance *)c;
+    if (instance) {
+        const double time_before = instance->data.time;
+        RECORD(STATUS_OK, "")
+    }
+    instance_free(instance);
 }
 
 fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories,
@@ -123,32 +143,40 @@ fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nC
 
 fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
                                fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime) {
-    (void)stopTimeDefined; /* a model without events has no end of its own */
-    (void)stopTime;
+    /* stopTime is only recorded: a model without events has no end of its own. */
     ENTER(fmi2SetupExperiment)
-    return STATUS(instance_setup_experiment(instance, function, toleranceDefined, tolerance, startTime));
+    const Status status = instance_setup_experiment(instance, function, toleranceDefined, tolerance,
+                                                    startTime);
+    RECORD(status, "toleranceDefined=%d, tolerance=%.17g, startTime=%.17g, stopTimeDefined=%d, "
+           "stopTime=%.17g", (int)toleranceDefined, tolerance, startTime, (int)stopTimeDefined, stopTime)
+    return STATUS(status);
 }
 
 fmi2Status fmi2EnterInitializationMode(fmi2Component c) {
     ENTER(fmi2EnterInitializationMode)
     instance->data.machine_state = STATE_INITIALIZATION_MODE;
+    RECORD(STATUS_OK, "")
     return fmi2OK;
 }
 
 fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
     ENTER(fmi2ExitInitializationMode)
-    return STATUS(instance_exit_initialization(instance, function));
+    const Status status = instance_exit_initialization(instance, function);
+    RECORD(status, "")
+    return STATUS(status);
 }
 
 fmi2Status fmi2Terminate(fmi2Component c) {
     ENTER(fmi2Terminate)
     instance->data.machine_state = STATE_TERMINATED;
+    RECORD(STATUS_OK, "")
     return fmi2OK;
 }
 
 fmi2Status fmi2Reset(fmi2Component c) {
     ENTER(fmi2Reset)
     instance_reset(instance);
+    RECORD(STATUS_OK, "")
     return fmi2OK;
 }
 
@@ -156,7 +184,9 @@ fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
     ENTER(fmi2GetReal)
     REQUIRE_ARRAY(vr, nvr)
     REQUIRE_ARRAY(value, nvr)
-    return STATUS(instance_get_real(instance, function, vr, nvr, value));
+    const Status status = instance_get_real(instance, function, vr, nvr, value);
+    RECORD_VALUES(status, vr, NULL, status == STATUS_OK ? nvr : 0, value)
+    return STATUS(status);
 }
 
 fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
@@ -164,7 +194,9 @@ fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
     ENTER(fmi2SetReal)
     REQUIRE_ARRAY(vr, nvr)
     REQUIRE_ARRAY(value, nvr)
-    return STATUS(instance_set_real(instance, function, vr, nvr, value));
+    const Status status = instance_set_real(instance, function, vr, nvr, value);
+    RECORD_VALUES(status, vr, NULL, nvr, value)
+    return STATUS(status);
 }
 
 /* The model has Real variables only: any Integer, Boolean or String reference is unknown. */
@@ -187,36 +219,50 @@ NO_VARIABLES_OF_TYPE(fmi2SetString, const fmi2String *)
 
 fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
     ENTER(fmi2GetFMUstate)
-    return STATUS(instance_get_state(instance, function, FMUstate));
+    const Status status = instance_get_state(instance, function, FMUstate);
+    RECORD(status, "state=%p", (void *)(FMUstate ? *FMUstate : NULL))
+    return STATUS(status);
 }
 
 fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate) {
     ENTER(fmi2SetFMUstate)
-    return STATUS(instance_set_state(instance, function, FMUstate));
+    const Status status = instance_set_state(instance, function, FMUstate);
+    RECORD(status, "state=%p", (void *)(FMUstate))
+    return STATUS(status);
 }
 
 fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
     ENTER(fmi2FreeFMUstate)
-    return STATUS(instance_free_state(instance, function, FMUstate));
+    void *const freed = FMUstate ? *FMUstate : NULL;
+    const Status status = instance_free_state(instance, function, FMUstate);
+    RECORD(status, "state=%p", freed)
+    return STATUS(status);
 }
 
 fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, size_t *size) {
     ENTER(fmi2SerializedFMUstateSize)
-    return STATUS(instance_serialized_state_size(instance, function, FMUstate, size));
+    const Status status = instance_serialized_state_size(instance, function, FMUstate, size);
+    RECORD(status, "state=%p", (void *)(FMUstate))
+    return STATUS(status);
 }
 
 fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serializedState[],
                                  size_t size) {
     ENTER(fmi2SerializeFMUstate)
-    return STATUS(instance_serialize_state(instance, function, FMUstate,
-                                           (unsigned char *)serializedState, size));
+    const Status status = instance_serialize_state(instance, function, FMUstate,
+                                                   (unsigned char *)serializedState, size);
+    RECORD(status, "state=%p, size=%lu", (void *)FMUstate, (unsigned long)size)
+    return STATUS(status);
 }
 
 fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size,
                                    fmi2FMUstate *FMUstate) {
     ENTER(fmi2DeSerializeFMUstate)
-    return STATUS(instance_deserialize_state(instance, function,
-                                             (const unsigned char *)serializedState, size, FMUstate));
+    const Status status = instance_deserialize_state(instance, function,
+                                                     (const unsigned char *)serializedState, size,
+                                                     FMUstate);
+    RECORD(status, "size=%lu, state=%p", (unsigned long)size, (void *)(FMUstate ? *FMUstate : NULL))
+    return STATUS(status);
 }
 
 fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[],
@@ -238,7 +284,9 @@ fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference
     REQUIRE_ARRAY(vr, nvr)
     REQUIRE_ARRAY(order, nvr)
     REQUIRE_ARRAY(value, nvr)
-    return STATUS(instance_set_input_derivatives(instance, function, vr, nvr, order, value));
+    const Status status = instance_set_input_derivatives(instance, function, vr, nvr, order, value);
+    RECORD_VALUES(status, vr, order, nvr, value)
+    return STATUS(status);
 }
 
 fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
@@ -254,8 +302,11 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
                       fmi2Real communicationStepSize, fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
     (void)noSetFMUStatePriorToCurrentPoint; /* states are copies: nothing to release early */
     ENTER(fmi2DoStep)
-    return STATUS(instance_do_step(instance, function, currentCommunicationPoint,
-                                   communicationStepSize));
+    const Status status = instance_do_step(instance, function, currentCommunicationPoint,
+                                           communicationStepSize);
+    RECORD(status, "currentCommunicationPoint=%.17g, communicationStepSize=%.17g",
+           currentCommunicationPoint, communicationStepSize)
+    return STATUS(status);
 }
 
 fmi2Status fmi2CancelStep(fmi2Component c) {
@@ -312,6 +363,7 @@ fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2Stri
 fmi2Status fmi2EnterEventMode(fmi2Component c) {
     ENTER(fmi2EnterEventMode)
     instance->data.machine_state = STATE_EVENT_MODE;
+    RECORD(STATUS_OK, "")
     return fmi2OK;
 }
 
@@ -330,6 +382,7 @@ fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *fmi2eventInfo) 
 fmi2Status fmi2EnterContinuousTimeMode(fmi2Component c) {
     ENTER(fmi2EnterContinuousTimeMode)
     instance->data.machine_state = STATE_CONTINUOUS_TIME_MODE;
+    RECORD(STATUS_OK, "")
     return fmi2OK;
 }
 
@@ -342,18 +395,23 @@ fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, fmi2Boolean noSetFMUStat
         return fmi2Error;
     *enterEventMode = fmi2False;
     *terminateSimulation = fmi2False;
+    RECORD(STATUS_OK, "")
     return fmi2OK;
 }
 
 fmi2Status fmi2SetTime(fmi2Component c, fmi2Real time) {
     ENTER(fmi2SetTime)
-    return STATUS(instance_set_time(instance, function, time));
+    const Status status = instance_set_time(instance, function, time);
+    RECORD(status, "time=%.17g", time)
+    return STATUS(status);
 }
 
 fmi2Status fmi2SetContinuousStates(fmi2Component c, const fmi2Real x[], size_t nx) {
     ENTER(fmi2SetContinuousStates)
     REQUIRE_ARRAY(x, nx)
-    return STATUS(instance_set_states(instance, function, x, nx));
+    const Status status = instance_set_states(instance, function, x, nx);
+    RECORD_VALUES(status, NULL, NULL, nx, x)
+    return STATUS(status);
 }
 
 fmi2Status fmi2GetDerivatives(fmi2Component c, fmi2Real derivatives[], size_t nx) {
