@@ -271,6 +271,10 @@ def cmd_judge(args) -> int:
     from .plot import plot_judgement
 
     signal = _torque_signal(args)
+    if args.calls is not None:
+        return _judge_calls(args, signal)
+    if args.result is None:
+        raise InvalidInput("judge needs a result file, a kit's folder, or --calls LOG")
     is_kit = args.result.is_dir()
     kit_files = [path for path in args.result.iterdir() if path.is_file()] if is_kit else []
     _check_outputs({"--json": args.json, **({} if is_kit else {"--plot": args.plot})},
@@ -451,6 +455,25 @@ def _add_demo(commands) -> argparse.ArgumentParser:
     return demo
 
 
+def _judge_calls(args, signal) -> int:
+    from .calls import IntendedRun, format_calls, judge_calls, write_calls_json
+    from .parameters import variables
+
+    if args.result is not None:
+        raise InvalidInput(f"--calls judges a log, not a result: leave out {args.result}")
+    _check_outputs({"--json": args.json}, {"--calls": args.calls})
+    intended = None if signal is None else IntendedRun(
+        signal, ramp=args.ramp, parameters=_parameters(args.assignments), start_time=args.start_time,
+        start_values={name: value for name, value in (("theta0", args.theta0), ("omega0", args.omega0))
+                      if value is not None})
+    names = {variable.valueReference: name for name, variable in variables(args.fmu).items()}
+    judged = judge_calls(args.calls, intended, names)
+    print(format_calls(judged))
+    if args.json:
+        print(f"wrote {write_calls_json(judged, args.json)}")
+    return 0 if all(not result["differences"] for result in judged.values()) else 1
+
+
 def _add_judge(commands) -> argparse.ArgumentParser:
     judge = commands.add_parser(
         "judge", help="judge a result file from any tool, and name the mistake",
@@ -460,9 +483,14 @@ def _add_judge(commands) -> argparse.ArgumentParser:
                     "explains the difference (input one step late or early, interpolated, held, "
                     "time grid drift, state not restored, integration error, or unexplained). "
                     "Given a scenario kit's folder, judges every NAME_out.csv in it.")
-    judge.add_argument("result", type=Path,
+    judge.add_argument("result", type=Path, nargs="?",
                        help="the result CSV, or a folder written by pendulum-fmu scenarios holding "
                             "NAME_out.csv files")
+    judge.add_argument("--calls", type=Path, default=None, metavar="LOG",
+                       help="judge what a master did instead of a result: LOG is the FMU's call "
+                            "record, or a master's whole log holding it or its own call log (fmpy "
+                            "--fmi-logging, fmusim --log-fmi-calls); with the run's options, names "
+                            "each difference by step, else prints the timeline (docs/calls.md)")
     _add_signal_arguments(judge, required=False)
     judge.add_argument("--start-time", type=_float, default=0.0,
                        help="start of the run in s (default: %(default)s)")

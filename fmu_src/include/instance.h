@@ -129,6 +129,12 @@ Status instance_error(const Instance *instance, const char *function, const char
    some drop the instance name; pendulum_fmu/calls.py reads the lines back. The adapters test
    instance_recording before they format anything, so that a step costs one test when it is off. */
 #define CALL_RECORD_MARKER "[pendulum-calls]"
+/* For the out-of-line recording paths of the functions a master calls every step. */
+#if defined(_MSC_VER)
+#define NOINLINE __declspec(noinline)
+#else
+#define NOINLINE __attribute__((noinline))
+#endif
 static inline int instance_recording(const Instance *instance) {
     return instance->log_categories & LOG_CALLS;
 }

@@ -61,18 +61,15 @@
                                                | STATE_CONTINUOUS_TIME_MODE | STATE_TERMINATED)
 
 /* Every function with an instance starts here: NULL instance, then the state mask. Each
-   function's name travels into the core for its messages; the instance's time before the call
-   is kept for the call record, which also records a call the state machine refuses. */
+   function's name travels into the core for its messages (a refused call is recorded there). */
 #define ENTER(name)                                                                    \
     static const char function[] = #name;                                             \
     Instance *instance = (Instance *)c;                                                \
-    if (!instance) return fmi2Error;                                                   \
-    const double time_before = instance->data.time;                                    \
-    (void)time_before;                                                                 \
-    if (!instance_state_allows(instance, MASK_##name, function)) {                     \
-        RECORD(STATUS_ERROR, "refused in this state")                                  \
-        return fmi2Error;                                                              \
-    }
+    if (!instance || !instance_state_allows(instance, MASK_##name, function))          \
+        return fmi2Error;
+
+/* The instance's time before the call, for its line in the call record. */
+#define KEEP_TIME const double time_before = instance->data.time;
 
 /* The call record's line for this call (instance.h), formatted only when the record is on. */
 #define RECORD(status, ...)                                                            \
@@ -81,6 +78,7 @@
 #define RECORD_VALUES(status, vr, order, n, value)                                     \
     if (instance_recording(instance))                                                  \
         instance_record_values(instance, function, time_before, (status), (vr), (order), (n), (value));
+
 
 /* Array arguments may be NULL only when their length is 0. */
 #define REQUIRE_ARRAY(name, length)                                                    \
@@ -100,6 +98,45 @@ static void forward_to_fmi2_logger(AnyFunction master_logger, void *environment,
                                    const char *message) {
     ((fmi2CallbackLogger)master_logger)(environment, instance_name, (fmi2Status)status, category,
                                         message);
+}
+
+/* The functions a master calls every step ask the record first and, when it is on, call one of
+   these out of line: so with it off a call stays a tail call into the core and a step pays one
+   test, not the frame and spills of the arguments a line needs. */
+static NOINLINE fmi2Status recorded_get_real(Instance *instance, const char *function,
+                                             const unsigned int vr[], size_t nvr, double value[]) {
+    KEEP_TIME
+    const Status status = instance_get_real(instance, function, vr, nvr, value);
+    RECORD_VALUES(status, vr, NULL, status == STATUS_OK ? nvr : 0, value)
+    return STATUS(status);
+}
+
+static NOINLINE fmi2Status recorded_set_real(Instance *instance, const char *function,
+                                             const unsigned int vr[], size_t nvr,
+                                             const double value[]) {
+    KEEP_TIME
+    const Status status = instance_set_real(instance, function, vr, nvr, value);
+    RECORD_VALUES(status, vr, NULL, nvr, value)
+    return STATUS(status);
+}
+
+static NOINLINE fmi2Status recorded_input_derivatives(Instance *instance, const char *function,
+                                                      const unsigned int vr[], size_t nvr,
+                                                      const int order[], const double value[]) {
+    KEEP_TIME
+    const Status status = instance_set_input_derivatives(instance, function, vr, nvr, order, value);
+    RECORD_VALUES(status, vr, order, nvr, value)
+    return STATUS(status);
+}
+
+static NOINLINE fmi2Status recorded_do_step(Instance *instance, const char *function,
+                                            double communication_point, double communication_step) {
+    KEEP_TIME
+    const Status status = instance_do_step(instance, function, communication_point,
+                                           communication_step);
+    RECORD(status, "currentCommunicationPoint=%.17g, communicationStepSize=%.17g",
+           communication_point, communication_step)
+    return STATUS(status);
 }
 
 const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
@@ -145,6 +182,7 @@ fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fm
                                fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime) {
     /* stopTime is only recorded: a model without events has no end of its own. */
     ENTER(fmi2SetupExperiment)
+    KEEP_TIME
     const Status status = instance_setup_experiment(instance, function, toleranceDefined, tolerance,
                                                     startTime);
     RECORD(status, "toleranceDefined=%d, tolerance=%.17g, startTime=%.17g, stopTimeDefined=%d, "
@@ -154,6 +192,7 @@ fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fm
 
 fmi2Status fmi2EnterInitializationMode(fmi2Component c) {
     ENTER(fmi2EnterInitializationMode)
+    KEEP_TIME
     instance->data.machine_state = STATE_INITIALIZATION_MODE;
     RECORD(STATUS_OK, "")
     return fmi2OK;
@@ -161,6 +200,7 @@ fmi2Status fmi2EnterInitializationMode(fmi2Component c) {
 
 fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
     ENTER(fmi2ExitInitializationMode)
+    KEEP_TIME
     const Status status = instance_exit_initialization(instance, function);
     RECORD(status, "")
     return STATUS(status);
@@ -168,6 +208,7 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
 
 fmi2Status fmi2Terminate(fmi2Component c) {
     ENTER(fmi2Terminate)
+    KEEP_TIME
     instance->data.machine_state = STATE_TERMINATED;
     RECORD(STATUS_OK, "")
     return fmi2OK;
@@ -175,6 +216,7 @@ fmi2Status fmi2Terminate(fmi2Component c) {
 
 fmi2Status fmi2Reset(fmi2Component c) {
     ENTER(fmi2Reset)
+    KEEP_TIME
     instance_reset(instance);
     RECORD(STATUS_OK, "")
     return fmi2OK;
@@ -184,9 +226,9 @@ fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
     ENTER(fmi2GetReal)
     REQUIRE_ARRAY(vr, nvr)
     REQUIRE_ARRAY(value, nvr)
-    const Status status = instance_get_real(instance, function, vr, nvr, value);
-    RECORD_VALUES(status, vr, NULL, status == STATUS_OK ? nvr : 0, value)
-    return STATUS(status);
+    if (instance_recording(instance))
+        return recorded_get_real(instance, function, vr, nvr, value);
+    return STATUS(instance_get_real(instance, function, vr, nvr, value));
 }
 
 fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
@@ -194,9 +236,8 @@ fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
     ENTER(fmi2SetReal)
     REQUIRE_ARRAY(vr, nvr)
     REQUIRE_ARRAY(value, nvr)
-    const Status status = instance_set_real(instance, function, vr, nvr, value);
-    RECORD_VALUES(status, vr, NULL, nvr, value)
-    return STATUS(status);
+    if (instance_recording(instance)) return recorded_set_real(instance, function, vr, nvr, value);
+    return STATUS(instance_set_real(instance, function, vr, nvr, value));
 }
 
 /* The model has Real variables only: any Integer, Boolean or String reference is unknown. */
@@ -219,6 +260,7 @@ NO_VARIABLES_OF_TYPE(fmi2SetString, const fmi2String *)
 
 fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
     ENTER(fmi2GetFMUstate)
+    KEEP_TIME
     const Status status = instance_get_state(instance, function, FMUstate);
     RECORD(status, "state=%p", (void *)(FMUstate ? *FMUstate : NULL))
     return STATUS(status);
@@ -226,6 +268,7 @@ fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
 
 fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate) {
     ENTER(fmi2SetFMUstate)
+    KEEP_TIME
     const Status status = instance_set_state(instance, function, FMUstate);
     RECORD(status, "state=%p", (void *)(FMUstate))
     return STATUS(status);
@@ -233,6 +276,7 @@ fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate) {
 
 fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
     ENTER(fmi2FreeFMUstate)
+    KEEP_TIME
     void *const freed = FMUstate ? *FMUstate : NULL;
     const Status status = instance_free_state(instance, function, FMUstate);
     RECORD(status, "state=%p", freed)
@@ -241,6 +285,7 @@ fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
 
 fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, size_t *size) {
     ENTER(fmi2SerializedFMUstateSize)
+    KEEP_TIME
     const Status status = instance_serialized_state_size(instance, function, FMUstate, size);
     RECORD(status, "state=%p", (void *)(FMUstate))
     return STATUS(status);
@@ -249,6 +294,7 @@ fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, si
 fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serializedState[],
                                  size_t size) {
     ENTER(fmi2SerializeFMUstate)
+    KEEP_TIME
     const Status status = instance_serialize_state(instance, function, FMUstate,
                                                    (unsigned char *)serializedState, size);
     RECORD(status, "state=%p, size=%lu", (void *)FMUstate, (unsigned long)size)
@@ -258,6 +304,7 @@ fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byt
 fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size,
                                    fmi2FMUstate *FMUstate) {
     ENTER(fmi2DeSerializeFMUstate)
+    KEEP_TIME
     const Status status = instance_deserialize_state(instance, function,
                                                      (const unsigned char *)serializedState, size,
                                                      FMUstate);
@@ -284,9 +331,9 @@ fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference
     REQUIRE_ARRAY(vr, nvr)
     REQUIRE_ARRAY(order, nvr)
     REQUIRE_ARRAY(value, nvr)
-    const Status status = instance_set_input_derivatives(instance, function, vr, nvr, order, value);
-    RECORD_VALUES(status, vr, order, nvr, value)
-    return STATUS(status);
+    if (instance_recording(instance))
+        return recorded_input_derivatives(instance, function, vr, nvr, order, value);
+    return STATUS(instance_set_input_derivatives(instance, function, vr, nvr, order, value));
 }
 
 fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
@@ -302,11 +349,10 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
                       fmi2Real communicationStepSize, fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
     (void)noSetFMUStatePriorToCurrentPoint; /* states are copies: nothing to release early */
     ENTER(fmi2DoStep)
-    const Status status = instance_do_step(instance, function, currentCommunicationPoint,
-                                           communicationStepSize);
-    RECORD(status, "currentCommunicationPoint=%.17g, communicationStepSize=%.17g",
-           currentCommunicationPoint, communicationStepSize)
-    return STATUS(status);
+    if (instance_recording(instance))
+        return recorded_do_step(instance, function, currentCommunicationPoint, communicationStepSize);
+    return STATUS(instance_do_step(instance, function, currentCommunicationPoint,
+                                   communicationStepSize));
 }
 
 fmi2Status fmi2CancelStep(fmi2Component c) {
@@ -362,6 +408,7 @@ fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2Stri
 
 fmi2Status fmi2EnterEventMode(fmi2Component c) {
     ENTER(fmi2EnterEventMode)
+    KEEP_TIME
     instance->data.machine_state = STATE_EVENT_MODE;
     RECORD(STATUS_OK, "")
     return fmi2OK;
@@ -381,6 +428,7 @@ fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *fmi2eventInfo) 
 
 fmi2Status fmi2EnterContinuousTimeMode(fmi2Component c) {
     ENTER(fmi2EnterContinuousTimeMode)
+    KEEP_TIME
     instance->data.machine_state = STATE_CONTINUOUS_TIME_MODE;
     RECORD(STATUS_OK, "")
     return fmi2OK;
@@ -390,6 +438,7 @@ fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, fmi2Boolean noSetFMUStat
                                        fmi2Boolean *enterEventMode, fmi2Boolean *terminateSimulation) {
     (void)noSetFMUStatePriorToCurrentPoint;
     ENTER(fmi2CompletedIntegratorStep)
+    KEEP_TIME
     if (instance_null_argument(instance, function, "enterEventMode", enterEventMode) ||
         instance_null_argument(instance, function, "terminateSimulation", terminateSimulation))
         return fmi2Error;
@@ -401,6 +450,7 @@ fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, fmi2Boolean noSetFMUStat
 
 fmi2Status fmi2SetTime(fmi2Component c, fmi2Real time) {
     ENTER(fmi2SetTime)
+    KEEP_TIME
     const Status status = instance_set_time(instance, function, time);
     RECORD(status, "time=%.17g", time)
     return STATUS(status);
@@ -408,6 +458,7 @@ fmi2Status fmi2SetTime(fmi2Component c, fmi2Real time) {
 
 fmi2Status fmi2SetContinuousStates(fmi2Component c, const fmi2Real x[], size_t nx) {
     ENTER(fmi2SetContinuousStates)
+    KEEP_TIME
     REQUIRE_ARRAY(x, nx)
     const Status status = instance_set_states(instance, function, x, nx);
     RECORD_VALUES(status, NULL, NULL, nx, x)

@@ -105,10 +105,16 @@ int instance_illegal_call(const Instance *instance, int mask, const char *functi
         instance_error(instance, function, "illegal call: a %s function, and this instance is for %s",
                        co_simulation ? "model-exchange" : "co-simulation",
                        co_simulation ? "co-simulation" : "model exchange");
+        if (instance_recording(instance))
+            instance_record_call(instance, function, instance->data.time, STATUS_ERROR,
+                                 "refused: a function of the other interface");
         return 0;
     }
     instance_error(instance, function, "illegal call sequence: not allowed in state '%s'",
                    state_name(instance->data.machine_state));
+    if (instance_recording(instance))
+        instance_record_call(instance, function, instance->data.time, STATUS_ERROR,
+                             "refused in state '%s'", state_name(instance->data.machine_state));
     return 0;
 }
 

@@ -1,0 +1,158 @@
+"""The call record and `judge --calls`: masters installable here (fmpy's API and command line)
+make deliberate mistakes, and the judge must name each one, at the step it was made, from the
+FMU's own record and from fmpy's call log alike.
+
+The expected readings are not computed by the judge's code: each mistake is made on purpose in
+the loop below (a torque a step late, a parameter left out), so the step and value it must name
+are known from how the loop was written."""
+
+import subprocess
+import sys
+
+import pytest
+from fmpy import extract, read_model_description, simulate_fmu
+from fmpy.fmi2 import FMU2Slave
+
+from pendulum_fmu.calls import IntendedRun, judge_calls, read_calls
+from pendulum_fmu.cli import main
+
+STEP = 1e-3
+N_STEPS = 10
+JUMP_STEP = 5  # the intended torque jumps from 0 to 20 N.m at t = 5 ms
+VARIABLE_NAMES = {0: "torque", 1: "theta", 2: "omega", 3: "alpha", 4: "mass", 5: "length",
+                  6: "inertia", 7: "gravity", 8: "damping"}
+
+
+@pytest.fixture(scope="module")
+def jump_csv(tmp_path_factory):
+    path = tmp_path_factory.mktemp("signals") / "jump.csv"
+    path.write_text(f"time,torque\n0,0\n{JUMP_STEP * STEP},0\n{JUMP_STEP * STEP},20\n{N_STEPS * STEP},20\n")
+    return path
+
+
+@pytest.fixture(scope="module")
+def ramp_csv(tmp_path_factory):
+    path = tmp_path_factory.mktemp("signals") / "ramp.csv"
+    path.write_text(f"time,torque\n0,0\n{N_STEPS * STEP},10\n")
+    return path
+
+
+def intended_torque(k):
+    return 20.0 if k >= JUMP_STEP else 0.0
+
+
+def drive(fmu, capsys, tmp_path, *, torque_of_step=intended_torque, derivative=None,
+          parameters=None, restore=None):
+    """Run N_STEPS by hand through fmpy's FMU2Slave with loggingOn (its default logger prints the
+    FMU's messages) and its call logger on; return (the FMU's record as the master printed it,
+    fmpy's call log) as files."""
+    description = read_model_description(fmu)
+    calls = []
+    slave = FMU2Slave(guid=description.guid, unzipDirectory=extract(fmu),
+                      modelIdentifier=description.coSimulation.modelIdentifier,
+                      instanceName="pendulum", fmiCallLogger=calls.append)
+    slave.instantiate(loggingOn=True)
+    slave.setupExperiment(startTime=0.0)
+    for name, value in (parameters or {}).items():
+        slave.setReal([next(v for v, n in VARIABLE_NAMES.items() if n == name)], [value])
+    slave.enterInitializationMode()
+    slave.exitInitializationMode()
+    saved, t = None, 0.0
+    for k in range(N_STEPS):
+        slave.setReal([0], [torque_of_step(k)])
+        if derivative is not None:
+            slave.setRealInputDerivatives([0], [1], [derivative])
+        if restore and k == restore[0]:
+            saved = slave.getFMUstate()
+        if restore and k == restore[1]:
+            slave.setFMUstate(saved)
+            t = restore[0] * STEP
+        slave.doStep(currentCommunicationPoint=t, communicationStepSize=STEP)
+        t += STEP
+    slave.terminate()
+    slave.freeInstance()
+    record = tmp_path / "stdout.log"
+    record.write_text(capsys.readouterr().out)
+    call_log = tmp_path / "fmpy_calls.log"
+    call_log.write_text("\n".join(calls) + "\n")
+    return record, call_log
+
+
+def reading(log, intended):
+    judged = judge_calls(log, intended, VARIABLE_NAMES)
+    assert len(judged) == 1
+    return next(iter(judged.values()))
+
+
+@pytest.mark.parametrize("source", [0, 1], ids=["fmu-record", "fmpy-call-log"])
+def test_a_master_that_does_what_was_intended_is_told_so(fmu, capsys, tmp_path, jump_csv, source):
+    log = drive(fmu, capsys, tmp_path, parameters={"mass": 3.0})[source]
+    result = reading(log, IntendedRun(jump_csv, parameters={"mass": 3.0}))
+    assert result["differences"] == []
+    assert [step["torque"] for step in result["steps"]] == [intended_torque(k) for k in range(N_STEPS)]
+    assert [step["time"] for step in result["steps"]] == pytest.approx([k * STEP for k in range(N_STEPS)],
+                                                                        abs=1e-15)
+
+
+@pytest.mark.parametrize("source", [0, 1], ids=["fmu-record", "fmpy-call-log"])
+@pytest.mark.parametrize("shift", [1, 2, -1])
+def test_input_applied_late_or_early_is_named_with_its_first_step(fmu, capsys, tmp_path, jump_csv,
+                                                                  source, shift):
+    log = drive(fmu, capsys, tmp_path, torque_of_step=lambda k: intended_torque(k - shift))[source]
+    found = reading(log, IntendedRun(jump_csv))["differences"]
+    # The first step whose torque differs: where the jump lands in the shifted run or the intended one.
+    first = JUMP_STEP + min(shift, 0)
+    word = "late" if shift > 0 else "early"
+    assert len(found) == 1, found
+    assert found[0].startswith(f"input applied {abs(shift)} step{'s' * (abs(shift) > 1)} {word} "
+                               f"from step {first} (t = ")
+
+
+@pytest.mark.parametrize("source", [0, 1], ids=["fmu-record", "fmpy-call-log"])
+def test_a_missing_parameter_is_named(fmu, capsys, tmp_path, jump_csv, source):
+    log = drive(fmu, capsys, tmp_path, parameters={"mass": 3.0})[source]
+    found = reading(log, IntendedRun(jump_csv, parameters={"mass": 3.0, "damping": 0.5}))["differences"]
+    assert found == ["parameter damping not set (intended 0.5; the FMU used its start value)"]
+
+
+@pytest.mark.parametrize("source", [0, 1], ids=["fmu-record", "fmpy-call-log"])
+def test_held_where_it_should_ramp(fmu, capsys, tmp_path, ramp_csv, source):
+    log = drive(fmu, capsys, tmp_path, torque_of_step=lambda k: k * STEP * 1000.0)[source]
+    found = reading(log, IntendedRun(ramp_csv, ramp=True))["differences"]
+    assert found == ["held where it should ramp from step 0 (t = 0): intended der(torque) = "
+                     "1000 N.m/s"]
+
+
+@pytest.mark.parametrize("source", [0, 1], ids=["fmu-record", "fmpy-call-log"])
+def test_ramped_where_it_should_hold(fmu, capsys, tmp_path, jump_csv, source):
+    log = drive(fmu, capsys, tmp_path, derivative=5.0)[source]
+    found = reading(log, IntendedRun(jump_csv))["differences"]
+    assert "ramped where it should hold from step 0 (t = 0): der(torque) = 5 N.m/s" in found
+
+
+def test_a_state_restored_to_another_time_is_named_from_the_record(fmu, capsys, tmp_path, jump_csv):
+    record, _ = drive(fmu, capsys, tmp_path, restore=(3, 7))
+    result = reading(record, IntendedRun(jump_csv))
+    restored = [line for line in result["differences"] if "FMU state restored" in line]
+    assert len(restored) == 1
+    assert restored[0].endswith("an FMU state restored to t = 0.0030000000000000001 at t = "
+                                "0.0070000000000000001")
+
+
+def test_fmpy_simulate_command_line_late_first_jump(fmu, tmp_path):
+    """fmpy 0.3.32's known behaviour (docs/signals.md): a jump in the first two rows is applied
+    one step late. Its own call log, from `fmpy simulate --fmi-logging`, shows where."""
+    csv = tmp_path / "first_row_jump.csv"
+    csv.write_text("time,torque\n0,0\n0,20\n0.01,20\n")
+    completed = subprocess.run([sys.executable, "-m", "fmpy", "simulate", str(fmu), "--input-file",
+                                str(csv), "--output-interval", str(STEP), "--stop-time", "0.01",
+                                "--fmi-logging", "--debug-logging",
+                                "--output-file", str(tmp_path / "out.csv")],
+                               check=True, capture_output=True, text=True)
+    log = tmp_path / "fmpy_stdout.log"
+    log.write_text(completed.stdout)
+    found = reading(log, IntendedRun(csv))["differences"]
+    assert found == ["input applied 1 step late from step 0 (t = 0): step n holds the torque meant "
+                     "for step n-1 (set after the step it was meant for)"]
+    assert main(["judge", "--calls", str(log), "--torque-file", str(csv), "--fmu", str(fmu)]) == 1
+    assert main(["judge", "--calls", str(log), "--fmu", str(fmu)]) == 0
