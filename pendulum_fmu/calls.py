@@ -134,7 +134,12 @@ class InstanceCalls:
         The timeline's lines other than steps: states saved, restored, serialized, resets,
         refused calls.
     restores : list of tuple
-        (call number, time before, time after) of each FMU state set.
+        (call number, time before, time after) of each FMU state set (times None in a master's
+        call log, which does not show them).
+    rewinds : list of tuple
+        (call number, time the FMU had reached, time the next step starts) of each step that
+        starts before the previous one ended: the steps from there on are redone, and only the
+        redone ones are kept in steps.
     model_exchange_times : list of float
         The times a Model Exchange master set.
     """
@@ -145,6 +150,7 @@ class InstanceCalls:
     set_before_start: dict = field(default_factory=dict)
     events: list = field(default_factory=list)
     restores: list = field(default_factory=list)
+    rewinds: list = field(default_factory=list)
     model_exchange_times: list = field(default_factory=list)
 
 
@@ -300,6 +306,14 @@ def reconstruct(calls: list[Call]) -> dict[str, InstanceCalls]:
         elif name == "DoStep":
             time = _number(call.arguments["currentCommunicationPoint"])
             size = _number(call.arguments["communicationStepSize"])
+            if record.steps:
+                reached = record.steps[-1].time + record.steps[-1].size
+                if time < reached - TIME_TOLERANCE * max(1.0, abs(reached)):
+                    record.rewinds.append((number, reached, time))
+                    record.events.append(f"call {number}: step from t = {time} after the FMU had "
+                                         f"reached t = {reached}: the steps from there are redone")
+                    record.steps = [step for step in record.steps
+                                    if step.time < time - TIME_TOLERANCE * max(1.0, abs(time))]
             record.steps.append(Step(len(record.steps), time, size, now["torque"], now["rate"],
                                      now["acceleration"], call.status))
             if call.status == "OK" and (now["rate"] or now["acceleration"]):
@@ -402,6 +416,10 @@ def differences(record: InstanceCalls, intended: IntendedRun) -> list[str]:
     for number, before, after in record.restores:
         if before is not None and after is not None and not math.isclose(before, after, abs_tol=TIME_TOLERANCE):
             found.append(f"call {number}: an FMU state restored to t = {after:.17g} at t = {before:.17g}")
+    if not any(before is not None for _, before, _ in record.restores):
+        found.extend(f"call {number}: the master went back from t = {reached:.17g} to t = "
+                     f"{time:.17g} (an FMU state restored to another time)"
+                     for number, reached, time in record.rewinds)
     steps = record.steps
     if record.interface == "ModelExchange" or (not steps and record.model_exchange_times):
         found.extend(_model_exchange(record))

@@ -130,13 +130,22 @@ def test_ramped_where_it_should_hold(fmu, capsys, tmp_path, jump_csv, source):
     assert "ramped where it should hold from step 0 (t = 0): der(torque) = 5 N.m/s" in found
 
 
-def test_a_state_restored_to_another_time_is_named_from_the_record(fmu, capsys, tmp_path, jump_csv):
-    record, _ = drive(fmu, capsys, tmp_path, restore=(3, 7))
-    result = reading(record, IntendedRun(jump_csv))
-    restored = [line for line in result["differences"] if "FMU state restored" in line]
-    assert len(restored) == 1
-    assert restored[0].endswith("an FMU state restored to t = 0.0030000000000000001 at t = "
-                                "0.0070000000000000001")
+def test_a_state_restored_to_another_time_is_named(fmu, capsys, tmp_path, jump_csv):
+    # Saved before step 3 (t = 3 ms), restored before step 7 (t = 7 ms): the master then steps
+    # from 3 ms with the torque of steps 7 to 9 (20 N.m), where the run meant 0 until 5 ms.
+    record, call_log = drive(fmu, capsys, tmp_path, restore=(3, 7))
+    from_record = reading(record, IntendedRun(jump_csv))
+    from_call_log = reading(call_log, IntendedRun(jump_csv))
+    assert from_record["differences"][0].endswith(
+        "an FMU state restored to t = 0.0030000000000000001 at t = 0.0070000000000000001")
+    assert from_call_log["differences"][0].endswith(
+        "the master went back from t = 0.0070000000000000001 to t = 0.0030000000000000001 (an FMU "
+        "state restored to another time)")
+    for result in (from_record, from_call_log):
+        # The kept steps: 0-2 as meant, then the redone ones from 3 ms.
+        assert [round(step["time"] / STEP) for step in result["steps"]] == list(range(6))
+        assert [step["torque"] for step in result["steps"]] == [0, 0, 0, 20, 20, 20]
+        assert result["differences"][1].startswith("input applied 2 steps early from step 3")
 
 
 def test_fmpy_simulate_command_line_late_first_jump(fmu, tmp_path):
