@@ -100,43 +100,46 @@ static void forward_to_fmi2_logger(AnyFunction master_logger, void *environment,
                                         message);
 }
 
-/* The functions a master calls every step ask the record first and, when it is on, call one of
-   these out of line: so with it off a call stays a tail call into the core and a step pays one
-   test, not the frame and spills of the arguments a line needs. */
+/* The functions a master calls every step ask the record first and, when it is on, go through
+   one of these out of line: each calls the entry point again with the record switched off for
+   the call, then records it. So with the record off an entry point keeps its path as it was (the
+   core's function inlined into it, its only caller; a tail call) and a step pays one test. */
+#define WITHOUT_RECORD(call)                                                           \
+    const double time_before = instance->data.time;                                    \
+    instance->log_categories &= ~LOG_CALLS;                                            \
+    const fmi2Status status = (call);                                                  \
+    instance->log_categories |= LOG_CALLS;
+
 static NOINLINE fmi2Status recorded_get_real(Instance *instance, const char *function,
                                              const unsigned int vr[], size_t nvr, double value[]) {
-    KEEP_TIME
-    const Status status = instance_get_real(instance, function, vr, nvr, value);
-    RECORD_VALUES(status, vr, NULL, status == STATUS_OK ? nvr : 0, value)
-    return STATUS(status);
+    WITHOUT_RECORD(fmi2GetReal(instance, vr, nvr, value))
+    RECORD_VALUES((Status)status, vr, NULL, status == fmi2OK ? nvr : 0, value)
+    return status;
 }
 
 static NOINLINE fmi2Status recorded_set_real(Instance *instance, const char *function,
                                              const unsigned int vr[], size_t nvr,
                                              const double value[]) {
-    KEEP_TIME
-    const Status status = instance_set_real(instance, function, vr, nvr, value);
-    RECORD_VALUES(status, vr, NULL, nvr, value)
-    return STATUS(status);
+    WITHOUT_RECORD(fmi2SetReal(instance, vr, nvr, value))
+    RECORD_VALUES((Status)status, vr, NULL, nvr, value)
+    return status;
 }
 
 static NOINLINE fmi2Status recorded_input_derivatives(Instance *instance, const char *function,
                                                       const unsigned int vr[], size_t nvr,
                                                       const int order[], const double value[]) {
-    KEEP_TIME
-    const Status status = instance_set_input_derivatives(instance, function, vr, nvr, order, value);
-    RECORD_VALUES(status, vr, order, nvr, value)
-    return STATUS(status);
+    WITHOUT_RECORD(fmi2SetRealInputDerivatives(instance, vr, nvr, order, value))
+    RECORD_VALUES((Status)status, vr, order, nvr, value)
+    return status;
 }
 
 static NOINLINE fmi2Status recorded_do_step(Instance *instance, const char *function,
-                                            double communication_point, double communication_step) {
-    KEEP_TIME
-    const Status status = instance_do_step(instance, function, communication_point,
-                                           communication_step);
-    RECORD(status, "currentCommunicationPoint=%.17g, communicationStepSize=%.17g",
+                                            double communication_point, double communication_step,
+                                            fmi2Boolean no_set_state_prior) {
+    WITHOUT_RECORD(fmi2DoStep(instance, communication_point, communication_step, no_set_state_prior))
+    RECORD((Status)status, "currentCommunicationPoint=%.17g, communicationStepSize=%.17g",
            communication_point, communication_step)
-    return STATUS(status);
+    return status;
 }
 
 const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
@@ -347,10 +350,12 @@ fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReferenc
 
 fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
                       fmi2Real communicationStepSize, fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
-    (void)noSetFMUStatePriorToCurrentPoint; /* states are copies: nothing to release early */
+    /* noSetFMUStatePriorToCurrentPoint only passes through: states are copies, nothing to release
+       early. */
     ENTER(fmi2DoStep)
     if (instance_recording(instance))
-        return recorded_do_step(instance, function, currentCommunicationPoint, communicationStepSize);
+        return recorded_do_step(instance, function, currentCommunicationPoint, communicationStepSize,
+                                noSetFMUStatePriorToCurrentPoint);
     return STATUS(instance_do_step(instance, function, currentCommunicationPoint,
                                    communicationStepSize));
 }
