@@ -165,3 +165,38 @@ def test_fmpy_simulate_command_line_late_first_jump(fmu, tmp_path):
                      "for step n-1 (set after the step it was meant for)"]
     assert main(["judge", "--calls", str(log), "--torque-file", str(csv), "--fmu", str(fmu)]) == 1
     assert main(["judge", "--calls", str(log), "--fmu", str(fmu)]) == 0
+
+
+LIBCOSIM_RUN = """
+import sys
+from libcosimpy.CosimExecution import CosimExecution
+from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+from libcosimpy.CosimManipulator import CosimManipulator
+from libcosimpy.CosimSlave import CosimLocalSlave
+log_output_level(CosimLogLevel.TRACE)
+execution = CosimExecution.from_step_size(step_size=1_000_000)
+pendulum = execution.add_local_slave(CosimLocalSlave(fmu_path=sys.argv[1], instance_name="pendulum"))
+manipulator = CosimManipulator.create_override()
+execution.add_manipulator(manipulator)
+for k in range(10):
+    # The override for step k set {late} step(s) late: the value meant for step k - {late}.
+    manipulator.slave_real_values(pendulum, [0], [20.0 if k - {late} >= 5 else 0.0])
+    execution.step()
+"""
+
+
+@pytest.mark.parametrize("late", [0, 1])
+def test_libcosim_trace_log(fmu, tmp_path, jump_csv, late):
+    """libcosim passes loggingOn and prints the record at its trace level, inside its own format;
+    its ns clock makes step sizes differ from 1 ms in the last bits, which is no difference."""
+    pytest.importorskip("libcosimpy", reason="libcosimpy not installed: pip install -e '.[test]'")
+    completed = subprocess.run([sys.executable, "-c", LIBCOSIM_RUN.replace("{late}", str(late)),
+                                str(fmu)], check=True, capture_output=True, text=True)
+    log = tmp_path / "libcosim.log"
+    log.write_text(completed.stdout + completed.stderr)
+    result = reading(log, IntendedRun(jump_csv))
+    assert [step["torque"] for step in result["steps"]] == [intended_torque(k - late) for k in range(N_STEPS)]
+    expected = [] if not late else [
+        "input applied 1 step late from step 5 (t = 0.0050000000000000001): step n holds the torque "
+        "meant for step n-1 (set after the step it was meant for)"]
+    assert result["differences"] == expected
