@@ -472,8 +472,11 @@ fmi2Status fmi2SetContinuousStates(fmi2Component c, const fmi2Real x[], size_t n
 
 fmi2Status fmi2GetDerivatives(fmi2Component c, fmi2Real derivatives[], size_t nx) {
     ENTER(fmi2GetDerivatives)
+    KEEP_TIME
     REQUIRE_ARRAY(derivatives, nx)
-    return STATUS(instance_get_derivatives(instance, function, derivatives, nx));
+    const Status status = instance_get_derivatives(instance, function, derivatives, nx);
+    RECORD_VALUES(status, NULL, NULL, status == STATUS_OK ? nx : 0, derivatives)
+    return STATUS(status);
 }
 
 fmi2Status fmi2GetEventIndicators(fmi2Component c, fmi2Real eventIndicators[], size_t ni) {
