@@ -142,6 +142,9 @@ class InstanceCalls:
         redone ones are kept in steps.
     model_exchange_times : list of float
         The times a Model Exchange master set.
+    evaluations : list of tuple
+        (time, states, derivatives) of each fmi2GetDerivatives in the record, the states those
+        a Model Exchange master last set.
     """
 
     instance: str
@@ -152,6 +155,7 @@ class InstanceCalls:
     restores: list = field(default_factory=list)
     rewinds: list = field(default_factory=list)
     model_exchange_times: list = field(default_factory=list)
+    evaluations: list = field(default_factory=list)
 
 
 def _number(text: str) -> float:
@@ -332,6 +336,10 @@ def reconstruct(calls: list[Call]) -> dict[str, InstanceCalls]:
             record.events.append(f"call {number}: {call.function} at t = {call.time_before}")
         elif name == "SetTime":
             record.model_exchange_times.append(_number(call.arguments["time"]))
+        elif name == "SetContinuousStates":
+            now["states"] = list(call.values.values())
+        elif name == "GetDerivatives" and "states" in now and call.time_before is not None:
+            record.evaluations.append((call.time_before, now["states"], list(call.values.values())))
     return instances
 
 
@@ -479,14 +487,28 @@ def differences(record: InstanceCalls, intended: IntendedRun) -> list[str]:
 
 
 def _model_exchange(record: InstanceCalls) -> list[str]:
+    """What a Model Exchange master's integrator was: explicit Euler when each state it set is
+    the previous one plus the time between them times the derivatives there, exactly."""
     times = np.unique(np.array(record.model_exchange_times))
     if len(times) < 2:
         return ["Model Exchange master: fewer than two time points set"]
     points = np.diff(times)
-    return [f"Model Exchange master: {len(record.model_exchange_times)} fmi2SetTime calls at "
-            f"{len(times)} distinct times, {float(times[0]):.17g} to {float(times[-1]):.17g} s; time "
-            f"points {points.min():.3g} to {points.max():.3g} s apart (the integrator's stages and "
-            f"steps)"]
+    summary = (f"{len(record.model_exchange_times)} fmi2SetTime calls at {len(times)} distinct "
+               f"times, {float(times[0]):.17g} to {float(times[-1]):.17g} s, "
+               f"{len(record.evaluations)} derivative evaluations")
+    pairs = list(zip(record.evaluations, record.evaluations[1:]))
+    euler = bool(pairs) and all(
+        t1 > t0 and np.allclose(x1, np.array(x0) + (t1 - t0) * np.array(dx0), rtol=1e-12, atol=1e-15)
+        for (t0, x0, dx0), (t1, x1, _) in pairs)
+    if euler:
+        sizes = np.diff([t for t, _, _ in record.evaluations])
+        step = (f"step {sizes[0]:.17g} s" if np.allclose(sizes, sizes[0], rtol=TIME_TOLERANCE, atol=0)
+                else f"steps {sizes.min():.17g} to {sizes.max():.17g} s")
+        return [f"Model Exchange master: explicit Euler at {step}, one derivative evaluation per "
+                f"step ({summary}); its error grows with the step, unlike the co-simulation FMU's "
+                "own integrator"]
+    return [f"Model Exchange master: not explicit Euler: {summary}, time points {points.min():.3g} "
+            f"to {points.max():.3g} s apart (a multi-stage or variable-step integrator)"]
 
 
 def timeline(record: InstanceCalls) -> list[str]:

@@ -200,3 +200,20 @@ def test_libcosim_trace_log(fmu, tmp_path, jump_csv, late):
         "input applied 1 step late from step 5 (t = 0.0050000000000000001): step n holds the torque "
         "meant for step n-1 (set after the step it was meant for)"]
     assert result["differences"] == expected
+
+
+@pytest.mark.parametrize("solver", ["Euler", "CVode"])
+def test_a_model_exchange_masters_integrator_is_read_from_its_calls(fmu, capsys, tmp_path, solver):
+    """fmpy's Model Exchange solvers: its fixed-step explicit Euler (each state set is the last
+    plus h times the derivatives returned there), and CVODE, which is not."""
+    simulate_fmu(fmu, fmi_type="ModelExchange", solver=solver, stop_time=10 * STEP, step_size=STEP,
+                 output_interval=STEP, debug_logging=True, start_values={"theta": 0.5})
+    log = tmp_path / "stdout.log"
+    log.write_text(capsys.readouterr().out)
+    found = reading(log, IntendedRun(0.0, start_values={"theta0": 0.5}))["differences"]
+    assert len(found) == 1
+    if solver == "Euler":
+        assert found[0].startswith("Model Exchange master: explicit Euler at step 0.001 s, one "
+                                   "derivative evaluation per step (10 fmi2SetTime calls")
+    else:
+        assert found[0].startswith("Model Exchange master: not explicit Euler")
