@@ -196,7 +196,7 @@ def _list(text: str) -> list[str]:
 def _master_call(match: re.Match, names: dict[int, str], handles: dict[str, str]) -> Call:
     arguments = {name: value.strip() for name, value in _ARGUMENT.findall(match["arguments"])}
     function = match["function"]
-    if function.endswith("Instantiate"):
+    if "Instantiate" in function:
         handle = match["result"] or ""
         instance = arguments.get("instanceName", "").strip('"') or handle or "instance"
         handles[handle] = instance
@@ -289,7 +289,7 @@ def reconstruct(calls: list[Call]) -> dict[str, InstanceCalls]:
         if call.status not in ("OK", "Warning") and name != "DoStep":
             record.events.append(f"call {number}: {call.function} returned {call.status}")
             continue
-        if name == "Instantiate":
+        if name.startswith("Instantiate"):
             record.interface = call.arguments.get("interface", "")
             if not record.interface and "fmuType" in call.arguments:
                 record.interface = "CoSimulation" if call.arguments["fmuType"] == "1" else "ModelExchange"
@@ -338,7 +338,7 @@ def reconstruct(calls: list[Call]) -> dict[str, InstanceCalls]:
             record.model_exchange_times.append(_number(call.arguments["time"]))
         elif name == "SetContinuousStates":
             now["states"] = list(call.values.values())
-        elif name == "GetDerivatives" and "states" in now and call.time_before is not None:
+        elif name in ("GetDerivatives", "GetContinuousStateDerivatives") and "states" in now and call.time_before is not None:
             record.evaluations.append((call.time_before, now["states"], list(call.values.values())))
     return instances
 

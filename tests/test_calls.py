@@ -9,6 +9,7 @@ are known from how the loop was written."""
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 from fmpy import extract, read_model_description, simulate_fmu
 from fmpy.fmi2 import FMU2Slave
@@ -217,3 +218,25 @@ def test_a_model_exchange_masters_integrator_is_read_from_its_calls(fmu, capsys,
                                    "derivative evaluation per step (10 fmi2SetTime calls")
     else:
         assert found[0].startswith("Model Exchange master: not explicit Euler")
+
+
+@pytest.mark.parametrize("source", ["fmu-record", "fmpy-call-log"])
+def test_fmi3_first_row_jump_through_fmpy(fmu3, capsys, tmp_path, source):
+    """The FMI 3.0 FMU keeps the same record; fmpy's FMI 3.0 call log names instances and
+    variables its own way (instance=, valueReferences=, values=)."""
+    csv = tmp_path / "first_row_jump.csv"
+    csv.write_text("time,torque\n0,0\n0,20\n0.005,20\n")
+    calls = []
+    simulate_fmu(fmu3, stop_time=0.005, output_interval=STEP, input=_table(csv), debug_logging=True,
+                 fmi_call_logger=calls.append)
+    log = tmp_path / "run.log"
+    log.write_text(capsys.readouterr().out if source == "fmu-record" else "\n".join(calls) + "\n")
+    result = reading(log, IntendedRun(csv))
+    assert [step["torque"] for step in result["steps"]] == [0, 20, 20, 20, 20]
+    assert result["differences"] == [
+        "input applied 1 step late from step 0 (t = 0): step n holds the torque meant for step n-1 "
+        "(set after the step it was meant for)"]
+
+
+def _table(csv):
+    return np.genfromtxt(csv, delimiter=",", names=True)

@@ -138,6 +138,25 @@ Status instance_error(const Instance *instance, const char *function, const char
 static inline int instance_recording(const Instance *instance) {
     return instance->log_categories & LOG_CALLS;
 }
+/* For the adapters' entry points, whose locals are `instance` and `function`: the time before
+   the call, kept for its line, and the line itself, formatted only when the record is on. */
+#define KEEP_TIME const double time_before = instance->data.time;
+#define RECORD(status, ...)                                                            \
+    if (instance_recording(instance))                                                  \
+        instance_record_call(instance, function, time_before, (status), __VA_ARGS__);
+#define RECORD_VALUES(status, vr, order, n, value)                                     \
+    if (instance_recording(instance))                                                  \
+        instance_record_values(instance, function, time_before, (status), (vr), (order), (n), \
+                               (value));
+/* The functions a master calls every step ask the record first and, when it is on, go out of
+   line to a function that calls the entry point again with the record switched off for the call
+   (this macro), then records it. So with the record off an entry point keeps its path as it was
+   (the core's function inlined into it, its only caller; a tail call) and a step pays one test. */
+#define WITHOUT_RECORD(status_type, call)                                              \
+    const double time_before = instance->data.time;                                    \
+    instance->log_categories &= ~LOG_CALLS;                                            \
+    const status_type status = (call);                                                 \
+    instance->log_categories |= LOG_CALLS;
 /* `format` describes the arguments; the line adds the FMU's time before and after the call and
    the status it returned. */
 void instance_record_call(const Instance *instance, const char *function, double time_before,

@@ -68,16 +68,7 @@
     if (!instance || !instance_state_allows(instance, MASK_##name, function))          \
         return fmi2Error;
 
-/* The instance's time before the call, for its line in the call record. */
-#define KEEP_TIME const double time_before = instance->data.time;
 
-/* The call record's line for this call (instance.h), formatted only when the record is on. */
-#define RECORD(status, ...)                                                            \
-    if (instance_recording(instance))                                                  \
-        instance_record_call(instance, function, time_before, (status), __VA_ARGS__);
-#define RECORD_VALUES(status, vr, order, n, value)                                     \
-    if (instance_recording(instance))                                                  \
-        instance_record_values(instance, function, time_before, (status), (vr), (order), (n), (value));
 
 
 /* Array arguments may be NULL only when their length is 0. */
@@ -100,19 +91,12 @@ static void forward_to_fmi2_logger(AnyFunction master_logger, void *environment,
                                         message);
 }
 
-/* The functions a master calls every step ask the record first and, when it is on, go through
-   one of these out of line: each calls the entry point again with the record switched off for
-   the call, then records it. So with the record off an entry point keeps its path as it was (the
-   core's function inlined into it, its only caller; a tail call) and a step pays one test. */
-#define WITHOUT_RECORD(call)                                                           \
-    const double time_before = instance->data.time;                                    \
-    instance->log_categories &= ~LOG_CALLS;                                            \
-    const fmi2Status status = (call);                                                  \
-    instance->log_categories |= LOG_CALLS;
 
+/* The functions a master calls every step go through these only when the record is on
+   (WITHOUT_RECORD, instance.h). */
 static NOINLINE fmi2Status recorded_get_real(Instance *instance, const char *function,
                                              const unsigned int vr[], size_t nvr, double value[]) {
-    WITHOUT_RECORD(fmi2GetReal(instance, vr, nvr, value))
+    WITHOUT_RECORD(fmi2Status, fmi2GetReal(instance, vr, nvr, value))
     RECORD_VALUES((Status)status, vr, NULL, status == fmi2OK ? nvr : 0, value)
     return status;
 }
@@ -120,7 +104,7 @@ static NOINLINE fmi2Status recorded_get_real(Instance *instance, const char *fun
 static NOINLINE fmi2Status recorded_set_real(Instance *instance, const char *function,
                                              const unsigned int vr[], size_t nvr,
                                              const double value[]) {
-    WITHOUT_RECORD(fmi2SetReal(instance, vr, nvr, value))
+    WITHOUT_RECORD(fmi2Status, fmi2SetReal(instance, vr, nvr, value))
     RECORD_VALUES((Status)status, vr, NULL, nvr, value)
     return status;
 }
@@ -128,7 +112,7 @@ static NOINLINE fmi2Status recorded_set_real(Instance *instance, const char *fun
 static NOINLINE fmi2Status recorded_input_derivatives(Instance *instance, const char *function,
                                                       const unsigned int vr[], size_t nvr,
                                                       const int order[], const double value[]) {
-    WITHOUT_RECORD(fmi2SetRealInputDerivatives(instance, vr, nvr, order, value))
+    WITHOUT_RECORD(fmi2Status, fmi2SetRealInputDerivatives(instance, vr, nvr, order, value))
     RECORD_VALUES((Status)status, vr, order, nvr, value)
     return status;
 }
@@ -136,7 +120,7 @@ static NOINLINE fmi2Status recorded_input_derivatives(Instance *instance, const 
 static NOINLINE fmi2Status recorded_do_step(Instance *instance, const char *function,
                                             double communication_point, double communication_step,
                                             fmi2Boolean no_set_state_prior) {
-    WITHOUT_RECORD(fmi2DoStep(instance, communication_point, communication_step, no_set_state_prior))
+    WITHOUT_RECORD(fmi2Status, fmi2DoStep(instance, communication_point, communication_step, no_set_state_prior))
     RECORD((Status)status, "currentCommunicationPoint=%.17g, communicationStepSize=%.17g",
            communication_point, communication_step)
     return status;
