@@ -48,3 +48,9 @@ class CannotWrite(PendulumFmuError, OSError):
 
 class MissingDependency(PendulumFmuError, ImportError):
     """An optional package a tool needs is not installed; the message gives the pip command."""
+
+
+class Skipped(UserWarning):
+    """A part of the run left out because this machine lacks what it needs (a tool's package); the
+    message is one line saying which part and how to get it. The command line prints it as that
+    line and goes on."""

@@ -17,7 +17,7 @@ import warnings
 
 from .. import __version__
 from ..build import PlatformSkipped
-from ..errors import PendulumFmuError
+from ..errors import PendulumFmuError, Skipped
 from ..stop_signals import STOPPING_SIGNALS, Stopped, restore_signals, stop_on_signals
 from . import build, compare, cross_check, demo, judge, scenarios, simulate, sweep
 from ._stdout import UntilTheReaderIsGone
@@ -88,7 +88,7 @@ def main(argv: list[str] | None = None) -> int:
     shown = warnings.showwarning
 
     def one_line(message, category, *where, **more):
-        if issubclass(category, PlatformSkipped):
+        if issubclass(category, (PlatformSkipped, Skipped)):
             print(f"{command}: {message}", file=sys.stderr)
         else:
             shown(message, category, *where, **more)

@@ -20,11 +20,12 @@ def add_parser(commands) -> argparse.ArgumentParser:
     compare.add_argument("--ramp", action="store_true",
                          help="ramp the torque along the CSV's piecewise-linear signal in every "
                               "tool that can (the FMU, the reference); OpenSim cannot and says so")
-    compare.add_argument("--tools", default="fmu,reference,opensim",
+    compare.add_argument("--tools", default=None,
                          help="comma-separated, each once: fmu, reference, opensim, mujoco, drake, "
                               "pybullet (NAME:default for the engine's own defaults), or "
                               "LABEL=path/to/Their.fmu for any FMI 2.0/3.0 FMU; the reference always "
-                              "runs as the judge (default: %(default)s)")
+                              "runs as the judge (default: fmu,reference,opensim, those installed; the line "
+                              "that says which were skipped says how to install them)")
     compare.add_argument("--map", dest="mapping", default=None, metavar="OURS=THEIRS[*FACTOR],...",
                          help="for LABEL=FMU tools: their variable names for torque, theta, omega, "
                               "alpha and the parameters, with a factor where they use other units, "
