@@ -55,9 +55,12 @@ def __dir__() -> list[str]:
 
 
 class _Package(types.ModuleType):
-    """This package's module type: the import system sets every submodule it loads as an
-    attribute of its package, which for the modules named like the function they hold would hide
-    the function (``pendulum_fmu.simulate`` the module after any ``import pendulum_fmu.simulate``)."""
+    """The package's module type, which keeps its functions from being hidden by their modules.
+
+    The import system sets every submodule it loads as an attribute of its package: for the modules
+    named like the function they hold, ``pendulum_fmu.simulate`` would be the module after any
+    ``import pendulum_fmu.simulate``.
+    """
 
     def __setattr__(self, name: str, value) -> None:
         if name in _LAZY and isinstance(value, types.ModuleType):
@@ -123,9 +126,9 @@ def default_fmu(fmi_version: int = 2):
         raise MissingFile(
             f"pendulum_fmu {__version__} at {Path(__file__).parent} has neither its packaged "
             f"data/{packaged_name} nor the FMU's sources beside it: reinstall it from its wheel or "
-            "sdist, or pass the FMU's path")
+            "sdist, or pass the FMU's path"
+        )
     if _extracted is None:
         _extracted = contextlib.ExitStack()
         atexit.register(_extracted.close)
     return _extracted.enter_context(resources.as_file(packaged))
-

@@ -1,5 +1,7 @@
-"""The API at the top of the package: its names, what importing it loads, what the command line's
-simulate loads. Each check runs in a fresh interpreter, whose sys.modules holds only what it did."""
+"""The API at the top of the package: its names, what importing it loads, what simulate loads.
+
+The checks of what is loaded run in a fresh interpreter, whose sys.modules holds only what it did.
+"""
 
 import json
 import subprocess
@@ -16,11 +18,15 @@ HEAVY = ("matplotlib", "dask", "distributed", "scipy", "fmpy", "numpy", "pyarrow
 
 
 def _loaded_after(code: str) -> dict:
-    """Run code in a fresh interpreter from the repository's root; what it prints last (JSON)
-    and the top-level packages and pendulum_fmu modules it loaded."""
-    script = (f"{code}\nimport json, sys\n"
-              "print(json.dumps({'top': sorted({name.split('.')[0] for name in sys.modules}), "
-              "'ours': sorted(name for name in sys.modules if name.startswith('pendulum_fmu'))}))")
+    """Run code in a fresh interpreter from the repository's root.
+
+    Returns what it printed, the top-level packages and the pendulum_fmu modules it loaded.
+    """
+    script = (
+        f"{code}\nimport json, sys\n"
+        "print(json.dumps({'top': sorted({name.split('.')[0] for name in sys.modules}), "
+        "'ours': sorted(name for name in sys.modules if name.startswith('pendulum_fmu'))}))"
+    )
     done = subprocess.run([sys.executable, "-c", script], cwd=ROOT, capture_output=True, text=True, check=True)
     *printed, loaded = done.stdout.splitlines()
     return {**json.loads(loaded), "printed": printed}
@@ -55,9 +61,11 @@ def test_the_names_at_the_top_are_the_api():
 
 
 def test_a_name_that_is_also_a_module_stays_the_function_once_the_module_is_imported():
-    loaded = _loaded_after("import pendulum_fmu.simulate, pendulum_fmu.judge\n"
-                           "import pendulum_fmu\n"
-                           "print(type(pendulum_fmu.simulate).__name__, type(pendulum_fmu.judge).__name__)")
+    loaded = _loaded_after(
+        "import pendulum_fmu.simulate, pendulum_fmu.judge\n"
+        "import pendulum_fmu\n"
+        "print(type(pendulum_fmu.simulate).__name__, type(pendulum_fmu.judge).__name__)"
+    )
     assert loaded["printed"] == ["function function"]
 
 

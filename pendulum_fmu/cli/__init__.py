@@ -45,16 +45,21 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="pendulum-fmu",
         description="A torque-driven pendulum as an FMI 2.0 (or 3.0) FMU: build it, "
-                    "simulate it, and compare it with scipy and OpenSim.")
+        "simulate it, and compare it with scipy and OpenSim.",
+    )
     parser.add_argument("--version", action="version", version=f"pendulum-fmu {__version__}")
-    parser.add_argument("--debug", action="store_true", default=False,
-                        help="show the Python traceback of an error instead of one line")
+    parser.add_argument(
+        "--debug", action="store_true", default=False, help="show the Python traceback of an error instead of one line"
+    )
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for command in COMMANDS:
         # Also after the command's name; SUPPRESS keeps it from hiding one given before it.
         command.add_parser(commands).add_argument(
-            "--debug", action="store_true", default=argparse.SUPPRESS,
-            help="show the Python traceback of an error instead of one line")
+            "--debug",
+            action="store_true",
+            default=argparse.SUPPRESS,
+            help="show the Python traceback of an error instead of one line",
+        )
     return parser
 
 
@@ -114,8 +119,11 @@ def main(argv: list[str] | None = None) -> int:
     except Exception as error:  # a bug of ours: still one line, the traceback on request
         if args.debug:
             raise
-        print(f"{command}: internal error: {type(error).__name__}: {error} (run again with --debug "
-              "for the traceback, and report it)", file=sys.stderr)
+        print(
+            f"{command}: internal error: {type(error).__name__}: {error} (run again with --debug "
+            "for the traceback, and report it)",
+            file=sys.stderr,
+        )
         return 3
     finally:
         sys.stdout = stdout

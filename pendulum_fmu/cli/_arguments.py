@@ -19,8 +19,7 @@ def assignment(text: str) -> tuple[str, str]:
 def output_path(text: str) -> Path:
     # An empty path would be the current folder: most likely an unset shell variable ("$OUT").
     if not text.strip():
-        raise argparse.ArgumentTypeError("an empty path; give a file or folder name (is a shell "
-                                         "variable unset?)")
+        raise argparse.ArgumentTypeError("an empty path; give a file or folder name (is a shell variable unset?)")
     return Path(text)
 
 
@@ -64,34 +63,58 @@ def torque_signal(args):
 def add_signal_arguments(parser, required: bool = True) -> None:
     group = parser.add_mutually_exclusive_group(required=required)
     group.add_argument("--torque", type=float_number, help="constant torque in N.m")
-    group.add_argument("--torque-file", type=Path,
-                       help="CSV with columns time,torque in fmpy's convention: linear between "
-                            "rows, a jump where a time repeats, held outside; each step holds the "
-                            "value just after its start unless --ramp (docs/signals.md)")
-    parser.add_argument("--stop-time", type=float_number, default=None,
-                        help="end of the simulation in s (default: 3, or the CSV's last time)")
-    parser.add_argument("--step-size", type=float_number, default=1e-3,
-                        help="communication step in s (default: %(default)s)")
-    parser.add_argument("--set", dest="assignments", type=assignment, action="append",
-                        metavar="NAME=VALUE",
-                        help="parameter: mass, length, inertia, gravity, damping (repeatable)")
+    group.add_argument(
+        "--torque-file",
+        type=Path,
+        help="CSV with columns time,torque in fmpy's convention: linear between "
+        "rows, a jump where a time repeats, held outside; each step holds the "
+        "value just after its start unless --ramp (docs/signals.md)",
+    )
+    parser.add_argument(
+        "--stop-time",
+        type=float_number,
+        default=None,
+        help="end of the simulation in s (default: 3, or the CSV's last time)",
+    )
+    parser.add_argument(
+        "--step-size", type=float_number, default=1e-3, help="communication step in s (default: %(default)s)"
+    )
+    parser.add_argument(
+        "--set",
+        dest="assignments",
+        type=assignment,
+        action="append",
+        metavar="NAME=VALUE",
+        help="parameter: mass, length, inertia, gravity, damping (repeatable)",
+    )
     parser.add_argument("--theta0", type=float_number, default=0.0, help="initial angle in rad")
     parser.add_argument("--omega0", type=float_number, default=0.0, help="initial rate in rad/s")
-    parser.add_argument("--max-steps", type=positive_int, default=None,
-                        help=f"refuse runs longer than this many steps (default: {DEFAULT_MAX_STEPS:,})")
+    parser.add_argument(
+        "--max-steps",
+        type=positive_int,
+        default=None,
+        help=f"refuse runs longer than this many steps (default: {DEFAULT_MAX_STEPS:,})",
+    )
     add_fmu_argument(parser)
 
 
 def add_fmu_argument(parser) -> None:
-    parser.add_argument("--fmu", type=Path, default=None,
-                        help="the FMU to run, whose own parameters and defaults apply (default: "
-                             "the packaged FMU, or dist/Pendulum.fmu in a source checkout)")
+    parser.add_argument(
+        "--fmu",
+        type=Path,
+        default=None,
+        help="the FMU to run, whose own parameters and defaults apply (default: "
+        "the packaged FMU, or dist/Pendulum.fmu in a source checkout)",
+    )
 
 
 def check_outputs(outputs: dict, inputs: dict) -> None:
-    """Refuse before the run an output (option -> path) that cannot be written, that another
-    output names too, or that is a file the command reads (option -> path): writing it would
-    destroy the input."""
+    """Refuse before the run an output that cannot be written, or that names a file twice.
+
+    An output (option -> path) is refused when it cannot be written, when another output names
+    it too, or when it is a file the command reads (option -> path): writing it would destroy the
+    input.
+    """
     from ..atomic_files import check_writable
 
     given = {option: Path(path) for option, path in outputs.items() if path}
@@ -104,9 +127,11 @@ def check_outputs(outputs: dict, inputs: dict) -> None:
     for number, (option, path) in enumerate(given.items()):
         for other, other_path in [*list(given.items())[:number], *read.items()]:
             if same_file(path, other_path):
-                raise InvalidInput(f"{option} {path} names the same file as {other}: writing it would "
-                                   f"{'destroy what the command reads' if other in read else 'lose one of the two'}; "
-                                   "choose another path")
+                raise InvalidInput(
+                    f"{option} {path} names the same file as {other}: writing it would "
+                    f"{'destroy what the command reads' if other in read else 'lose one of the two'}; "
+                    "choose another path"
+                )
 
 
 def same_file(one: Path, other: Path) -> bool:

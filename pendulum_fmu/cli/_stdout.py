@@ -8,9 +8,11 @@ import os
 
 
 class UntilTheReaderIsGone:
-    """stdout that drops what is printed once its reader is gone (piped into `head`, which
-    closed the pipe; a full /dev/full), so that the command still writes its files: what it
-    prints only reports them."""
+    """stdout that drops what is printed once its reader is gone.
+
+    The reader is gone when the output was piped into `head`, which closed the pipe, or into a
+    full /dev/full; the command still writes its files: what it prints only reports them.
+    """
 
     def __init__(self, stream):
         self._stream = stream

@@ -19,26 +19,46 @@ def _platforms(text: str) -> tuple[str, ...]:
 
 
 def add_parser(commands) -> argparse.ArgumentParser:
-    build = commands.add_parser("build", help="build the FMU (same as python build_fmu.py)",
-                                description="Build the FMU from fmu_src/ and modelDescription.xml "
-                                            "(a source checkout or the unpacked sdist).")
-    build.add_argument("--output", type=output_path, default=None,
-                       help=f"where to write the FMU (default: {CHECKOUT_FMUS[2]}, or {CHECKOUT_FMUS[3]} "
-                            "for FMI 3.0)")
-    build.add_argument("--fmi-version", type=int, choices=FMI_VERSIONS, default=2,
-                       help="FMI standard of the FMU (default: %(default)s)")
-    build.add_argument("--platforms", type=_platforms, default=None,
-                       help=f"comma-separated, among {', '.join(PLATFORMS)} (default: every one "
-                            "whose compiler is installed; the others are skipped with a note)")
-    build.add_argument("--linux-glibc", default=None, metavar="VERSION",
-                       help="build the Linux binaries with zig (pip install ziglang) to load on this glibc "
-                            "and every later one, such as 2.17, manylinux2014's (default: with gcc, for "
-                            "this machine's glibc)")
+    """Declare `build` and its options, each with its help, among the parser's commands."""
+    build = commands.add_parser(
+        "build",
+        help="build the FMU (same as python build_fmu.py)",
+        description="Build the FMU from fmu_src/ and modelDescription.xml (a source checkout or the unpacked sdist).",
+    )
+    build.add_argument(
+        "--output",
+        type=output_path,
+        default=None,
+        help=f"where to write the FMU (default: {CHECKOUT_FMUS[2]}, or {CHECKOUT_FMUS[3]} for FMI 3.0)",
+    )
+    build.add_argument(
+        "--fmi-version",
+        type=int,
+        choices=FMI_VERSIONS,
+        default=2,
+        help="FMI standard of the FMU (default: %(default)s)",
+    )
+    build.add_argument(
+        "--platforms",
+        type=_platforms,
+        default=None,
+        help=f"comma-separated, among {', '.join(PLATFORMS)} (default: every one "
+        "whose compiler is installed; the others are skipped with a note)",
+    )
+    build.add_argument(
+        "--linux-glibc",
+        default=None,
+        metavar="VERSION",
+        help="build the Linux binaries with zig (pip install ziglang) to load on this glibc "
+        "and every later one, such as 2.17, manylinux2014's (default: with gcc, for "
+        "this machine's glibc)",
+    )
     build.set_defaults(run=run)
     return build
 
 
 def run(args) -> int:
+    """Run `pendulum-fmu build` with the parsed arguments; returns the exit status."""
     from ..build import build_fmu
 
     output = args.output or CHECKOUT_FMUS[args.fmi_version]
