@@ -103,6 +103,12 @@ def default_fmu(fmi_version: int = 2):
         An installed package without its packaged FMU.
     BuildError
         A checkout whose FMU is stale and cannot be rebuilt here.
+
+    Examples
+    --------
+    >>> from pendulum_fmu import default_fmu
+    >>> default_fmu().name
+    'Pendulum.fmu'
     """
     global _extracted
     import atexit

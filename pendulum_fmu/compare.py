@@ -105,6 +105,33 @@ def write_differences(rows: list[dict], path: str | Path) -> Path:
 
 @dataclass
 class Comparison:
+    """What compare() ran and judged, and the files it wrote.
+
+    Attributes
+    ----------
+    runs : dict of str to numpy.ndarray
+        Each tool's results array (results.py), by its label; "reference" is the judge.
+    differences : list of dict
+        The rows of differences.csv: each tool against the reference, then each pair of tools.
+    tolerance : float
+        The largest difference in theta (rad) or omega (rad/s) for the tools to agree.
+    trajectories, table, figure : Path
+        trajectories.csv, differences.csv and comparison.png.
+    worst, torque_worst, torque_limit : float
+        The largest difference in theta or omega; the largest difference between the torque a tool
+        received and the signal, and the rounding allowed for it.
+    agree : bool
+        Whether every tool is within the tolerance and received the signal's torque.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pendulum_fmu import compare
+    >>> comparison = compare(20.0, "fmu,reference", output_dir=tempfile.mkdtemp(), stop_time=0.5)
+    >>> sorted(comparison.runs), bool(comparison.worst < comparison.tolerance)
+    (['fmu', 'reference'], True)
+    """
+
     runs: dict[str, np.ndarray]
     differences: list[dict]
     tolerance: float
@@ -187,6 +214,16 @@ def compare(torque: TorqueSignal, tools=None, *, output_dir: str | Path, step_si
         An FMU refused a step.
     CannotWrite
         output_dir cannot be written.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pendulum_fmu import compare
+    >>> comparison = compare(20.0, "fmu,reference", output_dir=tempfile.mkdtemp(), stop_time=1.0)
+    >>> comparison.agree, [row["tool"] for row in comparison.differences]
+    (True, ['fmu'])
+    >>> comparison.trajectories.name, comparison.table.name, comparison.figure.name
+    ('trajectories.csv', 'differences.csv', 'comparison.png')
     """
     if not isinstance(output_dir, str | os.PathLike):
         raise WrongType(f"output_dir is a folder's path, not {output_dir!r}")

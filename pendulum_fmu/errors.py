@@ -24,7 +24,19 @@ OSError for a file, ...). The kinds that belong to one module live there:
 
 
 class PendulumFmuError(Exception):
-    """Base of every error the user's input causes; the message is the one line to show."""
+    """Base of every error the user's input causes; the message is the one line to show.
+
+    Examples
+    --------
+    A stop time before the start, refused in one line:
+
+    >>> from pendulum_fmu import PendulumFmuError, simulate
+    >>> try:
+    ...     simulate(20.0, stop_time=-1)
+    ... except PendulumFmuError as error:
+    ...     print(error)
+    stop time -1 must be after start time 0.0
+    """
 
 
 class InvalidInput(PendulumFmuError, ValueError):

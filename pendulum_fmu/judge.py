@@ -85,7 +85,37 @@ class ResultFileError(InvalidInput):
 
 @dataclass
 class Judgement:
-    """The verdict on one result and its diagnosis (see the module's docstring)."""
+    """The verdict on one result and its diagnosis (see the module's docstring).
+
+    Attributes
+    ----------
+    verdict : {"pass", "fail"}
+        Whether max |dtheta| is within the tolerance; ``passed`` says the same as a bool.
+    diagnosis : str
+        The mistake that explains the difference, "agrees" or "unexplained".
+    residual, max_abs_dtheta, worst_time, tolerance : float
+        What is left once the diagnosis is explained (rad); the largest |dtheta| (rad) and its time
+        (s); the tolerance (rad).
+    candidates : dict
+        Per candidate mistake, the residual of its best variant (rad); None where it does not apply.
+    smallest_input_effect : float or None
+        The smallest difference an input-timing variant makes to this run (rad).
+    result, reference, explanation : numpy.ndarray
+        The result as read, the reference at its times, the variant the diagnosis names.
+    source : str
+        The result file's name, as reports show it.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from pendulum_fmu import judge, simulate
+    >>> from pendulum_fmu.results import write_csv
+    >>> result = write_csv(simulate(5.0, stop_time=0.5), Path(tempfile.mkdtemp()) / "fmu.csv")
+    >>> judgement = judge(result, 5.0, stop_time=0.5)
+    >>> judgement.verdict, bool(judgement.max_abs_dtheta <= judgement.tolerance)
+    ('pass', True)
+    """
 
     verdict: str
     diagnosis: str
@@ -416,6 +446,19 @@ def judge(result, torque, *, start_time: float = 0.0, stop_time: float | None = 
         and last rows are not the run's start and stop (a result of part of the run).
     InvalidInput
         A tolerance that is not positive and finite, or a run definition simulate() would refuse.
+
+    Examples
+    --------
+    The FMU's own run, written as a result file and judged:
+
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from pendulum_fmu import judge, simulate
+    >>> from pendulum_fmu.results import write_csv
+    >>> result = write_csv(simulate(20.0, stop_time=1.0), Path(tempfile.mkdtemp()) / "fmu.csv")
+    >>> judgement = judge(result, 20.0, stop_time=1.0)
+    >>> judgement.passed, judgement.diagnosis
+    (True, 'agrees')
     """
     tolerance = DEFAULT_TOLERANCE if tolerance is None else tolerance
     if not (math.isfinite(tolerance) and tolerance > 0):
@@ -540,6 +583,19 @@ def judge_kit(folder: str | Path, *, tolerance: float | None = None, mapping: st
     ------
     ResultFileError
         A folder that holds no scenario, or none with a result.
+
+    Examples
+    --------
+    A kit in which one scenario has a result (its reference, copied: it passes) and the others none:
+
+    >>> import shutil, tempfile
+    >>> from pathlib import Path
+    >>> from pendulum_fmu import judge_kit, write_scenarios
+    >>> kit = Path(tempfile.mkdtemp())
+    >>> _ = write_scenarios(kit)
+    >>> _ = shutil.copy(kit / "constant_torque_ref.csv", kit / "constant_torque_out.csv")
+    >>> {name: judgement and judgement.passed for name, judgement in judge_kit(kit).items()}
+    {'constant_torque': True, 'decimal_steps': None, 'ramp': None, 'random_steps': None, 'resume': None, 'steps_on_grid': None}
     """
     folder = Path(folder)
     found = settings_files(folder)

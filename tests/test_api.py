@@ -72,3 +72,21 @@ def test_a_name_that_is_also_a_module_stays_the_function_once_the_module_is_impo
 def test_a_name_the_api_has_not_is_an_attribute_error():
     with pytest.raises(AttributeError, match="has no attribute 'simulat'"):
         pendulum_fmu.simulat  # noqa: B018
+
+
+@pytest.mark.parametrize("name", [name for name in pendulum_fmu.__all__
+                                  if callable(getattr(pendulum_fmu, name))])
+def test_every_api_docstring_has_numpydoc_sections_and_its_examples_give_what_they_show(name):
+    import doctest
+    import inspect
+
+    thing = getattr(pendulum_fmu, name)
+    text = inspect.getdoc(thing)
+    wanted = ("Examples",) + (("Parameters", "Returns", "Raises") if inspect.isfunction(thing) else ())
+    assert all(f"{section}\n{'-' * len(section)}" in text for section in wanted), name
+    # Only the docstring's own examples (not its methods'), as doctest runs them.
+    tests = doctest.DocTestFinder(recurse=False).find(thing, name, globs={})
+    runner = doctest.DocTestRunner(optionflags=doctest.ELLIPSIS)
+    for test in tests:
+        runner.run(test)
+    assert runner.failures == 0 and runner.tries > 0, name

@@ -81,6 +81,15 @@ def run_sweep(study: Study, *, output_dir: str | os.PathLike, resume: bool = Fal
         output_dir cannot be written.
     SchedulerUnreachable
         The scheduler did not answer within connect_timeout.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pendulum_fmu import Study, run_sweep, sweep_grid
+    >>> study = Study(sweep_grid([5, 10], [0, 9.81]), stop_time=0.5)
+    >>> result = run_sweep(study, output_dir=tempfile.mkdtemp(), workers=1, progress=False)
+    >>> result.cases, result.failed, result.chunks_run == result.chunks
+    (4, 0, True)
     """
     from fsspec.implementations.local import LocalFileSystem
 
