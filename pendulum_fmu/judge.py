@@ -107,14 +107,17 @@ class Judgement:
 
     Examples
     --------
+    A run whose torque steps 1 ms after the signal's step, and the mistake it is given:
+
     >>> import tempfile
     >>> from pathlib import Path
     >>> from pendulum_fmu import judge, simulate
     >>> from pendulum_fmu.results import write_csv
-    >>> result = write_csv(simulate(5.0, stop_time=0.5), Path(tempfile.mkdtemp()) / "fmu.csv")
-    >>> judgement = judge(result, 5.0, stop_time=0.5)
-    >>> judgement.verdict, bool(judgement.max_abs_dtheta <= judgement.tolerance)
-    ('pass', True)
+    >>> late = simulate(lambda t: 0.0 if t < 0.251 else 20.0, stop_time=0.5)
+    >>> judgement = judge(write_csv(late, Path(tempfile.mkdtemp()) / "late.csv"),
+    ...                   lambda t: 0.0 if t < 0.25 else 20.0, stop_time=0.5)
+    >>> judgement.verdict, judgement.diagnosis, f"{judgement.max_abs_dtheta:.2e} rad"
+    ('fail', 'input one step late', '1.55e-04 rad')
     """
 
     verdict: str

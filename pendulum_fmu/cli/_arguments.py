@@ -139,3 +139,36 @@ def same_file(one: Path, other: Path) -> bool:
         return one.samefile(other)
     except OSError:  # one of them does not exist yet: the same file only by its name
         return one.resolve() == other.resolve()
+
+
+def signal_options(args: argparse.Namespace) -> dict:
+    """The keyword arguments of simulate, reference, compare and judge that the options give.
+
+    Those that add_signal_arguments declares, with the torque aside (torque_signal), and --ramp,
+    which every command that runs a signal declares with its own help.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line of a command that declared them.
+
+    Returns
+    -------
+    dict
+        stop_time, step_size, ramp, parameters, theta0, omega0, max_steps and fmu_path.
+
+    Raises
+    ------
+    InvalidInput
+        A --set whose value is not a number.
+    """
+    return {
+        "stop_time": args.stop_time,
+        "step_size": args.step_size,
+        "ramp": args.ramp,
+        "parameters": parameters_of(args.assignments),
+        "theta0": args.theta0,
+        "omega0": args.omega0,
+        "max_steps": args.max_steps,
+        "fmu_path": args.fmu,
+    }

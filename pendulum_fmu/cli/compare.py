@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from ._arguments import add_signal_arguments, float_number, output_path, parameters_of, torque_signal
+from ._arguments import add_signal_arguments, float_number, output_path, signal_options, torque_signal
 
 
 def add_parser(commands) -> argparse.ArgumentParser:
@@ -69,16 +69,9 @@ def run(args) -> int:
         torque_signal(args),
         args.tools,
         output_dir=args.output_dir,
-        step_size=args.step_size,
-        stop_time=args.stop_time,
-        ramp=args.ramp,
-        parameters=parameters_of(args.assignments),
-        theta0=args.theta0,
-        omega0=args.omega0,
         tolerance=args.tol,
         mapping=args.mapping,
-        max_steps=args.max_steps,
-        fmu_path=args.fmu,
+        **signal_options(args),
     )
     print(format_comparison(comparison))
     for path in (comparison.trajectories, comparison.table, comparison.figure):

@@ -7,7 +7,14 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..errors import InvalidInput
-from ._arguments import add_signal_arguments, check_outputs, float_number, output_path, parameters_of, torque_signal
+from ._arguments import (
+    add_signal_arguments,
+    check_outputs,
+    float_number,
+    output_path,
+    signal_options,
+    torque_signal,
+)
 
 if TYPE_CHECKING:
     from ..judge import Judgement
@@ -105,16 +112,9 @@ def run(args) -> int:
             args.result,
             signal,
             start_time=args.start_time,
-            stop_time=args.stop_time,
-            step_size=args.step_size,
-            ramp=args.ramp,
-            parameters=parameters_of(args.assignments),
-            theta0=args.theta0,
-            omega0=args.omega0,
             tolerance=args.tol,
             mapping=args.mapping,
-            fmu_path=args.fmu,
-            max_steps=args.max_steps,
+            **signal_options(args),
         )
         print(format_judgement(judgement))
         judged = {args.result.name: judgement}

@@ -6,7 +6,15 @@ import argparse
 
 import numpy as np
 
-from ._arguments import add_signal_arguments, check_outputs, float_number, output_path, parameters_of, torque_signal
+from ._arguments import (
+    add_signal_arguments,
+    check_outputs,
+    float_number,
+    output_path,
+    parameters_of,
+    signal_options,
+    torque_signal,
+)
 
 
 def add_parser(commands) -> argparse.ArgumentParser:
@@ -40,18 +48,7 @@ def run(args) -> int:
     check_outputs(
         {"--output": args.output, "--plot": args.plot}, {"--torque-file": args.torque_file, "--fmu": args.fmu}
     )
-    run = simulate(
-        torque_signal(args),
-        stop_time=args.stop_time,
-        step_size=args.step_size,
-        ramp=args.ramp,
-        parameters=parameters_of(args.assignments),
-        theta0=args.theta0,
-        omega0=args.omega0,
-        tolerance=args.tolerance,
-        max_steps=args.max_steps,
-        fmu_path=args.fmu,
-    )
+    run = simulate(torque_signal(args), tolerance=args.tolerance, **signal_options(args))
     last = run[-1]
     print(
         f"{len(run) - 1} steps to t = {last['time']:g} s: theta = {last['theta']:.12g} rad, "
