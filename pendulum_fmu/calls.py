@@ -7,7 +7,7 @@ LOG is any text holding calls, one per line, in any of these forms (other lines 
 - the FMU's own call record (category logCalls, on when the master turns logging on), found by
   its marker anywhere in a line, so inside any master's log format::
 
-      [OK] [pendulum-calls] instance="Pendulum" fmi2DoStep(currentCommunicationPoint=0, communicationStepSize=0.001) time=0->0.001 status=OK
+      [OK] [pendulum-calls] instance="Pendulum" fmi2SetReal(torque=20) time=0->0 status=OK
 
 - fmpy's call logger (``fmpy simulate --fmi-logging``, ``simulate_fmu(fmi_call_logger=print)``)
   and fmusim's (``--log-fmi-calls``), which need no option of the FMU::
@@ -34,7 +34,7 @@ import numpy as np
 
 from .atomic_files import replacing
 from .errors import InvalidInput, MissingFile
-from .torque_schedule import schedule
+from .torque_schedule import TorqueSignal, schedule
 
 MARKER = "[pendulum-calls]"
 INPUT = "torque"
@@ -50,9 +50,11 @@ VALUE_TOLERANCE = 1e-12
 # How many steps late or early the reading looks for.
 MAX_SHIFT = 10
 
-_RECORD = re.compile(r'\[pendulum-calls\] instance="(?P<instance>[^"]*)" (?P<function>fmi[23]\w+)'
-                     r'\((?P<arguments>.*)\) time=(?P<before>\S+)->(?P<after>\S+) status=(?P<status>\w+)')
-_MASTER = re.compile(r'(?P<function>fmi[23][A-Z]\w+)\((?P<arguments>.*)\)(?:\s*->\s*(?P<result>\S+))?\s*$')
+_RECORD = re.compile(
+    r'\[pendulum-calls\] instance="(?P<instance>[^"]*)" (?P<function>fmi[23]\w+)'
+    r"\((?P<arguments>.*)\) time=(?P<before>\S+)->(?P<after>\S+) status=(?P<status>\w+)"
+)
+_MASTER = re.compile(r"(?P<function>fmi[23][A-Z]\w+)\((?P<arguments>.*)\)(?:\s*->\s*(?P<result>\S+))?\s*$")
 # One argument of a master's call log: name=value, the value a list ([...] or {...}), a quoted
 # string or one token.
 _ARGUMENT = re.compile(r'(\w+)=(\[[^\]]*\]|\{[^}]*\}|"[^"]*"|[^,]*)')
@@ -170,8 +172,15 @@ def _record_call(match: re.Match, variables: frozenset) -> Call:
             values[name] = float(value)
         else:
             arguments[name] = value
-    return Call(match["instance"], match["function"], values, arguments, float(match["before"]),
-                float(match["after"]), match["status"])
+    return Call(
+        match["instance"],
+        match["function"],
+        values,
+        arguments,
+        float(match["before"]),
+        float(match["after"]),
+        match["status"],
+    )
 
 
 def _split_arguments(text: str) -> list[str]:
@@ -208,7 +217,7 @@ def _master_call(match: re.Match, names: dict[int, str], handles: dict[str, str]
     numbers = arguments.pop("value", arguments.pop("values", None))
     if references is not None and numbers is not None:
         orders = _list(arguments.pop("order", "")) or None
-        for position, (reference, value) in enumerate(zip(_list(references), _list(numbers))):
+        for position, (reference, value) in enumerate(zip(_list(references), _list(numbers), strict=False)):
             name = names.get(int(reference), f"vr{reference}")
             if orders:
                 name = f"der({name},{orders[position]})"
@@ -251,12 +260,13 @@ def read_calls(path: str | Path, variable_names: dict[int, str]) -> list[Call]:
         variables = frozenset(variable_names.values())
         return [_record_call(match, variables) for match in records]
     handles: dict[str, str] = {}
-    calls = [_master_call(match, variable_names, handles)
-             for line in lines if (match := _MASTER.search(line))]
+    calls = [_master_call(match, variable_names, handles) for line in lines if (match := _MASTER.search(line))]
     if not calls:
-        raise InvalidInput(f"{path}: no FMI call in it; turn on the FMU's call record (loggingOn, "
-                           "docs/calls.md) or the master's call logging (fmpy --fmi-logging, "
-                           "fmusim --log-fmi-calls)")
+        raise InvalidInput(
+            f"{path}: no FMI call in it; turn on the FMU's call record (loggingOn, "
+            "docs/calls.md) or the master's call logging (fmpy --fmi-logging, "
+            "fmusim --log-fmi-calls)"
+        )
     return calls
 
 
@@ -283,8 +293,9 @@ def reconstruct(calls: list[Call]) -> dict[str, InstanceCalls]:
     state: dict[str, dict] = {}
     for number, call in enumerate(calls, start=1):
         record = instances.setdefault(call.instance, InstanceCalls(call.instance))
-        now = state.setdefault(call.instance, {"torque": 0.0, "rate": 0.0, "acceleration": 0.0,
-                                               "initialized": False, "time": 0.0})
+        now = state.setdefault(
+            call.instance, {"torque": 0.0, "rate": 0.0, "acceleration": 0.0, "initialized": False, "time": 0.0}
+        )
         name = call.name
         if call.status not in ("OK", "Warning") and name != "DoStep":
             record.events.append(f"call {number}: {call.function} returned {call.status}")
@@ -314,12 +325,16 @@ def reconstruct(calls: list[Call]) -> dict[str, InstanceCalls]:
                 reached = record.steps[-1].time + record.steps[-1].size
                 if time < reached - TIME_TOLERANCE * max(1.0, abs(reached)):
                     record.rewinds.append((number, reached, time))
-                    record.events.append(f"call {number}: step from t = {time} after the FMU had "
-                                         f"reached t = {reached}: the steps from there are redone")
-                    record.steps = [step for step in record.steps
-                                    if step.time < time - TIME_TOLERANCE * max(1.0, abs(time))]
-            record.steps.append(Step(len(record.steps), time, size, now["torque"], now["rate"],
-                                     now["acceleration"], call.status))
+                    record.events.append(
+                        f"call {number}: step from t = {time} after the FMU had "
+                        f"reached t = {reached}: the steps from there are redone"
+                    )
+                    record.steps = [
+                        step for step in record.steps if step.time < time - TIME_TOLERANCE * max(1.0, abs(time))
+                    ]
+            record.steps.append(
+                Step(len(record.steps), time, size, now["torque"], now["rate"], now["acceleration"], call.status)
+            )
             if call.status == "OK" and (now["rate"] or now["acceleration"]):
                 # The FMU moves a ramped input along its polynomial to the step's end.
                 now["torque"] += size * (now["rate"] + 0.5 * size * now["acceleration"])
@@ -329,16 +344,25 @@ def reconstruct(calls: list[Call]) -> dict[str, InstanceCalls]:
             record.events.append(f"call {number}: reset at t = {call.time_before}")
         elif name in ("SetFMUstate", "SetFMUState"):
             record.restores.append((number, call.time_before, call.time_after))
-            record.events.append(f"call {number}: FMU state restored: t = {call.time_before} -> "
-                                 f"{call.time_after}")
-        elif name in ("GetFMUstate", "GetFMUState", "SerializeFMUstate", "SerializeFMUState",
-                      "DeSerializeFMUstate", "DeSerializeFMUState"):
+            record.events.append(f"call {number}: FMU state restored: t = {call.time_before} -> {call.time_after}")
+        elif name in (
+            "GetFMUstate",
+            "GetFMUState",
+            "SerializeFMUstate",
+            "SerializeFMUState",
+            "DeSerializeFMUstate",
+            "DeSerializeFMUState",
+        ):
             record.events.append(f"call {number}: {call.function} at t = {call.time_before}")
         elif name == "SetTime":
             record.model_exchange_times.append(_number(call.arguments["time"]))
         elif name == "SetContinuousStates":
             now["states"] = list(call.values.values())
-        elif name in ("GetDerivatives", "GetContinuousStateDerivatives") and "states" in now and call.time_before is not None:
+        elif (
+            name in ("GetDerivatives", "GetContinuousStateDerivatives")
+            and "states" in now
+            and call.time_before is not None
+        ):
             record.evaluations.append((call.time_before, now["states"], list(call.values.values())))
     return instances
 
@@ -360,7 +384,7 @@ class IntendedRun:
     start_time : float
     """
 
-    torque: object
+    torque: TorqueSignal
     ramp: bool = False
     parameters: dict = field(default_factory=dict)
     start_values: dict = field(default_factory=dict)
@@ -377,14 +401,17 @@ def _first_mismatch(applied: np.ndarray, intended: np.ndarray) -> int | None:
 
 
 def _shift(applied: np.ndarray, intended: np.ndarray, first: int) -> int | None:
-    """k > 0 when from `first` on each step applies what step k earlier was meant to (late), k < 0
-    when what step |k| later was meant to (early); None when no shift explains the steps."""
+    """The shift k of the steps from `first` on, or None when no shift explains them.
+
+    k > 0: each step applies what step k earlier was meant to (late); k < 0: what step |k| later
+    was meant to (early).
+    """
     n = len(applied)
     for k in (k for size in range(1, MAX_SHIFT + 1) for k in (size, -size)):
         lo, hi = max(first, k), min(n, n + k)
         if hi - lo < 1:
             continue
-        if _first_mismatch(applied[lo:hi], intended[lo - k:hi - k]) is None:
+        if _first_mismatch(applied[lo:hi], intended[lo - k : hi - k]) is None:
             return k
     return None
 
@@ -419,96 +446,131 @@ def differences(record: InstanceCalls, intended: IntendedRun) -> list[str]:
         if variable not in record.set_before_start and value != 0.0:
             found.append(f"start value {variable} not set (intended {value:.17g})")
         elif variable in record.set_before_start and not _close(record.set_before_start[variable], value):
-            found.append(f"start value {variable} set to {record.set_before_start[variable]:.17g}, "
-                         f"intended {value:.17g}")
+            found.append(
+                f"start value {variable} set to {record.set_before_start[variable]:.17g}, intended {value:.17g}"
+            )
     for number, before, after in record.restores:
         if before is not None and after is not None and not math.isclose(before, after, abs_tol=TIME_TOLERANCE):
             found.append(f"call {number}: an FMU state restored to t = {after:.17g} at t = {before:.17g}")
     if not any(before is not None for _, before, _ in record.restores):
-        found.extend(f"call {number}: the master went back from t = {reached:.17g} to t = "
-                     f"{time:.17g} (an FMU state restored to another time)"
-                     for number, reached, time in record.rewinds)
+        found.extend(
+            f"call {number}: the master went back from t = {reached:.17g} to t = "
+            f"{time:.17g} (an FMU state restored to another time)"
+            for number, reached, time in record.rewinds
+        )
     steps = record.steps
     if record.interface == "ModelExchange" or (not steps and record.model_exchange_times):
         found.extend(_model_exchange(record))
         return found
     if not steps:
-        return found + ["no communication step taken"]
+        return [*found, "no communication step taken"]
     sizes = np.array([step.size for step in steps])
     times = np.array([step.time for step in steps])
     size = float(sizes[0])
     if not np.allclose(sizes, size, rtol=TIME_TOLERANCE, atol=0):
         k = int(np.flatnonzero(~np.isclose(sizes, size, rtol=TIME_TOLERANCE, atol=0))[0])
-        found.append(f"variable step sizes: {sizes.min():.17g} to {sizes.max():.17g} s (step {k} "
-                     f"at t = {times[k]:.17g} is {sizes[k]:.17g} s, step 0 {size:.17g} s)")
+        found.append(
+            f"variable step sizes: {sizes.min():.17g} to {sizes.max():.17g} s (step {k} "
+            f"at t = {times[k]:.17g} is {sizes[k]:.17g} s, step 0 {size:.17g} s)"
+        )
         return found
     grid = intended.start_time + size * np.arange(len(steps))
     drift = np.abs(times - grid)
     if drift.max() > TIME_TOLERANCE * max(1.0, abs(grid[-1])):
         k = int(np.argmax(drift > TIME_TOLERANCE * max(1.0, abs(grid[-1]))))
-        found.append(f"communication points drift: step {k} starts at t = {times[k]:.17g}, not "
-                     f"{grid[k]:.17g} (up to {drift.max():.3g} s off by step {int(np.argmax(drift))})")
-    plan = schedule(intended.torque, start_time=intended.start_time,
-                    stop_time=float(times[-1] + sizes[-1]), step_size=size, ramp=intended.ramp)
+        found.append(
+            f"communication points drift: step {k} starts at t = {times[k]:.17g}, not "
+            f"{grid[k]:.17g} (up to {drift.max():.3g} s off by step {int(np.argmax(drift))})"
+        )
+    plan = schedule(
+        intended.torque,
+        start_time=intended.start_time,
+        stop_time=float(times[-1] + sizes[-1]),
+        step_size=size,
+        ramp=intended.ramp,
+    )
     n = min(len(steps), len(plan.torque))
     applied = np.array([step.torque for step in steps[:n]])
     rate = np.array([step.torque_rate for step in steps[:n]])
     first = _first_mismatch(applied, plan.torque[:n])
     if first is not None:
-        k = _shift(applied, plan.torque[:n], first)
+        shift = _shift(applied, plan.torque[:n], first)
         at = f"from step {first} (t = {times[first]:.17g})"
-        if k is not None and k > 0:
-            found.append(f"input applied {k} step{'s' * (k > 1)} late {at}: step n holds the torque "
-                         f"meant for step n-{k} (set after the step it was meant for)")
-        elif k is not None:
-            found.append(f"input applied {-k} step{'s' * (k < -1)} early {at}: step n holds the "
-                         f"torque meant for step n+{-k}")
+        if shift is not None and shift > 0:
+            found.append(
+                f"input applied {shift} step{'s' * (shift > 1)} late {at}: step n holds the torque "
+                f"meant for step n-{shift} (set after the step it was meant for)"
+            )
+        elif shift is not None:
+            found.append(
+                f"input applied {-shift} step{'s' * (shift < -1)} early {at}: step n holds the torque "
+                f"meant for step n+{-shift}"
+            )
         else:
-            found.append(f"torque differs {at}: {applied[first]:.17g} N.m applied, "
-                         f"{plan.torque[first]:.17g} N.m intended")
+            found.append(
+                f"torque differs {at}: {applied[first]:.17g} N.m applied, {plan.torque[first]:.17g} N.m intended"
+            )
     ramps, should_ramp = rate != 0, plan.torque_rate[:n] != 0
     if (ramps & ~should_ramp).any():
         k = int(np.flatnonzero(ramps & ~should_ramp)[0])
-        found.append(f"ramped where it should hold from step {k} (t = {times[k]:.17g}): "
-                     f"der(torque) = {rate[k]:.17g} N.m/s")
+        found.append(
+            f"ramped where it should hold from step {k} (t = {times[k]:.17g}): der(torque) = {rate[k]:.17g} N.m/s"
+        )
     if (~ramps & should_ramp).any():
         k = int(np.flatnonzero(~ramps & should_ramp)[0])
-        found.append(f"held where it should ramp from step {k} (t = {times[k]:.17g}): intended "
-                     f"der(torque) = {plan.torque_rate[k]:.17g} N.m/s")
+        found.append(
+            f"held where it should ramp from step {k} (t = {times[k]:.17g}): intended "
+            f"der(torque) = {plan.torque_rate[k]:.17g} N.m/s"
+        )
     elif (ramps & should_ramp).any():
         wrong = np.flatnonzero(ramps & should_ramp & ~np.isclose(rate, plan.torque_rate[:n], rtol=1e-9))
         if len(wrong):
             k = int(wrong[0])
-            found.append(f"ramp rate differs from step {k} (t = {times[k]:.17g}): {rate[k]:.17g} "
-                         f"N.m/s applied, {plan.torque_rate[k]:.17g} intended")
+            found.append(
+                f"ramp rate differs from step {k} (t = {times[k]:.17g}): {rate[k]:.17g} "
+                f"N.m/s applied, {plan.torque_rate[k]:.17g} intended"
+            )
     if len(steps) != len(plan.torque):
         found.append(f"{len(steps)} steps taken, {len(plan.torque)} intended")
     return found
 
 
 def _model_exchange(record: InstanceCalls) -> list[str]:
-    """What a Model Exchange master's integrator was: explicit Euler when each state it set is
-    the previous one plus the time between them times the derivatives there, exactly."""
+    """What a Model Exchange master's integrator was, from its calls.
+
+    Explicit Euler when each state it set is the previous one plus the time between them times
+    the derivatives there, exactly.
+    """
     times = np.unique(np.array(record.model_exchange_times))
     if len(times) < 2:
         return ["Model Exchange master: fewer than two time points set"]
     points = np.diff(times)
-    summary = (f"{len(record.model_exchange_times)} fmi2SetTime calls at {len(times)} distinct "
-               f"times, {float(times[0]):.17g} to {float(times[-1]):.17g} s, "
-               f"{len(record.evaluations)} derivative evaluations")
-    pairs = list(zip(record.evaluations, record.evaluations[1:]))
+    summary = (
+        f"{len(record.model_exchange_times)} fmi2SetTime calls at {len(times)} distinct "
+        f"times, {float(times[0]):.17g} to {float(times[-1]):.17g} s, "
+        f"{len(record.evaluations)} derivative evaluations"
+    )
+    pairs = list(zip(record.evaluations, record.evaluations[1:], strict=False))
     euler = bool(pairs) and all(
         t1 > t0 and np.allclose(x1, np.array(x0) + (t1 - t0) * np.array(dx0), rtol=1e-12, atol=1e-15)
-        for (t0, x0, dx0), (t1, x1, _) in pairs)
+        for (t0, x0, dx0), (t1, x1, _) in pairs
+    )
     if euler:
         sizes = np.diff([t for t, _, _ in record.evaluations])
-        step = (f"step {sizes[0]:.17g} s" if np.allclose(sizes, sizes[0], rtol=TIME_TOLERANCE, atol=0)
-                else f"steps {sizes.min():.17g} to {sizes.max():.17g} s")
-        return [f"Model Exchange master: explicit Euler at {step}, one derivative evaluation per "
-                f"step ({summary}); its error grows with the step, unlike the co-simulation FMU's "
-                "own integrator"]
-    return [f"Model Exchange master: not explicit Euler: {summary}, time points {points.min():.3g} "
-            f"to {points.max():.3g} s apart (a multi-stage or variable-step integrator)"]
+        step = (
+            f"step {sizes[0]:.17g} s"
+            if np.allclose(sizes, sizes[0], rtol=TIME_TOLERANCE, atol=0)
+            else f"steps {sizes.min():.17g} to {sizes.max():.17g} s"
+        )
+        return [
+            f"Model Exchange master: explicit Euler at {step}, one derivative evaluation per "
+            f"step ({summary}); its error grows with the step, unlike the co-simulation FMU's "
+            "own integrator"
+        ]
+    return [
+        f"Model Exchange master: not explicit Euler: {summary}, time points {points.min():.3g} "
+        f"to {points.max():.3g} s apart (a multi-stage or variable-step integrator)"
+    ]
 
 
 def timeline(record: InstanceCalls) -> list[str]:
@@ -529,14 +591,18 @@ def timeline(record: InstanceCalls) -> list[str]:
     """
     lines = [f"instance {record.instance} ({record.interface})"]
     if record.set_before_start:
-        lines.append("  set before initialization ended: " + ", ".join(
-            f"{name}={value:.17g}" for name, value in record.set_before_start.items()))
+        lines.append(
+            "  set before initialization ended: "
+            + ", ".join(f"{name}={value:.17g}" for name, value in record.set_before_start.items())
+        )
     lines.append(f"  {len(record.steps)} steps")
     for step in record.steps:
         ramp = (f", der(torque)={step.torque_rate:.17g}" if step.torque_rate else "") + (
-            f", der(torque,2)={step.torque_acceleration:.17g}" if step.torque_acceleration else "")
-        lines.append(f"  step {step.index}: t={step.time:.17g} h={step.size:.17g} "
-                     f"torque={step.torque:.17g}{ramp} {step.status}")
+            f", der(torque,2)={step.torque_acceleration:.17g}" if step.torque_acceleration else ""
+        )
+        lines.append(
+            f"  step {step.index}: t={step.time:.17g} h={step.size:.17g} torque={step.torque:.17g}{ramp} {step.status}"
+        )
     lines.extend(f"  {event}" for event in record.events)
     return lines
 
@@ -568,9 +634,14 @@ def judge_calls(log: str | Path, intended: IntendedRun | None, variable_names: d
     >>> judge_calls("run.log", IntendedRun(torque=20.0), {0: "torque"})  # doctest: +SKIP
     """
     instances = reconstruct(read_calls(log, variable_names))
-    return {name: {**asdict(record), "timeline": timeline(record),
-                   "differences": None if intended is None else differences(record, intended)}
-            for name, record in instances.items()}
+    return {
+        name: {
+            **asdict(record),
+            "timeline": timeline(record),
+            "differences": None if intended is None else differences(record, intended),
+        }
+        for name, record in instances.items()
+    }
 
 
 def format_calls(judged: dict, steps_shown: int = 20) -> str:
@@ -596,14 +667,14 @@ def format_calls(judged: dict, steps_shown: int = 20) -> str:
             if len(step_lines) > steps_shown:
                 hidden = set(step_lines[steps_shown:])
                 shown = [line for line in shown if line not in hidden] + [
-                    f"  ... {len(step_lines) - steps_shown} more steps (--json has them all)"]
+                    f"  ... {len(step_lines) - steps_shown} more steps (--json has them all)"
+                ]
             lines.extend(shown)
         elif found:
             lines.append(f"instance {name}: {len(found)} difference{'s' * (len(found) > 1)} from the intended run")
             lines.extend(f"  {line}" for line in found)
         else:
-            lines.append(f"instance {name}: the master did what the intended run asks "
-                         f"({len(result['steps'])} steps)")
+            lines.append(f"instance {name}: the master did what the intended run asks ({len(result['steps'])} steps)")
     return "\n".join(lines)
 
 
