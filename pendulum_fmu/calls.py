@@ -482,13 +482,7 @@ def differences(record: InstanceCalls, intended: IntendedRun) -> list[str]:
             f"communication points drift: step {k} starts at t = {times[k]:.17g}, not "
             f"{grid[k]:.17g} (up to {drift.max():.3g} s off by step {int(np.argmax(drift))})"
         )
-    plan = schedule(
-        intended.torque,
-        start_time=intended.start_time,
-        stop_time=float(times[-1] + sizes[-1]),
-        step_size=size,
-        ramp=intended.ramp,
-    )
+    plan = _plan(record, intended)
     n = min(len(steps), len(plan.torque))
     applied = np.array([step.torque for step in steps[:n]])
     rate = np.array([step.torque_rate for step in steps[:n]])
@@ -533,6 +527,18 @@ def differences(record: InstanceCalls, intended: IntendedRun) -> list[str]:
     if len(steps) != len(plan.torque):
         found.append(f"{len(steps)} steps taken, {len(plan.torque)} intended")
     return found
+
+
+def _plan(record: InstanceCalls, intended: IntendedRun):
+    """The intended run's schedule on the master's first step size, to where its steps end."""
+    last = record.steps[-1]
+    return schedule(
+        intended.torque,
+        start_time=intended.start_time,
+        stop_time=last.time + last.size,
+        step_size=record.steps[0].size,
+        ramp=intended.ramp,
+    )
 
 
 def _model_exchange(record: InstanceCalls) -> list[str]:
@@ -622,7 +628,8 @@ def judge_calls(log: str | Path, intended: IntendedRun | None, variable_names: d
     -------
     dict
         {instance: {"steps": [...], "set_before_start": {...}, "events": [...],
-        "differences": [...] or None}}.
+        "differences": [...] or None, "intended_torque": the torque each step of the intended
+        run holds at its start, or None}}.
 
     Raises
     ------
@@ -639,6 +646,9 @@ def judge_calls(log: str | Path, intended: IntendedRun | None, variable_names: d
             **asdict(record),
             "timeline": timeline(record),
             "differences": None if intended is None else differences(record, intended),
+            "intended_torque": None
+            if intended is None or not record.steps
+            else _plan(record, intended).torque.tolist(),
         }
         for name, record in instances.items()
     }

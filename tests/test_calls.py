@@ -9,6 +9,7 @@ the loop below (a torque a step late, a parameter left out), so the step and val
 are known from how the loop was written.
 """
 
+import json
 import subprocess
 import sys
 
@@ -205,6 +206,14 @@ def test_fmpy_simulate_command_line_late_first_jump(fmu, tmp_path):
     ]
     assert main(["judge", "--calls", str(log), "--torque-file", str(csv), "--fmu", str(fmu)]) == 1
     assert main(["judge", "--calls", str(log), "--fmu", str(fmu)]) == 0
+    figure, numbers = tmp_path / "calls.png", tmp_path / "calls.json"
+    arguments = ["--torque-file", str(csv), "--fmu", str(fmu), "--plot", str(figure), "--json", str(numbers)]
+    assert main(["judge", "--calls", str(log), *arguments]) == 1
+    assert figure.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    written = json.loads(numbers.read_text())["Pendulum"]
+    assert written["differences"] == found
+    assert [step["torque"] for step in written["steps"]] == [0] + [20] * 9
+    assert written["intended_torque"] == [20] * 10
 
 
 LIBCOSIM_RUN = """

@@ -148,7 +148,7 @@ def _judge_calls(args, signal) -> int:
 
     if args.result is not None:
         raise InvalidInput(f"--calls judges a log, not a result: leave out {args.result}")
-    check_outputs({"--json": args.json}, {"--calls": args.calls})
+    check_outputs({"--json": args.json, "--plot": args.plot}, {"--calls": args.calls})
     intended = (
         None
         if signal is None
@@ -163,6 +163,10 @@ def _judge_calls(args, signal) -> int:
     names = {variable.valueReference: name for name, variable in variables(args.fmu).items()}
     judged = judge_calls(args.calls, intended, names)
     print(format_calls(judged))
+    if args.plot:
+        from ..plot import plot_calls
+
+        print(f"wrote {plot_calls(judged, args.plot, args.calls.name)}")
     if args.json:
         print(f"wrote {write_calls_json(judged, args.json)}")
     return 0 if all(not result["differences"] for result in judged.values()) else 1
