@@ -450,7 +450,7 @@ fmi2Status fmi2SetContinuousStates(fmi2Component c, const fmi2Real x[], size_t n
     KEEP_TIME
     REQUIRE_ARRAY(x, nx)
     const Status status = instance_set_states(instance, function, x, nx);
-    RECORD_VALUES(status, NULL, NULL, nx, x)
+    RECORD_VALUES(status, NULL, NULL, status == STATUS_OK ? nx : 0, x)
     return STATUS(status);
 }
 

@@ -634,7 +634,7 @@ fmi3Status fmi3SetContinuousStates(fmi3Instance c, const fmi3Float64 continuousS
     KEEP_TIME
     REQUIRE_ARRAY(continuousStates, nContinuousStates)
     const Status status = instance_set_states(instance, function, continuousStates, nContinuousStates);
-    RECORD_VALUES(status, NULL, NULL, nContinuousStates, continuousStates)
+    RECORD_VALUES(status, NULL, NULL, status == STATUS_OK ? nContinuousStates : 0, continuousStates)
     return STATUS(status);
 }
 
