@@ -53,9 +53,15 @@ void instance_record_call(const Instance *instance, const char *function, double
     va_start(args, format);
     vsnprintf(arguments, sizeof(arguments), format, args);
     va_end(args);
+    /* The name sits between double quotes, so a reader finds where it ends: any in it become ' */
+    char name[MAX_INSTANCE_NAME];
+    for (size_t i = 0; i < sizeof(name); i++) {
+        name[i] = instance->name[i] == '"' ? '\'' : instance->name[i];
+        if (!name[i]) break;
+    }
     instance_log(instance, STATUS_OK, LOG_CALLS,
                  CALL_RECORD_MARKER " instance=\"%s\" %s(%s) time=%.17g->%.17g status=%s",
-                 instance->name, function, arguments, time_before, instance->data.time,
+                 name, function, arguments, time_before, instance->data.time,
                  status_names[status]);
 }
 
