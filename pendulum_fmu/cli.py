@@ -22,8 +22,9 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__
-from .build import CHECKOUT_FMUS, FMI_VERSIONS, PLATFORMS, BuildError, PlatformSkipped, check_platforms
-from .errors import InvalidInput, PendulumFmuError
+from . import FMU_FILES
+from ._checkout import build_tool, is_source_checkout
+from .errors import BuildError, InvalidInput, PendulumFmuError, PlatformSkipped
 from .stop_signals import STOPPING_SIGNALS, Stopped, restore_signals, stop_on_signals
 from .sweep import DEFAULT_MAX_CASES
 from .torque_schedule import DEFAULT_MAX_STEPS
@@ -111,7 +112,7 @@ def _add_fmu_argument(parser) -> None:
 def _platforms(text: str) -> tuple[str, ...]:
     platforms = tuple(name.strip() for name in text.split(",") if name.strip())
     try:
-        check_platforms(platforms)
+        build_tool().check_platforms(platforms)
     except BuildError as error:
         raise argparse.ArgumentTypeError(str(error)) from None
     return platforms
@@ -120,13 +121,20 @@ def _platforms(text: str) -> tuple[str, ...]:
 # --- the commands: each parses its arguments into one call and prints what came back ----------
 
 def cmd_build(args) -> int:
-    from .build import build_fmu
-
-    output = args.output or CHECKOUT_FMUS[args.fmi_version]
-    path = build_fmu(output, platforms=args.platforms, fmi_version=args.fmi_version, linux_glibc=args.linux_glibc)
+    build = build_tool()
+    output = args.output or build.CHECKOUT_FMUS[args.fmi_version]
+    path = build.build_fmu(output, platforms=args.platforms, fmi_version=args.fmi_version, linux_glibc=args.linux_glibc)
     with zipfile.ZipFile(path) as fmu:
         binaries = [name for name in fmu.namelist() if name.startswith("binaries/")]
     print(f"wrote {path} ({', '.join(binaries)})")
+    return 0
+
+
+def cmd_export(args) -> int:
+    from .export import export_fmu
+
+    exported = export_fmu(args.output, fmi_version=args.fmi_version, overwrite=args.overwrite)
+    print(f"wrote {exported.path} (binaries for {', '.join(exported.platforms)})")
     return 0
 
 
@@ -314,7 +322,11 @@ def cmd_scenarios(args) -> int:
 # --- the parser: one function per command ---------------------------------------------------
 
 def _add_build(commands) -> argparse.ArgumentParser:
-    build = commands.add_parser("build", help="build the FMU (same as python build_fmu.py)",
+    # The developer's build (python build_fmu.py), listed only in a checkout; users take the FMU
+    # with export.
+    tool = build_tool()
+    CHECKOUT_FMUS, FMI_VERSIONS, PLATFORMS = tool.CHECKOUT_FMUS, tool.FMI_VERSIONS, tool.PLATFORMS
+    build = commands.add_parser("build", help="build the FMU in a checkout (same as python build_fmu.py)",
                                 description="Build the FMU from fmu_src/ and modelDescription.xml "
                                             "(a source checkout or the unpacked sdist).")
     build.add_argument("--output", type=_output_path, default=None,
@@ -331,6 +343,21 @@ def _add_build(commands) -> argparse.ArgumentParser:
                             "this machine's glibc)")
     build.set_defaults(run=cmd_build)
     return build
+
+
+def _add_export(commands) -> argparse.ArgumentParser:
+    export = commands.add_parser("export", help="write the FMU into the current folder",
+                                 description="Write the FMU (Pendulum.fmu, or Pendulum-fmi3.fmu for FMI 3.0) "
+                                             "and say which platforms it has binaries for.")
+    export.add_argument("--fmi-version", type=int, choices=tuple(FMU_FILES), default=2,
+                        help="FMI standard of the FMU (default: %(default)s)")
+    export.add_argument("--output", type=_output_path, default=None,
+                        help=f"where to write it (default: {FMU_FILES[2]}, or {FMU_FILES[3]} for FMI 3.0, "
+                             "in the current folder)")
+    export.add_argument("--overwrite", action="store_true",
+                        help="replace a file already at the output path (default: refuse)")
+    export.set_defaults(run=cmd_export)
+    return export
 
 
 def _add_cross_check(commands) -> argparse.ArgumentParser:
@@ -510,7 +537,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--debug", action="store_true", default=False,
                         help="show the Python traceback of an error instead of one line")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for add in (_add_build, _add_cross_check, _add_simulate, _add_compare, _add_sweep, _add_demo,
+    developer = (_add_build,) if is_source_checkout() else ()
+    for add in (*developer, _add_export, _add_cross_check, _add_simulate, _add_compare, _add_sweep, _add_demo,
                 _add_judge, _add_scenarios):
         # Also after the command's name; SUPPRESS keeps it from hiding one given before it.
         add(commands).add_argument("--debug", action="store_true", default=argparse.SUPPRESS,

@@ -14,12 +14,13 @@ OSError for a file, ...). The kinds that belong to one module live there:
     judge.ResultFileError             a result file, or a kit's folder, that cannot be judged
     scenarios.KitExists               an output folder holding a scenario kit the run was not asked to replace
     demo.DemoExists                   an output folder holding a demo's outputs the run was not asked to replace
+    export.FmuExists                  an export's output file the run was not asked to replace
     engines.ToolCannotRamp            a ramp given to a tool that holds the torque
     engines.drake.UnequalSteps        unequal steps given to drake:default
     sweep.store.InUse                 an output folder another run holds
     sweep.store.StudyExists           an output folder holding a study the run was not asked to replace
     sweep.client.SchedulerUnreachable a dask scheduler that does not answer
-    build.BuildError                  an FMU that cannot be built
+    BuildError                        an FMU that cannot be built (by a checkout's fmu_build/)
 """
 
 
@@ -48,3 +49,14 @@ class CannotWrite(PendulumFmuError, OSError):
 
 class MissingDependency(PendulumFmuError, ImportError):
     """An optional package a tool needs is not installed; the message gives the pip command."""
+
+
+class BuildError(PendulumFmuError, RuntimeError):
+    """The FMU could not be built; the message says why. Raised by the repository's build tool
+    (fmu_build/, beside the package in a checkout), and defined here so that the package's callers
+    catch it without that tool."""
+
+
+class PlatformSkipped(UserWarning):
+    """A platform left out of a default build because its compiler is missing (the build tool
+    warns; the command line shows it in one line)."""

@@ -17,7 +17,7 @@ import pytest
 from fmpy import read_model_description
 
 from pendulum_fmu import __version__
-from pendulum_fmu.build import MODEL_DESCRIPTION, build_fmu
+from fmu_build import MODEL_DESCRIPTION, build_fmu
 from pendulum_fmu.cli import main
 from pendulum_fmu.parameters import default_parameters
 from pendulum_fmu.reference import reference

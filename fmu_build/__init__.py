@@ -1,4 +1,7 @@
-"""Build Pendulum.fmu from fmu_src/ and modelDescription.xml, for every platform we can compile for.
+"""The repository's build of Pendulum.fmu from fmu_src/ and modelDescription.xml, for every platform
+we can compile for: `python build_fmu.py`, the wheel build (setup.py, build_wheels.py), and a
+checkout's pendulum_fmu.default_fmu() when a source is newer than dist/Pendulum.fmu.
+It is a tool of the repository, not part of the installed package.
 
 The one build description is CMakeLists.txt (with a toolchain file per cross target in cmake/);
 this module drives it. The C code takes its value references, names and start values from the
@@ -33,9 +36,11 @@ from pathlib import Path
 import fmpy
 from fmpy import read_model_description
 
-from . import FMU_FILES, __version__, fmi3
-from .atomic_files import check_writable, replacing_path
-from .errors import PendulumFmuError
+from pendulum_fmu import FMU_FILES, __version__
+from pendulum_fmu.atomic_files import check_writable, replacing_path
+from pendulum_fmu.errors import BuildError, PlatformSkipped
+
+from . import fmi3
 
 ROOT = Path(__file__).resolve().parent.parent
 CMAKE_LISTS = ROOT / "CMakeLists.txt"
@@ -143,14 +148,6 @@ PLATFORMS = {platform.fmi2_folder: platform for platform in (
 )}
 
 
-class BuildError(PendulumFmuError, RuntimeError):
-    """The FMU could not be built; the message says why."""
-
-
-class PlatformSkipped(UserWarning):
-    """A platform left out of a default build because its compiler is missing."""
-
-
 def _check_sources_present() -> None:
     if not is_source_checkout():
         raise BuildError(
@@ -170,7 +167,7 @@ def generate_variables(model_description, out_dir: Path) -> list[Path]:
             )
     enum = ",\n".join(f"    VR_{v.name.upper()} = {v.valueReference}" for v in variables)
     inputs = ", ".join(f"VR_{v.name.upper()}" for v in variables if v.causality == "input")
-    header = f"""/* Generated from modelDescription.xml by pendulum_fmu/build.py: edit the XML, not this. */
+    header = f"""/* Generated from modelDescription.xml by fmu_build: edit the XML, not this. */
 #ifndef MODEL_VARIABLES_H
 #define MODEL_VARIABLES_H
 
@@ -195,7 +192,7 @@ extern const VariableInfo model_variables[N_VARIABLES];
         f"INITIAL_{(v.initial or 'none').upper()}, {float(v.start or 0.0)!r}}}"
         for v in variables
     )
-    table = f"""/* Generated from modelDescription.xml by pendulum_fmu/build.py: edit the XML, not this. */
+    table = f"""/* Generated from modelDescription.xml by fmu_build: edit the XML, not this. */
 #include "model_variables.h"
 
 const VariableInfo model_variables[N_VARIABLES] = {{
@@ -570,8 +567,7 @@ def build_pid_controller(out_file: str | os.PathLike) -> Path:
 
 def build_inputs() -> list[Path]:
     """Every file a checkout's FMU is built from: when one is newer than the FMU, it is stale."""
-    package = Path(__file__).parent
-    return [MODEL_DESCRIPTION, CMAKE_LISTS, Path(__file__), package / "__init__.py", Path(fmi3.__file__),
+    return [MODEL_DESCRIPTION, CMAKE_LISTS, ROOT / "pendulum_fmu" / "__init__.py", *Path(__file__).parent.glob("*.py"),
             *TOOLCHAINS.glob("*.cmake"), *(p for p in SOURCE_DIR.rglob("*") if p.is_file())]
 
 
