@@ -33,7 +33,6 @@ import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 
-import fmpy
 from fmpy import read_model_description
 
 from pendulum_fmu import FMU_FILES, __version__
@@ -41,6 +40,7 @@ from pendulum_fmu.atomic_files import check_writable, replacing_path
 from pendulum_fmu.errors import BuildError, PlatformSkipped
 
 from . import fmi3
+from .model_variables import ModelDescriptionError, generate_variables
 
 ROOT = Path(__file__).resolve().parent.parent
 CMAKE_LISTS = ROOT / "CMakeLists.txt"
@@ -53,10 +53,9 @@ FMI_VERSIONS = tuple(FMU_FILES)
 # FMI version -> the FMU a checkout builds and runs when none is named.
 CHECKOUT_FMUS = {version: ROOT / "dist" / name for version, name in FMU_FILES.items()}
 DEFAULT_FMU = CHECKOUT_FMUS[2]
-GENERATED_SOURCES = ("model_variables.h", "model_variables.c")
 MODEL_FILES = ("config.h", "model.c")
-# The FMI headers fmpy ships, rather than a vendored copy.
-FMI_HEADERS = Path(fmpy.__file__).parent / "c-code"
+# The FMI standard's own headers, kept in the repository as the Reference FMUs keep them.
+FMI_HEADERS = HEADERS_DIR / "fmi"
 
 
 @dataclass(frozen=True)
@@ -156,58 +155,13 @@ def _check_sources_present() -> None:
             "sdist; an installed package uses its packaged FMU (pendulum_fmu.default_fmu())")
 
 
-def generate_variables(model_description, out_dir: Path) -> list[Path]:
-    """Write model_variables.h (GUID, value reference enum) and model_variables.c (the table)."""
-    variables = model_description.modelVariables
-    for index, variable in enumerate(variables):
-        if variable.valueReference != index or variable.type != "Real":
-            raise BuildError(
-                f"{MODEL_DESCRIPTION}: variable {variable.name!r} must be Real with valueReference "
-                f"{index}: the C code indexes one array of Reals by value reference"
-            )
-    enum = ",\n".join(f"    VR_{v.name.upper()} = {v.valueReference}" for v in variables)
-    inputs = ", ".join(f"VR_{v.name.upper()}" for v in variables if v.causality == "input")
-    header = f"""/* Generated from modelDescription.xml by fmu_build: edit the XML, not this. */
-#ifndef MODEL_VARIABLES_H
-#define MODEL_VARIABLES_H
-
-#include "variable.h"
-
-#define MODEL_GUID "{model_description.guid}"
-#define N_VARIABLES {len(variables)}
-/* The inputs' value references: a step updates these, without a pass over every variable. */
-#define N_INPUTS {sum(v.causality == "input" for v in variables)}
-#define INPUT_REFERENCES {{{inputs}}}
-
-typedef enum {{
-{enum}
-}} ValueReference;
-
-extern const VariableInfo model_variables[N_VARIABLES];
-
-#endif
-"""
-    rows = ",\n".join(
-        f'    {{"{v.name}", CAUSALITY_{_enum_name(v.causality)}, VARIABILITY_{v.variability.upper()}, '
-        f"INITIAL_{(v.initial or 'none').upper()}, {float(v.start or 0.0)!r}}}"
-        for v in variables
-    )
-    table = f"""/* Generated from modelDescription.xml by fmu_build: edit the XML, not this. */
-#include "model_variables.h"
-
-const VariableInfo model_variables[N_VARIABLES] = {{
-{rows}
-}};
-"""
-    out_dir.mkdir(parents=True, exist_ok=True)
-    paths = [out_dir / name for name in GENERATED_SOURCES]
-    paths[0].write_text(header)
-    paths[1].write_text(table)
-    return paths
-
-
-def _enum_name(causality: str) -> str:
-    return "CALCULATED_PARAMETER" if causality == "calculatedParameter" else causality.upper()
+def _generate_variables(xml: Path, out_dir: Path) -> None:
+    """model_variables.h/.c, as CMake generates them too; BuildError for a description the C code
+    cannot take."""
+    try:
+        generate_variables(xml, out_dir)
+    except ModelDescriptionError as error:
+        raise BuildError(str(error)) from None
 
 
 def _check_source_files(model_description, xml: Path, sources: Path, fmi_version: int = 2) -> None:
@@ -229,7 +183,7 @@ def assemble_sources(sources: Path, model_dir: Path = PENDULUM_DIR,
     _check_sources_present()
     sources = Path(sources)
     sources.mkdir()
-    generate_variables(read_model_description(str(model_description_file)), sources)
+    _generate_variables(model_description_file, sources)
     _copy_sources(Path(model_dir), sources, fmi_version)
     return sources
 
@@ -319,7 +273,9 @@ def cmake_build(target: Target, work: Path, cmake_target: str, definitions: dict
     cmake = _cmake()
     build, installed = work / "build", work / "installed"
     environment = dict(os.environ)
+    # This Python runs the variables' generator (fmu_build/model_variables.py), as CMake would find it.
     configure = [cmake, "-S", project, "-B", build, f"-DFMI_HEADERS={FMI_HEADERS}",
+                 f"-DPython3_EXECUTABLE={sys.executable}",
                  *(f"-D{name}={value}" for name, value in (definitions or {}).items())]
     cross = not target.native or target.built_by_zig(linux_glibc)
     # On a Mac too: its toolchain file sets the architecture and the oldest macOS.
@@ -380,7 +336,7 @@ def compile_native_loop(platform: str, out_dir: str | os.PathLike, linux_glibc: 
     check_platforms([platform])
     check_toolchain(PLATFORMS[platform], linux_glibc=linux_glibc)
     with tempfile.TemporaryDirectory(prefix="pendulum_fmu_native_loop_") as tmp:
-        slices = [cmake_build(target, Path(tmp, target.name), "_cs_loop", linux_glibc=linux_glibc)
+        slices = [cmake_build(target, Path(tmp, target.name), "_cs_loop", {"MODEL_DIR": ""}, linux_glibc=linux_glibc)
                   for target in PLATFORMS[platform].targets]
         built = _merged(slices, Path(tmp, slices[0].name))
         out_file = Path(out_dir, built.name)
@@ -525,18 +481,15 @@ def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, *, model_dir: Path = PE
     identifier = model_description.coSimulation.modelIdentifier
     with tempfile.TemporaryDirectory(prefix="pendulum_fmu_build_") as tmp:
         tmp = Path(tmp)
-        generated = tmp / "generated"
-        generate_variables(model_description, generated)
         sources = tmp / "sources"
         sources.mkdir()
         _copy_sources(model_dir, sources, fmi_version)
-        for path in generated.iterdir():
-            shutil.copy2(path, sources)
+        _generate_variables(model_description_file, sources)  # as CMake generates them for the binaries
         _check_source_files(model_description, model_description_file, sources, fmi_version)
         if fmi_version == 3:
             (sources / "buildDescription.xml").write_text(fmi3.build_description(model_description_file))
-        definitions = {"MODEL_DIR": model_dir.resolve(), "GENERATED_DIR": generated,
-                       "MODEL_IDENTIFIER": identifier, "FMI_VERSION": fmi_version}
+        definitions = {"MODEL_DIR": model_dir.resolve(), "MODEL_DESCRIPTION": Path(model_description_file).resolve(),
+                       "FMI_VERSION": fmi_version}
         binaries = {}
         for name in platforms:
             platform = PLATFORMS[name]
