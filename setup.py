@@ -16,6 +16,7 @@ import importlib.machinery
 import shutil
 import sys
 import tempfile
+import warnings
 from pathlib import Path
 
 from setuptools import Extension, setup
@@ -35,13 +36,21 @@ class BuildPyWithFmu(build_py):
         # An editable install runs from the checkout, which builds dist/Pendulum.fmu on demand.
         if getattr(self, "editable_mode", False):
             return
-        from pendulum_fmu import FMU_FILES, __version__
         from fmu_build import build_fmu
+        from pendulum_fmu import FMU_FILES, __version__
+        from pendulum_fmu.errors import PlatformSkipped
+        from pendulum_fmu.export import fmu_platforms
 
         data = Path(self.build_lib, "pendulum_fmu", "data")
         for fmi_version, name in FMU_FILES.items():
-            fmu = build_fmu(data / name, fmi_version=fmi_version, linux_glibc=_linux_glibc(self))
-            print(f"pendulum_fmu {__version__}: built {fmu}")
+            with warnings.catch_warnings(record=True) as skipped:
+                warnings.simplefilter("always", PlatformSkipped)
+                fmu = build_fmu(data / name, fmi_version=fmi_version, linux_glibc=_linux_glibc(self))
+            # A platform this machine cannot build for: one line each, what to install in it.
+            for warning in skipped:
+                print(f"pendulum_fmu {__version__}: FMI {fmi_version}.0 FMU without {warning.message}",
+                      file=sys.stderr)
+            print(f"pendulum_fmu {__version__}: built {fmu} ({', '.join(fmu_platforms(fmu))})")
 
 
 class BuildNativeLoop(build_ext):

@@ -8,7 +8,7 @@ this module drives it. The C code takes its value references, names and start va
 model's modelDescription.xml: this module generates them (model_variables.h/.c), so the XML stays
 the single source of truth. fmu_src/src/ and fmu_src/include/ hold the FMI plumbing, which knows
 nothing of pendulums; each model has its own folder (config.h, model.c), listed in MODELS.
-Per platform, CMake configures and builds in a private temporary folder; llvm-lipo merges the two
+Per platform, CMake configures and builds in a private temporary folder; fmu_build/macho.py merges the two
 macOS slices into one universal binary; the FMU's zip is renamed into place whole. With a glibc
 floor (linux_glibc, CMake's LINUX_GLIBC) zig builds the Linux binaries to load on that glibc and
 every later one, as the manylinux wheels need.
@@ -40,6 +40,7 @@ from pendulum_fmu.atomic_files import check_writable, replacing_path
 from pendulum_fmu.errors import BuildError, PlatformSkipped
 
 from . import fmi3
+from .macho import MachOError, merge_universal
 from .model_variables import ModelDescriptionError, generate_variables
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -76,7 +77,6 @@ PENDULUM_DIR = MODELS["pendulum"].folder
 PID_CONTROLLER_DIR = MODELS["pid_controller"].folder
 ZIG = "zig"
 ZIG_PACKAGE = "pip install ziglang"
-LIPO = ("llvm-lipo-14", "llvm-lipo", "lipo")
 
 
 @dataclass(frozen=True)
@@ -207,10 +207,6 @@ def find_zig() -> str | None:
     return str(bundled) if bundled.is_file() else shutil.which(ZIG)
 
 
-def _lipo() -> str | None:
-    return next(filter(None, map(shutil.which, LIPO)), None)
-
-
 def _cmake() -> str:
     """cmake from PATH, else from the PyPI cmake package (which fmpy requires), as in a pip
     build environment."""
@@ -227,9 +223,8 @@ def _cmake() -> str:
 def check_toolchain(platform: Platform, fmi_version: int = 2, linux_glibc: str | None = None) -> None:
     """BuildError naming the package to install unless every tool that builds platform is here:
     the cross-compiler of each target (zig for a Linux target with linux_glibc; $CC, when set, on
-    a machine of the target's kind: else CMake finds the machine's compiler itself), and
-    llvm-lipo where FMI 2.0 merges slices into one binary. BuildError too when linux_glibc is not
-    a glibc version."""
+    a machine of the target's kind: else CMake finds the machine's compiler itself). BuildError
+    too when linux_glibc is not a glibc version."""
     if linux_glibc is not None and not re.fullmatch(r"2\.\d+", linux_glibc):
         raise BuildError(f"glibc floor {linux_glibc!r}: give a glibc version such as 2.17")
     for target in platform.targets:
@@ -241,9 +236,6 @@ def check_toolchain(platform: Platform, fmi_version: int = 2, linux_glibc: str |
             name = shlex.join(compiler) if compiler else "CC (empty)"
             hint = ZIG_PACKAGE if zig else "set CC to an installed compiler" if target.native else target.package
             raise BuildError(f"{platform.fmi2_folder}: C compiler {name} not found ({hint})")
-    if fmi_version == 2 and len(platform.targets) > 1 and _lipo() is None:
-        raise BuildError(f"{platform.fmi2_folder}: {LIPO[0]}, which merges its slices into one binary, "
-                         "not found (apt-get install llvm-14)")
 
 
 def run_tool(command: list, what: str, environment: dict | None = None) -> None:
@@ -298,11 +290,13 @@ def cmake_build(target: Target, work: Path, cmake_target: str, definitions: dict
 
 
 def _merged(slices: list[Path], out_file: Path) -> Path:
-    """One binary of the slices: the slice itself, or a universal Mach-O that llvm-lipo makes."""
+    """One binary of the slices: the slice itself, or a universal Mach-O (fmu_build/macho.py)."""
     if len(slices) == 1:
         return slices[0]
-    run_tool([_lipo(), "-create", *slices, "-output", out_file], f"the universal {out_file.name}")
-    return out_file
+    try:
+        return merge_universal(slices, out_file)
+    except MachOError as error:
+        raise BuildError(f"the universal {out_file.name}: {error}") from None
 
 
 def compile_native_loop(platform: str, out_dir: str | os.PathLike, linux_glibc: str | None = None) -> Path:
