@@ -319,16 +319,6 @@ def test_default_build_skips_a_platform_without_its_compiler_in_one_line(tmp_pat
     assert "linux64" in folders and platform not in folders
 
 
-@pytest.mark.skipif(find_zig() is None, reason="needs zig (pip install ziglang)")
-def test_default_build_skips_the_universal_macos_binary_without_lipo_in_one_line(monkeypatch):
-    monkeypatch.setattr(fmu_build, "LIPO", ("no-such-lipo",))
-    with pytest.warns(PlatformSkipped) as skipped:
-        assert "darwin64" not in available_platforms(fmi_version=2)
-    assert "darwin64" in available_platforms(fmi_version=3)  # whose two folders need no merging
-    assert [str(warning.message) for warning in skipped if "darwin64" in str(warning.message)] == [
-        "darwin64: no-such-lipo, which merges its slices into one binary, not found (apt-get install llvm-14); skipped"]
-
-
 def test_a_platform_named_explicitly_must_build(tmp_path, monkeypatch):
     _without_compiler(monkeypatch, "aarch64-linux")
     with pytest.raises(BuildError, match="apt-get install gcc-aarch64-linux-gnu"):
