@@ -63,8 +63,8 @@ FMI_HEADERS = HEADERS_DIR / "fmi"
 class Model:
     """A model built over the FMI plumbing."""
 
-    folder: Path          # its config.h and model.c
-    description: Path     # its FMI 2.0 modelDescription.xml
+    folder: Path  # its config.h and model.c
+    description: Path  # its FMI 2.0 modelDescription.xml
 
 
 # The build's one table of models. The pendulum's description is the project's top-level
@@ -82,14 +82,15 @@ ZIG_PACKAGE = "pip install ziglang"
 @dataclass(frozen=True)
 class Target:
     """One binary CMake builds: natively on a machine of its kind, with its toolchain file
-    (cmake/<toolchain>) elsewhere."""
+    (cmake/<toolchain>) elsewhere.
+    """
 
-    name: str                  # the FMI 3.0 platform folder
-    system: str                # sys.platform of a machine that builds it natively
+    name: str  # the FMI 3.0 platform folder
+    system: str  # sys.platform of a machine that builds it natively
     machines: tuple[str, ...]  # platform.machine() of such a machine (any, for macOS's both slices)
-    toolchain: str             # cmake/<toolchain>: how another machine builds it
-    cross_compiler: str        # the compiler that toolchain file runs
-    package: str               # what installs that compiler
+    toolchain: str  # cmake/<toolchain>: how another machine builds it
+    cross_compiler: str  # the compiler that toolchain file runs
+    package: str  # what installs that compiler
 
     @property
     def native(self) -> bool:
@@ -97,13 +98,15 @@ class Target:
 
     def built_by_zig(self, linux_glibc: str | None = None) -> bool:
         """Whether zig's C compiler builds it: a macOS target off a Mac, and a Linux target for a
-        glibc floor (cmake/linux.cmake)."""
+        glibc floor (cmake/linux.cmake).
+        """
         return (self.cross_compiler == ZIG and not self.native) or bool(linux_glibc and self.system == "linux")
 
     def compiler(self, linux_glibc: str | None = None) -> list[str]:
         """The C compiler command: zig's (the ziglang package's `zig cc`) where it builds the
         target, else $CC (split as a shell would, so CC="ccache gcc" works) or gcc on a machine of
-        the target's kind, the toolchain file's cross-compiler elsewhere."""
+        the target's kind, the toolchain file's cross-compiler elsewhere.
+        """
         if self.built_by_zig(linux_glibc):
             return [find_zig() or ZIG, "cc"]
         if self.native:
@@ -115,9 +118,9 @@ class Target:
 class Platform:
     """A platform an FMI 2.0 FMU can carry a binary for, and its FMI 3.0 folders."""
 
-    fmi2_folder: str            # binaries/<folder> in an FMI 2.0 FMU
+    fmi2_folder: str  # binaries/<folder> in an FMI 2.0 FMU
     targets: tuple[Target, ...]  # its binaries: one, or the slices of one universal Mach-O
-    suffix: str                 # of the FMU's shared library
+    suffix: str  # of the FMU's shared library
 
     @property
     def fmi3_folders(self) -> tuple[str, ...]:
@@ -133,18 +136,63 @@ class Platform:
         return all(target.native for target in self.targets)
 
 
-PLATFORMS = {platform.fmi2_folder: platform for platform in (
-    Platform("linux64", (Target("x86_64-linux", "linux", ("x86_64",), "x86_64-linux.cmake",
-                                "x86_64-linux-gnu-gcc", "apt-get install gcc-x86-64-linux-gnu"),), ".so"),
-    Platform("win64", (Target("x86_64-windows", "win32", ("AMD64",), "x86_64-windows.cmake",
-                              "x86_64-w64-mingw32-gcc", "apt-get install gcc-mingw-w64-x86-64"),), ".dll"),
-    # The folder name fmpy and the Reference FMUs use for Linux on ARM64.
-    Platform("aarch64-linux", (Target("aarch64-linux", "linux", ("aarch64",), "aarch64-linux.cmake",
-                                      "aarch64-linux-gnu-gcc", "apt-get install gcc-aarch64-linux-gnu"),), ".so"),
-    # fmpy loads binaries/darwin64 on Intel and Apple Silicon Macs alike: one universal Mach-O.
-    Platform("darwin64", (Target("x86_64-darwin", "darwin", (), "x86_64-darwin.cmake", ZIG, ZIG_PACKAGE),
-                          Target("aarch64-darwin", "darwin", (), "aarch64-darwin.cmake", ZIG, ZIG_PACKAGE)), ".dylib"),
-)}
+PLATFORMS = {
+    platform.fmi2_folder: platform
+    for platform in (
+        Platform(
+            "linux64",
+            (
+                Target(
+                    "x86_64-linux",
+                    "linux",
+                    ("x86_64",),
+                    "x86_64-linux.cmake",
+                    "x86_64-linux-gnu-gcc",
+                    "apt-get install gcc-x86-64-linux-gnu",
+                ),
+            ),
+            ".so",
+        ),
+        Platform(
+            "win64",
+            (
+                Target(
+                    "x86_64-windows",
+                    "win32",
+                    ("AMD64",),
+                    "x86_64-windows.cmake",
+                    "x86_64-w64-mingw32-gcc",
+                    "apt-get install gcc-mingw-w64-x86-64",
+                ),
+            ),
+            ".dll",
+        ),
+        # The folder name fmpy and the Reference FMUs use for Linux on ARM64.
+        Platform(
+            "aarch64-linux",
+            (
+                Target(
+                    "aarch64-linux",
+                    "linux",
+                    ("aarch64",),
+                    "aarch64-linux.cmake",
+                    "aarch64-linux-gnu-gcc",
+                    "apt-get install gcc-aarch64-linux-gnu",
+                ),
+            ),
+            ".so",
+        ),
+        # fmpy loads binaries/darwin64 on Intel and Apple Silicon Macs alike: one universal Mach-O.
+        Platform(
+            "darwin64",
+            (
+                Target("x86_64-darwin", "darwin", (), "x86_64-darwin.cmake", ZIG, ZIG_PACKAGE),
+                Target("aarch64-darwin", "darwin", (), "aarch64-darwin.cmake", ZIG, ZIG_PACKAGE),
+            ),
+            ".dylib",
+        ),
+    )
+}
 
 
 def _check_sources_present() -> None:
@@ -152,12 +200,14 @@ def _check_sources_present() -> None:
         raise BuildError(
             f"the FMU's sources (fmu_src/, modelDescription.xml, CMakeLists.txt) are not beside "
             f"{Path(__file__).parent}: to build, run python build_fmu.py in a clone or the unpacked "
-            "sdist; an installed package uses its packaged FMU (pendulum_fmu.default_fmu())")
+            "sdist; an installed package uses its packaged FMU (pendulum_fmu.default_fmu())"
+        )
 
 
 def _generate_variables(xml: Path, out_dir: Path) -> None:
     """model_variables.h/.c, as CMake generates them too; BuildError for a description the C code
-    cannot take."""
+    cannot take.
+    """
     try:
         generate_variables(xml, out_dir)
     except ModelDescriptionError as error:
@@ -176,10 +226,15 @@ def _check_source_files(model_description, xml: Path, sources: Path, fmi_version
             )
 
 
-def assemble_sources(sources: Path, model_dir: Path = PENDULUM_DIR,
-                     model_description_file: Path = MODEL_DESCRIPTION, fmi_version: int = 2) -> Path:
+def assemble_sources(
+    sources: Path,
+    model_dir: Path = PENDULUM_DIR,
+    model_description_file: Path = MODEL_DESCRIPTION,
+    fmi_version: int = 2,
+) -> Path:
     """Everything that compiles into the FMU, in one flat folder: what the FMU's sources/ holds,
-    which fmpy compile builds, and what the tests' C driver and fuzzers link."""
+    which fmpy compile builds, and what the tests' C driver and fuzzers link.
+    """
     _check_sources_present()
     sources = Path(sources)
     sources.mkdir()
@@ -191,14 +246,17 @@ def assemble_sources(sources: Path, model_dir: Path = PENDULUM_DIR,
 def _copy_sources(model_dir: Path, sources: Path, fmi_version: int) -> None:
     """The plumbing (with the entry points of one FMI version) and the model, into sources."""
     left_out = fmi3.adapter_left_out(fmi_version)
-    for path in [*sorted(HEADERS_DIR.glob("*.h")), *sorted(PLUMBING_DIR.glob("*.c")),
-                 *(model_dir / name for name in MODEL_FILES)]:
+    for path in [
+        *sorted(HEADERS_DIR.glob("*.h")),
+        *sorted(PLUMBING_DIR.glob("*.c")),
+        *(model_dir / name for name in MODEL_FILES),
+    ]:
         if path.name != left_out:
             shutil.copy2(path, sources)
 
 
 def find_zig() -> str | None:
-    """zig from the ziglang package (pip install ziglang), else from PATH."""
+    """Zig from the ziglang package (pip install ziglang), else from PATH."""
     try:
         import ziglang
     except ImportError:
@@ -208,8 +266,9 @@ def find_zig() -> str | None:
 
 
 def _cmake() -> str:
-    """cmake from PATH, else from the PyPI cmake package (which fmpy requires), as in a pip
-    build environment."""
+    """Cmake from PATH, else from the PyPI cmake package (which fmpy requires), as in a pip
+    build environment.
+    """
     found = shutil.which("cmake")
     if found is None:
         try:
@@ -224,7 +283,8 @@ def check_toolchain(platform: Platform, fmi_version: int = 2, linux_glibc: str |
     """BuildError naming the package to install unless every tool that builds platform is here:
     the cross-compiler of each target (zig for a Linux target with linux_glibc; $CC, when set, on
     a machine of the target's kind: else CMake finds the machine's compiler itself). BuildError
-    too when linux_glibc is not a glibc version."""
+    too when linux_glibc is not a glibc version.
+    """
     if linux_glibc is not None and not re.fullmatch(r"2\.\d+", linux_glibc):
         raise BuildError(f"glibc floor {linux_glibc!r}: give a glibc version such as 2.17")
     for target in platform.targets:
@@ -246,12 +306,17 @@ def run_tool(command: list, what: str, environment: dict | None = None) -> None:
     except OSError as error:
         raise BuildError(f"building {what} failed: {shlex.join(command[:1])}: {error.strerror}") from None
     if result.returncode != 0:
-        raise BuildError(f"building {what} failed:\n{shlex.join(command)}\n"
-                         f"{(result.stdout + result.stderr)[-4000:]}")
+        raise BuildError(f"building {what} failed:\n{shlex.join(command)}\n{(result.stdout + result.stderr)[-4000:]}")
 
 
-def cmake_build(target: Target, work: Path, cmake_target: str, definitions: dict | None = None,
-                project: Path = ROOT, linux_glibc: str | None = None) -> Path:
+def cmake_build(
+    target: Target,
+    work: Path,
+    cmake_target: str,
+    definitions: dict | None = None,
+    project: Path = ROOT,
+    linux_glibc: str | None = None,
+) -> Path:
     """Configure, build and install one target of a CMake project (CMakeLists.txt, or another
     that includes cmake/flags.cmake) for one platform target in the empty folder work; return
     the binary.
@@ -266,9 +331,16 @@ def cmake_build(target: Target, work: Path, cmake_target: str, definitions: dict
     build, installed = work / "build", work / "installed"
     environment = dict(os.environ)
     # This Python runs the variables' generator (fmu_build/model_variables.py), as CMake would find it.
-    configure = [cmake, "-S", project, "-B", build, f"-DFMI_HEADERS={FMI_HEADERS}",
-                 f"-DPython3_EXECUTABLE={sys.executable}",
-                 *(f"-D{name}={value}" for name, value in (definitions or {}).items())]
+    configure = [
+        cmake,
+        "-S",
+        project,
+        "-B",
+        build,
+        f"-DFMI_HEADERS={FMI_HEADERS}",
+        f"-DPython3_EXECUTABLE={sys.executable}",
+        *(f"-D{name}={value}" for name, value in (definitions or {}).items()),
+    ]
     cross = not target.native or target.built_by_zig(linux_glibc)
     # On a Mac too: its toolchain file sets the architecture and the oldest macOS.
     if cross or target.system == "darwin":
@@ -283,8 +355,11 @@ def cmake_build(target: Target, work: Path, cmake_target: str, definitions: dict
     what = f"{cmake_target} for {target.name}"
     run_tool(configure, what, environment)
     run_tool([cmake, "--build", build, "--target", cmake_target, "--config", "Release"], what, environment)
-    run_tool([cmake, "--install", build, "--prefix", installed, "--component", cmake_target,
-              "--config", "Release"], what, environment)
+    run_tool(
+        [cmake, "--install", build, "--prefix", installed, "--component", cmake_target, "--config", "Release"],
+        what,
+        environment,
+    )
     [binary] = [path for path in installed.iterdir() if path.is_file()]
     return binary
 
@@ -330,8 +405,10 @@ def compile_native_loop(platform: str, out_dir: str | os.PathLike, linux_glibc: 
     check_platforms([platform])
     check_toolchain(PLATFORMS[platform], linux_glibc=linux_glibc)
     with tempfile.TemporaryDirectory(prefix="pendulum_fmu_native_loop_") as tmp:
-        slices = [cmake_build(target, Path(tmp, target.name), "_cs_loop", {"MODEL_DIR": ""}, linux_glibc=linux_glibc)
-                  for target in PLATFORMS[platform].targets]
+        slices = [
+            cmake_build(target, Path(tmp, target.name), "_cs_loop", {"MODEL_DIR": ""}, linux_glibc=linux_glibc)
+            for target in PLATFORMS[platform].targets
+        ]
         built = _merged(slices, Path(tmp, slices[0].name))
         out_file = Path(out_dir, built.name)
         with replacing_path(out_file) as partial:
@@ -342,14 +419,30 @@ def compile_native_loop(platform: str, out_dir: str | os.PathLike, linux_glibc: 
 def documentation_html(model_description, fmi_version: int = 2) -> str:
     """documentation/index.html: what the model is and every variable with its unit and meaning."""
     rows = "\n".join(
-        "<tr>" + "".join(f"<td>{html.escape(str(cell))}</td>" for cell in (
-            v.name, v.valueReference, v.causality, v.variability, v.unit or "",
-            "" if v.start is None else v.start, v.description or "")) + "</tr>"
+        "<tr>"
+        + "".join(
+            f"<td>{html.escape(str(cell))}</td>"
+            for cell in (
+                v.name,
+                v.valueReference,
+                v.causality,
+                v.variability,
+                v.unit or "",
+                "" if v.start is None else v.start,
+                v.description or "",
+            )
+        )
+        + "</tr>"
         for v in model_description.modelVariables
     )
-    interfaces = " and ".join(name for name, present in (
-        ("Model Exchange", model_description.modelExchange), ("Co-Simulation", model_description.coSimulation))
-        if present)
+    interfaces = " and ".join(
+        name
+        for name, present in (
+            ("Model Exchange", model_description.modelExchange),
+            ("Co-Simulation", model_description.coSimulation),
+        )
+        if present
+    )
     name = html.escape(model_description.modelName)
     return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>{name} FMU</title>
@@ -383,14 +476,16 @@ def check_platforms(names) -> None:
     """BuildError unless names are one or more of PLATFORMS."""
     unknown = [name for name in names if name not in PLATFORMS]
     if unknown or not names:
-        raise BuildError(f"unknown platform(s) {', '.join(unknown) or '(none given)'}: choose "
-                         f"among {', '.join(PLATFORMS)}")
+        raise BuildError(
+            f"unknown platform(s) {', '.join(unknown) or '(none given)'}: choose among {', '.join(PLATFORMS)}"
+        )
 
 
 def available_platforms(fmi_version: int = 2, linux_glibc: str | None = None) -> tuple[str, ...]:
     """Every platform whose tools are present (zig for the Linux ones with linux_glibc); for each
     missing one, a PlatformSkipped warning naming the package that installs it. The machine's
-    own platform is never skipped."""
+    own platform is never skipped.
+    """
     present = []
     for name, platform in PLATFORMS.items():
         try:
@@ -406,19 +501,24 @@ def available_platforms(fmi_version: int = 2, linux_glibc: str | None = None) ->
 
 def _stamped_model_description(xml: Path, fmi_version: int = 2) -> str:
     """The model description as the FMU carries it (for FMI 3.0 generated from the FMI 2.0 one):
-    generationTool names this package's version."""
+    generationTool names this package's version.
+    """
     text = xml.read_text(encoding="utf-8") if fmi_version == 2 else fmi3.model_description(xml)
-    text, count = re.subn(r'generationTool="[^"]*"', f'generationTool="pendulum_fmu {__version__}"',
-                          text, count=1)
+    text, count = re.subn(r'generationTool="[^"]*"', f'generationTool="pendulum_fmu {__version__}"', text, count=1)
     if count != 1:
         raise BuildError(f"{xml}: no generationTool attribute to stamp the version into")
     return text
 
 
-def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, *, model_dir: Path = PENDULUM_DIR,
-              model_description_file: Path = MODEL_DESCRIPTION,
-              platforms: tuple[str, ...] | None = None, fmi_version: int = 2,
-              linux_glibc: str | None = None) -> Path:
+def build_fmu(
+    out_file: str | os.PathLike = DEFAULT_FMU,
+    *,
+    model_dir: Path = PENDULUM_DIR,
+    model_description_file: Path = MODEL_DESCRIPTION,
+    platforms: tuple[str, ...] | None = None,
+    fmi_version: int = 2,
+    linux_glibc: str | None = None,
+) -> Path:
     """Build an FMU (binaries/, sources/, documentation/) of a model over the FMI plumbing.
 
     Everything is compiled in a private temporary folder and the zip is renamed into place
@@ -482,22 +582,25 @@ def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, *, model_dir: Path = PE
         _check_source_files(model_description, model_description_file, sources, fmi_version)
         if fmi_version == 3:
             (sources / "buildDescription.xml").write_text(fmi3.build_description(model_description_file))
-        definitions = {"MODEL_DIR": model_dir.resolve(), "MODEL_DESCRIPTION": Path(model_description_file).resolve(),
-                       "FMI_VERSION": fmi_version}
+        definitions = {
+            "MODEL_DIR": model_dir.resolve(),
+            "MODEL_DESCRIPTION": Path(model_description_file).resolve(),
+            "FMI_VERSION": fmi_version,
+        }
         binaries = {}
         for name in platforms:
             platform = PLATFORMS[name]
-            slices = {target.name: cmake_build(target, tmp / name / target.name, "fmu", definitions,
-                                               linux_glibc=linux_glibc)
-                      for target in platform.targets}
+            slices = {
+                target.name: cmake_build(target, tmp / name / target.name, "fmu", definitions, linux_glibc=linux_glibc)
+                for target in platform.targets
+            }
             if fmi_version == 3:
                 binaries.update({f"binaries/{folder}/{binary.name}": binary for folder, binary in slices.items()})
             else:
                 binary = _merged(list(slices.values()), tmp / name / f"{identifier}{platform.suffix}")
                 binaries[f"binaries/{name}/{binary.name}"] = binary
         with replacing_path(out_file) as partial, zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as fmu:
-            fmu.writestr("modelDescription.xml",
-                         _stamped_model_description(Path(model_description_file), fmi_version))
+            fmu.writestr("modelDescription.xml", _stamped_model_description(Path(model_description_file), fmi_version))
             for name, binary in binaries.items():
                 fmu.write(binary, name)
             for source in sorted(sources.iterdir()):
@@ -514,8 +617,14 @@ def build_pid_controller(out_file: str | os.PathLike) -> Path:
 
 def build_inputs() -> list[Path]:
     """Every file a checkout's FMU is built from: when one is newer than the FMU, it is stale."""
-    return [MODEL_DESCRIPTION, CMAKE_LISTS, ROOT / "pendulum_fmu" / "__init__.py", *Path(__file__).parent.glob("*.py"),
-            *TOOLCHAINS.glob("*.cmake"), *(p for p in SOURCE_DIR.rglob("*") if p.is_file())]
+    return [
+        MODEL_DESCRIPTION,
+        CMAKE_LISTS,
+        ROOT / "pendulum_fmu" / "__init__.py",
+        *Path(__file__).parent.glob("*.py"),
+        *TOOLCHAINS.glob("*.cmake"),
+        *(p for p in SOURCE_DIR.rglob("*") if p.is_file()),
+    ]
 
 
 def fmu_is_stale(fmu: Path = DEFAULT_FMU) -> bool:
@@ -528,5 +637,6 @@ def fmu_is_stale(fmu: Path = DEFAULT_FMU) -> bool:
 
 def is_source_checkout() -> bool:
     """Whether this package sits beside the FMU's sources (a clone, an editable install, the
-    sdist being built), rather than installed from a wheel."""
+    sdist being built), rather than installed from a wheel.
+    """
     return SOURCE_DIR.is_dir() and MODEL_DESCRIPTION.is_file() and CMAKE_LISTS.is_file()

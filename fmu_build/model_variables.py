@@ -16,13 +16,19 @@ GENERATED_SOURCES = ("model_variables.h", "model_variables.c")
 # FMI 2.0's default of `initial` where a variable leaves it out, by variability and causality
 # (the standard's section 2.2.7); the combinations missing here have none.
 DEFAULT_INITIAL = {
-    ("constant", "output"): "exact", ("constant", "local"): "exact",
-    ("fixed", "parameter"): "exact", ("fixed", "calculatedParameter"): "calculated",
+    ("constant", "output"): "exact",
+    ("constant", "local"): "exact",
+    ("fixed", "parameter"): "exact",
+    ("fixed", "calculatedParameter"): "calculated",
     ("fixed", "local"): "calculated",
-    ("tunable", "parameter"): "exact", ("tunable", "calculatedParameter"): "calculated",
+    ("tunable", "parameter"): "exact",
+    ("tunable", "calculatedParameter"): "calculated",
     ("tunable", "local"): "calculated",
-    ("discrete", "input"): "exact", ("discrete", "output"): "calculated", ("discrete", "local"): "calculated",
-    ("continuous", "input"): "exact", ("continuous", "output"): "calculated",
+    ("discrete", "input"): "exact",
+    ("discrete", "output"): "calculated",
+    ("discrete", "local"): "calculated",
+    ("continuous", "input"): "exact",
+    ("continuous", "output"): "calculated",
     ("continuous", "local"): "calculated",
 }
 
@@ -32,8 +38,10 @@ class ModelDescriptionError(ValueError):
 
 
 def generate_variables(xml: str | Path, out_dir: str | Path) -> list[Path]:
-    """Write model_variables.h (GUID, value reference enum, inputs) and model_variables.c (the
-    table of variables) from an FMI 2.0 model description.
+    """Write model_variables.h and model_variables.c from an FMI 2.0 model description.
+
+    The header holds the GUID, the value references' enum and the inputs; the source the table of
+    variables.
 
     Parameters
     ----------
@@ -65,12 +73,20 @@ def generate_variables(xml: str | Path, out_dir: str | Path) -> list[Path]:
         if real is None or int(element.get("valueReference")) != index:
             raise ModelDescriptionError(
                 f"{xml}: variable {element.get('name')!r} must be Real with valueReference {index}: "
-                "the C code indexes one array of Reals by value reference")
+                "the C code indexes one array of Reals by value reference"
+            )
         causality = element.get("causality", "local")
         variability = element.get("variability", "continuous")
-        variables.append({"name": element.get("name"), "reference": index, "causality": causality,
-                          "variability": variability, "start": real.get("start"),
-                          "initial": element.get("initial", DEFAULT_INITIAL.get((variability, causality)))})
+        variables.append(
+            {
+                "name": element.get("name"),
+                "reference": index,
+                "causality": causality,
+                "variability": variability,
+                "start": real.get("start"),
+                "initial": element.get("initial", DEFAULT_INITIAL.get((variability, causality))),
+            }
+        )
     enum = ",\n".join(f"    VR_{v['name'].upper()} = {v['reference']}" for v in variables)
     inputs = ", ".join(f"VR_{v['name'].upper()}" for v in variables if v["causality"] == "input")
     header = f"""/* Generated from modelDescription.xml by fmu_build/model_variables.py: edit the XML, not this. */
@@ -79,10 +95,10 @@ def generate_variables(xml: str | Path, out_dir: str | Path) -> list[Path]:
 
 #include "variable.h"
 
-#define MODEL_GUID "{root.get('guid')}"
+#define MODEL_GUID "{root.get("guid")}"
 #define N_VARIABLES {len(variables)}
 /* The inputs' value references: a step updates these, without a pass over every variable. */
-#define N_INPUTS {sum(v['causality'] == 'input' for v in variables)}
+#define N_INPUTS {sum(v["causality"] == "input" for v in variables)}
 #define INPUT_REFERENCES {{{inputs}}}
 
 typedef enum {{
@@ -108,7 +124,7 @@ const VariableInfo model_variables[N_VARIABLES] = {{
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     paths = [out_dir / name for name in GENERATED_SOURCES]
-    for path, text in zip(paths, (header, table)):
+    for path, text in zip(paths, (header, table), strict=True):
         # Written only when changed, so that CMake recompiles only what a change of the XML touches.
         if not path.is_file() or path.read_text() != text:
             path.write_text(text)

@@ -21,7 +21,8 @@ CHECKOUT_MARKERS = (BUILD_TOOL, ROOT / "modelDescription.xml", ROOT / "CMakeList
 
 def is_source_checkout() -> bool:
     """Whether this package sits in a checkout (a clone, an editable install, the sdist being
-    built) with the FMU's sources and build tool, rather than installed from a wheel."""
+    built) with the FMU's sources and build tool, rather than installed from a wheel.
+    """
     return all(path.exists() for path in CHECKOUT_MARKERS)
 
 
@@ -44,10 +45,13 @@ def build_tool():
     if not is_source_checkout():
         from .errors import BuildError
 
-        raise BuildError(f"pendulum_fmu at {ROOT / 'pendulum_fmu'} is installed, not in a checkout: building "
-                         "needs the repository (python build_fmu.py in a clone or the unpacked sdist)")
-    spec = importlib.util.spec_from_file_location("fmu_build", BUILD_TOOL,
-                                                  submodule_search_locations=[str(BUILD_TOOL.parent)])
+        raise BuildError(
+            f"pendulum_fmu at {ROOT / 'pendulum_fmu'} is installed, not in a checkout: building "
+            "needs the repository (python build_fmu.py in a clone or the unpacked sdist)"
+        )
+    spec = importlib.util.spec_from_file_location(
+        "fmu_build", BUILD_TOOL, submodule_search_locations=[str(BUILD_TOOL.parent)]
+    )
     module = importlib.util.module_from_spec(spec)
     sys.modules["fmu_build"] = module
     try:

@@ -25,17 +25,31 @@ OSError for a file, ...). The kinds that belong to one module live there:
 
 
 class PendulumFmuError(Exception):
-    """Base of every error the user's input causes; the message is the one line to show."""
+    """Base of every error the user's input causes; the message is the one line to show.
+
+    Examples
+    --------
+    A stop time before the start, refused in one line:
+
+    >>> from pendulum_fmu import PendulumFmuError, simulate
+    >>> try:
+    ...     simulate(20.0, stop_time=-1)
+    ... except PendulumFmuError as error:
+    ...     print(error)
+    stop time -1 must be after start time 0.0
+    """
 
 
 class InvalidInput(PendulumFmuError, ValueError):
     """An argument, option, parameter or case the package refuses: a time, a step, a tolerance,
-    a parameter's name or value, a sweep's values."""
+    a parameter's name or value, a sweep's values.
+    """
 
 
 class WrongType(PendulumFmuError, TypeError):
     """An argument of a kind the function does not take (None for a folder, a list for a Study);
-    the message says what it takes."""
+    the message says what it takes.
+    """
 
 
 class MissingFile(PendulumFmuError, FileNotFoundError):
@@ -44,7 +58,8 @@ class MissingFile(PendulumFmuError, FileNotFoundError):
 
 class CannotWrite(PendulumFmuError, OSError):
     """An output cannot be written where it was asked for (a file where a folder must be, no
-    permission, a full disk)."""
+    permission, a full disk).
+    """
 
 
 class MissingDependency(PendulumFmuError, ImportError):
@@ -54,9 +69,18 @@ class MissingDependency(PendulumFmuError, ImportError):
 class BuildError(PendulumFmuError, RuntimeError):
     """The FMU could not be built; the message says why. Raised by the repository's build tool
     (fmu_build/, beside the package in a checkout), and defined here so that the package's callers
-    catch it without that tool."""
+    catch it without that tool.
+    """
 
 
 class PlatformSkipped(UserWarning):
     """A platform left out of a default build because its compiler is missing (the build tool
-    warns; the command line shows it in one line)."""
+    warns; the command line shows it in one line).
+    """
+
+
+class Skipped(UserWarning):
+    """A part of the run left out because this machine lacks what it needs (a tool's package); the
+    message is one line saying which part and how to get it. The command line prints it as that
+    line and goes on.
+    """

@@ -59,13 +59,17 @@ def fmu_platforms(fmu: str | os.PathLike) -> tuple[str, ...]:
     True
     """
     with zipfile.ZipFile(fmu) as archive:
-        folders = {parts[1] for parts in (name.split("/") for name in archive.namelist())
-                   if len(parts) == 3 and parts[0] == "binaries" and parts[2]}
+        folders = {
+            parts[1]
+            for parts in (name.split("/") for name in archive.namelist())
+            if len(parts) == 3 and parts[0] == "binaries" and parts[2]
+        }
     return tuple(sorted(folders))
 
 
-def export_fmu(output: str | os.PathLike | None = None, *, fmi_version: int = 2,
-               overwrite: bool = False) -> ExportedFmu:
+def export_fmu(
+    output: str | os.PathLike | None = None, *, fmi_version: int = 2, overwrite: bool = False
+) -> ExportedFmu:
     """Write the pendulum's FMU to output, whole or not at all.
 
     Parameters
@@ -102,8 +106,7 @@ def export_fmu(output: str | os.PathLike | None = None, *, fmi_version: int = 2,
     source = default_fmu(fmi_version)  # first: it says which FMI versions there are
     output = Path(FMU_FILES[fmi_version] if output is None else output)
     if not overwrite and output.exists():
-        raise FmuExists(f"{output} exists: pass --overwrite (overwrite=True) to replace it, "
-                        "or another --output")
+        raise FmuExists(f"{output} exists: pass --overwrite (overwrite=True) to replace it, or another --output")
     check_writable(output)
     with replacing_path(output) as partial:
         shutil.copyfile(source, partial)

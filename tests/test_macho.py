@@ -1,5 +1,6 @@
 """fmu_build/macho.py's universal Mach-O, judged by LLVM's own tools (llvm-lipo-14, llvm-objdump-14),
-which share no code with it."""
+which share no code with it.
+"""
 
 import shutil
 import struct
@@ -11,14 +12,14 @@ import pytest
 from fmu_build.macho import MachOError, merge_universal
 
 LLVM_TOOLS = ("llvm-lipo-14", "llvm-objdump-14")
-pytestmark = pytest.mark.skipif(not all(map(shutil.which, LLVM_TOOLS)),
-                                reason="needs llvm-lipo-14 and llvm-objdump-14 (apt-get install llvm-14)")
+pytestmark = pytest.mark.skipif(
+    not all(map(shutil.which, LLVM_TOOLS)), reason="needs llvm-lipo-14 and llvm-objdump-14 (apt-get install llvm-14)"
+)
 ARCHITECTURES = ("x86_64", "arm64")
 
 
 def _llvm(tool, *arguments):
-    return subprocess.run([f"llvm-{tool}-14", *map(str, arguments)], capture_output=True, text=True,
-                          check=True).stdout
+    return subprocess.run([f"llvm-{tool}-14", *map(str, arguments)], capture_output=True, text=True, check=True).stdout
 
 
 @pytest.fixture(scope="module")
