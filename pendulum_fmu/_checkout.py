@@ -20,8 +20,10 @@ CHECKOUT_MARKERS = (BUILD_TOOL, ROOT / "modelDescription.xml", ROOT / "CMakeList
 
 
 def is_source_checkout() -> bool:
-    """Whether this package sits in a checkout (a clone, an editable install, the sdist being
-    built) with the FMU's sources and build tool, rather than installed from a wheel.
+    """Whether this package sits in a checkout with the FMU's sources and build tool.
+
+    A clone, an editable install or the sdist being built is one; a package installed from a wheel
+    is not.
     """
     return all(path.exists() for path in CHECKOUT_MARKERS)
 
@@ -40,7 +42,7 @@ def build_tool():
         When this package is not in a checkout.
     """
     loaded = sys.modules.get("fmu_build")
-    if loaded is not None and Path(loaded.__file__).resolve() == BUILD_TOOL:
+    if loaded is not None and loaded.__file__ and Path(loaded.__file__).resolve() == BUILD_TOOL:
         return loaded
     if not is_source_checkout():
         from .errors import BuildError
@@ -52,6 +54,7 @@ def build_tool():
     spec = importlib.util.spec_from_file_location(
         "fmu_build", BUILD_TOOL, submodule_search_locations=[str(BUILD_TOOL.parent)]
     )
+    assert spec is not None and spec.loader is not None  # a .py file always has both
     module = importlib.util.module_from_spec(spec)
     sys.modules["fmu_build"] = module
     try:

@@ -1,5 +1,6 @@
-"""fmu_build/macho.py's universal Mach-O, judged by LLVM's own tools (llvm-lipo-14, llvm-objdump-14),
-which share no code with it.
+"""fmu_build/macho.py's universal Mach-O, judged by LLVM's tools, which share no code with it.
+
+llvm-lipo-14 cuts and makes universal binaries, llvm-objdump-14 reads them.
 """
 
 import shutil
@@ -62,7 +63,7 @@ def test_llvm_objdump_reads_each_slice_of_the_merged_binary(thin_slices, tmp_pat
 def test_refuses_what_is_not_a_thin_mach_o(thin_slices, tmp_path):
     elf = tmp_path / "not.so"
     elf.write_bytes(b"\x7fELF" + bytes(60))
-    with pytest.raises(MachOError, match="not.so is not a thin 64-bit Mach-O"):
+    with pytest.raises(MachOError, match=r"not\.so is not a thin 64-bit Mach-O"):
         merge_universal([thin_slices["x86_64"], elf], tmp_path / "out.dylib")
     fat = merge_universal(list(thin_slices.values()), tmp_path / "fat.dylib")
     assert struct.unpack(">II", fat.read_bytes()[:8]) == (0xCAFEBABE, 2)
