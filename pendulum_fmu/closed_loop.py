@@ -23,7 +23,7 @@ from fmpy.model_description import CoSimulation, DefaultExperiment, ModelDescrip
 from scipy.integrate import solve_ivp
 
 from .atomic_files import replacing
-from .build import PID_CONTROLLER_DIR, build_fmu, build_pid_controller
+from ._checkout import ROOT, build_tool
 from .errors import InvalidInput
 from .parameters import total_inertia
 from .simulate import resolve_parameters
@@ -36,7 +36,7 @@ WIRES = (("pendulum", "theta", "controller", "theta"),
 
 def controller_defaults() -> dict[str, float]:
     """setpoint, kp, ki, kd as the controller's modelDescription.xml sets them."""
-    variables = read_model_description(str(PID_CONTROLLER_DIR / "modelDescription.xml")).modelVariables
+    variables = read_model_description(str(ROOT / "fmu_src" / "pid_controller" / "modelDescription.xml")).modelVariables
     return {v.name: float(v.start) for v in variables if v.causality == "parameter"}
 
 
@@ -78,8 +78,9 @@ def create_closed_loop_fmu(out_file: str | Path, *, step_size: float = 1e-3) -> 
     out_file = Path(out_file)
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
-        files = {"pendulum": build_fmu(tmp / "Pendulum.fmu"),
-                 "controller": build_pid_controller(tmp / "PIDController.fmu")}
+        build = build_tool()
+        files = {"pendulum": build.build_fmu(tmp / "Pendulum.fmu"),
+                 "controller": build.build_pid_controller(tmp / "PIDController.fmu")}
         components, variables = {}, {}
         for name, path in files.items():
             description = read_model_description(str(path))

@@ -13,7 +13,7 @@ from libcosimpy.CosimManipulator import CosimManipulator  # noqa: E402
 from libcosimpy.CosimObserver import CosimObserver  # noqa: E402
 from libcosimpy.CosimSlave import CosimLocalSlave  # noqa: E402
 
-from pendulum_fmu.build import build_pid_controller  # noqa: E402
+from fmu_build import build_pid_controller  # noqa: E402
 from pendulum_fmu.closed_loop import WIRES, sampled_loop_reference  # noqa: E402
 from pendulum_fmu.reference import reference  # noqa: E402
 
