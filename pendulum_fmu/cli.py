@@ -270,6 +270,12 @@ def cmd_judge(args) -> int:
     from .judge import format_judgement, format_kit, judge, judge_kit, write_json
     from .plot import plot_judgement
 
+    if args.ssp is not None:
+        from .ssp_judge import format_ssp_verdict, judge_ssp_result
+        verdict = judge_ssp_result(args.result, args.ssp, mapping=args.mapping)
+        print(format_ssp_verdict(verdict))
+        return 0 if verdict.passed else 1
+
     signal = _torque_signal(args)
     is_kit = args.result.is_dir()
     kit_files = [path for path in args.result.iterdir() if path.is_file()] if is_kit else []
@@ -451,6 +457,35 @@ def _add_demo(commands) -> argparse.ArgumentParser:
     return demo
 
 
+def cmd_export_ssp(args) -> int:
+    from .ssp import export_ssp
+    written = export_ssp(args.output, controller=dict(args.controller or ()),
+                         parameters=_parameters(args.assignments), stop_time=args.stop_time,
+                         step_size=args.step_size, overwrite=args.overwrite)
+    print(f"wrote {written}")
+    return 0
+
+
+def _add_export_ssp(commands) -> argparse.ArgumentParser:
+    export = commands.add_parser("export-ssp", help="write ClosedLoop.ssp: pendulum and PID controller for any SSP master",
+                                 description="Write the closed loop as an SSP 1.0 archive: both FMUs, their "
+                                             "connections, a parameter set per FMU, the DefaultExperiment "
+                                             "and the fixed-step annotations of libcosim and OMSimulator.")
+    export.add_argument("output", type=_output_path, nargs="?", default=Path("ClosedLoop.ssp"),
+                        help="the .ssp to write (default: %(default)s)")
+    export.add_argument("--controller", type=_assignment, action="append", metavar="NAME=VALUE",
+                        help="controller parameter in its set: setpoint (default 0.3), kp, ki, kd (repeatable)")
+    export.add_argument("--set", dest="assignments", type=_assignment, action="append", metavar="NAME=VALUE",
+                        help="pendulum parameter in its set: mass, length, inertia, gravity, damping (repeatable)")
+    export.add_argument("--stop-time", type=_float, default=3.0,
+                        help="the DefaultExperiment's stop time in s (default: %(default)s)")
+    export.add_argument("--step-size", type=_float, default=1e-3,
+                        help="the fixed communication step in s (default: %(default)s)")
+    export.add_argument("--overwrite", action="store_true", help="replace an existing output")
+    export.set_defaults(run=cmd_export_ssp)
+    return export
+
+
 def _add_judge(commands) -> argparse.ArgumentParser:
     judge = commands.add_parser(
         "judge", help="judge a result file from any tool, and name the mistake",
@@ -480,6 +515,10 @@ def _add_judge(commands) -> argparse.ArgumentParser:
     judge.add_argument("--plot", type=_output_path, default=None,
                        help="write a PNG of the torque, theta and |dtheta| (for a kit: a folder, one "
                             "NAME.png per scenario)")
+    judge.add_argument("--ssp", type=Path, default=None, metavar="ClosedLoop.ssp",
+                       help="judge a closed-loop result (time, theta) of this SSP from any master: "
+                            "name its coupling, whether the parameter sets arrived, its step and "
+                            "stop time (docs/ssp.md)")
     judge.set_defaults(run=cmd_judge)
     return judge
 
@@ -511,7 +550,7 @@ def build_parser() -> argparse.ArgumentParser:
                         help="show the Python traceback of an error instead of one line")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for add in (_add_build, _add_cross_check, _add_simulate, _add_compare, _add_sweep, _add_demo,
-                _add_judge, _add_scenarios):
+                _add_judge, _add_scenarios, _add_export_ssp):
         # Also after the command's name; SUPPRESS keeps it from hiding one given before it.
         add(commands).add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
                                    help="show the Python traceback of an error instead of one line")
