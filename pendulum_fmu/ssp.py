@@ -48,8 +48,10 @@ class SspExists(PendulumFmuError, FileExistsError):
 
 
 class SspFileError(PendulumFmuError, ValueError):
-    """A file given as the closed loop's SSP that is not one (no zip, no SystemStructure.ssd, no
-    parameter set)."""
+    """A file given as the closed loop's SSP that is not one.
+
+    No zip, no SystemStructure.ssd, no step annotation or no parameter set.
+    """
 
 
 @dataclass(frozen=True)
@@ -73,7 +75,7 @@ class SspSettings:
 
 
 def _positive(name: str, value) -> float:
-    if not (isinstance(value, numbers.Real) and 0 < value < math.inf):
+    if not (isinstance(value, numbers.Real) and 0 < float(value) < math.inf):
         raise InvalidInput(f"{name} {value!r} must be a positive number of seconds")
     return float(value)
 
@@ -114,8 +116,10 @@ def parameter_set_xml(name: str, values: dict[str, float]) -> bytes:
 
 
 def system_structure_xml(stop_time: float, step_size: float) -> bytes:
-    """SystemStructure.ssd of the closed loop: components, connections, DefaultExperiment and the
-    fixed-step annotations of libcosim and OMSimulator.
+    """SystemStructure.ssd of the closed loop.
+
+    Components, connections, DefaultExperiment and the fixed-step annotations of libcosim and
+    OMSimulator.
 
     Parameters
     ----------
@@ -135,36 +139,58 @@ def system_structure_xml(stop_time: float, step_size: float) -> bytes:
     for prefix, uri in NAMESPACES.items():
         ElementTree.register_namespace(prefix, uri)
     root = ElementTree.Element(_tag("ssd", "SystemStructureDescription"), version="1.0", name="ClosedLoop")
-    system = _element(root, "ssd", "System", name="ClosedLoop",
-                      description="The pendulum under the PID controller, fixed step")
+    system = _element(
+        root, "ssd", "System", name="ClosedLoop", description="The pendulum under the PID controller, fixed step"
+    )
     elements = _element(system, "ssd", "Elements")
     for name, (source, connectors) in COMPONENTS.items():
-        component = _element(elements, "ssd", "Component", name=name, source=source,
-                             type="application/x-fmu-sharedlibrary")
+        component = _element(
+            elements, "ssd", "Component", name=name, source=source, type="application/x-fmu-sharedlibrary"
+        )
         listed = _element(component, "ssd", "Connectors")
         for connector, kind in connectors.items():
             _element(_element(listed, "ssd", "Connector", name=connector, kind=kind), "ssc", "Real")
         bindings = _element(component, "ssd", "ParameterBindings")
-        _element(bindings, "ssd", "ParameterBinding", source=f"resources/{name}.ssv",
-                 type="application/x-ssp-parameter-set")
+        _element(
+            bindings, "ssd", "ParameterBinding", source=f"resources/{name}.ssv", type="application/x-ssp-parameter-set"
+        )
     connections = _element(system, "ssd", "Connections")
     for start, output, end, into in WIRES:
-        _element(connections, "ssd", "Connection", startElement=start, startConnector=output,
-                 endElement=end, endConnector=into)
+        _element(
+            connections,
+            "ssd",
+            "Connection",
+            startElement=start,
+            startConnector=output,
+            endElement=end,
+            endConnector=into,
+        )
     oms = _element(_element(system, "ssd", "Annotations"), "ssc", "Annotation", type="org.openmodelica")
     information = _element(_element(oms, "oms", "Annotations"), "oms", "SimulationInformation")
-    _element(information, "oms", "FixedStepMaster", description="oms-ma", stepSize=repr(step_size),
-             absoluteTolerance="1e-12", relativeTolerance="1e-12")
+    _element(
+        information,
+        "oms",
+        "FixedStepMaster",
+        description="oms-ma",
+        stepSize=repr(step_size),
+        absoluteTolerance="1e-12",
+        relativeTolerance="1e-12",
+    )
     experiment = _element(root, "ssd", "DefaultExperiment", startTime="0.0", stopTime=repr(stop_time))
-    osp = _element(_element(experiment, "ssd", "Annotations"), "ssc", "Annotation",
-                   type="com.opensimulationplatform")
+    osp = _element(_element(experiment, "ssd", "Annotations"), "ssc", "Annotation", type="com.opensimulationplatform")
     _element(_element(osp, "osp", "Algorithm"), "osp", "FixedStepAlgorithm", baseStepSize=repr(step_size))
     return ElementTree.tostring(root, encoding="UTF-8", xml_declaration=True)
 
 
-def export_ssp(out_file: str | os.PathLike = "ClosedLoop.ssp", *, controller: dict | None = None,
-               parameters: dict | None = None, stop_time: float = 3.0, step_size: float = 1e-3,
-               overwrite: bool = False) -> Path:
+def export_ssp(
+    out_file: str | os.PathLike = "ClosedLoop.ssp",
+    *,
+    controller: dict | None = None,
+    parameters: dict | None = None,
+    stop_time: float = 3.0,
+    step_size: float = 1e-3,
+    overwrite: bool = False,
+) -> Path:
     """Write ClosedLoop.ssp: the pendulum and the PID controller FMUs wired into one system.
 
     Parameters
@@ -220,8 +246,10 @@ def export_ssp(out_file: str | os.PathLike = "ClosedLoop.ssp", *, controller: di
     if out_file.exists() and not overwrite:
         raise SspExists(f"{out_file} exists: pass --overwrite to replace it, or name another file")
     with tempfile.TemporaryDirectory(prefix="pendulum_fmu_ssp_") as tmp:
-        fmus = {"pendulum": build_fmu(Path(tmp) / "Pendulum.fmu"),
-                "controller": build_pid_controller(Path(tmp) / "PIDController.fmu")}
+        fmus = {
+            "pendulum": build_fmu(Path(tmp) / "Pendulum.fmu"),
+            "controller": build_pid_controller(Path(tmp) / "PIDController.fmu"),
+        }
         with replacing(out_file, "wb") as file, zipfile.ZipFile(file, "w", zipfile.ZIP_DEFLATED) as archive:
             archive.writestr("SystemStructure.ssd", system_structure_xml(stop_time, step_size))
             for name, (source, _) in COMPONENTS.items():
@@ -231,10 +259,21 @@ def export_ssp(out_file: str | os.PathLike = "ClosedLoop.ssp", *, controller: di
     return out_file
 
 
+def _attribute(element: ElementTree.Element, path: str, attribute: str) -> str:
+    """The attribute of the element at path under element; a KeyError naming both when either is missing."""
+    found = element if path == "." else element.find(path, NAMESPACES)
+    value = None if found is None else found.get(attribute)
+    if value is None:
+        raise KeyError(f"no {path}/@{attribute}")
+    return value
+
+
 def _parameter_set(archive: zipfile.ZipFile, name: str) -> dict[str, float]:
     root = ElementTree.fromstring(archive.read(name))
-    return {p.get("name"): float(p.find("ssv:Real", NAMESPACES).get("value"))
-            for p in root.iterfind("ssv:Parameters/ssv:Parameter", NAMESPACES)}
+    return {
+        _attribute(p, ".", "name"): float(_attribute(p, "ssv:Real", "value"))
+        for p in root.iterfind("ssv:Parameters/ssv:Parameter", NAMESPACES)
+    }
 
 
 def read_ssp(path: str | os.PathLike) -> SspSettings:
@@ -267,14 +306,19 @@ def read_ssp(path: str | os.PathLike) -> SspSettings:
     try:
         with zipfile.ZipFile(path) as archive:
             ssd = ElementTree.fromstring(archive.read("SystemStructure.ssd"))
-            experiment = ssd.find("ssd:DefaultExperiment", NAMESPACES)
-            step = ssd.find(".//osp:FixedStepAlgorithm", NAMESPACES)
-            bindings = {c.get("name"): c.find("ssd:ParameterBindings/ssd:ParameterBinding", NAMESPACES).get("source")
-                        for c in ssd.iterfind("ssd:System/ssd:Elements/ssd:Component", NAMESPACES)}
+            bindings = {
+                _attribute(c, ".", "name"): _attribute(c, "ssd:ParameterBindings/ssd:ParameterBinding", "source")
+                for c in ssd.iterfind("ssd:System/ssd:Elements/ssd:Component", NAMESPACES)
+            }
             sets = {name: _parameter_set(archive, source) for name, source in bindings.items()}
-            return SspSettings(stop_time=float(experiment.get("stopTime")),
-                               step_size=float(step.get("baseStepSize")),
-                               controller=sets["controller"], pendulum=sets["pendulum"])
-    except (zipfile.BadZipFile, KeyError, AttributeError, TypeError, ValueError, ElementTree.ParseError) as error:
-        raise SspFileError(f"{path} is not the closed loop's SSP ({type(error).__name__}: {error}): "
-                           f"write one with `pendulum-fmu export-ssp`") from None
+            return SspSettings(
+                stop_time=float(_attribute(ssd, "ssd:DefaultExperiment", "stopTime")),
+                step_size=float(_attribute(ssd, ".//osp:FixedStepAlgorithm", "baseStepSize")),
+                controller=sets["controller"],
+                pendulum=sets["pendulum"],
+            )
+    except (zipfile.BadZipFile, KeyError, ValueError, ElementTree.ParseError) as error:
+        raise SspFileError(
+            f"{path} is not the closed loop's SSP ({type(error).__name__}: {error}): "
+            f"write one with `pendulum-fmu export-ssp`"
+        ) from None

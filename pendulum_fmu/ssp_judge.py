@@ -12,6 +12,7 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass, field
 from functools import lru_cache
+from pathlib import Path
 
 import numpy as np
 
@@ -61,10 +62,12 @@ class SspVerdict:
 
 
 @lru_cache(maxsize=32)
-def _reference_theta(stop_time: float, step_size: float, coupling: str, controller: tuple,
-                     pendulum: tuple) -> np.ndarray:
-    return sampled_loop_reference(stop_time, step_size, controller=dict(controller),
-                                  parameters=dict(pendulum), coupling=coupling)["theta"]
+def _reference_theta(
+    stop_time: float, step_size: float, coupling: str, controller: tuple, pendulum: tuple
+) -> np.ndarray:
+    return sampled_loop_reference(
+        stop_time, step_size, controller=dict(controller), parameters=dict(pendulum), coupling=coupling
+    )["theta"]
 
 
 def judge_coupling(time, theta, settings: SspSettings, *, tolerance: float = MATCH_TOLERANCE) -> SspVerdict:
@@ -100,11 +103,15 @@ def judge_coupling(time, theta, settings: SspSettings, *, tolerance: float = MAT
     step_size = float(np.median(np.diff(time)))
     index = np.rint(time / step_size).astype(int)
     if np.max(np.abs(time - index * step_size)) > 1e-6 * step_size:
-        raise ResultFileError(f"the result's times are not multiples of one step ({step_size:.9g} s): "
-                              "give the rows of a fixed-step run, one per communication point")
+        raise ResultFileError(
+            f"the result's times are not multiples of one step ({step_size:.9g} s): "
+            "give the rows of a fixed-step run, one per communication point"
+        )
     steps = int(index[-1]) + 1  # one more than the last row: a row may hold the end of its step
-    sets = {True: (tuple(sorted(settings.controller.items())), tuple(sorted(settings.pendulum.items()))),
-            False: ((), ())}
+    sets = {
+        True: (tuple(sorted(settings.controller.items())), tuple(sorted(settings.pendulum.items()))),
+        False: ((), ()),
+    }
     scores = {}
     for coupling in COUPLINGS:
         for applied, (controller, pendulum) in sets.items():
@@ -123,13 +130,19 @@ def judge_coupling(time, theta, settings: SspSettings, *, tolerance: float = MAT
     if abs(end_time - settings.stop_time) > 0.5 * step_size:
         problems.append(f"ran to {end_time:.9g} s where the DefaultExperiment stops at {settings.stop_time:.9g} s")
     if shift:
-        problems.append("each row holds the value at the end of the step that starts at its time "
-                        "(labelled one step early)")
+        problems.append(
+            "each row holds the value at the end of the step that starts at its time (labelled one step early)"
+        )
     return SspVerdict(coupling, applied, bool(shift), error, step_size, end_time, problems)
 
 
-def judge_ssp_result(result: str | os.PathLike, ssp: str | os.PathLike, *,
-                     mapping: str | dict | None = None, tolerance: float = MATCH_TOLERANCE) -> SspVerdict:
+def judge_ssp_result(
+    result: str | os.PathLike,
+    ssp: str | os.PathLike,
+    *,
+    mapping: str | dict | None = None,
+    tolerance: float = MATCH_TOLERANCE,
+) -> SspVerdict:
     """judge_coupling on a result CSV against the SSP it ran.
 
     Parameters
@@ -156,7 +169,7 @@ def judge_ssp_result(result: str | os.PathLike, ssp: str | os.PathLike, *,
     --------
     >>> judge_ssp_result("out.csv", "ClosedLoop.ssp", mapping="theta=pendulum.theta")  # doctest: +SKIP
     """
-    rows = read_result(result, mapping)
+    rows = read_result(Path(result), mapping)
     return judge_coupling(rows["time"], rows["theta"], read_ssp(ssp), tolerance=tolerance)
 
 
@@ -176,10 +189,12 @@ def format_ssp_verdict(verdict: SspVerdict) -> str:
     >>> print(format_ssp_verdict(verdict))  # doctest: +SKIP
     coupling: jacobi ...
     """
-    lines = [f"coupling: {verdict.coupling} ({COUPLINGS[verdict.coupling]})",
-             f"parameter set applied: {'yes' if verdict.parameter_set_applied else 'no'}",
-             f"step {verdict.step_size:.9g} s, last value at {verdict.end_time:.9g} s, "
-             f"{verdict.max_error:.3g} rad from the coupling's reference",
-             *(f"problem: {problem}" for problem in verdict.problems),
-             "PASS: right for its coupling and the SSP" if verdict.passed else "FAIL"]
+    lines = [
+        f"coupling: {verdict.coupling} ({COUPLINGS[verdict.coupling]})",
+        f"parameter set applied: {'yes' if verdict.parameter_set_applied else 'no'}",
+        f"step {verdict.step_size:.9g} s, last value at {verdict.end_time:.9g} s, "
+        f"{verdict.max_error:.3g} rad from the coupling's reference",
+        *(f"problem: {problem}" for problem in verdict.problems),
+        "PASS: right for its coupling and the SSP" if verdict.passed else "FAIL",
+    ]
     return "\n".join(lines)

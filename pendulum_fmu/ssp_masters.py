@@ -99,8 +99,7 @@ def run_fmpy_ssp(ssp: str | os.PathLike, *, parameter_set: bool = False) -> tupl
         for component, values in (("controller", settings.controller), ("pendulum", settings.pendulum)):
             for name, value in values.items():
                 given.parameters.append(Parameter(name=f"{component}.{name}", type="Real", value=value))
-    result = simulate_ssp(str(ssp), stop_time=settings.stop_time, step_size=settings.step_size,
-                          parameter_set=given)
+    result = simulate_ssp(str(ssp), stop_time=settings.stop_time, step_size=settings.step_size, parameter_set=given)
     return result["time"], result["pendulum.theta"]
 
 
@@ -136,12 +135,24 @@ def run_fmucontainer(ssp: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     with tempfile.TemporaryDirectory(prefix="pendulum_fmu_fmucontainer_") as work:
         # fmucontainer writes its FMU beside the SSP it reads: a copy, so the user's folder stays as it was.
         copy = Path(shutil.copy(ssp, Path(work) / "ClosedLoop.ssp"))
-        subprocess.run([sys.executable, "-c", "import sys; from fmu_manipulation_toolbox.cli.fmucontainer "
-                        "import fmucontainer; sys.exit(fmucontainer())", "-fmu-directory", work,
-                        "-container", f"{copy.name}:{settings.step_size!r}"],
-                       cwd=work, check=True, capture_output=True)
-        result = simulate_fmu(str(copy.with_suffix(".fmu")), stop_time=settings.stop_time,
-                              output_interval=settings.step_size)
+        subprocess.run(
+            [
+                sys.executable,
+                "-c",
+                "import sys; from fmu_manipulation_toolbox.cli.fmucontainer "
+                "import fmucontainer; sys.exit(fmucontainer())",
+                "-fmu-directory",
+                work,
+                "-container",
+                f"{copy.name}:{settings.step_size!r}",
+            ],
+            cwd=work,
+            check=True,
+            capture_output=True,
+        )
+        result = simulate_fmu(
+            str(copy.with_suffix(".fmu")), stop_time=settings.stop_time, output_interval=settings.step_size
+        )
     return result["time"], result["pendulum.theta"]
 
 
@@ -173,8 +184,10 @@ def masters_table(ssp: str | os.PathLike) -> str:
     >>> print(masters_table("ClosedLoop.ssp"))  # doctest: +SKIP
     """
     settings = read_ssp(ssp)
-    rows = ["| master | theta at stop time | coupling | parameter set applied | from its reference "
-            "| problems |", "|---|---|---|---|---|---|"]
+    rows = [
+        "| master | theta at stop time | coupling | parameter set applied | from its reference | problems |",
+        "|---|---|---|---|---|---|",
+    ]
     for name, run in MASTERS.items():
         try:
             time, theta = run(ssp)
@@ -185,9 +198,11 @@ def masters_table(ssp: str | os.PathLike) -> str:
         # fmpy.ssp labels each value with its step's start: the value at the stop time is the one
         # labelled a step earlier.
         at_stop = np.interp(settings.stop_time - verdict.labelled_at_step_start * verdict.step_size, time, theta)
-        rows.append(f"| {name} | {float(at_stop)!r} | {verdict.coupling} | "
-                    f"{'yes' if verdict.parameter_set_applied else 'no'} | {verdict.max_error:.2g} rad | "
-                    f"{'; '.join(verdict.problems) or 'none'} |")
+        rows.append(
+            f"| {name} | {float(at_stop)!r} | {verdict.coupling} | "
+            f"{'yes' if verdict.parameter_set_applied else 'no'} | {verdict.max_error:.2g} rad | "
+            f"{'; '.join(verdict.problems) or 'none'} |"
+        )
     return "\n".join(rows)
 
 
@@ -212,6 +227,7 @@ def main(argv=None) -> int:
 
     try:
         from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+
         log_output_level(CosimLogLevel.WARNING)  # libcosim's debug lines would bury the table
     except ImportError:
         pass  # its row says it is not installed

@@ -1,5 +1,7 @@
-"""ClosedLoop.ssp: the export, the couplings' references, every SSP master installable here held to
-its coupling's reference, and the judge that names the coupling."""
+"""ClosedLoop.ssp: the export, the couplings' references, the masters and the judge.
+
+Every SSP master installable here is held to its coupling's reference, and the judge names it.
+"""
 
 import os
 import zipfile
@@ -23,22 +25,30 @@ def ssp(tmp_path_factory):
 
 
 def _reference(ssp_settings, coupling, applied=True):
-    return sampled_loop_reference(ssp_settings.stop_time + ssp_settings.step_size, ssp_settings.step_size,
-                                  controller=ssp_settings.controller if applied else None,
-                                  parameters=ssp_settings.pendulum if applied else None, coupling=coupling)
+    return sampled_loop_reference(
+        ssp_settings.stop_time + ssp_settings.step_size,
+        ssp_settings.step_size,
+        controller=ssp_settings.controller if applied else None,
+        parameters=ssp_settings.pendulum if applied else None,
+        coupling=coupling,
+    )
 
 
 def test_export_validates_against_the_ssp_1_0_schemas_and_reads_back(ssp):
     with zipfile.ZipFile(ssp) as archive:
         names = set(archive.namelist())
-        documents = {name: lxml.etree.fromstring(archive.read(name)) for name in names
-                     if name.endswith((".ssd", ".ssv"))}
+        documents = {
+            name: lxml.etree.fromstring(archive.read(name)) for name in names if name.endswith((".ssd", ".ssv"))
+        }
     assert {"resources/Pendulum.fmu", "resources/PIDController.fmu"} <= names
     assert sorted(documents) == ["SystemStructure.ssd", "resources/controller.ssv", "resources/pendulum.ssv"]
     for name, document in documents.items():
-        schema = lxml.etree.XMLSchema(file=os.path.join(SCHEMAS, "SystemStructureDescription.xsd"
-                                                        if name.endswith(".ssd") else
-                                                        "SystemStructureParameterValues.xsd"))
+        schema = lxml.etree.XMLSchema(
+            file=os.path.join(
+                SCHEMAS,
+                "SystemStructureDescription.xsd" if name.endswith(".ssd") else "SystemStructureParameterValues.xsd",
+            )
+        )
         assert schema.validate(document), (name, schema.error_log)
     settings = read_ssp(ssp)
     assert (settings.stop_time, settings.step_size) == (2.0, 1e-3)
@@ -69,11 +79,11 @@ def test_each_couplings_reference_is_the_exact_sampled_double_integrator(couplin
     expected = [theta]
     for k in range(n):
         error_integral_after = integral + h * (gains["setpoint"] - theta)
-        measured, used_integral = {"gauss-seidel-pendulum-first": ((theta, omega), integral),
-                                   "gauss-seidel-controller-first": ((theta, omega), error_integral_after)
-                                   }.get(coupling, (sent, integral))
-        u = (gains["kp"] * (gains["setpoint"] - measured[0]) + gains["ki"] * used_integral
-             - gains["kd"] * measured[1])
+        measured, used_integral = {
+            "gauss-seidel-pendulum-first": ((theta, omega), integral),
+            "gauss-seidel-controller-first": ((theta, omega), error_integral_after),
+        }.get(coupling, (sent, integral))
+        u = gains["kp"] * (gains["setpoint"] - measured[0]) + gains["ki"] * used_integral - gains["kd"] * measured[1]
         if coupling == "jacobi-first-exchange-missing" and k == 0:
             u = 0.0
         sent, integral = (theta, omega), error_integral_after
@@ -88,6 +98,7 @@ def test_libcosim_runs_the_ssp_as_it_is_jacobi_with_its_parameter_sets(ssp):
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
 
     from pendulum_fmu.ssp_masters import run_libcosim
+
     log_output_level(CosimLogLevel.WARNING)
     time, theta = run_libcosim(ssp)
     settings = read_ssp(ssp)
@@ -100,6 +111,7 @@ def test_libcosim_runs_the_ssp_as_it_is_jacobi_with_its_parameter_sets(ssp):
 
 def test_fmpy_ssp_is_jacobi_without_the_first_exchange_and_ignores_the_bound_sets(ssp):
     from pendulum_fmu.ssp_masters import run_fmpy_ssp
+
     settings = read_ssp(ssp)
     for given, applied in ((False, False), (True, True)):
         time, theta = run_fmpy_ssp(ssp, parameter_set=given)
@@ -108,8 +120,11 @@ def test_fmpy_ssp_is_jacobi_without_the_first_exchange_and_ignores_the_bound_set
         assert len(time) == len(expected) - 1 == 2001
         assert np.max(np.abs(theta - expected["theta"][1:])) < 1e-12
         verdict = judge_coupling(time, theta, settings)
-        assert (verdict.coupling, verdict.parameter_set_applied, verdict.labelled_at_step_start) == \
-            ("jacobi-first-exchange-missing", applied, True)
+        assert (verdict.coupling, verdict.parameter_set_applied, verdict.labelled_at_step_start) == (
+            "jacobi-first-exchange-missing",
+            applied,
+            True,
+        )
         assert verdict.end_time == pytest.approx(2.001)
         assert any("ran to 2.001 s" in problem for problem in verdict.problems)
 
@@ -117,6 +132,7 @@ def test_fmpy_ssp_is_jacobi_without_the_first_exchange_and_ignores_the_bound_set
 def test_fmucontainer_is_jacobi_and_ignores_the_parameter_bindings(ssp):
     pytest.importorskip("fmu_manipulation_toolbox")
     from pendulum_fmu.ssp_masters import run_fmucontainer
+
     settings = read_ssp(ssp)
     time, theta = run_fmucontainer(ssp)
     expected = _reference(settings, "jacobi", applied=False)
@@ -133,8 +149,9 @@ def test_judge_names_a_wrong_step_and_an_early_stop_from_the_command_line(ssp, t
     # --stopTime), its columns named its own way.
     run = sampled_loop_reference(1.0, 2e-3, controller=settings.controller, coupling="gauss-seidel-pendulum-first")
     result = tmp_path / "out.csv"
-    np.savetxt(result, np.column_stack([run["time"], run["theta"]]), delimiter=",", header="t,phi",
-               comments="", fmt="%.17g")
+    np.savetxt(
+        result, np.column_stack([run["time"], run["theta"]]), delimiter=",", header="t,phi", comments="", fmt="%.17g"
+    )
     assert main(["judge", str(result), "--ssp", str(ssp), "--map", "time=t,theta=phi"]) == 1
     printed = capsys.readouterr().out
     assert "coupling: gauss-seidel-pendulum-first" in printed
@@ -142,7 +159,18 @@ def test_judge_names_a_wrong_step_and_an_early_stop_from_the_command_line(ssp, t
     assert "step 0.002 s where the SSP asks 0.001 s" in printed
     assert "ran to 1 s where the DefaultExperiment stops at 2 s" in printed
     # A result of none of the couplings: the nearest is named, and it fails.
-    np.savetxt(result, np.column_stack([run["time"], run["theta"] * 1.001]), delimiter=",",
-               header="t,phi", comments="", fmt="%.17g")
+    np.savetxt(
+        result,
+        np.column_stack([run["time"], run["theta"] * 1.001]),
+        delimiter=",",
+        header="t,phi",
+        comments="",
+        fmt="%.17g",
+    )
     assert main(["judge", str(result), "--ssp", str(ssp), "--map", "time=t,theta=phi"]) == 1
     assert "matches no coupling: nearest" in capsys.readouterr().out
+    not_an_ssp = tmp_path / "ClosedLoop.ssp"
+    not_an_ssp.write_text("time,theta\n")
+    assert main(["judge", str(result), "--ssp", str(not_an_ssp), "--map", "time=t,theta=phi"]) == 2
+    error = capsys.readouterr().err.strip()
+    assert "is not the closed loop's SSP" in error and len(error.splitlines()) == 1
