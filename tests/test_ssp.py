@@ -3,6 +3,7 @@
 Every SSP master installable here is held to its coupling's reference, and the judge names it.
 """
 
+import json
 import os
 import zipfile
 
@@ -174,3 +175,21 @@ def test_judge_names_a_wrong_step_and_an_early_stop_from_the_command_line(ssp, t
     assert main(["judge", str(result), "--ssp", str(not_an_ssp), "--map", "time=t,theta=phi"]) == 2
     error = capsys.readouterr().err.strip()
     assert "is not the closed loop's SSP" in error and len(error.splitlines()) == 1
+
+
+def test_the_kits_closed_loop_names_each_couplings_reference_as_that_coupling(tmp_path, capsys):
+    kit = tmp_path / "kit"
+    assert main(["scenarios", "--output-dir", str(kit), "--closed-loop"]) == 0
+    assert "wrote" in capsys.readouterr().out
+    settings = json.loads((kit / "ClosedLoop.json").read_text())
+    ssp_settings = read_ssp(kit / settings["ssp"])
+    assert (settings["stop_time"], settings["step_size"]) == (ssp_settings.stop_time, ssp_settings.step_size)
+    assert settings["controller"] == ssp_settings.controller and settings["pendulum"] == ssp_settings.pendulum
+    references = np.genfromtxt(kit / settings["reference"], delimiter=",", names=True, deletechars="")
+    assert references.dtype.names == ("time", *COUPLINGS)
+    for coupling in COUPLINGS:
+        # Each column, handed to the judge as a master's result, is that coupling and right.
+        verdict = judge_coupling(references["time"], references[coupling], ssp_settings)
+        assert (verdict.coupling, verdict.problems) == (coupling, [])
+    assert main(["scenarios", "--output-dir", str(kit), "--closed-loop"]) == 2
+    assert "--overwrite" in capsys.readouterr().err
