@@ -324,3 +324,44 @@ def plot_judgement(judgement, path: str | Path, title: str) -> Path:
     axes[2].set_ylabel(r"$|\Delta\theta|$ in rad")
     axes[2].set_xlabel(TIME_LABEL)
     return _finish(fig, axes, f"{title}: {judgement.verdict}, {judgement.diagnosis}", path)
+
+
+@_drawing
+def plot_calls(judged: dict, path: str | Path, title: str) -> Path:
+    """What a master did to each instance, from its calls (calls.judge_calls's result).
+
+    Parameters
+    ----------
+    judged : dict
+        As pendulum_fmu.calls.judge_calls returns it.
+    path : str or Path
+        The figure's file.
+    title : str
+
+    Returns
+    -------
+    Path
+
+    Examples
+    --------
+    >>> plot_calls(judge_calls("run.log", None, {0: "torque"}), "calls.png", "run.log")  # doctest: +SKIP
+    """
+    fig, axes = plt.subplots(len(judged), 1, figsize=(10, 3 + 2.5 * len(judged)), squeeze=False)
+    for ax, (name, result) in zip(axes[:, 0], judged.items(), strict=True):
+        steps = result["steps"]
+        time = [step["time"] for step in steps]
+        ax.step(time, [step["torque"] for step in steps], where="post", linewidth=2,
+                label="torque at each step's start, as the master set it")
+        if result["intended_torque"] is not None:
+            intended = result["intended_torque"][: len(time)]
+            ax.step(time[: len(intended)], intended, where="post", linestyle="--", linewidth=1.5,
+                    label="the intended run's")
+        found = result["differences"]
+        ax.set_title(f"instance {name}" + ("" if found is None else f": {len(found)} difference(s)"),
+                     fontsize=10)
+        if found:
+            ax.text(0.01, 0.04, "\n".join(found[:4]), transform=ax.transAxes, fontsize=7,
+                    verticalalignment="bottom")
+        ax.set_ylabel(r"Torque $\tau$ in N.m")
+        ax.set_xlabel(TIME_LABEL)
+    return _finish(fig, axes, title, path)

@@ -379,6 +379,21 @@ NAME_in.csv --step-size ... --set ...`) gives the full table, `--plot` a figure,
 numbers. `NAME_ref.csv` holds the reference itself: time (s), torque (N.m), theta (rad), omega
 (rad/s), alpha (rad/s2) at every communication point, from scipy (DOP853, tolerance 1e-12).
 
+With each `NAME_out.csv`, send the FMU's call record of that run as `NAME_calls.log`: the FMU
+writes one `[pendulum-calls]` line per call it receives (category `logCalls`) when the master
+turns logging on, and `pendulum-fmu judge --calls NAME_calls.log` with the scenario's options
+names what the master did differently, step by step. How to get it:
+
+- fmpy: `fmpy simulate ... --debug-logging > NAME_calls.log` (API: `simulate_fmu(...,
+  debug_logging=True)`, stdout); `--fmi-logging` adds fmpy's own call log, which the judge also
+  reads.
+- fmusim: `--logging-on --log-file NAME_calls.log`, or `--log-fmi-calls --fmi-log-file
+  NAME_calls.log` (fmusim's own call log).
+- libcosim: `log_output_level(CosimLogLevel.TRACE)`; send its whole output.
+- OMSimulator: a release build drops the FMU's messages of status OK; send its `setLogFile` log
+  with the FMU's debug logging on if your build shows them.
+- Simulink (FMIKit), Dymola: turn on the FMU's debug logging and send the log they write.
+
 `{KIT_FMU}` carries the same files under `{LS_REF_FOLDER}` as related files of the FMI layered
 standard FMI-LS-REF {LS_REF_VERSION}: `fmi-ls-manifest.xml`, the experiments file
 `{EXPERIMENTS_FILE}`, and per scenario its parameter set, settings, input and reference.

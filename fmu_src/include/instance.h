@@ -84,7 +84,8 @@ typedef enum {
     LOG_STATUS_WARNING = 1 << 0,
     LOG_STATUS_DISCARD = 1 << 1,
     LOG_STATUS_ERROR = 1 << 2,
-    LOG_ALL = 1 << 3
+    LOG_ALL = 1 << 3,
+    LOG_CALLS = 1 << 4                   /* the call record: one line per call received */
 } LogCategory;
 
 typedef struct {
@@ -121,6 +122,50 @@ void instance_reset(Instance *instance);
 void instance_log(const Instance *instance, Status status, LogCategory category,
                   const char *format, ...);
 Status instance_error(const Instance *instance, const char *function, const char *format, ...);
+
+/* The call record: one line per call the instance receives, under category logCalls, so that a
+   user can show what a master did to the FMU. Each line starts with CALL_RECORD_MARKER and names
+   the instance inside the message, because masters print messages in formats of their own and
+   some drop the instance name; pendulum_fmu/calls.py reads the lines back. The adapters test
+   instance_recording before they format anything, so that a step costs one test when it is off. */
+#define CALL_RECORD_MARKER "[pendulum-calls]"
+/* For the out-of-line recording paths of the functions a master calls every step. */
+#if defined(_MSC_VER)
+#define NOINLINE __declspec(noinline)
+#else
+#define NOINLINE __attribute__((noinline))
+#endif
+static inline int instance_recording(const Instance *instance) {
+    return instance->log_categories & LOG_CALLS;
+}
+/* For the adapters' entry points, whose locals are `instance` and `function`: the time before
+   the call, kept for its line, and the line itself, formatted only when the record is on. */
+#define KEEP_TIME const double time_before = instance->data.time;
+#define RECORD(status, ...)                                                            \
+    if (instance_recording(instance))                                                  \
+        instance_record_call(instance, function, time_before, (status), __VA_ARGS__);
+#define RECORD_VALUES(status, vr, order, n, value)                                     \
+    if (instance_recording(instance))                                                  \
+        instance_record_values(instance, function, time_before, (status), (vr), (order), (n), \
+                               (value));
+/* The functions a master calls every step ask the record first and, when it is on, go out of
+   line to a function that calls the entry point again with the record switched off for the call
+   (this macro), then records it. So with the record off an entry point keeps its path as it was
+   (the core's function inlined into it, its only caller; a tail call) and a step pays one test. */
+#define WITHOUT_RECORD(status_type, call)                                              \
+    const double time_before = instance->data.time;                                    \
+    instance->log_categories &= ~LOG_CALLS;                                            \
+    const status_type status = (call);                                                 \
+    instance->log_categories |= LOG_CALLS;
+/* `format` describes the arguments; the line adds the FMU's time before and after the call and
+   the status it returned. */
+void instance_record_call(const Instance *instance, const char *function, double time_before,
+                          Status status, const char *format, ...);
+/* The arguments are values by variable name (vr given: "torque=20"), input derivatives by name
+   and order (order given too: "der(torque,1)=5"), or a state vector (vr NULL: "x[0]=0.1"). */
+void instance_record_values(const Instance *instance, const char *function, double time_before,
+                            Status status, const unsigned int vr[], const int order[], size_t n,
+                            const double value[]);
 
 /* Logs why mask does not allow the call (the function is the other interface's, or the machine
    state is not in it); returns 0. */

@@ -61,12 +61,15 @@
                                                | STATE_CONTINUOUS_TIME_MODE | STATE_TERMINATED)
 
 /* Every function with an instance starts here: NULL instance, then the state mask. Each
-   function's name travels into the core for its messages. */
+   function's name travels into the core for its messages (a refused call is recorded there). */
 #define ENTER(name)                                                                    \
     static const char function[] = #name;                                             \
     Instance *instance = (Instance *)c;                                                \
     if (!instance || !instance_state_allows(instance, MASK_##name, function))          \
         return fmi2Error;
+
+
+
 
 /* Array arguments may be NULL only when their length is 0. */
 #define REQUIRE_ARRAY(name, length)                                                    \
@@ -86,6 +89,41 @@ static void forward_to_fmi2_logger(AnyFunction master_logger, void *environment,
                                    const char *message) {
     ((fmi2CallbackLogger)master_logger)(environment, instance_name, (fmi2Status)status, category,
                                         message);
+}
+
+
+/* The functions a master calls every step go through these only when the record is on
+   (WITHOUT_RECORD, instance.h). */
+static NOINLINE fmi2Status recorded_get_real(Instance *instance, const char *function,
+                                             const unsigned int vr[], size_t nvr, double value[]) {
+    WITHOUT_RECORD(fmi2Status, fmi2GetReal(instance, vr, nvr, value))
+    RECORD_VALUES((Status)status, vr, NULL, status == fmi2OK ? nvr : 0, value)
+    return status;
+}
+
+static NOINLINE fmi2Status recorded_set_real(Instance *instance, const char *function,
+                                             const unsigned int vr[], size_t nvr,
+                                             const double value[]) {
+    WITHOUT_RECORD(fmi2Status, fmi2SetReal(instance, vr, nvr, value))
+    RECORD_VALUES((Status)status, vr, NULL, nvr, value)
+    return status;
+}
+
+static NOINLINE fmi2Status recorded_input_derivatives(Instance *instance, const char *function,
+                                                      const unsigned int vr[], size_t nvr,
+                                                      const int order[], const double value[]) {
+    WITHOUT_RECORD(fmi2Status, fmi2SetRealInputDerivatives(instance, vr, nvr, order, value))
+    RECORD_VALUES((Status)status, vr, order, nvr, value)
+    return status;
+}
+
+static NOINLINE fmi2Status recorded_do_step(Instance *instance, const char *function,
+                                            double communication_point, double communication_step,
+                                            fmi2Boolean no_set_state_prior) {
+    WITHOUT_RECORD(fmi2Status, fmi2DoStep(instance, communication_point, communication_step, no_set_state_prior))
+    RECORD((Status)status, "currentCommunicationPoint=%.17g, communicationStepSize=%.17g",
+           communication_point, communication_step)
+    return status;
 }
 
 const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
@@ -112,7 +150,13 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
 }
 
 void fmi2FreeInstance(fmi2Component c) {
-    instance_free((Instance *)c);
+    static const char function[] = "fmi2FreeInstance";
+    Instance *instance = (Instance *)c;
+    if (instance) {
+        const double time_before = instance->data.time;
+        RECORD(STATUS_OK, "")
+    }
+    instance_free(instance);
 }
 
 fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories,
@@ -123,32 +167,45 @@ fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nC
 
 fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
                                fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime) {
-    (void)stopTimeDefined; /* a model without events has no end of its own */
-    (void)stopTime;
+    /* stopTime is only recorded: a model without events has no end of its own. */
     ENTER(fmi2SetupExperiment)
-    return STATUS(instance_setup_experiment(instance, function, toleranceDefined, tolerance, startTime));
+    KEEP_TIME
+    const Status status = instance_setup_experiment(instance, function, toleranceDefined, tolerance,
+                                                    startTime);
+    RECORD(status, "toleranceDefined=%d, tolerance=%.17g, startTime=%.17g, stopTimeDefined=%d, "
+           "stopTime=%.17g", (int)toleranceDefined, tolerance, startTime, (int)stopTimeDefined, stopTime)
+    return STATUS(status);
 }
 
 fmi2Status fmi2EnterInitializationMode(fmi2Component c) {
     ENTER(fmi2EnterInitializationMode)
+    KEEP_TIME
     instance->data.machine_state = STATE_INITIALIZATION_MODE;
+    RECORD(STATUS_OK, "")
     return fmi2OK;
 }
 
 fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
     ENTER(fmi2ExitInitializationMode)
-    return STATUS(instance_exit_initialization(instance, function));
+    KEEP_TIME
+    const Status status = instance_exit_initialization(instance, function);
+    RECORD(status, "")
+    return STATUS(status);
 }
 
 fmi2Status fmi2Terminate(fmi2Component c) {
     ENTER(fmi2Terminate)
+    KEEP_TIME
     instance->data.machine_state = STATE_TERMINATED;
+    RECORD(STATUS_OK, "")
     return fmi2OK;
 }
 
 fmi2Status fmi2Reset(fmi2Component c) {
     ENTER(fmi2Reset)
+    KEEP_TIME
     instance_reset(instance);
+    RECORD(STATUS_OK, "")
     return fmi2OK;
 }
 
@@ -156,6 +213,8 @@ fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
     ENTER(fmi2GetReal)
     REQUIRE_ARRAY(vr, nvr)
     REQUIRE_ARRAY(value, nvr)
+    if (instance_recording(instance))
+        return recorded_get_real(instance, function, vr, nvr, value);
     return STATUS(instance_get_real(instance, function, vr, nvr, value));
 }
 
@@ -164,6 +223,7 @@ fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
     ENTER(fmi2SetReal)
     REQUIRE_ARRAY(vr, nvr)
     REQUIRE_ARRAY(value, nvr)
+    if (instance_recording(instance)) return recorded_set_real(instance, function, vr, nvr, value);
     return STATUS(instance_set_real(instance, function, vr, nvr, value));
 }
 
@@ -187,36 +247,56 @@ NO_VARIABLES_OF_TYPE(fmi2SetString, const fmi2String *)
 
 fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
     ENTER(fmi2GetFMUstate)
-    return STATUS(instance_get_state(instance, function, FMUstate));
+    KEEP_TIME
+    const Status status = instance_get_state(instance, function, FMUstate);
+    RECORD(status, "state=%p", (void *)(FMUstate ? *FMUstate : NULL))
+    return STATUS(status);
 }
 
 fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate) {
     ENTER(fmi2SetFMUstate)
-    return STATUS(instance_set_state(instance, function, FMUstate));
+    KEEP_TIME
+    const Status status = instance_set_state(instance, function, FMUstate);
+    RECORD(status, "state=%p", (void *)(FMUstate))
+    return STATUS(status);
 }
 
 fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
     ENTER(fmi2FreeFMUstate)
-    return STATUS(instance_free_state(instance, function, FMUstate));
+    KEEP_TIME
+    void *const freed = FMUstate ? *FMUstate : NULL;
+    const Status status = instance_free_state(instance, function, FMUstate);
+    RECORD(status, "state=%p", freed)
+    return STATUS(status);
 }
 
 fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, size_t *size) {
     ENTER(fmi2SerializedFMUstateSize)
-    return STATUS(instance_serialized_state_size(instance, function, FMUstate, size));
+    KEEP_TIME
+    const Status status = instance_serialized_state_size(instance, function, FMUstate, size);
+    RECORD(status, "state=%p", (void *)(FMUstate))
+    return STATUS(status);
 }
 
 fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serializedState[],
                                  size_t size) {
     ENTER(fmi2SerializeFMUstate)
-    return STATUS(instance_serialize_state(instance, function, FMUstate,
-                                           (unsigned char *)serializedState, size));
+    KEEP_TIME
+    const Status status = instance_serialize_state(instance, function, FMUstate,
+                                                   (unsigned char *)serializedState, size);
+    RECORD(status, "state=%p, size=%lu", (void *)FMUstate, (unsigned long)size)
+    return STATUS(status);
 }
 
 fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size,
                                    fmi2FMUstate *FMUstate) {
     ENTER(fmi2DeSerializeFMUstate)
-    return STATUS(instance_deserialize_state(instance, function,
-                                             (const unsigned char *)serializedState, size, FMUstate));
+    KEEP_TIME
+    const Status status = instance_deserialize_state(instance, function,
+                                                     (const unsigned char *)serializedState, size,
+                                                     FMUstate);
+    RECORD(status, "size=%lu, state=%p", (unsigned long)size, (void *)(FMUstate ? *FMUstate : NULL))
+    return STATUS(status);
 }
 
 fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[],
@@ -238,6 +318,8 @@ fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference
     REQUIRE_ARRAY(vr, nvr)
     REQUIRE_ARRAY(order, nvr)
     REQUIRE_ARRAY(value, nvr)
+    if (instance_recording(instance))
+        return recorded_input_derivatives(instance, function, vr, nvr, order, value);
     return STATUS(instance_set_input_derivatives(instance, function, vr, nvr, order, value));
 }
 
@@ -252,8 +334,12 @@ fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReferenc
 
 fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
                       fmi2Real communicationStepSize, fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
-    (void)noSetFMUStatePriorToCurrentPoint; /* states are copies: nothing to release early */
+    /* noSetFMUStatePriorToCurrentPoint only passes through: states are copies, nothing to release
+       early. */
     ENTER(fmi2DoStep)
+    if (instance_recording(instance))
+        return recorded_do_step(instance, function, currentCommunicationPoint, communicationStepSize,
+                                noSetFMUStatePriorToCurrentPoint);
     return STATUS(instance_do_step(instance, function, currentCommunicationPoint,
                                    communicationStepSize));
 }
@@ -311,7 +397,9 @@ fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2Stri
 
 fmi2Status fmi2EnterEventMode(fmi2Component c) {
     ENTER(fmi2EnterEventMode)
+    KEEP_TIME
     instance->data.machine_state = STATE_EVENT_MODE;
+    RECORD(STATUS_OK, "")
     return fmi2OK;
 }
 
@@ -329,7 +417,9 @@ fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *fmi2eventInfo) 
 
 fmi2Status fmi2EnterContinuousTimeMode(fmi2Component c) {
     ENTER(fmi2EnterContinuousTimeMode)
+    KEEP_TIME
     instance->data.machine_state = STATE_CONTINUOUS_TIME_MODE;
+    RECORD(STATUS_OK, "")
     return fmi2OK;
 }
 
@@ -337,29 +427,40 @@ fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, fmi2Boolean noSetFMUStat
                                        fmi2Boolean *enterEventMode, fmi2Boolean *terminateSimulation) {
     (void)noSetFMUStatePriorToCurrentPoint;
     ENTER(fmi2CompletedIntegratorStep)
+    KEEP_TIME
     if (instance_null_argument(instance, function, "enterEventMode", enterEventMode) ||
         instance_null_argument(instance, function, "terminateSimulation", terminateSimulation))
         return fmi2Error;
     *enterEventMode = fmi2False;
     *terminateSimulation = fmi2False;
+    RECORD(STATUS_OK, "")
     return fmi2OK;
 }
 
 fmi2Status fmi2SetTime(fmi2Component c, fmi2Real time) {
     ENTER(fmi2SetTime)
-    return STATUS(instance_set_time(instance, function, time));
+    KEEP_TIME
+    const Status status = instance_set_time(instance, function, time);
+    RECORD(status, "time=%.17g", time)
+    return STATUS(status);
 }
 
 fmi2Status fmi2SetContinuousStates(fmi2Component c, const fmi2Real x[], size_t nx) {
     ENTER(fmi2SetContinuousStates)
+    KEEP_TIME
     REQUIRE_ARRAY(x, nx)
-    return STATUS(instance_set_states(instance, function, x, nx));
+    const Status status = instance_set_states(instance, function, x, nx);
+    RECORD_VALUES(status, NULL, NULL, status == STATUS_OK ? nx : 0, x)
+    return STATUS(status);
 }
 
 fmi2Status fmi2GetDerivatives(fmi2Component c, fmi2Real derivatives[], size_t nx) {
     ENTER(fmi2GetDerivatives)
+    KEEP_TIME
     REQUIRE_ARRAY(derivatives, nx)
-    return STATUS(instance_get_derivatives(instance, function, derivatives, nx));
+    const Status status = instance_get_derivatives(instance, function, derivatives, nx);
+    RECORD_VALUES(status, NULL, NULL, status == STATUS_OK ? nx : 0, derivatives)
+    return STATUS(status);
 }
 
 fmi2Status fmi2GetEventIndicators(fmi2Component c, fmi2Real eventIndicators[], size_t ni) {

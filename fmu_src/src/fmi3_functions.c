@@ -131,6 +131,40 @@ static void forward_to_fmi3_logger(AnyFunction master_logger, void *environment,
     ((fmi3LogMessageCallback)master_logger)(environment, (fmi3Status)status, category, message);
 }
 
+/* The functions a master calls every step go through these only when the record is on
+   (WITHOUT_RECORD, instance.h). */
+static NOINLINE fmi3Status recorded_get_float64(Instance *instance, const char *function,
+                                                const fmi3ValueReference vr[], size_t nvr,
+                                                fmi3Float64 values[], size_t n_values) {
+    WITHOUT_RECORD(fmi3Status, fmi3GetFloat64(instance, vr, nvr, values, n_values))
+    RECORD_VALUES((Status)status, vr, NULL, status == fmi3OK ? nvr : 0, values)
+    return status;
+}
+
+static NOINLINE fmi3Status recorded_set_float64(Instance *instance, const char *function,
+                                                const fmi3ValueReference vr[], size_t nvr,
+                                                const fmi3Float64 values[], size_t n_values) {
+    WITHOUT_RECORD(fmi3Status, fmi3SetFloat64(instance, vr, nvr, values, n_values))
+    RECORD_VALUES((Status)status, vr, NULL, nvr == n_values ? nvr : 0, values)
+    return status;
+}
+
+static NOINLINE fmi3Status recorded_do_step(Instance *instance, const char *function,
+                                            fmi3Float64 communication_point,
+                                            fmi3Float64 communication_step,
+                                            fmi3Boolean no_set_state_prior,
+                                            fmi3Boolean *event_handling_needed,
+                                            fmi3Boolean *terminate_simulation,
+                                            fmi3Boolean *early_return,
+                                            fmi3Float64 *last_successful_time) {
+    WITHOUT_RECORD(fmi3Status, fmi3DoStep(instance, communication_point, communication_step,
+                                          no_set_state_prior, event_handling_needed,
+                                          terminate_simulation, early_return, last_successful_time))
+    RECORD((Status)status, "currentCommunicationPoint=%.17g, communicationStepSize=%.17g",
+           communication_point, communication_step)
+    return status;
+}
+
 static fmi3Instance instantiate(const char *function, fmi3String name, fmi3String token,
                                 InterfaceType type, fmi3Boolean loggingOn,
                                 fmi3InstanceEnvironment environment,
@@ -192,47 +226,67 @@ fmi3Instance fmi3InstantiateScheduledExecution(fmi3String instanceName, fmi3Stri
 }
 
 void fmi3FreeInstance(fmi3Instance c) {
-    instance_free((Instance *)c);
+    static const char function[] = "fmi3FreeInstance";
+    Instance *instance = (Instance *)c;
+    if (instance) {
+        KEEP_TIME
+        RECORD(STATUS_OK, "")
+    }
+    instance_free(instance);
 }
 
 fmi3Status fmi3EnterInitializationMode(fmi3Instance c, fmi3Boolean toleranceDefined,
                                        fmi3Float64 tolerance, fmi3Float64 startTime,
                                        fmi3Boolean stopTimeDefined, fmi3Float64 stopTime) {
-    (void)stopTimeDefined; /* a model without events has no end of its own */
-    (void)stopTime;
+    /* stopTime is only recorded: a model without events has no end of its own. */
     ENTER(fmi3EnterInitializationMode)
+    KEEP_TIME
     const Status status = instance_setup_experiment(instance, function, toleranceDefined, tolerance,
                                                     startTime);
     if (status == STATUS_OK) instance->data.machine_state = STATE_INITIALIZATION_MODE;
+    RECORD(status, "toleranceDefined=%d, tolerance=%.17g, startTime=%.17g, stopTimeDefined=%d, "
+           "stopTime=%.17g", (int)toleranceDefined, tolerance, startTime, (int)stopTimeDefined, stopTime)
     return STATUS(status);
 }
 
 fmi3Status fmi3ExitInitializationMode(fmi3Instance c) {
     ENTER(fmi3ExitInitializationMode)
-    return STATUS(instance_exit_initialization(instance, function));
+    KEEP_TIME
+    const Status status = instance_exit_initialization(instance, function);
+    RECORD(status, "")
+    return STATUS(status);
 }
 
 fmi3Status fmi3EnterEventMode(fmi3Instance c) {
     ENTER(fmi3EnterEventMode)
+    KEEP_TIME
     instance->data.machine_state = STATE_EVENT_MODE;
+    RECORD(STATUS_OK, "")
     return fmi3OK;
 }
 
 fmi3Status fmi3Terminate(fmi3Instance c) {
     ENTER(fmi3Terminate)
+    KEEP_TIME
     instance->data.machine_state = STATE_TERMINATED;
+    RECORD(STATUS_OK, "")
     return fmi3OK;
 }
 
 fmi3Status fmi3Reset(fmi3Instance c) {
     ENTER(fmi3Reset)
+    KEEP_TIME
     instance_reset(instance);
+    RECORD(STATUS_OK, "")
     return fmi3OK;
 }
 
 fmi3Status fmi3GetFloat64(fmi3Instance c, const fmi3ValueReference valueReferences[],
                           size_t nValueReferences, fmi3Float64 values[], size_t nValues) {
     ENTER(fmi3GetFloat64)
+    if (instance_recording(instance))
+        return recorded_get_float64(instance, function, valueReferences, nValueReferences, values,
+                                    nValues);
     REQUIRE_ARRAY(valueReferences, nValueReferences)
     REQUIRE_ARRAY(values, nValues)
     REQUIRE_COUNT(nValues, nValueReferences)
@@ -250,6 +304,9 @@ fmi3Status fmi3GetFloat64(fmi3Instance c, const fmi3ValueReference valueReferenc
 fmi3Status fmi3SetFloat64(fmi3Instance c, const fmi3ValueReference valueReferences[],
                           size_t nValueReferences, const fmi3Float64 values[], size_t nValues) {
     ENTER(fmi3SetFloat64)
+    if (instance_recording(instance))
+        return recorded_set_float64(instance, function, valueReferences, nValueReferences, values,
+                                    nValues);
     REQUIRE_ARRAY(valueReferences, nValueReferences)
     REQUIRE_ARRAY(values, nValues)
     REQUIRE_COUNT(nValues, nValueReferences)
@@ -359,34 +416,53 @@ fmi3Status fmi3GetVariableDependencies(fmi3Instance c, fmi3ValueReference depend
 
 fmi3Status fmi3GetFMUState(fmi3Instance c, fmi3FMUState *FMUState) {
     ENTER(fmi3GetFMUState)
-    return STATUS(instance_get_state(instance, function, FMUState));
+    KEEP_TIME
+    const Status status = instance_get_state(instance, function, FMUState);
+    RECORD(status, "state=%p", (void *)(FMUState ? *FMUState : NULL))
+    return STATUS(status);
 }
 
 fmi3Status fmi3SetFMUState(fmi3Instance c, fmi3FMUState FMUState) {
     ENTER(fmi3SetFMUState)
-    return STATUS(instance_set_state(instance, function, FMUState));
+    KEEP_TIME
+    const Status status = instance_set_state(instance, function, FMUState);
+    RECORD(status, "state=%p", (void *)(FMUState))
+    return STATUS(status);
 }
 
 fmi3Status fmi3FreeFMUState(fmi3Instance c, fmi3FMUState *FMUState) {
     ENTER(fmi3FreeFMUState)
-    return STATUS(instance_free_state(instance, function, FMUState));
+    KEEP_TIME
+    void *const freed = FMUState ? *FMUState : NULL;
+    const Status status = instance_free_state(instance, function, FMUState);
+    RECORD(status, "state=%p", freed)
+    return STATUS(status);
 }
 
 fmi3Status fmi3SerializedFMUStateSize(fmi3Instance c, fmi3FMUState FMUState, size_t *size) {
     ENTER(fmi3SerializedFMUStateSize)
-    return STATUS(instance_serialized_state_size(instance, function, FMUState, size));
+    KEEP_TIME
+    const Status status = instance_serialized_state_size(instance, function, FMUState, size);
+    RECORD(status, "state=%p", (void *)(FMUState))
+    return STATUS(status);
 }
 
 fmi3Status fmi3SerializeFMUState(fmi3Instance c, fmi3FMUState FMUState, fmi3Byte serializedState[],
                                  size_t size) {
     ENTER(fmi3SerializeFMUState)
-    return STATUS(instance_serialize_state(instance, function, FMUState, serializedState, size));
+    KEEP_TIME
+    const Status status = instance_serialize_state(instance, function, FMUState, serializedState, size);
+    RECORD(status, "state=%p", (void *)(FMUState))
+    return STATUS(status);
 }
 
 fmi3Status fmi3DeserializeFMUState(fmi3Instance c, const fmi3Byte serializedState[], size_t size,
                                    fmi3FMUState *FMUState) {
     ENTER(fmi3DeserializeFMUState)
-    return STATUS(instance_deserialize_state(instance, function, serializedState, size, FMUState));
+    KEEP_TIME
+    const Status status = instance_deserialize_state(instance, function, serializedState, size, FMUState);
+    RECORD(status, "state=%p", (void *)(FMUState ? *FMUState : NULL))
+    return STATUS(status);
 }
 
 fmi3Status fmi3GetDirectionalDerivative(fmi3Instance c, const fmi3ValueReference unknowns[],
@@ -524,7 +600,9 @@ fmi3Status fmi3UpdateDiscreteStates(fmi3Instance c, fmi3Boolean *discreteStatesN
 
 fmi3Status fmi3EnterContinuousTimeMode(fmi3Instance c) {
     ENTER(fmi3EnterContinuousTimeMode)
+    KEEP_TIME
     instance->data.machine_state = STATE_CONTINUOUS_TIME_MODE;
+    RECORD(STATUS_OK, "")
     return fmi3OK;
 }
 
@@ -537,26 +615,37 @@ fmi3Status fmi3CompletedIntegratorStep(fmi3Instance c, fmi3Boolean noSetFMUState
         return fmi3Error;
     *enterEventMode = fmi3False;
     *terminateSimulation = fmi3False;
+    KEEP_TIME
+    RECORD(STATUS_OK, "")
     return fmi3OK;
 }
 
 fmi3Status fmi3SetTime(fmi3Instance c, fmi3Float64 time) {
     ENTER(fmi3SetTime)
-    return STATUS(instance_set_time(instance, function, time));
+    KEEP_TIME
+    const Status status = instance_set_time(instance, function, time);
+    RECORD(status, "time=%.17g", time)
+    return STATUS(status);
 }
 
 fmi3Status fmi3SetContinuousStates(fmi3Instance c, const fmi3Float64 continuousStates[],
                                    size_t nContinuousStates) {
     ENTER(fmi3SetContinuousStates)
+    KEEP_TIME
     REQUIRE_ARRAY(continuousStates, nContinuousStates)
-    return STATUS(instance_set_states(instance, function, continuousStates, nContinuousStates));
+    const Status status = instance_set_states(instance, function, continuousStates, nContinuousStates);
+    RECORD_VALUES(status, NULL, NULL, status == STATUS_OK ? nContinuousStates : 0, continuousStates)
+    return STATUS(status);
 }
 
 fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance c, fmi3Float64 derivatives[],
                                              size_t nContinuousStates) {
     ENTER(fmi3GetContinuousStateDerivatives)
+    KEEP_TIME
     REQUIRE_ARRAY(derivatives, nContinuousStates)
-    return STATUS(instance_get_derivatives(instance, function, derivatives, nContinuousStates));
+    const Status status = instance_get_derivatives(instance, function, derivatives, nContinuousStates);
+    RECORD_VALUES(status, NULL, NULL, status == STATUS_OK ? nContinuousStates : 0, derivatives)
+    return STATUS(status);
 }
 
 fmi3Status fmi3GetEventIndicators(fmi3Instance c, fmi3Float64 eventIndicators[],
@@ -620,8 +709,13 @@ fmi3Status fmi3DoStep(fmi3Instance c, fmi3Float64 currentCommunicationPoint,
                       fmi3Float64 communicationStepSize, fmi3Boolean noSetFMUStatePriorToCurrentPoint,
                       fmi3Boolean *eventHandlingNeeded, fmi3Boolean *terminateSimulation,
                       fmi3Boolean *earlyReturn, fmi3Float64 *lastSuccessfulTime) {
-    (void)noSetFMUStatePriorToCurrentPoint; /* states are copies: nothing to release early */
+    /* noSetFMUStatePriorToCurrentPoint only passes through: states are copies, nothing to release
+       early. */
     ENTER(fmi3DoStep)
+    if (instance_recording(instance))
+        return recorded_do_step(instance, function, currentCommunicationPoint, communicationStepSize,
+                                noSetFMUStatePriorToCurrentPoint, eventHandlingNeeded,
+                                terminateSimulation, earlyReturn, lastSuccessfulTime);
     if (instance_null_argument(instance, function, "eventHandlingNeeded", eventHandlingNeeded) ||
         instance_null_argument(instance, function, "terminateSimulation", terminateSimulation) ||
         instance_null_argument(instance, function, "earlyReturn", earlyReturn) ||

@@ -11,14 +11,15 @@
 #define TIME_MATCH_TOLERANCE 1e-9
 
 static const char *const category_names[] = {"logStatusWarning", "logStatusDiscard",
-                                             "logStatusError", "logAll"};
+                                             "logStatusError", "logAll", "logCalls"};
 #define N_CATEGORIES (sizeof(category_names) / sizeof(category_names[0]))
 
 void instance_log(const Instance *instance, Status status, LogCategory category,
                   const char *format, ...) {
-    char message[512];
+    /* Room for a call record that sets every variable at round-trip precision. */
+    char message[1024];
     va_list args;
-    if (category == LOG_ALL && !(instance->log_categories & LOG_ALL)) return;
+    if (category >= LOG_ALL && !(instance->log_categories & category)) return;
     va_start(args, format);
     vsnprintf(message, sizeof(message), format, args);
     va_end(args);
@@ -43,6 +44,54 @@ Status instance_error(const Instance *instance, const char *function, const char
     return STATUS_ERROR;
 }
 
+static const char *const status_names[] = {"OK", "Warning", "Discard", "Error", "Fatal"};
+
+void instance_record_call(const Instance *instance, const char *function, double time_before,
+                          Status status, const char *format, ...) {
+    char arguments[896];
+    va_list args;
+    va_start(args, format);
+    vsnprintf(arguments, sizeof(arguments), format, args);
+    va_end(args);
+    /* The name sits between double quotes, so a reader finds where it ends: any in it become ' */
+    char name[MAX_INSTANCE_NAME];
+    for (size_t i = 0; i < sizeof(name); i++) {
+        name[i] = instance->name[i] == '"' ? '\'' : instance->name[i];
+        if (!name[i]) break;
+    }
+    instance_log(instance, STATUS_OK, LOG_CALLS,
+                 CALL_RECORD_MARKER " instance=\"%s\" %s(%s) time=%.17g->%.17g status=%s",
+                 name, function, arguments, time_before, instance->data.time,
+                 status_names[status]);
+}
+
+void instance_record_values(const Instance *instance, const char *function, double time_before,
+                            Status status, const unsigned int vr[], const int order[], size_t n,
+                            const double value[]) {
+    char arguments[896];
+    size_t used = 0;
+    arguments[0] = '\0';
+    for (size_t i = 0; i < n && used < sizeof(arguments); i++) {
+        const char *separator = i ? ", " : "";
+        int written;
+        if (vr && vr[i] >= N_VARIABLES)
+            written = snprintf(arguments + used, sizeof(arguments) - used, "%svr%u=%.17g",
+                               separator, vr[i], value[i]);
+        else if (vr && order)
+            written = snprintf(arguments + used, sizeof(arguments) - used, "%sder(%s,%d)=%.17g",
+                               separator, model_variables[vr[i]].name, order[i], value[i]);
+        else if (vr)
+            written = snprintf(arguments + used, sizeof(arguments) - used, "%s%s=%.17g", separator,
+                               model_variables[vr[i]].name, value[i]);
+        else
+            written = snprintf(arguments + used, sizeof(arguments) - used, "%sx[%lu]=%.17g",
+                               separator, (unsigned long)i, value[i]);
+        if (written < 0) break;
+        used += (size_t)written;
+    }
+    instance_record_call(instance, function, time_before, status, "%s", arguments);
+}
+
 static const char *state_name(int state) {
     switch (state) {
         case STATE_INSTANTIATED: return "instantiated";
@@ -62,10 +111,16 @@ int instance_illegal_call(const Instance *instance, int mask, const char *functi
         instance_error(instance, function, "illegal call: a %s function, and this instance is for %s",
                        co_simulation ? "model-exchange" : "co-simulation",
                        co_simulation ? "co-simulation" : "model exchange");
+        if (instance_recording(instance))
+            instance_record_call(instance, function, instance->data.time, STATUS_ERROR,
+                                 "refused: a function of the other interface");
         return 0;
     }
     instance_error(instance, function, "illegal call sequence: not allowed in state '%s'",
                    state_name(instance->data.machine_state));
+    if (instance_recording(instance))
+        instance_record_call(instance, function, instance->data.time, STATUS_ERROR,
+                             "refused in state '%s'", state_name(instance->data.machine_state));
     return 0;
 }
 
@@ -112,8 +167,11 @@ Instance *instance_create(const char *function, const char *name, const char *to
     snprintf(instance->name, sizeof(instance->name), "%s", name);
     instance->type = type;
     instance->log_categories = logging_on ? (LOG_STATUS_WARNING | LOG_STATUS_DISCARD
-                                             | LOG_STATUS_ERROR | LOG_ALL) : 0;
+                                             | LOG_STATUS_ERROR | LOG_ALL | LOG_CALLS) : 0;
     instance_reset(instance);
+    if (instance_recording(instance))
+        instance_record_call(instance, function, instance->data.time, STATUS_OK, "interface=%s",
+                             type == INTERFACE_CO_SIMULATION ? "CoSimulation" : "ModelExchange");
     return instance;
 }
 
@@ -141,7 +199,7 @@ Status instance_set_debug_logging(Instance *instance, const char *function, int 
                                   size_t n_categories, const char *const categories[]) {
     int bits = 0;
     if (n_categories == 0) {
-        bits = LOG_STATUS_WARNING | LOG_STATUS_DISCARD | LOG_STATUS_ERROR | LOG_ALL;
+        bits = LOG_STATUS_WARNING | LOG_STATUS_DISCARD | LOG_STATUS_ERROR | LOG_ALL | LOG_CALLS;
     } else {
         if (instance_null_argument(instance, function, "categories", categories))
             return STATUS_ERROR;

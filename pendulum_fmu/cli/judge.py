@@ -12,6 +12,7 @@ from ._arguments import (
     check_outputs,
     float_number,
     output_path,
+    parameters_of,
     signal_options,
     torque_signal,
 )
@@ -35,7 +36,17 @@ def add_parser(commands) -> argparse.ArgumentParser:
     judge.add_argument(
         "result",
         type=Path,
+        nargs="?",
         help="the result CSV, or a folder written by pendulum-fmu scenarios holding NAME_out.csv files",
+    )
+    judge.add_argument(
+        "--calls",
+        type=Path,
+        default=None,
+        metavar="LOG",
+        help="judge what a master did instead of a result: LOG is the FMU's call record, or a master's "
+        "whole log holding it or its own call log (fmpy --fmi-logging, fmusim --log-fmi-calls); with "
+        "the run's options, names each difference by step, else prints the timeline (docs/calls.md)",
     )
     add_signal_arguments(judge, required=False)
     judge.add_argument(
@@ -95,6 +106,10 @@ def run(args) -> int:
         return 0 if verdict.passed else 1
 
     signal = torque_signal(args)
+    if args.calls is not None:
+        return _judge_calls(args, signal)
+    if args.result is None:
+        raise InvalidInput("judge needs a result file, a kit's folder, or --calls LOG")
     is_kit = args.result.is_dir()
     kit_files = [path for path in args.result.iterdir() if path.is_file()] if is_kit else []
     check_outputs(
@@ -139,3 +154,34 @@ def run(args) -> int:
     if args.json:
         print(f"wrote {write_json(verdicts, args.json)}")
     return 0 if all(judgement.passed for judgement in judged.values()) else 1
+
+
+def _judge_calls(args, signal) -> int:
+    """`judge --calls LOG`: the master's calls against the intended run (pendulum_fmu.calls)."""
+    from ..calls import IntendedRun, format_calls, judge_calls, write_calls_json
+    from ..parameters import variables
+
+    if args.result is not None:
+        raise InvalidInput(f"--calls judges a log, not a result: leave out {args.result}")
+    check_outputs({"--json": args.json, "--plot": args.plot}, {"--calls": args.calls})
+    intended = (
+        None
+        if signal is None
+        else IntendedRun(
+            signal,
+            ramp=args.ramp,
+            parameters=parameters_of(args.assignments),
+            start_time=args.start_time,
+            start_values={"theta0": args.theta0, "omega0": args.omega0},
+        )
+    )
+    names = {variable.valueReference: name for name, variable in variables(args.fmu).items()}
+    judged = judge_calls(args.calls, intended, names)
+    print(format_calls(judged))
+    if args.plot:
+        from ..plot import plot_calls
+
+        print(f"wrote {plot_calls(judged, args.plot, args.calls.name)}")
+    if args.json:
+        print(f"wrote {write_calls_json(judged, args.json)}")
+    return 0 if all(not result["differences"] for result in judged.values()) else 1
