@@ -101,6 +101,11 @@ def run(args) -> int:
     if args.ssp is not None:
         from ..ssp_judge import format_ssp_verdict, judge_ssp_result
 
+        if args.result is None or args.calls is not None:
+            raise InvalidInput(
+                "judge --ssp reads the master's result CSV, not a call log: "
+                "pendulum-fmu judge RESULT.csv --ssp ClosedLoop.ssp [--map theta=COLUMN]"
+            )
         verdict = judge_ssp_result(args.result, args.ssp, mapping=args.mapping)
         print(format_ssp_verdict(verdict))
         return 0 if verdict.passed else 1
