@@ -13,6 +13,8 @@ OSError for a file, ...). The kinds that belong to one module live there:
     mapped_fmu.MapError               a --map, or an FMU that does not fit it
     judge.ResultFileError             a result file, or a kit's folder, that cannot be judged
     scenarios.KitExists               an output folder holding a scenario kit the run was not asked to replace
+    ssp.SspExists                     an SSP the export was not asked to replace
+    ssp.SspFileError                  a file given as the closed loop's SSP that is not one
     demo.DemoExists                   an output folder holding a demo's outputs the run was not asked to replace
     export.FmuExists                  an export's output file the run was not asked to replace
     engines.ToolCannotRamp            a ramp given to a tool that holds the torque
