@@ -59,3 +59,7 @@ html_theme_options = {
     "secondary_sidebar_items": ["page-toc"],
 }
 html_sidebars = {"**": ["sidebar-nav-bs"]}
+
+# The parser's help texts are plain text that sphinx-argparse reads as reStructuredText, where
+# |dtheta| would be a substitution: each stands for itself.
+rst_prolog = "\n".join(rf".. |{name}| replace:: \|{name}\|" for name in ("dtheta", "domega"))

@@ -53,8 +53,12 @@ def write_examples_page(app) -> None:
     header = (docs / "examples_intro.md").read_text(encoding="utf-8")
     text = header.rstrip() + "\n\n" + "\n".join(sections)
     page = folder / "index.md"
+    # Rewritten only when it changed, so that Sphinx rereads it only then.
     if not page.exists() or page.read_text(encoding="utf-8") != text:
-        page.write_text(text, encoding="utf-8")
+        from pendulum_fmu.atomic_files import replacing
+
+        with replacing(page, encoding="utf-8") as file:
+            file.write(text)
 
 
 def setup(app):
