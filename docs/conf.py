@@ -55,6 +55,8 @@ html_title = f"pendulum-fmu {release}"
 html_static_path = []
 html_theme_options = {
     "navigation_with_keys": False,
+    # The page titles are long: three in the header, the rest under "More".
+    "header_links_before_dropdown": 3,
     "show_toc_level": 2,
     "secondary_sidebar_items": ["page-toc"],
 }

@@ -146,6 +146,18 @@ def template_pattern(command: str) -> re.Pattern:
     return re.compile(".+?".join(re.escape(part) for part in parts))
 
 
+def measured_figures(command: str) -> dict[str, str]:
+    """{name: figure} of the measured block of command, as the document that holds it says,
+    the names its benchmark's TEMPLATE gives them."""
+    module = importlib.import_module(command.split(" -m ", 1)[1].split()[0])
+    pattern = re.sub(r"\\\{(\w+)\\\}", r"(?P<\1>.+?)", re.escape(" ".join(module.TEMPLATE.split())))
+    for document in DOCUMENTS:
+        for block in blocks(document.read_text(encoding="utf-8").splitlines()):
+            if block.kind == "measured" and block.command == command:
+                return re.fullmatch(pattern, " ".join(block.text.split())).groupdict()
+    raise LookupError(f"no document holds the measured block of `{command}`")
+
+
 def sections(lines: list[str]) -> dict[str, list[int]]:
     """{heading: its line indices} of the #, ## and ### headings, each to the next heading."""
     found, current = {}, None
