@@ -1,6 +1,8 @@
-"""The docs site builds by the command the README names, without a warning (-W), and holds what
-its pages promise: the API reference from the docstrings, every command of the parser, the
-examples' figures, every docs page."""
+"""The docs site builds by the command the README names, without a warning (-W).
+
+It holds what its pages promise: the API reference from the docstrings, every command of the
+parser, the examples' figures, every docs page.
+"""
 
 import re
 import shlex
@@ -28,8 +30,13 @@ def site(tmp_path_factory):
     argv = readme_build_command()
     assert "-W" in argv and argv[-2:] == ["docs", "docs/_build/html"]
     output = tmp_path_factory.mktemp("site")
-    done = subprocess.run([sys.executable, "-m", "sphinx", *argv[1:-1], str(output)], cwd=ROOT,
-                          capture_output=True, text=True, timeout=900)
+    done = subprocess.run(
+        [sys.executable, "-m", "sphinx", *argv[1:-1], str(output)],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=900,
+    )
     assert done.returncode == 0, f"the docs build failed (warnings are errors):\n{done.stderr[-4000:]}"
     return output
 
@@ -40,12 +47,15 @@ def test_every_docs_page_is_in_the_site(site):
     assert not missing, f"docs pages not built (add them to a toctree in docs/index.md): {missing}"
 
 
-@pytest.mark.parametrize("name", ["pendulum_fmu.simulate.simulate", "pendulum_fmu.reference.reference",
-                                  "pendulum_fmu.compare.compare", "pendulum_fmu.judge.judge",
-                                  "pendulum_fmu.sweep.run_sweep", "pendulum_fmu.default_fmu"])
+@pytest.mark.parametrize("name", ["simulate", "reference", "compare", "judge", "run_sweep", "default_fmu"])
 def test_the_api_reference_shows_each_function_s_numpydoc_sections(site, name):
-    html = (site / "generated" / f"{name}.html").read_text(encoding="utf-8")
-    for section in ("Parameters", "Returns"):
+    """Each name at the top of the package has its page, with its numpydoc sections.
+
+    The page documents the function itself, not the module of the same name.
+    """
+    html = (site / "generated" / f"pendulum_fmu.{name}.html").read_text(encoding="utf-8")
+    assert f'id="pendulum_fmu.{name}"' in html, f"{name}: documented as something else than the function"
+    for section in ("Parameters", "Returns", "Examples"):
         assert re.search(rf">{section}<", html), f"{name}: no {section} section on its page"
 
 
@@ -67,6 +77,12 @@ def test_the_examples_page_shows_every_figure_the_examples_wrote(site):
     images = re.findall(r'<img [^>]*src="([^"]+\.png)"', html)
     assert len(images) >= 6, images
     assert all((site / "examples" / image).is_file() for image in images)
-    for name in ("constant_torque", "gravity_overlay", "parameter_study", "closed_loop_pd",
-                 "compare_with_opensim", "fmpy_command_line"):
+    for name in (
+        "constant_torque",
+        "gravity_overlay",
+        "parameter_study",
+        "closed_loop_pd",
+        "compare_with_opensim",
+        "fmpy_command_line",
+    ):
         assert f"{name}.py" in html

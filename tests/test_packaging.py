@@ -164,10 +164,12 @@ def _installed_bytes(distribution) -> int:
 
 
 def test_the_documented_sizes_are_this_build_s(artefacts, installed):
-    """The wheel, the installed package and the environment `pip install` of the wheel makes are
-    the sizes the install page states, within SIZE_TOLERANCE. The environment is measured as the
-    fresh venv (pip) plus the package plus every distribution the wheel requires, as installed
-    in the test environment (which the fresh venv borrows through its .pth line)."""
+    """The wheel, the installed package and its environment are the sizes the install page states.
+
+    Each within SIZE_TOLERANCE. The environment `pip install` of the wheel makes is measured as
+    the fresh venv (pip) plus the package plus every distribution the wheel requires, as
+    installed in the test environment (which the fresh venv borrows through its .pth line).
+    """
     venv, site_packages = installed
     stated = measured_figures(INSTALL_BENCHMARK)
     dependencies = {key: dist for key, dist in _dependency_closure("pendulum-fmu").items() if key != "pendulum-fmu"}

@@ -1,5 +1,4 @@
-"""Every shell command the READMEs and the docs pages show runs exactly as written, as a newcomer
-would run it.
+"""Every shell command the READMEs and the docs pages show runs as written, as a newcomer runs it.
 
 What counts as a command: each line of an indented (4-space) code block and of a ```sh, ```bash,
 ```shell or ```console fenced block (console lines start with "$ "), lines ending in a backslash
@@ -158,9 +157,11 @@ def command_outputs(gitignore: str) -> set[str]:
 
 
 def copy_of_the_clone(root: Path, target: Path) -> Path:
-    """The clone at root copied to target as its commands meet it fresh: without the build's
-    outputs and without what the documents' commands wrote into it; `.venv` stands for the
-    set-up (this interpreter's environment)."""
+    """The clone at root copied to target as its commands meet it fresh.
+
+    The copy holds neither the build's outputs nor what the documents' commands wrote into the
+    clone; its `.venv` stands for the set-up (this interpreter's environment).
+    """
     left_out = command_outputs((root / ".gitignore").read_text(encoding="utf-8"))
 
     def ignored(folder, names):
@@ -176,8 +177,7 @@ def copy_of_the_clone(root: Path, target: Path) -> Path:
 
 @pytest.fixture(scope="module")
 def copies(tmp_path_factory):
-    """One copy of the repository per README (one for all the docs pages), made when its first
-    command runs."""
+    """One copy of the repository per README (one for all the docs pages), made on first use."""
     made = {}
 
     def copy_for(document):

@@ -1,9 +1,11 @@
-"""The figures of the README and the docs pages are what the commands their markers name print
-(tests/readme_figures.py), and a figure outside a block, a stale block or a measured block in
-other words is found."""
+"""The figures of the README and the docs pages are what the commands their markers name print.
 
-import readme_figures
+The commands are those of tests/readme_figures.py; a figure outside a block, a stale block or a
+measured block in other words is found.
+"""
+
 import pytest
+import readme_figures
 from readme_figures import DOCUMENTS, ROOT, problems, template_pattern
 
 from benchmarks.install import TEMPLATE, render
@@ -34,7 +36,8 @@ def test_a_stale_block_a_loose_figure_and_a_reworded_measurement_are_found():
     found = problems(text)
     assert len(found) == 3, found
     assert "prints another block" in found[0] and "benchmarks.install" in found[1]
-    assert found[2] == "a figure outside a block: Set up, install and build wheels: '63 s' in 'Installing takes 63 s; `--timeout 5 s` is code, not a figure.'"
+    assert found[2] == ("a figure outside a block: Set up, install and build wheels: '63 s' in "
+                        "'Installing takes 63 s; `--timeout 5 s` is code, not a figure.'")
 
 
 def test_what_the_install_benchmark_prints_has_the_readme_block_s_shape():

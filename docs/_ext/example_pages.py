@@ -27,15 +27,29 @@ TIMEOUT_S = 300
 
 def _page(name: str, source: Path, printed: str, figures: list[Path], folder: Path) -> str:
     summary = ast.get_docstring(ast.parse(source.read_text(encoding="utf-8"))) or ""
-    parts = [f"## `{name}.py`", "", " ".join(summary.split()), "",
-             f"```{{literalinclude}} ../../examples/{name}.py", ":language: python", "```", "",
-             f"It printed (`python examples/{name}.py`):", "", "```text", printed.rstrip(), "```", ""]
+    parts = [
+        f"## `{name}.py`",
+        "",
+        " ".join(summary.split()),
+        "",
+        f"```{{literalinclude}} ../../examples/{name}.py",
+        ":language: python",
+        "```",
+        "",
+        f"It printed (`python examples/{name}.py`):",
+        "",
+        "```text",
+        printed.rstrip(),
+        "```",
+        "",
+    ]
     for figure in figures:
         parts += [f"![{figure.stem}]({figure.relative_to(folder).as_posix()})", ""]
     return "\n".join(parts)
 
 
 def write_examples_page(app) -> None:
+    """Run every example and write docs/examples/index.md, the page that shows them."""
     docs = Path(app.srcdir)
     root = docs.parent
     folder = docs / "examples"
@@ -44,8 +58,14 @@ def write_examples_page(app) -> None:
         output_dir = folder / name
         source = root / "examples" / f"{name}.py"
         environment = dict(os.environ, MPLBACKEND="Agg")
-        done = subprocess.run([sys.executable, str(source), "--output-dir", str(output_dir), *arguments],
-                              cwd=root, env=environment, capture_output=True, text=True, timeout=TIMEOUT_S)
+        done = subprocess.run(
+            [sys.executable, str(source), "--output-dir", str(output_dir), *arguments],
+            cwd=root,
+            env=environment,
+            capture_output=True,
+            text=True,
+            timeout=TIMEOUT_S,
+        )
         if done.returncode != 0:
             raise RuntimeError(f"examples/{name}.py exited {done.returncode}:\n{done.stderr[-3000:]}")
         printed = done.stdout.replace(str(root) + os.sep, "")
@@ -62,5 +82,6 @@ def write_examples_page(app) -> None:
 
 
 def setup(app):
+    """Register the examples page with Sphinx (the extension's entry point)."""
     app.connect("builder-inited", write_examples_page)
     return {"parallel_read_safe": True, "version": "1"}
