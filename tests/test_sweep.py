@@ -3,6 +3,7 @@ references, resume, failures, fsspec URLs, a cluster of separate processes, sign
 concurrent runs, and the studies refused before anything starts."""
 
 import glob
+import json
 import logging
 import os
 import signal
@@ -18,6 +19,7 @@ import pyarrow.csv
 import pyarrow.dataset as ds
 import pytest
 from dask.distributed import Client, LocalCluster
+from fsspec.implementations.local import LocalFileSystem
 
 import benchmarks.scale
 
@@ -26,7 +28,8 @@ from pendulum_fmu.cli import main
 from pendulum_fmu.errors import InvalidInput
 from pendulum_fmu.reference import reference
 from pendulum_fmu.sweep import OUTPUTS, Study, run_sweep, sweep_grid
-from pendulum_fmu.sweep.store import StudyExists
+from pendulum_fmu.sweep.store import Store, StudyExists
+from pendulum_fmu.sweep.worker import Task, run_chunk
 
 I_TOTAL = 20.0 + 40.0 * 0.5**2  # the tutorial's pendulum about its pivot
 STOP_TIME, STEP_SIZE = 0.5, 1e-3
@@ -162,6 +165,57 @@ def test_resume_runs_only_the_chunks_not_written(tmp_path, threads_scheduler):
                       scheduler=threads_scheduler, progress=False)
     assert fresh.chunks_run == fresh.chunks and len(_table(fresh.cases_table)["case"]) == 3
     assert not list(tmp_path.glob("**/.*"))
+
+
+def _stale_task(output_dir) -> Task:
+    """The task a worker of the run that last wrote output_dir holds: its store and run token."""
+    manifest = json.loads((output_dir / "study.json").read_text())
+    study = manifest["study"]
+    return Task(fmu=str(default_fmu()), store=Store(LocalFileSystem(), str(output_dir), "parquet"),
+                stop_time=study["stop_time"], step_size=study["step_size"],
+                outputs=tuple(study["outputs"]), stride=study["stride"], run=manifest["run"])
+
+
+def test_a_stale_workers_part_never_enters_the_study_that_replaced_its_own(tmp_path, threads_scheduler):
+    # Issue 32: a worker stopped mid-study writes its chunk after the study was replaced by
+    # another (--overwrite, another grid) in the same folder.
+    old_cases = sweep_grid([10.0, 20.0], [9.81], {"damping": [0.0, 0.5]})
+    new_cases = sweep_grid([10.0, 20.0], [9.81], {"damping": [0.0, 0.25]})
+    run_sweep(Study(old_cases, stop_time=STOP_TIME), output_dir=tmp_path, scheduler=threads_scheduler,
+              progress=False)
+    stale = _stale_task(tmp_path)
+    new = run_sweep(Study(new_cases, stop_time=STOP_TIME), output_dir=tmp_path, overwrite=True,
+                    scheduler=threads_scheduler, progress=False)
+    assert new.chunks == 4 and _stale_task(tmp_path).run != stale.run
+    parts = {p: p.read_bytes() for p in tmp_path.glob("*/part-*")}
+    cases, trajectories = _table(tmp_path / "cases"), _table(tmp_path / "trajectories")
+    # The stopped worker continues: chunk 1 of the old study, case 1, damping 0.5.
+    assert run_chunk(1, 1, old_cases.columns(1, 2), stale)[:3] == (1, 1, 0)
+    assert len(list(tmp_path.glob("*/_part-000001.*.staged"))) == 2  # it did write
+    # No reader takes it: the folder's tables, the package's reading of the cases, a resume.
+    assert {p: p.read_bytes() for p in tmp_path.glob("*/part-*")} == parts
+    for name, table in (("cases", cases), ("trajectories", trajectories)):
+        again = _table(tmp_path / name)
+        assert all(np.array_equal(again[k], table[k]) for k in table), name
+    expected = _exact({"torque": 10.0, "damping": 0.25})
+    assert cases["damping"][1] == 0.25 and cases["final_theta"][1] == expected["theta"][-1]
+    assert np.array_equal(trajectories["theta"][trajectories["case"] == 1], expected["theta"])
+    assert Store(LocalFileSystem(), str(tmp_path), "parquet").read_cases(["torque", "gravity", "damping"])[
+        "final_theta"].to_pylist() == cases["final_theta"].tolist()
+    resumed = run_sweep(Study(new_cases, stop_time=STOP_TIME), output_dir=tmp_path, resume=True,
+                        scheduler=threads_scheduler, progress=False)
+    assert resumed.chunks_run == 0 and {p: p.read_bytes() for p in tmp_path.glob("*/part-*")} == parts
+    assert not list(tmp_path.glob("*/_part-*"))  # and the stale parts are gone
+
+
+def test_a_run_commits_only_the_parts_staged_under_its_own_token(tmp_path):
+    store = Store(LocalFileSystem(), str(tmp_path), "parquet")
+    store.write_table("cases", 0, {"case": np.arange(3)}, "other-run")
+    with pytest.raises(FileNotFoundError):
+        store.commit(0, "this-run", ("cases",))
+    assert store.done_chunks() == set()
+    store.commit(0, "other-run", ("cases",))
+    assert store.done_chunks() == {0} and _table(tmp_path / "cases")["case"].tolist() == [0, 1, 2]
 
 
 def test_output_to_a_file_url(tmp_path):

@@ -176,7 +176,8 @@ class Totals:
 
 def run_chunks(client, task: Task, chunks: Iterable[tuple[int, int, dict]], bar) -> Totals:
     """Run each chunk (its index, the number of its first case, its values) on a worker,
-    advancing the bar as each finishes."""
+    committing its parts (only those of this run: task.run) and advancing the bar as each
+    finishes."""
     totals = Totals()
     futures = [client.submit(run_chunk, index, first, values, task, pure=False)
                for index, first, values in chunks]
@@ -187,7 +188,8 @@ def run_chunks(client, task: Task, chunks: Iterable[tuple[int, int, dict]], bar)
         future.add_done_callback(finished.put)
     for _ in futures:
         future = finished.get()
-        _, count, failed, written, cpu, stepping = future.result()
+        index, count, failed, written, cpu, stepping = future.result()
+        task.store.commit(index, task.run, task.tables())
         totals.failed += failed
         totals.bytes += written
         totals.worker_cpu_seconds += cpu

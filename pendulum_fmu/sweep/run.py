@@ -6,6 +6,7 @@ import math
 import numbers
 import os
 import time
+import uuid
 from pathlib import Path
 
 import numpy as np
@@ -105,12 +106,14 @@ def run_sweep(study: Study, *, output_dir: str | os.PathLike, resume: bool = Fal
         chunk_cases = _chunk_cases(target.held(), definition, study, resume, overwrite, url)
         # A study that replaces another is written apart and moved into place once whole.
         store = target.staging() if overwrite else target
+        # This run's token: only parts staged under it are committed (see store.py).
         task = Task(fmu=fmu, store=store, stop_time=float(study.stop_time),
-                    step_size=float(study.step_size), outputs=study.outputs, stride=study.stride)
+                    step_size=float(study.step_size), outputs=study.outputs, stride=study.stride,
+                    run=uuid.uuid4().hex)
         try:
             try:
                 with dask_client(scheduler, workers, connect_timeout) as client:
-                    store.start(definition, chunk_cases)
+                    store.start(definition, chunk_cases, task.run)
                     chunks = range(math.ceil(len(cases) / chunk_cases))
                     done = store.done_chunks()
                     pending = [index for index in chunks if index not in done]
