@@ -15,6 +15,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import signal
 import socket
 import subprocess
 import sys
@@ -44,6 +45,15 @@ def free_port() -> int:
 def dask_processes(workers: int):
     """The address of a `dask scheduler` with `workers` single-threaded `dask worker`s, each its
     own process on localhost, started as a user starts them on a cluster; stopped on exit."""
+    with dask_process_handles(workers) as (address, _):
+        yield address
+
+
+@contextlib.contextmanager
+def dask_process_handles(workers: int, nanny: bool = True):
+    """(address, [the scheduler's process, each worker's]) of a cluster as dask_processes
+    starts it; nanny=False: each worker is the process that runs its tasks (no nanny restarts
+    it), for the fault tests to stop or kill."""
     from dask.distributed import Client
 
     port = free_port()
@@ -53,13 +63,16 @@ def dask_processes(workers: int):
                                    "--port", str(port), "--no-dashboard"], **quiet)]
     try:
         processes += [subprocess.Popen([sys.executable, "-m", "dask", "worker", address, "--host",
-                                        "127.0.0.1", "--nthreads", "1", "--no-dashboard"], **quiet)
+                                        "127.0.0.1", "--nthreads", "1", "--no-dashboard",
+                                        *(() if nanny else ("--no-nanny",))], **quiet)
                       for _ in range(workers)]
         with Client(address, timeout=60) as client:
             client.wait_for_workers(workers, timeout=60)
-        yield address
+        yield address, processes
     finally:
         for process in reversed(processes):
+            if process.poll() is None:
+                os.kill(process.pid, signal.SIGCONT)  # a stopped one, to let it end
             process.terminate()
         for process in processes:
             process.wait(timeout=30)

@@ -409,6 +409,86 @@ def test_a_chunk_whose_worker_dies_is_run_again(tmp_path, dask_processes):
     assert not list(tmp_path.glob("**/.*"))
 
 
+def test_a_scheduler_killed_mid_study_is_one_line_and_resume_on_a_new_one_finishes(tmp_path):
+    # Issue 32, fault 2: the cluster's failure, not ours: exit 2 (as for an unreachable
+    # scheduler), one line naming --resume, none of dask's log.
+    torques = list(map(str, np.linspace(1.0, 40.0, 128)))  # 64 chunks of 2 cases
+    arguments = ("--torque", *torques, "--stop-time", "300", "--outputs", "theta",
+                 "--output-interval", "1")
+    with benchmarks.scale.dask_process_handles(1) as (address, processes):
+        sweep = subprocess.Popen(_sweep_command(tmp_path, *arguments, "--scheduler", address),
+                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        deadline = time.monotonic() + 120
+        while not list(tmp_path.glob("cases/part-*")):
+            assert sweep.poll() is None and time.monotonic() < deadline, sweep.communicate()
+            time.sleep(0.01)
+        processes[0].kill()
+        out, err = sweep.communicate(timeout=120)
+    assert sweep.returncode == 2 and out == "", (out, err)
+    lines = [line for line in err.splitlines() if not line.startswith("sweep: ")]  # progress
+    assert lines == [f"pendulum-fmu sweep: error: the dask scheduler at {address} was lost "
+                     "mid-study (scheduler-connection-lost); the chunks that finished are kept in "
+                     f"{tmp_path}: start a scheduler and run the same command with --resume to "
+                     "run the rest"], err
+    written = len(list(tmp_path.glob("cases/part-*")))
+    assert 0 < written < 64
+    with benchmarks.scale.dask_processes(1) as address:
+        resumed = subprocess.run(_sweep_command(tmp_path, *arguments, "--scheduler", address,
+                                                "--resume"), capture_output=True, text=True, timeout=300)
+    assert resumed.returncode == 0, resumed.stderr
+    assert f"({64 - written} of 64 chunks run;" in resumed.stdout
+    table, trajectories = _table(tmp_path / "cases"), _table(tmp_path / "trajectories")
+    assert table["case"].tolist() == list(range(128)) and set(table["status"]) == {"ok"}
+    assert np.array_equal(np.unique(trajectories["case"]), np.arange(128))
+    for number in (0, 127):  # a chunk of the first run, and one of the resumed run
+        expected = simulate.simulate(float(torques[number]), stop_time=300.0)
+        assert table["final_theta"][number] == expected["theta"][-1]
+
+
+@pytest.mark.skipif(not hasattr(signal, "SIGSTOP"), reason="no SIGSTOP on this platform")
+def test_a_worker_stopped_mid_study_and_continued_after_an_overwrite_changes_nothing(tmp_path, monkeypatch):
+    # Issue 32, fault 1 with the real fault: a worker (no nanny) stopped with SIGSTOP mid-study;
+    # the study finishes without it; another grid replaces it (--overwrite); the worker is
+    # continued and writes its old chunk into the folder.
+    monkeypatch.setenv("DASK_DISTRIBUTED__SCHEDULER__WORKER_TTL", "2s")  # a stopped worker is dropped
+    torques = list(np.linspace(1.0, 40.0, 64))
+    options = dict(stop_time=300.0, outputs=["theta"], output_interval=1.0)
+    old = Study(sweep_grid(torques, [9.81], {"damping": [0.0, 0.5]}), **options)
+    new = Study(sweep_grid(torques, [9.81], {"damping": [0.0, 0.25]}), **options)
+    with benchmarks.scale.dask_process_handles(2, nanny=False) as (address, processes):
+        stopped = psutil.Process(processes[1].pid)
+        results = []
+        first = threading.Thread(target=lambda: results.append(run_sweep(
+            old, output_dir=tmp_path, scheduler=address, progress=False)))
+        first.start()
+        deadline = time.monotonic() + 120
+        while not (list(tmp_path.glob("cases/part-*")) and stopped.cpu_percent(0.05) > 50):
+            assert first.is_alive() and time.monotonic() < deadline
+        stopped.suspend()  # mid-chunk: it was computing
+        first.join(timeout=300)
+        assert results[0].cases == 128 and results[0].failed == 0
+        stale_run = _stale_task(tmp_path).run
+        run_sweep(new, output_dir=tmp_path, overwrite=True, scheduler=address, progress=False)
+        parts = {p: p.read_bytes() for p in tmp_path.glob("*/part-*")}
+        stopped.resume()
+        deadline = time.monotonic() + 60
+        while not list(tmp_path.glob(f"cases/_part-*.{stale_run}.staged")):
+            assert time.monotonic() < deadline, list(tmp_path.glob("*/_*"))
+            time.sleep(0.05)
+    assert {p: p.read_bytes() for p in tmp_path.glob("*/part-*")} == parts
+    table, trajectories = _table(tmp_path / "cases"), _table(tmp_path / "trajectories")
+    assert table["case"].tolist() == list(range(128)) and set(table["damping"]) == {0.0, 0.25}
+    assert len(trajectories["case"]) == 128 * 301
+    # Every case of the new study is the new study's: its damping's trajectory, to the bit.
+    for number in range(1, 128, 2):  # the damping-0.25 cases
+        expected = simulate.simulate(torques[number // 2], parameters={"damping": 0.25}, stop_time=300.0)
+        assert np.array_equal(trajectories["theta"][trajectories["case"] == number],
+                              expected["theta"][::1000]), number
+    again = run_sweep(new, output_dir=tmp_path, resume=True, workers=1, progress=False)
+    assert again.chunks_run == 0 and {p: p.read_bytes() for p in tmp_path.glob("*/part-*")} == parts
+    assert not list(tmp_path.glob("*/_part-*"))
+
+
 def test_an_unreachable_silent_or_wrong_scheduler_is_one_line_within_the_timeout(tmp_path, capsys):
     closed = f"tcp://127.0.0.1:{benchmarks.scale.free_port()}"
     held = []  # the silent server's connections, open till the test ends

@@ -24,6 +24,11 @@ class SchedulerUnreachable(PendulumFmuError, ConnectionError):
     """The dask scheduler did not answer; the message names the address."""
 
 
+class SchedulerLost(PendulumFmuError, ConnectionError):
+    """The dask scheduler went away while the study ran (killed, its host lost); the message
+    says what the output folder keeps and names --resume."""
+
+
 @contextlib.contextmanager
 def dask_client(scheduler: str | None, workers: int | None, connect_timeout: float):
     """A dask client: on a local cluster of `workers` processes started (and closed) here, or on
@@ -51,8 +56,21 @@ def dask_client(scheduler: str | None, workers: int | None, connect_timeout: flo
             f"no dask scheduler answered at {scheduler} within {connect_timeout:g} s"
             f"{f' ({reason})' if reason else ''}; check the address (start one with `dask "
             "scheduler`), raise --connect-timeout, or leave out --scheduler for a local cluster")
-    with client:
+    with _quiet(logging.getLogger("distributed.client")), client:
         yield client
+
+
+@contextlib.contextmanager
+def _quiet(logger: logging.Logger):
+    """logger silenced: a lost scheduler has the client log each failed reconnection with its
+    traceback (tens of lines), where the sweep reports the loss in one line (SchedulerLost);
+    a local cluster's logs are silenced alike (silence_logs)."""
+    level = logger.level
+    logger.setLevel(logging.CRITICAL + 1)
+    try:
+        yield
+    finally:
+        logger.setLevel(level)
 
 
 def _first_line(error: BaseException) -> str:
