@@ -251,7 +251,8 @@ def cmd_sweep(args) -> int:
           + (f" ({result.chunks_run} of {result.chunks} chunks run; the others were "
              "written by an earlier run)" if resumed else ""))
     for path in (result.trajectories, result.cases_table, result.figure):
-        print(f"wrote {path}")
+        if path is not None:  # no trajectories with --outputs none
+            print(f"wrote {path}")
     if result.failed:
         # The other cases ran and are written; a script still learns that some did not.
         print(f"pendulum-fmu sweep: {result.failed} of {result.cases} cases failed: their "

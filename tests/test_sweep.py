@@ -6,6 +6,7 @@ import glob
 import json
 import logging
 import os
+import re
 import signal
 import socket
 import subprocess
@@ -247,6 +248,32 @@ def test_many_cases_draw_quantile_bands(tmp_path, threads_scheduler):
                         scheduler=threads_scheduler, progress=False)
     assert not (tmp_path / "trajectories").exists()  # no outputs: the cases table alone
     assert result.figure.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_the_command_names_only_what_it_wrote_and_one_duration(tmp_path, capsys, monkeypatch):
+    # Issue 28 item 5: --outputs none printed `wrote .../trajectories`; the progress line and the
+    # summary gave two durations for one run.
+    drawn = []
+
+    class Terminal:  # stderr as a terminal: the bar redrawn in place, and left on screen
+        def write(self, text):
+            drawn.append(text)
+
+        def flush(self):
+            pass
+
+        def isatty(self):
+            return True
+
+    monkeypatch.setattr(sys, "stderr", Terminal())
+    assert main(["sweep", "--torque", "2", "4", "--stop-time", "0.1", "--outputs", "none",
+                 "--workers", "1", "--output-dir", str(tmp_path)]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert re.fullmatch(r"2 cases in \d+\.\d s", out[0]), out
+    assert out[1:] == [f"wrote {tmp_path / 'cases'}", f"wrote {tmp_path / 'sweep.png'}"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cases", "study.json", "sweep.png"]
+    bar = "".join(drawn)
+    assert "2/2 cases, 0 failed" in bar and not re.search(r"\d s\b", bar), bar
 
 
 # --- a folder that holds a study: refused, resumed, or replaced once the new one is whole ----

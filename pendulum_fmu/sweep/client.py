@@ -170,7 +170,9 @@ def progress_bar(total: int, done: int, enabled: bool):
     elsewhere (a log) a plain line every few seconds, and the last count."""
     from tqdm import tqdm
 
-    counts = "{n_fmt}/{total_fmt} cases{postfix}, {elapsed_s:.1f} s"
+    # No time: the run's one duration, cluster and figure included, is the summary's (run_sweep's
+    # seconds), which a second, shorter one here would contradict.
+    counts = "{n_fmt}/{total_fmt} cases{postfix}"
     # miniters=1: every update counts and only the interval thins them out, so tqdm's monitor
     # thread never redraws a bar on its own.
     if sys.stderr.isatty():

@@ -146,7 +146,8 @@ def run_sweep(study: Study, *, output_dir: str | os.PathLike, resume: bool = Fal
     where = (Path(target.root).joinpath if isinstance(target.filesystem, LocalFileSystem)
              else f"{url.rstrip('/')}/".__add__)
     return SweepResult(
-        output_dir=where(""), trajectories=where("trajectories"), cases_table=where("cases"),
+        output_dir=where(""), trajectories=where("trajectories") if study.outputs else None,
+        cases_table=where("cases"),
         figure=where("sweep.png"), cases=len(cases),
         failed=int(np.sum(table["status"].to_numpy(zero_copy_only=False) == "failed")),
         chunks=len(chunks), chunks_run=len(pending), bytes=totals.bytes,
