@@ -49,7 +49,7 @@ def fixed_cost_rows(fmu: BuiltFmu, repetitions: int) -> list[Row]:
     }
     opensim = importlib.util.find_spec("opensim") is not None
     if opensim:
-        from pendulum_fmu.opensim_model import opensim_simulate
+        from pendulum_fmu.engines.opensim import opensim_simulate
         contenders["opensim 1 s"] = lambda: timed(lambda: opensim_simulate(one_second.time,
                                                                            one_second.torque))[0]
     seconds = {name: median(values) for name, values in interleaved(contenders, repetitions).items()}

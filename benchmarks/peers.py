@@ -26,10 +26,10 @@ def opensim_rows(fmu: BuiltFmu, repetitions: int) -> list[Row]:
     """OpenSim's tutorial pendulum against simulate(), each end to end (building or opening the
     model included, as a user pays it), and the theta error of each against the scipy oracle."""
     part = "peer OpenSim"
-    # opensim_model imports opensim only when called, so ask for the package itself.
+    # engines.opensim imports opensim only when called, so ask for the package itself.
     if importlib.util.find_spec("opensim") is None:
         return [skipped(part, "OpenSim 4.6 against the FMU", "the opensim package is not installed")]
-    from pendulum_fmu.opensim_model import opensim_simulate
+    from pendulum_fmu.engines.opensim import opensim_simulate
 
     plan = schedule(TORQUE, stop_time=STOP_TIME, step_size=STEP)
     theta = {}

@@ -1,12 +1,74 @@
-"""A torque-driven pendulum as an FMI 2.0 Co-Simulation FMU, and the tools to compare it."""
+"""A torque-driven pendulum as an FMI 2.0 Co-Simulation FMU, and the tools to compare it.
+
+The API is this package's names; each is imported from its module on first use, so that
+``import pendulum_fmu`` loads neither numpy, fmpy, scipy, matplotlib nor dask::
+
+    from pendulum_fmu import compare, default_fmu, judge, reference, run_sweep, simulate, Study
+
+Four of the names are also the names of the modules that hold them (simulate, reference, compare,
+judge): ``pendulum_fmu.simulate`` is the function; the module is ``import_module("pendulum_fmu.simulate")``,
+and ``from pendulum_fmu.simulate import ...`` works as ever.
+"""
+
+import sys
+import types
 
 # The package version's one source: pyproject.toml reads it, the FMU's generationTool carries it.
 __version__ = "0.1.0"
 
-# Nothing is imported here at import time, not even the standard library's importlib.resources:
-# the program (pendulum_fmu.entry) sets its signal handlers as soon as this package is loaded,
-# before anything that takes a noticeable time.
-__all__ = ["FMU_FILES", "__version__", "default_fmu"]
+# Nothing else is imported here at import time, not even the standard library's
+# importlib.resources: the program (pendulum_fmu.entry) sets its signal handlers as soon as this
+# package is loaded, before anything that takes a noticeable time.
+
+# The public name -> the module that holds it, imported on first use (__getattr__ below).
+_LAZY = {
+    "simulate": "simulate",
+    "reference": "reference",
+    "compare": "compare",
+    "Comparison": "compare",
+    "judge": "judge",
+    "judge_kit": "judge",
+    "Judgement": "judge",
+    "run_sweep": "sweep",
+    "sweep_grid": "sweep",
+    "Study": "sweep",
+    "SweepResult": "sweep",
+    "write_scenarios": "scenarios",
+    "PendulumFmuError": "errors",
+}
+__all__ = ["FMU_FILES", "__version__", "default_fmu", *_LAZY]
+
+
+def __getattr__(name: str):
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    from importlib import import_module
+
+    value = getattr(import_module(f"{__name__}.{module}"), name)
+    globals()[name] = value  # found here from now on, without this function
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__})
+
+
+class _Package(types.ModuleType):
+    """The package's module type, which keeps its functions from being hidden by their modules.
+
+    The import system sets every submodule it loads as an attribute of its package: for the modules
+    named like the function they hold, ``pendulum_fmu.simulate`` would be the module after any
+    ``import pendulum_fmu.simulate``.
+    """
+
+    def __setattr__(self, name: str, value) -> None:
+        if name in _LAZY and isinstance(value, types.ModuleType):
+            return
+        super().__setattr__(name, value)
+
+
+sys.modules[__name__].__class__ = _Package
 
 # FMI version -> the FMU's file name, in a checkout's dist/ and in the installed package's data/:
 # the one list of the FMI versions this package builds.
@@ -41,6 +103,12 @@ def default_fmu(fmi_version: int = 2):
         An installed package without its packaged FMU.
     BuildError
         A checkout whose FMU is stale and cannot be rebuilt here.
+
+    Examples
+    --------
+    >>> from pendulum_fmu import default_fmu
+    >>> default_fmu().name
+    'Pendulum.fmu'
     """
     global _extracted
     import atexit
@@ -64,9 +132,9 @@ def default_fmu(fmi_version: int = 2):
         raise MissingFile(
             f"pendulum_fmu {__version__} at {Path(__file__).parent} has neither its packaged "
             f"data/{packaged_name} nor the FMU's sources beside it: reinstall it from its wheel or "
-            "sdist, or pass the FMU's path")
+            "sdist, or pass the FMU's path"
+        )
     if _extracted is None:
         _extracted = contextlib.ExitStack()
         atexit.register(_extracted.close)
     return _extracted.enter_context(resources.as_file(packaged))
-

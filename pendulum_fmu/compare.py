@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from .atomic_files import check_writable, replacing
-from .compare_tools import ToolSpecError, parse_tools
+from .compare_tools import ToolSpecError, installed_defaults, parse_tools
 from .errors import InvalidInput, WrongType
 from .plot import case_title, plot_comparison
 from .reference import reference
@@ -27,7 +27,6 @@ from .simulate import resolve_parameters
 from .torque_schedule import TorqueSchedule, TorqueSignal, schedule
 
 REFERENCE = "reference"
-TOOLS = ("fmu", REFERENCE, "opensim")
 # The torque a tool received may differ from the signal by rounding only (relative to the
 # signal's size; on a steep ramp an ulp of time is more than an ulp of torque).
 TORQUE_ROUNDING = 1e-9
@@ -106,6 +105,33 @@ def write_differences(rows: list[dict], path: str | Path) -> Path:
 
 @dataclass
 class Comparison:
+    """What compare() ran and judged, and the files it wrote.
+
+    Attributes
+    ----------
+    runs : dict of str to numpy.ndarray
+        Each tool's results array (results.py), by its label; "reference" is the judge.
+    differences : list of dict
+        The rows of differences.csv: each tool against the reference, then each pair of tools.
+    tolerance : float
+        The largest difference in theta (rad) or omega (rad/s) for the tools to agree.
+    trajectories, table, figure : Path
+        trajectories.csv, differences.csv and comparison.png.
+    worst, torque_worst, torque_limit : float
+        The largest difference in theta or omega; the largest difference between the torque a tool
+        received and the signal, and the rounding allowed for it.
+    agree : bool
+        Whether every tool is within the tolerance and received the signal's torque.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pendulum_fmu import compare
+    >>> comparison = compare(20.0, "fmu,reference", output_dir=tempfile.mkdtemp(), stop_time=0.5)
+    >>> sorted(comparison.runs), bool(comparison.worst < comparison.tolerance)
+    (['fmu', 'reference'], True)
+    """
+
     runs: dict[str, np.ndarray]
     differences: list[dict]
     tolerance: float
@@ -133,7 +159,7 @@ class Comparison:
         return self.worst <= self.tolerance and self.torque_worst <= self.torque_limit
 
 
-def compare(torque: TorqueSignal, tools=TOOLS, *, output_dir: str | Path, step_size: float = 1e-3,
+def compare(torque: TorqueSignal, tools=None, *, output_dir: str | Path, step_size: float = 1e-3,
             start_time: float = 0.0, stop_time: float | None = None, ramp: bool = False,
             parameters: dict | None = None, theta0: float = 0.0, omega0: float = 0.0,
             tolerance: float = 1e-9, title: str | None = None, fmu_path: str | Path | None = None,
@@ -150,7 +176,9 @@ def compare(torque: TorqueSignal, tools=TOOLS, *, output_dir: str | Path, step_s
         The signal, as simulate() takes it.
     tools : str or sequence of str, optional
         As --tools gives them (compare_tools.py): fmu, reference, opensim, mujoco, drake,
-        pybullet (NAME:default for an engine's own defaults), LABEL=path/to/Their.fmu.
+        pybullet (NAME:default for an engine's own defaults), LABEL=path/to/Their.fmu. By default
+        fmu, reference and opensim, those of them that are installed; the others are left out
+        with a warning (errors.Skipped) that says how to install them.
     output_dir : str or Path
         Where to write trajectories.csv (every tool's torque, theta, omega, alpha),
         differences.csv (each tool against the reference: max and RMS of theta, omega, alpha,
@@ -186,10 +214,20 @@ def compare(torque: TorqueSignal, tools=TOOLS, *, output_dir: str | Path, step_s
         An FMU refused a step.
     CannotWrite
         output_dir cannot be written.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pendulum_fmu import compare
+    >>> comparison = compare(20.0, "fmu,reference", output_dir=tempfile.mkdtemp(), stop_time=1.0)
+    >>> comparison.agree, [row["tool"] for row in comparison.differences]
+    (True, ['fmu'])
+    >>> comparison.trajectories.name, comparison.table.name, comparison.figure.name
+    ('trajectories.csv', 'differences.csv', 'comparison.png')
     """
     if not isinstance(output_dir, str | os.PathLike):
         raise WrongType(f"output_dir is a folder's path, not {output_dir!r}")
-    parsed = parse_tools(tools, mapping=mapping, fmu_path=fmu_path)
+    parsed = parse_tools(installed_defaults() if tools is None else tools, mapping=mapping, fmu_path=fmu_path)
     if len(parsed) < 2:
         raise ToolSpecError(f"compare needs at least two tools, got {parsed[0].label}: "
                             f"e.g. --tools fmu,{REFERENCE}")

@@ -9,8 +9,9 @@ mapped_fmu.py). Every tool has the same runner:
 
     tool.run(plan, parameters=..., theta0=..., omega0=...) -> results array (results.py)
 
-A tool whose Python package is missing is refused when the list is parsed, with the pip command
-that installs it.
+A tool whose Python package is missing is refused when the list names it, with the pip command
+that installs it; of the default list, compare runs the tools that are installed and warns
+(errors.Skipped) which it left out.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from __future__ import annotations
 import importlib
 import importlib.util
 import re
+import warnings
 from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
@@ -25,11 +27,10 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-from . import results
-from .engines import MODES, check_held, check_mode
-from .errors import InvalidInput, WrongType
+from .engines import MODES, check_mode
+from .errors import InvalidInput, Skipped, WrongType
 from .reference import reference_schedule
-from .simulate import resolve_parameters, simulate_plan
+from .simulate import simulate_plan
 from .torque_schedule import TorqueSchedule
 
 
@@ -62,24 +63,6 @@ def run_reference(plan: TorqueSchedule, *, parameters: dict | None = None, theta
     return reference_schedule(plan, parameters=parameters, theta0=theta0, omega0=omega0)
 
 
-# default: the Manager's own integrator (Runge-Kutta-Merson) at its own accuracy.
-OPENSIM_ACCURACY = {"accurate": 1e-12, "default": None}
-
-
-def run_opensim(plan: TorqueSchedule, *, parameters: dict | None = None, theta0: float = 0.0,
-                omega0: float = 0.0, mode: str = "accurate") -> np.ndarray:
-    from .opensim_model import opensim_simulate
-
-    check_held(plan, "opensim")
-    check_mode(mode, "opensim")
-    run = opensim_simulate(plan.time, plan.torque, theta0=theta0, omega0=omega0,
-                           accuracy=OPENSIM_ACCURACY[mode], **resolve_parameters(parameters))
-    out = results.empty(len(plan.time))
-    for name in results.FIELDS:
-        out[name] = run[name]
-    return out
-
-
 @dataclass(frozen=True)
 class Kind:
     """A tool that --tools names: where its runner is, the package it needs, its modes."""
@@ -97,11 +80,13 @@ class Kind:
 KINDS = {
     "fmu": Kind("pendulum_fmu.compare_tools:run_fmu"),
     "reference": Kind("pendulum_fmu.compare_tools:run_reference"),
-    "opensim": Kind("pendulum_fmu.compare_tools:run_opensim", "opensim", "opensim", MODES),
+    "opensim": Kind("pendulum_fmu.engines.opensim:run", "opensim", "opensim", MODES),
     "mujoco": Kind("pendulum_fmu.engines.mujoco:run", "mujoco", "mujoco", MODES),
     "drake": Kind("pendulum_fmu.engines.drake:run", "pydrake", "drake", MODES),
     "pybullet": Kind("pendulum_fmu.engines.pybullet:run", "pybullet", "pybullet", MODES),
 }
+# The tools compare runs when none are named: of these, the ones installed here.
+DEFAULT_TOOLS = ("fmu", "reference", "opensim")
 _LABEL = re.compile(r"^[A-Za-z_][A-Za-z0-9_.-]*$")
 
 
@@ -109,6 +94,34 @@ def installed(name: str) -> bool:
     """Whether the tool's Python package can be imported here."""
     package = KINDS[name].package
     return package is None or importlib.util.find_spec(package) is not None
+
+
+def install_hint(name: str) -> str:
+    """The pip command that installs what the tool needs: its extra of this package, which is
+    installed from a clone or a wheel (it is on no package registry)."""
+    extra = KINDS[name].extra
+    return f'pip install ".[{extra}]" in a clone of pendulum-fmu (or "WHEEL.whl[{extra}]" for its wheel)'
+
+
+def installed_defaults() -> list[str]:
+    """The default tools that are installed here; warns (errors.Skipped) in one line which are not
+    and how to install them.
+
+    Returns
+    -------
+    list of str
+        Of DEFAULT_TOOLS, those whose Python package can be imported, in order.
+
+    Examples
+    --------
+    >>> installed_defaults()[:2]
+    ['fmu', 'reference']
+    """
+    missing = [name for name in DEFAULT_TOOLS if not installed(name)]
+    if missing:
+        warnings.warn("skipped " + "; ".join(f"{name} ({KINDS[name].package} is not installed: {install_hint(name)})"
+                                             for name in missing), Skipped, stacklevel=3)
+    return [name for name in DEFAULT_TOOLS if name not in missing]
 
 
 def _mapped_fmu(label: str, path: str, mapping: str | None) -> Tool:
@@ -131,8 +144,7 @@ def _named(item: str, fmu_path: str | Path | None) -> Tool:
         raise ToolSpecError(f"--tools {item}: {name} has mode{'s' if len(kind.modes) > 1 else ''} "
                             f"{', '.join(kind.modes)}, not {mode!r}")
     if not installed(name):
-        raise ToolSpecError(f"--tools {name}: {kind.package} is not installed; install it with: "
-                            f'pip install "pendulum-fmu[{kind.extra}]"')
+        raise ToolSpecError(f"--tools {name}: {kind.package} is not installed; install it with: {install_hint(name)}")
     runner = partial(kind.load(), mode=mode)
     if name == "fmu":
         runner = partial(runner, fmu_path=fmu_path)

@@ -7,12 +7,12 @@ cluster. It prints what it finds and writes the figures and tables into one fold
 
 from __future__ import annotations
 
-import importlib.util
 from pathlib import Path
 
 import numpy as np
 
 from .compare import compare, format_comparison
+from .compare_tools import installed_defaults
 from .errors import PendulumFmuError
 from .parameters import default_parameters, total_inertia
 from .plot import plot_overlay
@@ -63,11 +63,7 @@ def run_demo(output_dir: str | Path, workers: int | None = None, overwrite: bool
     if held and not overwrite:
         raise DemoExists(f"{out} already holds a demo's outputs ({', '.join(held)}): choose another "
                          "output directory, or add --overwrite to run the demo again in their place")
-    tools = ["fmu", "reference"]
-    if importlib.util.find_spec("opensim") is not None:
-        tools.append("opensim")
-    else:
-        print("OpenSim is not installed, so it is left out (pip install opensim)")
+    tools = installed_defaults()  # warns which it skipped, and how to install them
     print(f"Tutorial case: constant torque {TORQUE:g} N.m, 3 s in 1 ms steps; tools: {', '.join(tools)}")
     runs, agree = {}, True
     for label, gravity, folder in (("No Gravity", 0.0, "no_gravity"), ("With Gravity", 9.81, "gravity")):

@@ -25,7 +25,19 @@ OSError for a file, ...). The kinds that belong to one module live there:
 
 
 class PendulumFmuError(Exception):
-    """Base of every error the user's input causes; the message is the one line to show."""
+    """Base of every error the user's input causes; the message is the one line to show.
+
+    Examples
+    --------
+    A stop time before the start, refused in one line:
+
+    >>> from pendulum_fmu import PendulumFmuError, simulate
+    >>> try:
+    ...     simulate(20.0, stop_time=-1)
+    ... except PendulumFmuError as error:
+    ...     print(error)
+    stop time -1 must be after start time 0.0
+    """
 
 
 class InvalidInput(PendulumFmuError, ValueError):
@@ -49,3 +61,9 @@ class CannotWrite(PendulumFmuError, OSError):
 
 class MissingDependency(PendulumFmuError, ImportError):
     """An optional package a tool needs is not installed; the message gives the pip command."""
+
+
+class Skipped(UserWarning):
+    """A part of the run left out because this machine lacks what it needs (a tool's package); the
+    message is one line saying which part and how to get it. The command line prints it as that
+    line and goes on."""

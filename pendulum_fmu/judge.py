@@ -85,7 +85,40 @@ class ResultFileError(InvalidInput):
 
 @dataclass
 class Judgement:
-    """The verdict on one result and its diagnosis (see the module's docstring)."""
+    """The verdict on one result and its diagnosis (see the module's docstring).
+
+    Attributes
+    ----------
+    verdict : {"pass", "fail"}
+        Whether max |dtheta| is within the tolerance; ``passed`` says the same as a bool.
+    diagnosis : str
+        The mistake that explains the difference, "agrees" or "unexplained".
+    residual, max_abs_dtheta, worst_time, tolerance : float
+        What is left once the diagnosis is explained (rad); the largest |dtheta| (rad) and its time
+        (s); the tolerance (rad).
+    candidates : dict
+        Per candidate mistake, the residual of its best variant (rad); None where it does not apply.
+    smallest_input_effect : float or None
+        The smallest difference an input-timing variant makes to this run (rad).
+    result, reference, explanation : numpy.ndarray
+        The result as read, the reference at its times, the variant the diagnosis names.
+    source : str
+        The result file's name, as reports show it.
+
+    Examples
+    --------
+    A run whose torque steps 1 ms after the signal's step, and the mistake it is given:
+
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from pendulum_fmu import judge, simulate
+    >>> from pendulum_fmu.results import write_csv
+    >>> late = simulate(lambda t: 0.0 if t < 0.251 else 20.0, stop_time=0.5)
+    >>> judgement = judge(write_csv(late, Path(tempfile.mkdtemp()) / "late.csv"),
+    ...                   lambda t: 0.0 if t < 0.25 else 20.0, stop_time=0.5)
+    >>> judgement.verdict, judgement.diagnosis, f"{judgement.max_abs_dtheta:.2e} rad"
+    ('fail', 'input one step late', '1.55e-04 rad')
+    """
 
     verdict: str
     diagnosis: str
@@ -416,6 +449,19 @@ def judge(result, torque, *, start_time: float = 0.0, stop_time: float | None = 
         and last rows are not the run's start and stop (a result of part of the run).
     InvalidInput
         A tolerance that is not positive and finite, or a run definition simulate() would refuse.
+
+    Examples
+    --------
+    The FMU's own run, written as a result file and judged:
+
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from pendulum_fmu import judge, simulate
+    >>> from pendulum_fmu.results import write_csv
+    >>> result = write_csv(simulate(20.0, stop_time=1.0), Path(tempfile.mkdtemp()) / "fmu.csv")
+    >>> judgement = judge(result, 20.0, stop_time=1.0)
+    >>> judgement.passed, judgement.diagnosis
+    (True, 'agrees')
     """
     tolerance = DEFAULT_TOLERANCE if tolerance is None else tolerance
     if not (math.isfinite(tolerance) and tolerance > 0):
@@ -540,6 +586,20 @@ def judge_kit(folder: str | Path, *, tolerance: float | None = None, mapping: st
     ------
     ResultFileError
         A folder that holds no scenario, or none with a result.
+
+    Examples
+    --------
+    A kit in which one scenario has a result (its reference, copied: it passes) and the others none:
+
+    >>> import shutil, tempfile
+    >>> from pathlib import Path
+    >>> from pendulum_fmu import judge_kit, write_scenarios
+    >>> kit = Path(tempfile.mkdtemp())
+    >>> _ = write_scenarios(kit)
+    >>> _ = shutil.copy(kit / "constant_torque_ref.csv", kit / "constant_torque_out.csv")
+    >>> verdicts = judge_kit(kit)
+    >>> verdicts["constant_torque"].passed, [name for name, judgement in verdicts.items() if judgement is None]
+    (True, ['decimal_steps', 'ramp', 'random_steps', 'resume', 'steps_on_grid'])
     """
     folder = Path(folder)
     found = settings_files(folder)

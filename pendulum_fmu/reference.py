@@ -323,6 +323,17 @@ def reference(torque=20.0, *, start_time: float = 0.0, stop_time: float | None =
     InvalidInput
         A signal the reference cannot read, parameters the FMU refuses, or values with which
         solve_ivp fails (mass*gravity*length past the largest double, say).
+
+    Examples
+    --------
+    The FMU's run against the oracle, which shares no code with it:
+
+    >>> from pendulum_fmu import reference, simulate
+    >>> oracle = reference(20.0, stop_time=1.0)
+    >>> round(float(oracle["theta"][-1]), 6)
+    0.187205
+    >>> bool(abs(simulate(20.0, stop_time=1.0)["theta"] - oracle["theta"]).max() < 1e-9)
+    True
     """
     if not (isinstance(torque, (str, Path, list, tuple, np.ndarray, int, float)) or callable(torque)):
         raise InvalidInput(f"the reference takes a constant, a callable, a per-step array or a CSV path, "

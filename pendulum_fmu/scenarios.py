@@ -447,6 +447,14 @@ def write_scenarios(output_dir: str | Path, fmu_path: str | Path | None = None,
         A folder that holds a kit's files, without overwrite.
     CannotWrite
         A folder that cannot be written.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pendulum_fmu import write_scenarios
+    >>> written = write_scenarios(tempfile.mkdtemp())
+    >>> sorted(path.name for path in written if path.name.startswith("ramp"))
+    ['ramp.json', 'ramp_in.csv', 'ramp_ref.csv']
     """
     fmu = fmu_file(fmu_path)
     version = model_description(fmu).fmiVersion

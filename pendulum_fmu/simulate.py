@@ -367,6 +367,17 @@ def simulate(torque: TorqueSignal = 20.0, *, start_time: float = 0.0, stop_time:
         The FMU refused the parameters or a step; the message carries what it logged.
     MissingFile
         No FMU at fmu_path.
+
+    Examples
+    --------
+    A constant 20 N.m for 1 s in 1 ms steps:
+
+    >>> from pendulum_fmu import simulate
+    >>> run = simulate(20.0, stop_time=1.0)
+    >>> len(run), run.dtype.names
+    (1001, ('time', 'torque', 'theta', 'omega', 'alpha'))
+    >>> round(float(run["theta"][-1]), 6)
+    0.187205
     """
     plan = schedule(torque, start_time=start_time, stop_time=stop_time, step_size=step_size,
                     ramp=ramp, max_steps=max_steps)

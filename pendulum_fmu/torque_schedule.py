@@ -56,6 +56,11 @@ DEFAULT_STOP_TIME = 3.0
 # close to 3 hours of simulated time, and a typo in a time (epoch seconds, 1e-8 s steps) is
 # likelier than a run that long.
 DEFAULT_MAX_STEPS = 10_000_000
+# A study larger than this is refused unless asked for (run_sweep's max_cases, --max-cases): at a
+# millisecond a case it is a quarter of an hour on 1,000 cores, and a grid multiplied out by a
+# stray value list is likelier than a study that large. Here beside the other size limit, so that
+# the command line's help reads it without loading the sweep.
+DEFAULT_MAX_CASES = 1_000_000
 # Runs needing less memory than this are not checked against what the machine has left: reading
 # it (/proc/meminfo) costs more than such a run, which no machine that runs Python lacks.
 MEMORY_CHECKED_FROM = 2**26  # bytes (64 MiB: about 700,000 steps)

@@ -1,6 +1,10 @@
 """--tools / --map parsing, and another FMU (ours rebuilt with other names) as a tool."""
 
+import csv
 import shutil
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -9,6 +13,7 @@ from pendulum_fmu import compare_tools
 from pendulum_fmu.build import MODEL_DESCRIPTION, PENDULUM_DIR, SOURCE_DIR, build_fmu
 from pendulum_fmu.cli import main
 from pendulum_fmu.compare import run_tools
+from pendulum_fmu.errors import Skipped
 from pendulum_fmu.mapped_fmu import MapError, Mapped, MappedFmu, parse_map
 from pendulum_fmu.reference import reference_schedule
 from pendulum_fmu.torque_schedule import schedule
@@ -66,7 +71,7 @@ def test_bad_tool_lists_are_refused_in_one_line(spec, message):
 def test_a_missing_extra_names_the_pip_command(monkeypatch):
     monkeypatch.setattr(compare_tools, "installed", lambda name: name != "pybullet")
     with pytest.raises(compare_tools.ToolSpecError, match=r'pybullet is not installed; install it with: '
-                                                   r'pip install "pendulum-fmu\[pybullet\]"'):
+                                                   r'pip install "\.\[pybullet\]" in a clone'):
         compare_tools.parse_tools("fmu,pybullet")
 
 
@@ -172,3 +177,28 @@ def test_every_tool_takes_its_defaults_from_the_fmu_compared(tmp_path):
     expected = reference_schedule(PLAN, parameters={"mass": 10.0})
     assert max_error(runs["reference"], expected) < 1e-12
     assert max_error(runs["reference"], reference_schedule(PLAN)) > 1e-3  # the mass matters here
+
+
+def test_compare_on_a_plain_install_runs_the_tools_installed_and_says_which_it_skipped(tmp_path):
+    # A fresh interpreter in which OpenSim and the engines cannot be imported, as on an install
+    # without the extras: a None in sys.modules is what Python's import reads as "not there".
+    script = ("import sys\n"
+              "sys.modules.update(dict.fromkeys(['opensim', 'mujoco', 'pydrake', 'pybullet']))\n"
+              "from pendulum_fmu.cli import main\n"
+              f"sys.exit(main(['compare', '--torque', '20', '--output-dir', {str(tmp_path)!r}]))\n")
+    done = subprocess.run([sys.executable, "-c", script], cwd=Path(__file__).resolve().parents[1],
+                          capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert done.stderr == ('pendulum-fmu compare: skipped opensim (opensim is not installed: pip install '
+                           '".[opensim]" in a clone of pendulum-fmu (or "WHEEL.whl[opensim]" for its wheel))\n')
+    with open(tmp_path / "differences.csv", newline="") as file:
+        rows = list(csv.DictReader(file))
+    # The FMU ran, and against the scipy reference it agrees to the default tolerance.
+    assert [(row["tool"], row["against"]) for row in rows] == [("fmu", "reference")]
+    assert 0 < float(rows[0]["theta_max"]) < 1e-9
+
+
+def test_the_default_tools_leave_out_what_is_not_installed_with_a_warning(monkeypatch):
+    monkeypatch.setattr(compare_tools, "installed", lambda name: name != "opensim")
+    with pytest.warns(Skipped, match=r'^skipped opensim \(opensim is not installed: pip install "\.\[opensim\]"'):
+        assert compare_tools.installed_defaults() == ["fmu", "reference"]

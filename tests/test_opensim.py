@@ -7,7 +7,7 @@ import pytest
 
 from pendulum_fmu.cli import main
 from pendulum_fmu.compare import compare
-from pendulum_fmu.opensim_model import _build_pendulum_model, _import_opensim, opensim_simulate
+from pendulum_fmu.engines.opensim import _build_pendulum_model, _import_opensim, opensim_simulate
 
 try:
     osim = _import_opensim()

@@ -62,7 +62,7 @@ def dask_client(scheduler: str | None, workers: int | None, connect_timeout: flo
 
 @contextlib.contextmanager
 def _quiet(logger: logging.Logger):
-    """logger silenced: a lost scheduler has the client log each failed reconnection with its
+    """The logger silenced: a lost scheduler has the client log each failed reconnection with its
     traceback (tens of lines), where the sweep reports the loss in one line (SchedulerLost);
     a local cluster's logs are silenced alike (silence_logs)."""
     level = logger.level

@@ -89,6 +89,13 @@ def sweep_grid(torques, gravities=(9.81,), extra: dict | None = None) -> Grid:
     ------
     InvalidInput
         A name that cannot be swept, or values that are no flat list of distinct finite numbers.
+
+    Examples
+    --------
+    >>> from pendulum_fmu import sweep_grid
+    >>> grid = sweep_grid([5, 10], [0, 9.81], {"damping": [0.0, 0.5]})
+    >>> len(grid), grid[0]
+    (8, {'torque': 5.0, 'gravity': 0.0, 'damping': 0.0})
     """
     if not isinstance(extra, Mapping | None):
         raise WrongType(f"extra is a dict {{name: [values, ...]}}, e.g. {{'damping': [0, 0.5]}}; got "

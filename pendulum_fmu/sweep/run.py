@@ -14,6 +14,7 @@ import numpy as np
 
 from ..errors import InvalidInput, MissingDependency, WrongType
 from ..parameters import fmu_file, pendulum_variables
+from ..torque_schedule import DEFAULT_MAX_CASES
 from .client import SchedulerLost, dask_client, progress_bar, run_chunks
 from .figure import draw
 from .grid import columns
@@ -21,10 +22,6 @@ from .store import Held, Store, StudyExists
 from .study import Study, SweepResult
 from .worker import Task
 
-# A study larger than this is refused unless asked for (max_cases, --max-cases): at a
-# millisecond a case it is a quarter of an hour on 1,000 cores, and a grid multiplied out by a
-# stray value list is likelier than a study that large.
-DEFAULT_MAX_CASES = 1_000_000
 
 
 def run_sweep(study: Study, *, output_dir: str | os.PathLike, resume: bool = False,
@@ -86,6 +83,15 @@ def run_sweep(study: Study, *, output_dir: str | os.PathLike, resume: bool = Fal
         output_dir cannot be written.
     SchedulerUnreachable
         The scheduler did not answer within connect_timeout.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pendulum_fmu import Study, run_sweep, sweep_grid
+    >>> study = Study(sweep_grid([5, 10], [0, 9.81]), stop_time=0.5)
+    >>> result = run_sweep(study, output_dir=tempfile.mkdtemp(), workers=1, progress=False)
+    >>> result.cases, result.failed, result.chunks_run == result.chunks
+    (4, 0, True)
     """
     from fsspec.implementations.local import LocalFileSystem
 

@@ -61,6 +61,13 @@ class Study:
         unknown format.
     MissingFile, parameters.FmuFileError
         No file at fmu_path, or none that is a pendulum FMU this machine can run.
+
+    Examples
+    --------
+    >>> from pendulum_fmu import Study, sweep_grid
+    >>> study = Study(sweep_grid([5, 10]), stop_time=0.5, outputs=("theta",))
+    >>> study.names, study.points, study.outputs
+    (['torque', 'gravity'], 501, ('theta',))
     """
 
     cases: Grid | Sequence[dict]
@@ -130,10 +137,21 @@ class SweepResult:
     """What a sweep wrote, and what it cost.
 
     Paths are Path objects on the local file system and URLs elsewhere.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from pendulum_fmu import Study, run_sweep, sweep_grid
+    >>> folder = Path(tempfile.mkdtemp())
+    >>> result = run_sweep(Study(sweep_grid([5, 10]), stop_time=0.1), output_dir=folder, workers=1, progress=False)
+    >>> result.cases, result.failed, result.trajectories == folder / "trajectories"
+    (2, 0, True)
     """
 
     output_dir: Path | str
-    trajectories: Path | str | None  # a folder of a file per chunk: case, time and the outputs kept; None with no outputs
+    # A folder of a file per chunk: case, time and the outputs kept; None with no outputs.
+    trajectories: Path | str | None
     cases_table: Path | str  # a folder of a file per chunk: a row per case (its values, summaries, status)
     figure: Path | str  # sweep.png
     cases: int

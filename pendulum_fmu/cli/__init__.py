@@ -1,0 +1,131 @@
+"""pendulum-fmu: build, simulate and compare the torque-driven pendulum FMU.
+
+One module per command, each with its ``add_parser(commands)``, which declares the command's
+options, and its ``run(args)``, which turns them into one call of the package's API and prints
+what came back. A command imports what it runs only when it runs, so that ``pendulum-fmu
+simulate`` loads neither the sweep nor matplotlib. A user's error (a PendulumFmuError) is one line
+and exit 2; anything else is a bug of ours, one line too, with the traceback on --debug.
+"""
+
+from __future__ import annotations
+
+import argparse
+import signal
+import sys
+import threading
+import warnings
+
+from .. import __version__
+from ..build import PlatformSkipped
+from ..errors import PendulumFmuError, Skipped
+from ..stop_signals import STOPPING_SIGNALS, Stopped, restore_signals, stop_on_signals
+from . import build, compare, cross_check, demo, judge, scenarios, simulate, sweep
+from ._stdout import UntilTheReaderIsGone
+
+__all__ = ["build_parser", "main"]
+
+# In the order `pendulum-fmu --help` lists them.
+COMMANDS = (build, cross_check, simulate, compare, sweep, demo, judge, scenarios)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The parser of the whole command line: every command's options, each with its help.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        Its ``parse_args`` gives the arguments with ``run``, the chosen command's function.
+
+    Examples
+    --------
+    >>> args = build_parser().parse_args(["simulate", "--torque", "20"])
+    >>> args.command, args.torque
+    ('simulate', 20.0)
+    """
+    parser = argparse.ArgumentParser(
+        prog="pendulum-fmu",
+        description="A torque-driven pendulum as an FMI 2.0 (or 3.0) FMU: build it, "
+        "simulate it, and compare it with scipy and OpenSim.",
+    )
+    parser.add_argument("--version", action="version", version=f"pendulum-fmu {__version__}")
+    parser.add_argument(
+        "--debug", action="store_true", default=False, help="show the Python traceback of an error instead of one line"
+    )
+    commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    for command in COMMANDS:
+        # Also after the command's name; SUPPRESS keeps it from hiding one given before it.
+        command.add_parser(commands).add_argument(
+            "--debug",
+            action="store_true",
+            default=argparse.SUPPRESS,
+            help="show the Python traceback of an error instead of one line",
+        )
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run one command line.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments after the program's name (default: ``sys.argv[1:]``).
+
+    Returns
+    -------
+    int
+        The exit status: 0, 1 when a comparison, a judgement or a sweep found what it reports,
+        2 for a user's error, 3 for a bug of ours, 128 + n on signal n.
+
+    Raises
+    ------
+    SystemExit
+        From argparse, for ``--help``, ``--version`` or arguments it cannot parse (status 2).
+
+    Examples
+    --------
+    >>> main(["simulate", "--torque", "20", "--stop-time", "0.01"])  # doctest: +SKIP
+    10 steps to t = 0.01 s: theta = ...
+    0
+    """
+    args = build_parser().parse_args(argv)
+    command = f"pendulum-fmu {args.command}"
+    shown = warnings.showwarning
+
+    def one_line(message, category, *where, **more):
+        if issubclass(category, (PlatformSkipped, Skipped)):
+            print(f"{command}: {message}", file=sys.stderr)
+        else:
+            shown(message, category, *where, **more)
+
+    # Signal handlers can only be set from the main thread; elsewhere Ctrl-C stays Python's.
+    previous = stop_on_signals() if threading.current_thread() is threading.main_thread() else {}
+    stdout, sys.stdout = sys.stdout, UntilTheReaderIsGone(sys.stdout)
+    try:
+        with warnings.catch_warnings():
+            warnings.showwarning = one_line
+            return args.run(args)
+    except (Stopped, KeyboardInterrupt) as stopped:
+        if args.debug:
+            raise
+        number = getattr(stopped, "signal_number", signal.SIGINT)
+        print(f"{command}: {STOPPING_SIGNALS[number]}; no output file was left half written", file=sys.stderr)
+        return 128 + number
+    except PendulumFmuError as error:
+        if args.debug:
+            raise
+        print(f"{command}: error: {error}", file=sys.stderr)
+        return 2
+    except Exception as error:  # a bug of ours: still one line, the traceback on request
+        if args.debug:
+            raise
+        print(
+            f"{command}: internal error: {type(error).__name__}: {error} (run again with --debug "
+            "for the traceback, and report it)",
+            file=sys.stderr,
+        )
+        return 3
+    finally:
+        sys.stdout = stdout
+        if previous:
+            restore_signals(previous)

@@ -1,0 +1,66 @@
+"""pendulum-fmu simulate: the FMU under a torque signal, through fmpy."""
+
+from __future__ import annotations
+
+import argparse
+
+import numpy as np
+
+from ._arguments import (
+    add_signal_arguments,
+    check_outputs,
+    float_number,
+    output_path,
+    parameters_of,
+    signal_options,
+    torque_signal,
+)
+
+
+def add_parser(commands) -> argparse.ArgumentParser:
+    """Declare `simulate` and its options, each with its help, among the parser's commands."""
+    simulate = commands.add_parser(
+        "simulate",
+        help="simulate the FMU under a torque signal",
+        description="Simulate the FMU through fmpy; the torque is held over each communication step unless --ramp.",
+    )
+    add_signal_arguments(simulate)
+    simulate.add_argument(
+        "--ramp", action="store_true", help="ramp the torque linearly over each step (input derivatives)"
+    )
+    simulate.add_argument(
+        "--tolerance",
+        type=float_number,
+        default=None,
+        help="relative tolerance of the FMU's integrator (default: 1e-10)",
+    )
+    simulate.add_argument("--output", type=output_path, help="write time,torque,theta,omega,alpha CSV")
+    simulate.add_argument("--plot", type=output_path, help="write a PNG of theta and omega")
+    simulate.set_defaults(run=run)
+    return simulate
+
+
+def run(args) -> int:
+    """Run `pendulum-fmu simulate` with the parsed arguments; returns the exit status."""
+    from .. import results
+    from ..simulate import simulate
+
+    check_outputs(
+        {"--output": args.output, "--plot": args.plot}, {"--torque-file": args.torque_file, "--fmu": args.fmu}
+    )
+    run = simulate(torque_signal(args), tolerance=args.tolerance, **signal_options(args))
+    last = run[-1]
+    print(
+        f"{len(run) - 1} steps to t = {last['time']:g} s: theta = {last['theta']:.12g} rad, "
+        f"omega = {last['omega']:.12g} rad/s, alpha = {last['alpha']:.12g} rad/s2; "
+        f"max |theta| = {np.max(np.abs(run['theta'])):.6g} rad"
+    )
+    if args.output:
+        results.write_csv(run, args.output)
+        print(f"wrote {args.output} ({','.join(results.FIELDS)}; units {', '.join(results.UNITS.values())})")
+    if args.plot:
+        from ..plot import case_title, plot_overlay
+
+        title = case_title(torque_signal(args), parameters_of(args.assignments), args.theta0, args.omega0, args.fmu)
+        print(f"wrote {plot_overlay({'FMU': run}, args.plot, title)}")
+    return 0

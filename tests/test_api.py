@@ -1,0 +1,92 @@
+"""The API at the top of the package: its names, what importing it loads, what simulate loads.
+
+The checks of what is loaded run in a fresh interpreter, whose sys.modules holds only what it did.
+"""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import pendulum_fmu
+
+ROOT = Path(__file__).resolve().parents[1]
+HEAVY = ("matplotlib", "dask", "distributed", "scipy", "fmpy", "numpy", "pyarrow")
+
+
+def _loaded_after(code: str) -> dict:
+    """Run code in a fresh interpreter from the repository's root.
+
+    Returns what it printed, the top-level packages and the pendulum_fmu modules it loaded.
+    """
+    script = (
+        f"{code}\nimport json, sys\n"
+        "print(json.dumps({'top': sorted({name.split('.')[0] for name in sys.modules}), "
+        "'ours': sorted(name for name in sys.modules if name.startswith('pendulum_fmu'))}))"
+    )
+    done = subprocess.run([sys.executable, "-c", script], cwd=ROOT, capture_output=True, text=True, check=True)
+    *printed, loaded = done.stdout.splitlines()
+    return {**json.loads(loaded), "printed": printed}
+
+
+def test_import_pendulum_fmu_loads_no_numerics_nor_plotting():
+    loaded = _loaded_after("import pendulum_fmu")
+    assert not set(HEAVY) & set(loaded["top"])
+    assert loaded["ours"] == ["pendulum_fmu"]
+
+
+def test_the_command_lines_simulate_loads_neither_the_sweep_nor_matplotlib():
+    loaded = _loaded_after("from pendulum_fmu.cli import main\nmain(['simulate', '--torque', '20'])")
+    assert "matplotlib" not in loaded["top"] and "dask" not in loaded["top"]
+    assert not [name for name in loaded["ours"] if name.startswith("pendulum_fmu.sweep")]
+    assert "pendulum_fmu.plot" not in loaded["ours"]
+    # It still simulated: the final angle it printed against the scipy reference.
+    theta = float(loaded["printed"][0].split("theta = ")[1].split(" rad")[0])
+    assert theta == pytest.approx(pendulum_fmu.reference(20.0)["theta"][-1], abs=1e-9)
+
+
+def test_the_names_at_the_top_are_the_api():
+    from pendulum_fmu import Study, compare, default_fmu, judge, reference, run_sweep, simulate
+    from pendulum_fmu.sweep.run import run_sweep as sweep_runner
+
+    assert run_sweep is sweep_runner and Study.__name__ == "Study" and callable(default_fmu)
+    assert callable(compare) and callable(judge)
+    # The FMU through fmpy against the independent scipy reference, both by their top names.
+    run, oracle = simulate(20.0, stop_time=1.0), reference(20.0, stop_time=1.0)
+    assert np.max(np.abs(run["theta"] - oracle["theta"])) < 1e-9
+    assert set(pendulum_fmu.__all__) <= set(dir(pendulum_fmu))
+
+
+def test_a_name_that_is_also_a_module_stays_the_function_once_the_module_is_imported():
+    loaded = _loaded_after(
+        "import pendulum_fmu.simulate, pendulum_fmu.judge\n"
+        "import pendulum_fmu\n"
+        "print(type(pendulum_fmu.simulate).__name__, type(pendulum_fmu.judge).__name__)"
+    )
+    assert loaded["printed"] == ["function function"]
+
+
+def test_a_name_the_api_has_not_is_an_attribute_error():
+    with pytest.raises(AttributeError, match="has no attribute 'simulat'"):
+        pendulum_fmu.simulat  # noqa: B018
+
+
+@pytest.mark.parametrize("name", [name for name in pendulum_fmu.__all__
+                                  if callable(getattr(pendulum_fmu, name))])
+def test_every_api_docstring_has_numpydoc_sections_and_its_examples_give_what_they_show(name):
+    import doctest
+    import inspect
+
+    thing = getattr(pendulum_fmu, name)
+    text = inspect.getdoc(thing)
+    wanted = ("Examples",) + (("Parameters", "Returns", "Raises") if inspect.isfunction(thing) else ())
+    assert all(f"{section}\n{'-' * len(section)}" in text for section in wanted), name
+    # Only the docstring's own examples (not its methods'), as doctest runs them.
+    tests = doctest.DocTestFinder(recurse=False).find(thing, name, globs={})
+    runner = doctest.DocTestRunner(optionflags=doctest.ELLIPSIS)
+    for test in tests:
+        runner.run(test)
+    assert runner.failures == 0 and runner.tries > 0, name
