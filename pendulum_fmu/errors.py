@@ -22,6 +22,7 @@ OSError for a file, ...). The kinds that belong to one module live there:
     sweep.store.InUse                 an output folder another run holds
     sweep.store.StudyExists           an output folder holding a study the run was not asked to replace
     sweep.client.SchedulerUnreachable a dask scheduler that does not answer
+    sweep.client.SchedulerLost        a dask scheduler lost while a study ran
     BuildError                        an FMU that cannot be built (by a checkout's fmu_build/)
 """
 
