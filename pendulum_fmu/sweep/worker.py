@@ -1,9 +1,9 @@
 """What a dask worker does with a chunk of cases: simulate each, write the chunk's two parts.
 
 A worker thread steps its cases through its thread's FMU instance (simulate.simulator),
-restarted between cases, each
-case in one call into the native loop (cs_loop.py); the FMI 3.0 FMU, or a machine without the
-native loop, runs the same case through fmpy's calls.
+restarted between cases, the whole chunk in one call into the native loop (cs_loop.py), into one
+preallocated (cases, points, outputs) array; the FMI 3.0 FMU, or a machine without the native
+loop, runs each case through fmpy's calls.
 """
 
 from __future__ import annotations
@@ -62,15 +62,22 @@ class Runner:
         return np.column_stack([np.broadcast_to(given.get(name, default), count)
                                 for name, default in self.defaults.items()]).astype(float)
 
-    def run(self, start_values: np.ndarray, points: np.ndarray, outputs: np.ndarray) -> None:
-        """theta, omega and alpha of one case (its row of start_values) at every communication
-        point into outputs (points x 3). FmuError when the FMU refuses the case; the next case's
-        restart starts from fmi2Reset, whatever state the refusal left."""
-        self.simulator.slave.messages.lines.clear()
+    def run_cases(self, start_values: np.ndarray, points: np.ndarray, outputs: np.ndarray) -> list[str]:
+        """theta, omega and alpha of each case (a row of start_values) at every communication
+        point into outputs (cases x points x 3). Returns per case "" or why the FMU refused it
+        (its row then NaN); the next case's restart starts from fmi2Reset, whatever state the
+        refusal left."""
         if self.stepper is not None:
-            self.stepper.run(points, None, None, outputs, start_values=start_values)
-        else:
-            self._run_python(dict(zip(self.defaults, start_values.tolist())), points, outputs)
+            return self.stepper.run_cases(points, start_values, outputs)
+        messages = [""] * len(start_values)
+        for case, values in enumerate(start_values.tolist()):
+            self.simulator.slave.messages.lines.clear()
+            try:
+                self._run_python(dict(zip(self.defaults, values)), points, outputs[case])
+            except FmuError as error:
+                messages[case] = str(error)
+                outputs[case] = np.nan
+        return messages
 
     def _run_python(self, start: dict[str, float], points: np.ndarray, outputs: np.ndarray) -> None:
         """The same case through fmpy's calls: FMI 3.0 FMUs, or no native loop."""
@@ -112,16 +119,10 @@ def run_chunk(index: int, first: int, values: dict[str, np.ndarray], task: Task)
     points = communication_points(0.0, task.stop_time, task.step_size)
     count = len(next(iter(values.values())))
     recorded = np.empty((count, len(points), len(OUTPUTS)))
-    messages = [""] * count
     runner = _runner(task.fmu)
     start_values = runner.start_values(values, count)
     stepping = time.thread_time()
-    for i in range(count):
-        try:
-            runner.run(start_values[i], points, recorded[i])
-        except FmuError as error:
-            messages[i] = str(error)
-            recorded[i] = np.nan
+    messages = runner.run_cases(start_values, points, recorded)
     stepping = time.thread_time() - stepping
     ok = np.array([not message for message in messages], bool)
     numbers = first + np.arange(count)
