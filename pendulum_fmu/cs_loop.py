@@ -33,7 +33,7 @@ _FMI_FUNCTIONS = ("fmi2Reset", "fmi2SetupExperiment", "fmi2EnterInitializationMo
 
 
 # What _cs_loop.c's cs_loop_interface() returns for the arguments this module passes.
-INTERFACE = 5
+INTERFACE = 6
 
 
 @lru_cache(maxsize=1)
@@ -53,7 +53,7 @@ def _library():
                     + [pointer] * 7)
     run.restype = ctypes.c_int
     run_cases = library.cs_loop_run_cases
-    run_cases.argtypes = [pointer] * 3 + [size] + [pointer] * 3 + [size] * 3 + [pointer] * 5
+    run_cases.argtypes = [pointer] * 3 + [size] + [pointer] * 3 + [size] * 4 + [pointer] * 6
     run_cases.restype = ctypes.c_int
     return run, run_cases
 
@@ -111,6 +111,7 @@ class Stepper:
         self._start_values = np.empty(self.starts)
         self._start_values_address = self._start_values.ctypes.data
         self._failed_case = ctypes.c_size_t()
+        self._case_outputs = np.empty((0, self.outputs))  # run_cases' room for one case, kept
         self._reports = ctypes.byref(self._failed_step), ctypes.byref(self._failed_call)
         self._run, self._run_cases = _library()
 
@@ -163,8 +164,9 @@ class Stepper:
         start_values : numpy.ndarray
             (cases, start references), C-contiguous float64: a row per case.
         outputs : numpy.ndarray
-            (cases, N + 1, outputs), C-contiguous float64, filled with each case's outputs at
-            every point; a refused case's row is NaN.
+            (outputs, cases, N + 1), C-contiguous float64, filled with each case's outputs at
+            every point: outputs[j] is output j of every case, one contiguous series (a table
+            column without a copy); a refused case's values are NaN.
         tolerance : float, optional
             The relative tolerance of every restart; None for the FMU's own.
 
@@ -180,23 +182,25 @@ class Stepper:
         """
         cases, points = len(start_values), len(time)
         start_values = _checked(start_values, (cases, self.starts), np.float64, "start_values")
-        outputs = _checked(outputs, (cases, points, self.outputs), np.float64, "outputs")
+        outputs = _checked(outputs, (self.outputs, cases, points), np.float64, "outputs")
+        if self._case_outputs.shape != (points, self.outputs):
+            self._case_outputs = np.empty((points, self.outputs))
         if tolerance is not None:
             self._tolerance.value = tolerance
         messages, first = [""] * cases, 0
         while first < cases:
             self.messages.lines.clear()  # so that a refusal's message is its case's own
             status = self._run_cases(
-                *self._fmu, *self._start_references, start_values[first:].ctypes.data,
+                *self._fmu, *self._start_references, start_values.ctypes.data,
                 None if tolerance is None else ctypes.addressof(self._tolerance),
-                *self._output_references, cases - first, points - 1,
-                _address(time, (points,), np.float64, "time"), outputs[first:].ctypes.data,
-                ctypes.byref(self._failed_case), *self._reports)
+                *self._output_references, cases, first, points - 1,
+                _address(time, (points,), np.float64, "time"), self._case_outputs.ctypes.data,
+                outputs.ctypes.data, ctypes.byref(self._failed_case), *self._reports)
             if status <= 1:
                 break
-            refused = first + self._failed_case.value
+            refused = self._failed_case.value
             messages[refused] = str(self._error(status, time))
-            outputs[refused] = np.nan
+            outputs[:, refused] = np.nan
             first = refused + 1
         self.messages.lines.clear()
         return messages

@@ -94,8 +94,9 @@ def test_a_chunk_in_one_call_matches_case_by_case_and_the_physics_bit_for_bit(fm
     slave = simulate.open_fmu(fmu)
     try:
         stepper = cs_loop.Stepper(slave, np.empty(0, np.uint32), outputs, references)
-        chunk = np.empty((len(cases), len(points), 3))
+        chunk = np.empty((3, len(cases), len(points)))
         messages = stepper.run_cases(points, cases, chunk)
+        chunk = chunk.transpose(1, 2, 0)  # (cases, points, outputs), as run() writes a case
         assert messages[0] == messages[2] == messages[3] == ""
         assert messages[1].startswith("initialization failed: ") and "mass must be > 0" in messages[1]
         assert np.isnan(chunk[1]).all()
