@@ -140,8 +140,9 @@ def run_chunk(index: int, first: int, values: dict[str, np.ndarray], task: Task)
             **{name: kept[OUTPUTS.index(name)].reshape(-1) for name in task.outputs}},
             task.run, split=("time", *task.outputs))
     theta = recorded[OUTPUTS.index("theta")]
-    # max |theta| as max(max, -min): two passes and no temporary the size of the chunk.
-    summaries = [*recorded[:, :, -1], np.maximum(theta.max(axis=1), -theta.min(axis=1))]
+    # max |theta| as |max(max, -min)|: two passes and no temporary the size of the chunk (the
+    # outer abs only for theta all -0.0, where abs first gives 0.0).
+    summaries = [*recorded[:, :, -1], np.abs(np.maximum(theta.max(axis=1), -theta.min(axis=1)))]
     written += task.store.write_table("cases", index, {
         "case": numbers, **values, **dict(zip(SUMMARIES, summaries)),
         "status": np.where(ok, "ok", "failed").tolist(), "message": messages}, task.run)
