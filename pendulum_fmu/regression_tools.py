@@ -1,9 +1,8 @@
-"""What the field's regression tools would say about a result: csv-compare's tube and the FMI
-cross-check's band, beside the judge's diagnosis.
+"""What the field's regression tools would say about a result, beside the judge's diagnosis.
 
-Both compare a result with a reference result and pass differences that a tolerance in time
-hides, so a master that is a step late can pass them. The judge shows their verdicts so a
-user sees when that happens.
+csv-compare's tube and the FMI cross-check's band both compare a result with a reference result
+and pass differences that a tolerance in time hides, so a master that is a step late can pass
+them. The judge shows their verdicts so a user sees when that happens.
 
 csv-compare's tube (modelica-tools/csv-compare; lbl-srg/funnel's pyfunnel computes the same
 tube). Around each reference point (t_i, y_i) stands a rectangle of half-width
@@ -67,8 +66,10 @@ def _base(values: np.ndarray, smallest: float) -> float:
 
 
 def _range_max(values: np.ndarray, first: np.ndarray, end: np.ndarray) -> np.ndarray:
-    """max(values[first:end]) for each pair (-inf where empty), by a sparse table: log2(n)
-    levels of maxima over 2**k points, so each query reads two entries."""
+    """max(values[first:end]) for each pair (-inf where empty), by a sparse table.
+
+    The table holds log2(n) levels of maxima over 2**k points, so each query reads two entries.
+    """
     table = [values]
     while 2 ** len(table) <= len(values):
         half = 2 ** (len(table) - 1)
@@ -186,7 +187,7 @@ def cross_check_band(t_ref, y_ref, t, y) -> ToolVerdict:
     half_height = 0.1 * _base(np.interp(band_time, t_ref, y_ref), 5.0)
     count = int(np.count_nonzero(outside))
     return ToolVerdict("FMI cross-check band", count <= CROSS_CHECK_OUTSIDE_SHARE * len(y), count, len(y),
-                       (window // 2) * (band_time[-1] - band_time[0]) / (samples - 1), half_height)
+                       float((window // 2) * (band_time[-1] - band_time[0]) / (samples - 1)), half_height)
 
 
 def regression_verdicts(times, reference, result) -> list[dict]:

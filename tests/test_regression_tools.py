@@ -1,6 +1,8 @@
-"""csv-compare's tube and the FMI cross-check's band (pendulum_fmu/regression_tools.py), against
-the tube's definition evaluated plainly, hand-checkable steps, and a one-step-late master that
-the tube passes while the judge names it late."""
+"""csv-compare's tube and the FMI cross-check's band (pendulum_fmu/regression_tools.py).
+
+Against the tube's definition evaluated plainly, hand-checkable steps, and a one-step-late master
+that the tube passes while the judge names it late.
+"""
 
 import numpy as np
 import pytest
@@ -10,8 +12,11 @@ from pendulum_fmu.regression_tools import cross_check_band, csv_compare_tube, tu
 
 
 def brute_force_envelopes(t_ref, y_ref, at, half_width, half_height):
-    """The tube's definition, point by point: the reference line's lowest and highest value over
-    [t - half_width, t + half_width], each segment's extremes at the ends of its part inside."""
+    """The tube's definition, point by point.
+
+    The reference line's lowest and highest value over [t - half_width, t + half_width], each
+    segment's extremes at the ends of its part inside.
+    """
     lower, upper = [], []
     for t in at:
         a, b = t - half_width, t + half_width
