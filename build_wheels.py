@@ -5,8 +5,8 @@ arm64), Windows amd64, all from this Linux machine.
 
 One build makes the FMUs (FMI 2.0 and 3.0, a binary for every platform) and every wheel carries
 them; each wheel adds the native co-simulation loop built for its own platform
-(pendulum_fmu.build.compile_native_loop). Every Linux binary, the FMUs' and the native loops, is
-built by zig for glibc MANYLINUX_GLIBC (pendulum_fmu.build's linux_glibc), so that the Linux
+(fmu_build.compile_native_loop). Every Linux binary, the FMUs' and the native loops, is
+built by zig for glibc MANYLINUX_GLIBC (fmu_build's linux_glibc), so that the Linux
 wheels load on that glibc and every later one. The steps, with the wheel package's own tools:
 1. `python -m build --wheel` builds this machine's wheel, the FMUs inside;
 2. per platform, `wheel unpack`, its native loop in place of this machine's, `wheel pack`
@@ -36,7 +36,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from pendulum_fmu import FMU_FILES
-from pendulum_fmu.build import PLATFORMS, BuildError, check_toolchain, compile_native_loop
+from fmu_build import PLATFORMS, BuildError, check_toolchain, compile_native_loop
 from pendulum_fmu.atomic_files import replacing_path
 
 ROOT = Path(__file__).resolve().parent
@@ -52,7 +52,7 @@ TOOLS = {"build": "pip install build", "wheel": "pip install wheel", "auditwheel
 
 @dataclass(frozen=True)
 class WheelPlatform:
-    """A wheel: the platform (a key of pendulum_fmu.build.PLATFORMS) whose native loop and FMU
+    """A wheel: the platform (a key of fmu_build.PLATFORMS) whose native loop and FMU
     binaries it loads."""
 
     platform: str
@@ -106,7 +106,7 @@ def _zig_on_path() -> dict:
 
 def _extract_fmu_binaries(wheel: Path, out_dir: Path) -> None:
     """The binaries of the wheel's FMUs into out_dir/<FMU file>/binaries/<folder>/; WheelhouseError
-    unless they are there for every platform of pendulum_fmu.build.PLATFORMS."""
+    unless they are there for every platform of fmu_build.PLATFORMS."""
     with zipfile.ZipFile(wheel) as archive:
         for fmi_version, name in FMU_FILES.items():
             with zipfile.ZipFile(archive.open(f"pendulum_fmu/data/{name}")) as fmu:

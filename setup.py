@@ -3,12 +3,12 @@
 - build_py also builds the FMI 2.0 and 3.0 FMUs into the wheel's pendulum_fmu/data/, from this
   source tree (a clone or the unpacked sdist), for every platform whose compiler is installed.
 - build_ext builds the native co-simulation loop, pendulum_fmu/_cs_loop.c, through the project's
-  one build description (CMakeLists.txt, driven by pendulum_fmu/build.py) with this machine's
+  one build description (CMakeLists.txt, driven by fmu_build/) with this machine's
   compiler. It is plain C loaded with ctypes (pendulum_fmu/cs_loop.py), not a CPython module:
   it has the platform's plain name (_cs_loop.so, _cs_loop.pyd) and the wheel is tagged
   py3-none-<platform>, one wheel for every Python 3 on a platform.
 - bdist_wheel --linux-glibc 2.17 has both build the Linux binaries with zig for that oldest glibc
-  (pendulum_fmu.build's linux_glibc); build_wheels.py passes it, through
+  (fmu_build's linux_glibc); build_wheels.py passes it, through
   python -m build -C--build-option=--linux-glibc=2.17.
 """
 
@@ -16,6 +16,7 @@ import importlib.machinery
 import shutil
 import sys
 import tempfile
+import warnings
 from pathlib import Path
 
 from setuptools import Extension, setup
@@ -35,20 +36,28 @@ class BuildPyWithFmu(build_py):
         # An editable install runs from the checkout, which builds dist/Pendulum.fmu on demand.
         if getattr(self, "editable_mode", False):
             return
+        from fmu_build import build_fmu
         from pendulum_fmu import FMU_FILES, __version__
-        from pendulum_fmu.build import build_fmu
+        from pendulum_fmu.errors import PlatformSkipped
+        from pendulum_fmu.export import fmu_platforms
 
         data = Path(self.build_lib, "pendulum_fmu", "data")
         for fmi_version, name in FMU_FILES.items():
-            fmu = build_fmu(data / name, fmi_version=fmi_version, linux_glibc=_linux_glibc(self))
-            print(f"pendulum_fmu {__version__}: built {fmu}")
+            with warnings.catch_warnings(record=True) as skipped:
+                warnings.simplefilter("always", PlatformSkipped)
+                fmu = build_fmu(data / name, fmi_version=fmi_version, linux_glibc=_linux_glibc(self))
+            # A platform this machine cannot build for: one line each, what to install in it.
+            for warning in skipped:
+                print(f"pendulum_fmu {__version__}: FMI {fmi_version}.0 FMU without {warning.message}",
+                      file=sys.stderr)
+            print(f"pendulum_fmu {__version__}: built {fmu} ({', '.join(fmu_platforms(fmu))})")
 
 
 class BuildNativeLoop(build_ext):
     """The native loop by CMake, for the platform of this machine."""
 
     def build_extension(self, extension):
-        from pendulum_fmu.build import PLATFORMS, compile_native_loop
+        from fmu_build import PLATFORMS, compile_native_loop
 
         [platform] = [name for name, platform in PLATFORMS.items() if platform.native]
         target = Path(self.get_ext_fullpath(extension.name))

@@ -1,7 +1,7 @@
 # zig's C compiler (PyPI ziglang: pip install ziglang) for the target ZIG_TARGET, a zig target
 # triple such as aarch64-macos.11.0 (the minimum OS version is part of it) or aarch64-linux-gnu.
 # zig brings each target's libc headers and link stubs, so no SDK or sysroot is needed for plain C.
-# ZIG is the zig executable (pendulum_fmu/build.py passes the one in the ziglang package).
+# ZIG is the zig executable (fmu_build/ passes the one in the ziglang package).
 # The project's try_compile checks (CheckIPOSupported) read this file again without the cache:
 # the environment carries ZIG and ZIG_TARGET to them.
 foreach(variable ZIG_TARGET ZIG)

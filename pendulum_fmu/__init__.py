@@ -82,7 +82,8 @@ def default_fmu(fmi_version: int = 2):
     """The FMU this package runs when none is named.
 
     In a source checkout (a clone or an editable install): dist/Pendulum.fmu, rebuilt first when
-    any of its sources is newer. In an installed package: the FMU packaged with it. Nothing is
+    any of its sources is newer, by the repository's build tool (fmu_build/, found beside the
+    package). In an installed package: the FMU packaged with it. Nothing is
     ever written into site-packages.
 
     Parameters
@@ -116,16 +117,17 @@ def default_fmu(fmi_version: int = 2):
     from importlib import resources
     from pathlib import Path
 
-    from .build import CHECKOUT_FMUS, build_fmu, fmu_is_stale, is_source_checkout
+    from ._checkout import build_tool, is_source_checkout
     from .errors import InvalidInput, MissingFile
 
     if fmi_version not in FMU_FILES:
         raise InvalidInput(f"no FMI {fmi_version} FMU: the FMI versions are {', '.join(map(str, FMU_FILES))}")
     packaged_name = FMU_FILES[fmi_version]
-    checkout_fmu = CHECKOUT_FMUS[fmi_version]
     if is_source_checkout():
-        if fmu_is_stale(checkout_fmu):
-            build_fmu(checkout_fmu, fmi_version=fmi_version)
+        build = build_tool()
+        checkout_fmu = build.CHECKOUT_FMUS[fmi_version]
+        if build.fmu_is_stale(checkout_fmu):
+            build.build_fmu(checkout_fmu, fmi_version=fmi_version)
         return checkout_fmu
     packaged = resources.files(__name__) / "data" / packaged_name
     if not packaged.is_file():

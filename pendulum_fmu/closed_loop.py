@@ -23,7 +23,7 @@ from fmpy.model_description import CoSimulation, DefaultExperiment, ModelDescrip
 from scipy.integrate import solve_ivp
 
 from .atomic_files import replacing
-from .build import PID_CONTROLLER_DIR, build_fmu, build_pid_controller
+from ._checkout import ROOT, build_tool
 from .errors import InvalidInput
 from .parameters import total_inertia
 from .simulate import resolve_parameters
@@ -36,7 +36,7 @@ WIRES = (("pendulum", "theta", "controller", "theta"),
 
 def controller_defaults() -> dict[str, float]:
     """setpoint, kp, ki, kd as the controller's modelDescription.xml sets them."""
-    variables = read_model_description(str(PID_CONTROLLER_DIR / "modelDescription.xml")).modelVariables
+    variables = read_model_description(str(ROOT / "fmu_src" / "pid_controller" / "modelDescription.xml")).modelVariables
     return {v.name: float(v.start) for v in variables if v.causality == "parameter"}
 
 
@@ -78,8 +78,9 @@ def create_closed_loop_fmu(out_file: str | Path, *, step_size: float = 1e-3) -> 
     out_file = Path(out_file)
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
-        files = {"pendulum": build_fmu(tmp / "Pendulum.fmu"),
-                 "controller": build_pid_controller(tmp / "PIDController.fmu")}
+        build = build_tool()
+        files = {"pendulum": build.build_fmu(tmp / "Pendulum.fmu"),
+                 "controller": build.build_pid_controller(tmp / "PIDController.fmu")}
         components, variables = {}, {}
         for name, path in files.items():
             description = read_model_description(str(path))
@@ -110,19 +111,62 @@ def create_closed_loop_fmu(out_file: str | Path, *, step_size: float = 1e-3) -> 
     return out_file
 
 
+# How a master orders the loop's data exchange, each by the torque it holds over step k
+# (t_k to t_(k+1)): the controller's law on which theta and omega, with its error integral to when.
+COUPLINGS = {
+    "gauss-seidel-pendulum-first": "the pendulum steps first; its theta and omega reach the controller "
+                                   "before the controller's torque is read (theta_k, integral to t_k)",
+    "gauss-seidel-controller-first": "the controller steps first on theta_k and its torque, integral "
+                                     "to t_(k+1), drives the pendulum over the same step",
+    "jacobi": "both step on what was exchanged at t_k: the torque read after the controller's last "
+              "step (theta_(k-1), integral to t_k); the first from the initial exchange",
+    "jacobi-first-exchange-missing": "as jacobi, but nothing is exchanged before the first step: the "
+                                     "pendulum's first step holds torque 0",
+}
+
+
 def sampled_loop_reference(stop_time: float = 6.0, step_size: float = 1e-3, *,
                            controller: dict | None = None, parameters: dict | None = None,
-                           feedthrough_delay: bool = False, rtol: float = 1e-12) -> np.ndarray:
-    """time, theta, omega, torque of the sampled loop: each step a torque from the controller is
-    held while scipy integrates the pendulum; the controller's error integral of a held error is
-    exact.
+                           coupling: str = "gauss-seidel-pendulum-first",
+                           rtol: float = 1e-12) -> np.ndarray:
+    """time, theta, omega, torque of the sampled loop under one master's coupling.
 
-    Masters differ in when they read the controller's torque, a direct feedthrough of theta:
-    fmpy's container sets the controller's new inputs first, so the torque for step k comes from
-    theta_k (feedthrough_delay=False). libcosim reads each slave's outputs right after its step,
-    before the new inputs reach it, so the torque for step k comes from theta_(k-1) and the
-    integral at t_k (feedthrough_delay=True).
+    Each step a torque from the PID law (written here in Python, not the controller FMU's code)
+    is held while scipy integrates the pendulum; the controller's error integral of a held error
+    is exact. Masters differ in when they read the controller's torque, a direct feedthrough of
+    theta (see COUPLINGS): fmpy's container is Gauss-Seidel with the pendulum first, libcosim
+    Jacobi, fmpy.ssp Jacobi with no exchange before the first step.
+
+    Parameters
+    ----------
+    stop_time, step_size : float, optional
+        The experiment's end and the master's fixed communication step, in s.
+    controller : dict, optional
+        setpoint, kp, ki, kd over the controller's defaults.
+    parameters : dict, optional
+        The pendulum's parameters over its defaults.
+    coupling : str, optional
+        A key of COUPLINGS.
+    rtol : float, optional
+        scipy's relative and absolute tolerance per step.
+
+    Returns
+    -------
+    numpy.ndarray
+        Structured array of time, theta, omega and the torque held over the step from that time,
+        one row per communication point from 0 to stop_time.
+
+    Raises
+    ------
+    InvalidInput
+        A coupling that is not one of COUPLINGS, or parameters the pendulum refuses.
+
+    Examples
+    --------
+    >>> theta = sampled_loop_reference(3.0, coupling="jacobi", controller={"setpoint": 0.3})["theta"]
     """
+    if coupling not in COUPLINGS:
+        raise InvalidInput(f"coupling {coupling!r} is none of {', '.join(COUPLINGS)}")
     gains = {**controller_defaults(), **(controller or {})}
     p = resolve_parameters(parameters)
     inverse_inertia = 1.0 / total_inertia(p)
@@ -130,18 +174,27 @@ def sampled_loop_reference(stop_time: float = 6.0, step_size: float = 1e-3, *,
     n = int(round(stop_time / step_size))
     out = np.zeros(n + 1, dtype=[("time", "f8"), ("theta", "f8"), ("omega", "f8"), ("torque", "f8")])
     state, integral = np.zeros(2), 0.0
-    measured = state  # what the controller's inputs hold when its torque is read
+    previous = state  # theta, omega at the last communication point, what a Jacobi master last sent
+
+    def law(measured, error_integral):
+        return (gains["kp"] * (gains["setpoint"] - measured[0]) + gains["ki"] * error_integral
+                - gains["kd"] * measured[1])
+
     for k in range(n + 1):
-        if not feedthrough_delay:
-            measured = state
-        torque = (gains["kp"] * (gains["setpoint"] - measured[0]) + gains["ki"] * integral
-                  - gains["kd"] * measured[1])
+        next_integral = integral + step_size * (gains["setpoint"] - state[0])
+        if coupling == "gauss-seidel-pendulum-first":
+            torque = law(state, integral)
+        elif coupling == "gauss-seidel-controller-first":
+            torque = law(state, next_integral)
+        elif coupling == "jacobi-first-exchange-missing" and k == 0:
+            torque = 0.0
+        else:
+            torque = law(previous, integral)
         out[k] = (k * step_size, state[0], state[1], torque)
         if k == n:
             break
         rhs = lambda t, y, u=torque: (y[1], (u - gravity_moment * np.sin(y[0])  # noqa: E731
                                               - p["damping"] * y[1]) * inverse_inertia)
-        integral += step_size * (gains["setpoint"] - state[0])
-        measured = state
+        integral, previous = next_integral, state
         state = solve_ivp(rhs, (0.0, step_size), state, method="DOP853", rtol=rtol, atol=rtol).y[:, -1]
     return out

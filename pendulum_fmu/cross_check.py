@@ -15,11 +15,11 @@ import shutil
 import zipfile
 from pathlib import Path
 
+import fmpy
 import numpy as np
 
 from . import __version__
 from .atomic_files import check_writable, replacing, replacing_path
-from .build import PLATFORMS
 from .parameters import fmu_file, model_description, pendulum_variables
 from .simulate import simulate
 from .torque_schedule import TorqueTable
@@ -82,7 +82,7 @@ def write_cross_check(output_dir: str | Path, fmu_path: str | Path | None = None
                    tolerance=RELATIVE_TOLERANCE, fmu_path=fmu)
     reference_rows = [[repr(float(t)), *(repr(float(v)) for v in values)]
                       for t, *values in zip(run["time"], *(run[name] for name in OUTPUTS))]
-    computed_on = next((name for name, platform in PLATFORMS.items() if platform.native), "this machine's")
+    computed_on = fmpy.platform_tuple  # this machine, as FMI 3.0 names platforms
     for folder in folders:
         # Each write below makes the folder, or says in one line why it cannot.
         with replacing_path(folder / f"{model_name}.fmu") as copy:

@@ -13,13 +13,17 @@ OSError for a file, ...). The kinds that belong to one module live there:
     mapped_fmu.MapError               a --map, or an FMU that does not fit it
     judge.ResultFileError             a result file, or a kit's folder, that cannot be judged
     scenarios.KitExists               an output folder holding a scenario kit the run was not asked to replace
+    ssp.SspExists                     an SSP the export was not asked to replace
+    ssp.SspFileError                  a file given as the closed loop's SSP that is not one
     demo.DemoExists                   an output folder holding a demo's outputs the run was not asked to replace
+    export.FmuExists                  an export's output file the run was not asked to replace
     engines.ToolCannotRamp            a ramp given to a tool that holds the torque
     engines.drake.UnequalSteps        unequal steps given to drake:default
     sweep.store.InUse                 an output folder another run holds
     sweep.store.StudyExists           an output folder holding a study the run was not asked to replace
     sweep.client.SchedulerUnreachable a dask scheduler that does not answer
-    build.BuildError                  an FMU that cannot be built
+    sweep.client.SchedulerLost        a dask scheduler lost while a study ran
+    BuildError                        an FMU that cannot be built (by a checkout's fmu_build/)
 """
 
 
@@ -41,12 +45,14 @@ class PendulumFmuError(Exception):
 
 class InvalidInput(PendulumFmuError, ValueError):
     """An argument, option, parameter or case the package refuses: a time, a step, a tolerance,
-    a parameter's name or value, a sweep's values."""
+    a parameter's name or value, a sweep's values.
+    """
 
 
 class WrongType(PendulumFmuError, TypeError):
     """An argument of a kind the function does not take (None for a folder, a list for a Study);
-    the message says what it takes."""
+    the message says what it takes.
+    """
 
 
 class MissingFile(PendulumFmuError, FileNotFoundError):
@@ -55,14 +61,29 @@ class MissingFile(PendulumFmuError, FileNotFoundError):
 
 class CannotWrite(PendulumFmuError, OSError):
     """An output cannot be written where it was asked for (a file where a folder must be, no
-    permission, a full disk)."""
+    permission, a full disk).
+    """
 
 
 class MissingDependency(PendulumFmuError, ImportError):
     """An optional package a tool needs is not installed; the message gives the pip command."""
 
 
+class BuildError(PendulumFmuError, RuntimeError):
+    """The FMU could not be built; the message says why. Raised by the repository's build tool
+    (fmu_build/, beside the package in a checkout), and defined here so that the package's callers
+    catch it without that tool.
+    """
+
+
+class PlatformSkipped(UserWarning):
+    """A platform left out of a default build because its compiler is missing (the build tool
+    warns; the command line shows it in one line).
+    """
+
+
 class Skipped(UserWarning):
     """A part of the run left out because this machine lacks what it needs (a tool's package); the
     message is one line saying which part and how to get it. The command line prints it as that
-    line and goes on."""
+    line and goes on.
+    """

@@ -436,14 +436,14 @@ def judge(result, torque, *, start_time: float = 0.0, stop_time: float | None = 
     start_time, stop_time, step_size, ramp, parameters, theta0, omega0, max_steps, fmu_path
         The run's definition, as simulate() takes it.
     tolerance : float, optional
-        The largest |dtheta| (rad) that passes (default: DEFAULT_TOLERANCE, 1e-9 rad).
+        The largest ``|dtheta|`` (rad) that passes (default: DEFAULT_TOLERANCE, 1e-9 rad).
     mapping : str or dict, optional
         The result's column names and unit factors (--map), for a CSV.
 
     Returns
     -------
     Judgement
-        The verdict, the diagnosis and its residual, max |dtheta| and where, every candidate's
+        The verdict, the diagnosis and its residual, ``max |dtheta|`` and where, every candidate's
         residual and effect.
 
     Raises

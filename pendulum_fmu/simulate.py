@@ -11,7 +11,6 @@ import array
 import ctypes
 import itertools
 import os
-import tempfile
 import threading
 import weakref
 from collections import OrderedDict
@@ -20,13 +19,13 @@ from pathlib import Path
 
 import fmpy
 import numpy as np
-from fmpy import extract
 from fmpy.fmi1 import printLogMessage
 from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
 from fmpy.fmi3 import FMU3Slave
 
 from . import cs_loop, default_fmu, results
 from .errors import InvalidInput, PendulumFmuError
+from .model import fmu_model
 from .parameters import (default_parameters, file_version, fmu_file, merged_parameters, merged_with,
                          model_description, pendulum_variables, start_value, value_reference)
 from .torque_schedule import TorqueSignal, TorqueSchedule, schedule
@@ -110,22 +109,10 @@ def instantiate(slave: FMU2Slave | FMU3Slave, messages: MessageLog, fmu_path) ->
         raise messages.instantiation_error(fmu_path) from None
 
 
-_extracted: dict[tuple[str, int], tuple[tempfile.TemporaryDirectory, object]] = {}
-_extracting = threading.Lock()  # threads of one dask worker share the cache
-
-
-def _unzipped(fmu_path: Path):
-    """(folder, model description) of an FMU file, extracted and parsed once per process; the
-    folder is removed at exit."""
-    description = model_description(fmu_path)  # refuses what is no FMU before it is unzipped
-    key = (str(fmu_path.resolve()), file_version(fmu_path))
-    with _extracting:
-        if key not in _extracted:
-            folder = tempfile.TemporaryDirectory(prefix="pendulum_fmu_")
-            extract(str(fmu_path), unzipdir=folder.name)
-            _extracted[key] = folder, description
-        folder, description = _extracted[key]
-    return folder.name, description
+def _unzipped(fmu_path):
+    """(folder, model description) of an FMU file, extracted once per model (model.FmuModel)."""
+    model = fmu_model(fmu_path)  # refuses what is no FMU before it is unzipped
+    return model.folder, model.description
 
 
 def fmi2_library(folder: str, model_identifier: str) -> str | None:
@@ -183,9 +170,9 @@ def open_fmu(fmu_path: str | Path | None = None, *, parameters: dict | None = No
 
 def _instantiated(fmu_path: Path, instance_name: str):
     """An instantiated FMU2Slave or FMU3Slave, not yet initialized (see open_fmu)."""
-    pendulum_variables(fmu_path)  # FmuFileError when it is no pendulum FMU this machine runs
-    folder, description = _unzipped(fmu_path)
-    fmi_version = int(description.fmiVersion[0])
+    model = fmu_model(fmu_path)
+    model.pendulum_variables  # FmuFileError when it is no pendulum FMU this machine runs
+    folder, description, fmi_version = model.folder, model.description, model.fmi_version
     messages = MessageLog(fmi_version)
     arguments = dict(guid=description.guid, unzipDirectory=folder, instanceName=instance_name,
                      modelIdentifier=description.coSimulation.modelIdentifier)
@@ -196,7 +183,7 @@ def _instantiated(fmu_path: Path, instance_name: str):
     instantiate(slave, messages, fmu_path)
     slave.fmi_version = fmi_version
     slave.messages = messages  # keeps the logger callback alive as long as the slave
-    slave.fmu_path = fmu_path  # whose parameters and value references apply
+    slave.fmu_path = model  # whose parameters and value references apply, parsed once
     return slave
 
 
@@ -205,9 +192,9 @@ def initialize(slave: FMU2Slave | FMU3Slave, *, parameters: dict | None = None, 
     """Set the parameters and start values of an instantiated (or reset) slave from open_fmu and
     leave it in step mode; FmuError says why the FMU refused."""
     # The FMU checks the parameters itself, here as everywhere (resolve_parameters).
-    start = {**merged_parameters(parameters, slave.fmu_path), "theta": start_value("theta0", theta0, "rad"),
+    start = {**merged_with(slave.fmu_path.default_parameters, parameters), "theta": start_value("theta0", theta0, "rad"),
              "omega": start_value("omega0", omega0, "rad/s")}
-    references = [value_reference(n, slave.fmu_path) for n in start]
+    references = [slave.fmu_path.value_reference(n) for n in start]
     try:
         if slave.fmi_version == 3:
             slave.enterInitializationMode(tolerance=tolerance, startTime=start_time)
@@ -237,7 +224,7 @@ def _stepper(slave, start_names: tuple[str, ...] = ()) -> cs_loop.Stepper:
     """The native loop bound to a slave: the torque in, RECORDED out, a restart setting
     start_names."""
     def references(names):
-        return np.array([value_reference(name, slave.fmu_path) for name in names], np.uint32)
+        return np.array([slave.fmu_path.value_reference(name) for name in names], np.uint32)
     return cs_loop.Stepper(slave, references(["torque"]), references(RECORDED), references(start_names))
 
 
@@ -276,8 +263,8 @@ def run_schedule_python(slave: FMU2Slave | FMU3Slave, plan: TorqueSchedule) -> n
              ("fmi2SetReal", "fmi2GetReal", "fmi2SetRealInputDerivatives", "fmi2DoStep"))
     set_real, get_real, set_rate, do_step = (dll[name] if name else None for name in names)
     component = ctypes.c_void_p(slave.component)
-    torque_vr = (ctypes.c_uint * 1)(value_reference("torque", slave.fmu_path))
-    recorded_vr = (ctypes.c_uint * 4)(*(value_reference(n, slave.fmu_path) for n in RECORDED))
+    torque_vr = (ctypes.c_uint * 1)(slave.fmu_path.value_reference("torque"))
+    recorded_vr = (ctypes.c_uint * 4)(*(slave.fmu_path.value_reference(n) for n in RECORDED))
     one, four = ctypes.c_size_t(1), ctypes.c_size_t(4)
     first_order = (ctypes.c_int * 1)(1)
     no_rollback = ctypes.c_int(1)
@@ -447,7 +434,7 @@ class Simulator:
     def __init__(self, fmu_path: Path, version: tuple):
         self.fmu_path, self.version = fmu_path, version
         self.slave = _instantiated(fmu_path, "pendulum")
-        self.defaults = default_parameters(fmu_path)
+        self.defaults = default_parameters(self.slave.fmu_path)
         self.stepper = (_stepper(self.slave, (*self.defaults, *self.START_STATES))
                         if cs_loop.drives(self.slave) else None)
 

@@ -735,7 +735,7 @@ def main(argv=None):
 
     from fmpy import read_model_description
 
-    from pendulum_fmu.build import build_fmu
+    from fmu_build import build_fmu
 
     out = Path((argv or sys.argv[1:] or ["docs/robustness.md"])[0])
     with tempfile.TemporaryDirectory() as tmp:

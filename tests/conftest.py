@@ -1,6 +1,6 @@
 import pytest
 
-from pendulum_fmu.build import build_fmu
+from fmu_build import build_fmu
 
 
 @pytest.fixture(scope="session")

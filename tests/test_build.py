@@ -17,7 +17,7 @@ import pytest
 from fmpy import read_model_description
 
 from pendulum_fmu import __version__
-from pendulum_fmu.build import MODEL_DESCRIPTION, build_fmu
+from fmu_build import MODEL_DESCRIPTION, build_fmu
 from pendulum_fmu.cli import main
 from pendulum_fmu.parameters import default_parameters
 from pendulum_fmu.reference import reference
@@ -78,7 +78,7 @@ def test_eight_builds_into_one_path_at_once_all_succeed(tmp_path):
 
 
 def test_checkout_fmu_is_rebuilt_when_a_source_is_newer(tmp_path):
-    for name in ("pendulum_fmu", "fmu_src", "cmake"):
+    for name in ("pendulum_fmu", "fmu_build", "fmu_src", "cmake"):
         shutil.copytree(ROOT / name, tmp_path / name, ignore=shutil.ignore_patterns("__pycache__"))
     shutil.copy2(MODEL_DESCRIPTION, tmp_path)
     shutil.copy2(ROOT / "CMakeLists.txt", tmp_path)

@@ -17,8 +17,8 @@ I_TOTAL = 30.0
 def test_every_command_has_help():
     parser = build_parser()
     commands = parser._subparsers._group_actions[0].choices
-    assert set(commands) == {"build", "cross-check", "simulate", "compare", "sweep", "demo", "judge",
-                             "scenarios"}
+    assert set(commands) == {"build", "export", "cross-check", "simulate", "compare", "sweep", "demo", "judge",
+                             "scenarios", "export-ssp"}
     for name, command in commands.items():
         assert command.description, name
         for action in command._actions:

@@ -4,7 +4,7 @@ import numpy as np
 from fmpy import simulate_fmu
 from fmpy.validation import validate_fmu
 
-from pendulum_fmu.build import build_pid_controller
+from fmu_build import build_pid_controller
 from pendulum_fmu.closed_loop import create_closed_loop_fmu, sampled_loop_reference
 
 

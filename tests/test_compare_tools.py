@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from pendulum_fmu import compare_tools
-from pendulum_fmu.build import MODEL_DESCRIPTION, PENDULUM_DIR, SOURCE_DIR, build_fmu
+from fmu_build import MODEL_DESCRIPTION, PENDULUM_DIR, SOURCE_DIR, build_fmu
 from pendulum_fmu.cli import main
 from pendulum_fmu.compare import run_tools
 from pendulum_fmu.errors import Skipped

@@ -27,5 +27,5 @@ def test_every_exception_class_of_the_package_is_a_user_error():
                 defined[f"{value.__module__}.{name}"] = value
     assert {"pendulum_fmu.torque_schedule.TorqueFileError", "pendulum_fmu.simulate.FmuError",
             "pendulum_fmu.parameters.FmuFileError",
-            "pendulum_fmu.build.BuildError", "pendulum_fmu.sweep.store.InUse"} <= set(defined)
+            "pendulum_fmu.errors.BuildError", "pendulum_fmu.sweep.store.InUse"} <= set(defined)
     assert [name for name, value in defined.items() if not issubclass(value, PendulumFmuError)] == []

@@ -14,7 +14,7 @@ from fmpy.fmi2 import FMU2Model
 from fmpy.fmi3 import FMU3Model
 from fmpy.validation import validate_fmu
 
-from pendulum_fmu.build import MODEL_DESCRIPTION
+from fmu_build import MODEL_DESCRIPTION
 from pendulum_fmu.cli import main
 from pendulum_fmu.parameters import default_parameters, total_inertia
 from pendulum_fmu.reference import reference, reference_schedule

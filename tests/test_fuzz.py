@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from pendulum_fmu.build import FMI_HEADERS, PLUMBING_DIR, assemble_sources
+from fmu_build import FMI_HEADERS, PLUMBING_DIR, assemble_sources
 
 HARNESSES = Path(__file__).resolve().parent / "fuzz"
 DEFAULT_SECONDS = 15  # per harness, as CI runs it

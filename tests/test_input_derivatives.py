@@ -10,7 +10,7 @@ from fmpy import read_model_description
 from fmpy.fmi2 import FMU2Slave
 from scipy.integrate import solve_ivp
 
-from pendulum_fmu.build import build_pid_controller
+from fmu_build import build_pid_controller
 from pendulum_fmu.closed_loop import controller_defaults, sampled_loop_reference
 from pendulum_fmu.parameters import default_parameters, total_inertia
 from pendulum_fmu.simulate import MessageLog, _unzipped, open_fmu

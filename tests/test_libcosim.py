@@ -13,7 +13,7 @@ from libcosimpy.CosimManipulator import CosimManipulator  # noqa: E402
 from libcosimpy.CosimObserver import CosimObserver  # noqa: E402
 from libcosimpy.CosimSlave import CosimLocalSlave  # noqa: E402
 
-from pendulum_fmu.build import build_pid_controller  # noqa: E402
+from fmu_build import build_pid_controller  # noqa: E402
 from pendulum_fmu.closed_loop import WIRES, sampled_loop_reference  # noqa: E402
 from pendulum_fmu.reference import reference  # noqa: E402
 
@@ -65,7 +65,7 @@ def test_two_slaves_close_the_loop_through_connections(fmu, tmp_path):
     times, _, theta = series.time_series_real_samples(slaves["pendulum"], vr["pendulum"]["theta"],
                                                       from_step=0, sample_count=4001)
     # libcosim hands the controller's torque over one step after the theta it came from.
-    expected = sampled_loop_reference(stop_time=4.0, feedthrough_delay=True)
+    expected = sampled_loop_reference(stop_time=4.0, coupling="jacobi")
     index = np.rint(np.array(times) / STEP_NS).astype(int)
     assert len(index) >= 3000
     assert np.max(np.abs(np.array(theta) - expected["theta"][index])) < 1e-9

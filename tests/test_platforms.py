@@ -20,10 +20,10 @@ import numpy as np
 import pytest
 from fmpy import read_model_description
 
-import pendulum_fmu.build
+import fmu_build
 from benchmarks.builds import build_bare_master, build_step_master
 from build_wheels import MANYLINUX_GLIBC
-from pendulum_fmu.build import (FMI_VERSIONS, PLATFORMS, BuildError, PlatformSkipped, available_platforms,
+from fmu_build import (FMI_VERSIONS, PLATFORMS, BuildError, PlatformSkipped, available_platforms,
                                 build_fmu, find_zig)
 from pendulum_fmu.cli import main
 from pendulum_fmu.reference import reference
@@ -302,7 +302,7 @@ def test_build_command_builds_for_any_glibc_floor_and_refuses_a_malformed_one_in
 def _without_compiler(monkeypatch, platform):
     targets = tuple(dataclasses.replace(target, cross_compiler="no-such-cross-gcc")
                     for target in PLATFORMS[platform].targets)
-    monkeypatch.setitem(pendulum_fmu.build.PLATFORMS, platform, dataclasses.replace(PLATFORMS[platform], targets=targets))
+    monkeypatch.setitem(fmu_build.PLATFORMS, platform, dataclasses.replace(PLATFORMS[platform], targets=targets))
 
 
 @pytest.mark.parametrize("platform, package", [("win64", "apt-get install gcc-mingw-w64-x86-64"),
@@ -317,16 +317,6 @@ def test_default_build_skips_a_platform_without_its_compiler_in_one_line(tmp_pat
     with zipfile.ZipFile(fmu) as archive:
         folders = {name.split("/")[1] for name in archive.namelist() if name.startswith("binaries/")}
     assert "linux64" in folders and platform not in folders
-
-
-@pytest.mark.skipif(find_zig() is None, reason="needs zig (pip install ziglang)")
-def test_default_build_skips_the_universal_macos_binary_without_lipo_in_one_line(monkeypatch):
-    monkeypatch.setattr(pendulum_fmu.build, "LIPO", ("no-such-lipo",))
-    with pytest.warns(PlatformSkipped) as skipped:
-        assert "darwin64" not in available_platforms(fmi_version=2)
-    assert "darwin64" in available_platforms(fmi_version=3)  # whose two folders need no merging
-    assert [str(warning.message) for warning in skipped if "darwin64" in str(warning.message)] == [
-        "darwin64: no-such-lipo, which merges its slices into one binary, not found (apt-get install llvm-14); skipped"]
 
 
 def test_a_platform_named_explicitly_must_build(tmp_path, monkeypatch):

@@ -7,7 +7,7 @@ import pytest
 from fmpy import read_model_description
 
 from bad_calls import CASES, CASES_FMI3, Harness, Harness3, markdown, run_case, status_name
-from pendulum_fmu.build import ROOT
+from fmu_build import ROOT
 
 
 def _harness(fmu, folder, kind, platform):

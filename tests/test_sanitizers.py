@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from pendulum_fmu.build import FMI_HEADERS, PLUMBING_DIR, assemble_sources
+from fmu_build import FMI_HEADERS, PLUMBING_DIR, assemble_sources
 
 DRIVER = Path(__file__).resolve().parent / "c" / "driver.c"
 # The loads, and the bounds the native runs must keep (tests/readme_figures.py shows them).

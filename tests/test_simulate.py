@@ -10,7 +10,7 @@ import pytest
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
-from pendulum_fmu.build import MODEL_DESCRIPTION, build_fmu
+from fmu_build import MODEL_DESCRIPTION, build_fmu
 from pendulum_fmu.torque_schedule import TorqueTable, schedule
 from pendulum_fmu.simulate import RECORDED, open_fmu, run_schedule_python, simulate, simulate_plan, simulator
 

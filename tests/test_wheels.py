@@ -27,7 +27,7 @@ from packaging.utils import parse_wheel_filename
 from benchmarks.builds import build_bare_master
 from build_wheels import LEGACY_MANYLINUX, MANYLINUX_GLIBC, WHEELS, WheelhouseError, build_wheels, check_tools, main
 from pendulum_fmu import FMU_FILES, __version__
-from pendulum_fmu.build import PLATFORMS
+from fmu_build import PLATFORMS
 from pendulum_fmu.cli import main as cli
 from pendulum_fmu.reference import reference
 from tests.arm64_python import Arm64Python, Unavailable
@@ -50,7 +50,7 @@ needs_build = pytest.mark.packaging
 
 @pytest.fixture(scope="module")
 def wheelhouse(tmp_path_factory):
-    """{platform of pendulum_fmu.build.PLATFORMS: its wheel}."""
+    """{platform of fmu_build.PLATFORMS: its wheel}."""
     try:
         check_tools()
     except WheelhouseError as missing:

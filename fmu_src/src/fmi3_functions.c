@@ -12,7 +12,7 @@
 #include "instance.h"
 
 /* The independent variable `time` has the value reference after the model's variables: the
-   FMI 3.0 model description (pendulum_fmu/fmi3.py) numbers it so. */
+   FMI 3.0 model description (fmu_build/fmi3.py) numbers it so. */
 #define VR_TIME N_VARIABLES
 
 #define ANY_STATE (CO_SIMULATION_STATES | MODEL_EXCHANGE_STATES)

@@ -16,16 +16,17 @@ import threading
 import warnings
 
 from .. import __version__
-from ..build import PlatformSkipped
-from ..errors import PendulumFmuError, Skipped
+from .._checkout import is_source_checkout
+from ..errors import PendulumFmuError, PlatformSkipped, Skipped
 from ..stop_signals import STOPPING_SIGNALS, Stopped, restore_signals, stop_on_signals
-from . import build, compare, cross_check, demo, judge, scenarios, simulate, sweep
+from . import build, compare, cross_check, demo, export, export_ssp, judge, scenarios, simulate, sweep
 from ._stdout import UntilTheReaderIsGone
 
 __all__ = ["build_parser", "main"]
 
-# In the order `pendulum-fmu --help` lists them.
-COMMANDS = (build, cross_check, simulate, compare, sweep, demo, judge, scenarios)
+# In the order `pendulum-fmu --help` lists them. build is the developer's (python build_fmu.py),
+# listed only in a checkout, whose build tool it runs; users take the FMU with export.
+COMMANDS = (build, export, cross_check, simulate, compare, sweep, demo, judge, scenarios, export_ssp)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -53,6 +54,8 @@ def build_parser() -> argparse.ArgumentParser:
     )
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for command in COMMANDS:
+        if command is build and not is_source_checkout():
+            continue
         # Also after the command's name; SUPPRESS keeps it from hiding one given before it.
         command.add_parser(commands).add_argument(
             "--debug",

@@ -1,18 +1,23 @@
-"""pendulum-fmu build: the FMU from fmu_src/ and modelDescription.xml."""
+"""pendulum-fmu build: the FMU from fmu_src/ and modelDescription.xml, in a checkout only.
+
+It runs the repository's build tool (fmu_build/, beside the package), the developer's build that
+`python build_fmu.py` runs too; an installed package does not list this command.
+"""
 
 from __future__ import annotations
 
 import argparse
 import zipfile
 
-from ..build import CHECKOUT_FMUS, FMI_VERSIONS, PLATFORMS, BuildError, check_platforms
+from .._checkout import build_tool
+from ..errors import BuildError
 from ._arguments import output_path
 
 
 def _platforms(text: str) -> tuple[str, ...]:
     platforms = tuple(name.strip() for name in text.split(",") if name.strip())
     try:
-        check_platforms(platforms)
+        build_tool().check_platforms(platforms)
     except BuildError as error:
         raise argparse.ArgumentTypeError(str(error)) from None
     return platforms
@@ -20,9 +25,11 @@ def _platforms(text: str) -> tuple[str, ...]:
 
 def add_parser(commands) -> argparse.ArgumentParser:
     """Declare `build` and its options, each with its help, among the parser's commands."""
+    tool = build_tool()
+    CHECKOUT_FMUS, FMI_VERSIONS, PLATFORMS = tool.CHECKOUT_FMUS, tool.FMI_VERSIONS, tool.PLATFORMS
     build = commands.add_parser(
         "build",
-        help="build the FMU (same as python build_fmu.py)",
+        help="build the FMU in a checkout (same as python build_fmu.py)",
         description="Build the FMU from fmu_src/ and modelDescription.xml (a source checkout or the unpacked sdist).",
     )
     build.add_argument(
@@ -59,10 +66,9 @@ def add_parser(commands) -> argparse.ArgumentParser:
 
 def run(args) -> int:
     """Run `pendulum-fmu build` with the parsed arguments; returns the exit status."""
-    from ..build import build_fmu
-
-    output = args.output or CHECKOUT_FMUS[args.fmi_version]
-    path = build_fmu(output, platforms=args.platforms, fmi_version=args.fmi_version, linux_glibc=args.linux_glibc)
+    tool = build_tool()
+    output = args.output or tool.CHECKOUT_FMUS[args.fmi_version]
+    path = tool.build_fmu(output, platforms=args.platforms, fmi_version=args.fmi_version, linux_glibc=args.linux_glibc)
     with zipfile.ZipFile(path) as fmu:
         binaries = [name for name in fmu.namelist() if name.startswith("binaries/")]
     print(f"wrote {path} ({', '.join(binaries)})")

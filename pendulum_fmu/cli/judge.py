@@ -81,6 +81,14 @@ def add_parser(commands) -> argparse.ArgumentParser:
         default=None,
         help="write a PNG of the torque, theta and |dtheta| (for a kit: a folder, one NAME.png per scenario)",
     )
+    judge.add_argument(
+        "--ssp",
+        type=Path,
+        default=None,
+        metavar="ClosedLoop.ssp",
+        help="judge a closed-loop result (time, theta) of this SSP from any master: name its coupling, "
+        "whether the parameter sets arrived, its step and stop time (docs/ssp.md)",
+    )
     judge.set_defaults(run=run)
     return judge
 
@@ -89,6 +97,18 @@ def run(args) -> int:
     """Run `pendulum-fmu judge` with the parsed arguments; returns the exit status."""
     from ..judge import format_judgement, format_kit, judge, judge_kit, write_json
     from ..plot import plot_judgement
+
+    if args.ssp is not None:
+        from ..ssp_judge import format_ssp_verdict, judge_ssp_result
+
+        if args.result is None or args.calls is not None:
+            raise InvalidInput(
+                "judge --ssp reads the master's result CSV, not a call log: "
+                "pendulum-fmu judge RESULT.csv --ssp ClosedLoop.ssp [--map theta=COLUMN]"
+            )
+        verdict = judge_ssp_result(args.result, args.ssp, mapping=args.mapping)
+        print(format_ssp_verdict(verdict))
+        return 0 if verdict.passed else 1
 
     signal = torque_signal(args)
     if args.calls is not None:

@@ -25,6 +25,12 @@ def add_parser(commands) -> argparse.ArgumentParser:
         "results (NAME_out.csv) are kept (without it, a folder holding a "
         "kit is refused)",
     )
+    scenarios.add_argument(
+        "--closed-loop",
+        action="store_true",
+        help="also write the pendulum under the PID controller as ClosedLoop.ssp, with its settings "
+        "(ClosedLoop.json) and a reference per coupling (ClosedLoop_ref.csv); needs a source checkout",
+    )
     add_fmu_argument(scenarios)
     scenarios.set_defaults(run=run)
     return scenarios
@@ -34,6 +40,11 @@ def run(args) -> int:
     """Run `pendulum-fmu scenarios` with the parsed arguments; returns the exit status."""
     from ..scenarios import write_scenarios
 
-    for path in write_scenarios(args.output_dir, args.fmu, overwrite=args.overwrite):
+    written = write_scenarios(args.output_dir, args.fmu, overwrite=args.overwrite)
+    if args.closed_loop:
+        from ..ssp_kit import write_closed_loop_kit
+
+        written += write_closed_loop_kit(args.output_dir, overwrite=args.overwrite)
+    for path in written:
         print(f"wrote {path}")
     return 0

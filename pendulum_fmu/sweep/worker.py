@@ -32,6 +32,11 @@ class Task:
     step_size: float
     outputs: tuple[str, ...]
     stride: int  # keep every stride-th communication point (and the last)
+    run: str  # the token of the run: the parts are staged under it (see store.py)
+
+    def tables(self) -> tuple[str, ...]:
+        """The tables a chunk writes a part of, in the order they are committed."""
+        return ("trajectories", "cases") if self.outputs else ("cases",)
 
 
 class Runner:
@@ -97,7 +102,8 @@ def kept_points(points: int, stride: int) -> np.ndarray:
 
 
 def run_chunk(index: int, first: int, values: dict[str, np.ndarray], task: Task) -> tuple:
-    """Simulate a chunk of cases on a worker and write its parts.
+    """Simulate a chunk of cases on a worker and write its parts, staged for the run's client to
+    commit.
 
     values: the chunk's cases, one array per name; first: the number of its first case.
     Returns (index, cases, failed, bytes written, CPU seconds of this thread, of which stepping).
@@ -128,10 +134,10 @@ def run_chunk(index: int, first: int, values: dict[str, np.ndarray], task: Task)
         written += task.store.write_table("trajectories", index, {
             "case": np.repeat(numbers[ok], len(keep)), "time": np.tile(points[keep], int(ok.sum())),
             **{name: kept[:, :, OUTPUTS.index(name)].ravel() for name in task.outputs}},
-            split=("time", *task.outputs))
+            task.run, split=("time", *task.outputs))
     final = recorded[:, -1]
     summaries = [*final.T, np.max(np.abs(recorded[:, :, 0]), axis=1)]
     written += task.store.write_table("cases", index, {
         "case": numbers, **values, **dict(zip(SUMMARIES, summaries)),
-        "status": np.where(ok, "ok", "failed").tolist(), "message": messages})
+        "status": np.where(ok, "ok", "failed").tolist(), "message": messages}, task.run)
     return index, count, count - int(ok.sum()), written, time.thread_time() - cpu, stepping

@@ -1,11 +1,14 @@
-"""Build Pendulum.fmu from fmu_src/ and modelDescription.xml, for every platform we can compile for.
+"""The repository's build of Pendulum.fmu from fmu_src/ and modelDescription.xml, for every platform
+we can compile for: `python build_fmu.py`, the wheel build (setup.py, build_wheels.py), and a
+checkout's pendulum_fmu.default_fmu() when a source is newer than dist/Pendulum.fmu.
+It is a tool of the repository, not part of the installed package.
 
 The one build description is CMakeLists.txt (with a toolchain file per cross target in cmake/);
 this module drives it. The C code takes its value references, names and start values from the
 model's modelDescription.xml: this module generates them (model_variables.h/.c), so the XML stays
 the single source of truth. fmu_src/src/ and fmu_src/include/ hold the FMI plumbing, which knows
 nothing of pendulums; each model has its own folder (config.h, model.c), listed in MODELS.
-Per platform, CMake configures and builds in a private temporary folder; llvm-lipo merges the two
+Per platform, CMake configures and builds in a private temporary folder; fmu_build/macho.py merges the two
 macOS slices into one universal binary; the FMU's zip is renamed into place whole. With a glibc
 floor (linux_glibc, CMake's LINUX_GLIBC) zig builds the Linux binaries to load on that glibc and
 every later one, as the manylinux wheels need.
@@ -30,12 +33,15 @@ import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 
-import fmpy
 from fmpy import read_model_description
 
-from . import FMU_FILES, __version__, fmi3
-from .atomic_files import check_writable, replacing_path
-from .errors import PendulumFmuError
+from pendulum_fmu import FMU_FILES, __version__
+from pendulum_fmu.atomic_files import check_writable, replacing_path
+from pendulum_fmu.errors import BuildError, PlatformSkipped
+
+from . import fmi3
+from .macho import MachOError, merge_universal
+from .model_variables import ModelDescriptionError, generate_variables
 
 ROOT = Path(__file__).resolve().parent.parent
 CMAKE_LISTS = ROOT / "CMakeLists.txt"
@@ -48,18 +54,17 @@ FMI_VERSIONS = tuple(FMU_FILES)
 # FMI version -> the FMU a checkout builds and runs when none is named.
 CHECKOUT_FMUS = {version: ROOT / "dist" / name for version, name in FMU_FILES.items()}
 DEFAULT_FMU = CHECKOUT_FMUS[2]
-GENERATED_SOURCES = ("model_variables.h", "model_variables.c")
 MODEL_FILES = ("config.h", "model.c")
-# The FMI headers fmpy ships, rather than a vendored copy.
-FMI_HEADERS = Path(fmpy.__file__).parent / "c-code"
+# The FMI standard's own headers, kept in the repository as the Reference FMUs keep them.
+FMI_HEADERS = HEADERS_DIR / "fmi"
 
 
 @dataclass(frozen=True)
 class Model:
     """A model built over the FMI plumbing."""
 
-    folder: Path          # its config.h and model.c
-    description: Path     # its FMI 2.0 modelDescription.xml
+    folder: Path  # its config.h and model.c
+    description: Path  # its FMI 2.0 modelDescription.xml
 
 
 # The build's one table of models. The pendulum's description is the project's top-level
@@ -72,20 +77,20 @@ PENDULUM_DIR = MODELS["pendulum"].folder
 PID_CONTROLLER_DIR = MODELS["pid_controller"].folder
 ZIG = "zig"
 ZIG_PACKAGE = "pip install ziglang"
-LIPO = ("llvm-lipo-14", "llvm-lipo", "lipo")
 
 
 @dataclass(frozen=True)
 class Target:
     """One binary CMake builds: natively on a machine of its kind, with its toolchain file
-    (cmake/<toolchain>) elsewhere."""
+    (cmake/<toolchain>) elsewhere.
+    """
 
-    name: str                  # the FMI 3.0 platform folder
-    system: str                # sys.platform of a machine that builds it natively
+    name: str  # the FMI 3.0 platform folder
+    system: str  # sys.platform of a machine that builds it natively
     machines: tuple[str, ...]  # platform.machine() of such a machine (any, for macOS's both slices)
-    toolchain: str             # cmake/<toolchain>: how another machine builds it
-    cross_compiler: str        # the compiler that toolchain file runs
-    package: str               # what installs that compiler
+    toolchain: str  # cmake/<toolchain>: how another machine builds it
+    cross_compiler: str  # the compiler that toolchain file runs
+    package: str  # what installs that compiler
 
     @property
     def native(self) -> bool:
@@ -93,13 +98,15 @@ class Target:
 
     def built_by_zig(self, linux_glibc: str | None = None) -> bool:
         """Whether zig's C compiler builds it: a macOS target off a Mac, and a Linux target for a
-        glibc floor (cmake/linux.cmake)."""
+        glibc floor (cmake/linux.cmake).
+        """
         return (self.cross_compiler == ZIG and not self.native) or bool(linux_glibc and self.system == "linux")
 
     def compiler(self, linux_glibc: str | None = None) -> list[str]:
         """The C compiler command: zig's (the ziglang package's `zig cc`) where it builds the
         target, else $CC (split as a shell would, so CC="ccache gcc" works) or gcc on a machine of
-        the target's kind, the toolchain file's cross-compiler elsewhere."""
+        the target's kind, the toolchain file's cross-compiler elsewhere.
+        """
         if self.built_by_zig(linux_glibc):
             return [find_zig() or ZIG, "cc"]
         if self.native:
@@ -111,9 +118,9 @@ class Target:
 class Platform:
     """A platform an FMI 2.0 FMU can carry a binary for, and its FMI 3.0 folders."""
 
-    fmi2_folder: str            # binaries/<folder> in an FMI 2.0 FMU
+    fmi2_folder: str  # binaries/<folder> in an FMI 2.0 FMU
     targets: tuple[Target, ...]  # its binaries: one, or the slices of one universal Mach-O
-    suffix: str                 # of the FMU's shared library
+    suffix: str  # of the FMU's shared library
 
     @property
     def fmi3_folders(self) -> tuple[str, ...]:
@@ -129,26 +136,63 @@ class Platform:
         return all(target.native for target in self.targets)
 
 
-PLATFORMS = {platform.fmi2_folder: platform for platform in (
-    Platform("linux64", (Target("x86_64-linux", "linux", ("x86_64",), "x86_64-linux.cmake",
-                                "x86_64-linux-gnu-gcc", "apt-get install gcc-x86-64-linux-gnu"),), ".so"),
-    Platform("win64", (Target("x86_64-windows", "win32", ("AMD64",), "x86_64-windows.cmake",
-                              "x86_64-w64-mingw32-gcc", "apt-get install gcc-mingw-w64-x86-64"),), ".dll"),
-    # The folder name fmpy and the Reference FMUs use for Linux on ARM64.
-    Platform("aarch64-linux", (Target("aarch64-linux", "linux", ("aarch64",), "aarch64-linux.cmake",
-                                      "aarch64-linux-gnu-gcc", "apt-get install gcc-aarch64-linux-gnu"),), ".so"),
-    # fmpy loads binaries/darwin64 on Intel and Apple Silicon Macs alike: one universal Mach-O.
-    Platform("darwin64", (Target("x86_64-darwin", "darwin", (), "x86_64-darwin.cmake", ZIG, ZIG_PACKAGE),
-                          Target("aarch64-darwin", "darwin", (), "aarch64-darwin.cmake", ZIG, ZIG_PACKAGE)), ".dylib"),
-)}
-
-
-class BuildError(PendulumFmuError, RuntimeError):
-    """The FMU could not be built; the message says why."""
-
-
-class PlatformSkipped(UserWarning):
-    """A platform left out of a default build because its compiler is missing."""
+PLATFORMS = {
+    platform.fmi2_folder: platform
+    for platform in (
+        Platform(
+            "linux64",
+            (
+                Target(
+                    "x86_64-linux",
+                    "linux",
+                    ("x86_64",),
+                    "x86_64-linux.cmake",
+                    "x86_64-linux-gnu-gcc",
+                    "apt-get install gcc-x86-64-linux-gnu",
+                ),
+            ),
+            ".so",
+        ),
+        Platform(
+            "win64",
+            (
+                Target(
+                    "x86_64-windows",
+                    "win32",
+                    ("AMD64",),
+                    "x86_64-windows.cmake",
+                    "x86_64-w64-mingw32-gcc",
+                    "apt-get install gcc-mingw-w64-x86-64",
+                ),
+            ),
+            ".dll",
+        ),
+        # The folder name fmpy and the Reference FMUs use for Linux on ARM64.
+        Platform(
+            "aarch64-linux",
+            (
+                Target(
+                    "aarch64-linux",
+                    "linux",
+                    ("aarch64",),
+                    "aarch64-linux.cmake",
+                    "aarch64-linux-gnu-gcc",
+                    "apt-get install gcc-aarch64-linux-gnu",
+                ),
+            ),
+            ".so",
+        ),
+        # fmpy loads binaries/darwin64 on Intel and Apple Silicon Macs alike: one universal Mach-O.
+        Platform(
+            "darwin64",
+            (
+                Target("x86_64-darwin", "darwin", (), "x86_64-darwin.cmake", ZIG, ZIG_PACKAGE),
+                Target("aarch64-darwin", "darwin", (), "aarch64-darwin.cmake", ZIG, ZIG_PACKAGE),
+            ),
+            ".dylib",
+        ),
+    )
+}
 
 
 def _check_sources_present() -> None:
@@ -156,61 +200,18 @@ def _check_sources_present() -> None:
         raise BuildError(
             f"the FMU's sources (fmu_src/, modelDescription.xml, CMakeLists.txt) are not beside "
             f"{Path(__file__).parent}: to build, run python build_fmu.py in a clone or the unpacked "
-            "sdist; an installed package uses its packaged FMU (pendulum_fmu.default_fmu())")
+            "sdist; an installed package uses its packaged FMU (pendulum_fmu.default_fmu())"
+        )
 
 
-def generate_variables(model_description, out_dir: Path) -> list[Path]:
-    """Write model_variables.h (GUID, value reference enum) and model_variables.c (the table)."""
-    variables = model_description.modelVariables
-    for index, variable in enumerate(variables):
-        if variable.valueReference != index or variable.type != "Real":
-            raise BuildError(
-                f"{MODEL_DESCRIPTION}: variable {variable.name!r} must be Real with valueReference "
-                f"{index}: the C code indexes one array of Reals by value reference"
-            )
-    enum = ",\n".join(f"    VR_{v.name.upper()} = {v.valueReference}" for v in variables)
-    inputs = ", ".join(f"VR_{v.name.upper()}" for v in variables if v.causality == "input")
-    header = f"""/* Generated from modelDescription.xml by pendulum_fmu/build.py: edit the XML, not this. */
-#ifndef MODEL_VARIABLES_H
-#define MODEL_VARIABLES_H
-
-#include "variable.h"
-
-#define MODEL_GUID "{model_description.guid}"
-#define N_VARIABLES {len(variables)}
-/* The inputs' value references: a step updates these, without a pass over every variable. */
-#define N_INPUTS {sum(v.causality == "input" for v in variables)}
-#define INPUT_REFERENCES {{{inputs}}}
-
-typedef enum {{
-{enum}
-}} ValueReference;
-
-extern const VariableInfo model_variables[N_VARIABLES];
-
-#endif
-"""
-    rows = ",\n".join(
-        f'    {{"{v.name}", CAUSALITY_{_enum_name(v.causality)}, VARIABILITY_{v.variability.upper()}, '
-        f"INITIAL_{(v.initial or 'none').upper()}, {float(v.start or 0.0)!r}}}"
-        for v in variables
-    )
-    table = f"""/* Generated from modelDescription.xml by pendulum_fmu/build.py: edit the XML, not this. */
-#include "model_variables.h"
-
-const VariableInfo model_variables[N_VARIABLES] = {{
-{rows}
-}};
-"""
-    out_dir.mkdir(parents=True, exist_ok=True)
-    paths = [out_dir / name for name in GENERATED_SOURCES]
-    paths[0].write_text(header)
-    paths[1].write_text(table)
-    return paths
-
-
-def _enum_name(causality: str) -> str:
-    return "CALCULATED_PARAMETER" if causality == "calculatedParameter" else causality.upper()
+def _generate_variables(xml: Path, out_dir: Path) -> None:
+    """model_variables.h/.c, as CMake generates them too; BuildError for a description the C code
+    cannot take.
+    """
+    try:
+        generate_variables(xml, out_dir)
+    except ModelDescriptionError as error:
+        raise BuildError(str(error)) from None
 
 
 def _check_source_files(model_description, xml: Path, sources: Path, fmi_version: int = 2) -> None:
@@ -225,14 +226,19 @@ def _check_source_files(model_description, xml: Path, sources: Path, fmi_version
             )
 
 
-def assemble_sources(sources: Path, model_dir: Path = PENDULUM_DIR,
-                     model_description_file: Path = MODEL_DESCRIPTION, fmi_version: int = 2) -> Path:
+def assemble_sources(
+    sources: Path,
+    model_dir: Path = PENDULUM_DIR,
+    model_description_file: Path = MODEL_DESCRIPTION,
+    fmi_version: int = 2,
+) -> Path:
     """Everything that compiles into the FMU, in one flat folder: what the FMU's sources/ holds,
-    which fmpy compile builds, and what the tests' C driver and fuzzers link."""
+    which fmpy compile builds, and what the tests' C driver and fuzzers link.
+    """
     _check_sources_present()
     sources = Path(sources)
     sources.mkdir()
-    generate_variables(read_model_description(str(model_description_file)), sources)
+    _generate_variables(model_description_file, sources)
     _copy_sources(Path(model_dir), sources, fmi_version)
     return sources
 
@@ -240,14 +246,17 @@ def assemble_sources(sources: Path, model_dir: Path = PENDULUM_DIR,
 def _copy_sources(model_dir: Path, sources: Path, fmi_version: int) -> None:
     """The plumbing (with the entry points of one FMI version) and the model, into sources."""
     left_out = fmi3.adapter_left_out(fmi_version)
-    for path in [*sorted(HEADERS_DIR.glob("*.h")), *sorted(PLUMBING_DIR.glob("*.c")),
-                 *(model_dir / name for name in MODEL_FILES)]:
+    for path in [
+        *sorted(HEADERS_DIR.glob("*.h")),
+        *sorted(PLUMBING_DIR.glob("*.c")),
+        *(model_dir / name for name in MODEL_FILES),
+    ]:
         if path.name != left_out:
             shutil.copy2(path, sources)
 
 
 def find_zig() -> str | None:
-    """zig from the ziglang package (pip install ziglang), else from PATH."""
+    """Zig from the ziglang package (pip install ziglang), else from PATH."""
     try:
         import ziglang
     except ImportError:
@@ -256,13 +265,10 @@ def find_zig() -> str | None:
     return str(bundled) if bundled.is_file() else shutil.which(ZIG)
 
 
-def _lipo() -> str | None:
-    return next(filter(None, map(shutil.which, LIPO)), None)
-
-
 def _cmake() -> str:
-    """cmake from PATH, else from the PyPI cmake package (which fmpy requires), as in a pip
-    build environment."""
+    """Cmake from PATH, else from the PyPI cmake package (which fmpy requires), as in a pip
+    build environment.
+    """
     found = shutil.which("cmake")
     if found is None:
         try:
@@ -276,9 +282,9 @@ def _cmake() -> str:
 def check_toolchain(platform: Platform, fmi_version: int = 2, linux_glibc: str | None = None) -> None:
     """BuildError naming the package to install unless every tool that builds platform is here:
     the cross-compiler of each target (zig for a Linux target with linux_glibc; $CC, when set, on
-    a machine of the target's kind: else CMake finds the machine's compiler itself), and
-    llvm-lipo where FMI 2.0 merges slices into one binary. BuildError too when linux_glibc is not
-    a glibc version."""
+    a machine of the target's kind: else CMake finds the machine's compiler itself). BuildError
+    too when linux_glibc is not a glibc version.
+    """
     if linux_glibc is not None and not re.fullmatch(r"2\.\d+", linux_glibc):
         raise BuildError(f"glibc floor {linux_glibc!r}: give a glibc version such as 2.17")
     for target in platform.targets:
@@ -290,9 +296,6 @@ def check_toolchain(platform: Platform, fmi_version: int = 2, linux_glibc: str |
             name = shlex.join(compiler) if compiler else "CC (empty)"
             hint = ZIG_PACKAGE if zig else "set CC to an installed compiler" if target.native else target.package
             raise BuildError(f"{platform.fmi2_folder}: C compiler {name} not found ({hint})")
-    if fmi_version == 2 and len(platform.targets) > 1 and _lipo() is None:
-        raise BuildError(f"{platform.fmi2_folder}: {LIPO[0]}, which merges its slices into one binary, "
-                         "not found (apt-get install llvm-14)")
 
 
 def run_tool(command: list, what: str, environment: dict | None = None) -> None:
@@ -303,12 +306,17 @@ def run_tool(command: list, what: str, environment: dict | None = None) -> None:
     except OSError as error:
         raise BuildError(f"building {what} failed: {shlex.join(command[:1])}: {error.strerror}") from None
     if result.returncode != 0:
-        raise BuildError(f"building {what} failed:\n{shlex.join(command)}\n"
-                         f"{(result.stdout + result.stderr)[-4000:]}")
+        raise BuildError(f"building {what} failed:\n{shlex.join(command)}\n{(result.stdout + result.stderr)[-4000:]}")
 
 
-def cmake_build(target: Target, work: Path, cmake_target: str, definitions: dict | None = None,
-                project: Path = ROOT, linux_glibc: str | None = None) -> Path:
+def cmake_build(
+    target: Target,
+    work: Path,
+    cmake_target: str,
+    definitions: dict | None = None,
+    project: Path = ROOT,
+    linux_glibc: str | None = None,
+) -> Path:
     """Configure, build and install one target of a CMake project (CMakeLists.txt, or another
     that includes cmake/flags.cmake) for one platform target in the empty folder work; return
     the binary.
@@ -322,8 +330,17 @@ def cmake_build(target: Target, work: Path, cmake_target: str, definitions: dict
     cmake = _cmake()
     build, installed = work / "build", work / "installed"
     environment = dict(os.environ)
-    configure = [cmake, "-S", project, "-B", build, f"-DFMI_HEADERS={FMI_HEADERS}",
-                 *(f"-D{name}={value}" for name, value in (definitions or {}).items())]
+    # This Python runs the variables' generator (fmu_build/model_variables.py), as CMake would find it.
+    configure = [
+        cmake,
+        "-S",
+        project,
+        "-B",
+        build,
+        f"-DFMI_HEADERS={FMI_HEADERS}",
+        f"-DPython3_EXECUTABLE={sys.executable}",
+        *(f"-D{name}={value}" for name, value in (definitions or {}).items()),
+    ]
     cross = not target.native or target.built_by_zig(linux_glibc)
     # On a Mac too: its toolchain file sets the architecture and the oldest macOS.
     if cross or target.system == "darwin":
@@ -338,18 +355,23 @@ def cmake_build(target: Target, work: Path, cmake_target: str, definitions: dict
     what = f"{cmake_target} for {target.name}"
     run_tool(configure, what, environment)
     run_tool([cmake, "--build", build, "--target", cmake_target, "--config", "Release"], what, environment)
-    run_tool([cmake, "--install", build, "--prefix", installed, "--component", cmake_target,
-              "--config", "Release"], what, environment)
+    run_tool(
+        [cmake, "--install", build, "--prefix", installed, "--component", cmake_target, "--config", "Release"],
+        what,
+        environment,
+    )
     [binary] = [path for path in installed.iterdir() if path.is_file()]
     return binary
 
 
 def _merged(slices: list[Path], out_file: Path) -> Path:
-    """One binary of the slices: the slice itself, or a universal Mach-O that llvm-lipo makes."""
+    """One binary of the slices: the slice itself, or a universal Mach-O (fmu_build/macho.py)."""
     if len(slices) == 1:
         return slices[0]
-    run_tool([_lipo(), "-create", *slices, "-output", out_file], f"the universal {out_file.name}")
-    return out_file
+    try:
+        return merge_universal(slices, out_file)
+    except MachOError as error:
+        raise BuildError(f"the universal {out_file.name}: {error}") from None
 
 
 def compile_native_loop(platform: str, out_dir: str | os.PathLike, linux_glibc: str | None = None) -> Path:
@@ -383,8 +405,10 @@ def compile_native_loop(platform: str, out_dir: str | os.PathLike, linux_glibc: 
     check_platforms([platform])
     check_toolchain(PLATFORMS[platform], linux_glibc=linux_glibc)
     with tempfile.TemporaryDirectory(prefix="pendulum_fmu_native_loop_") as tmp:
-        slices = [cmake_build(target, Path(tmp, target.name), "_cs_loop", linux_glibc=linux_glibc)
-                  for target in PLATFORMS[platform].targets]
+        slices = [
+            cmake_build(target, Path(tmp, target.name), "_cs_loop", {"MODEL_DIR": ""}, linux_glibc=linux_glibc)
+            for target in PLATFORMS[platform].targets
+        ]
         built = _merged(slices, Path(tmp, slices[0].name))
         out_file = Path(out_dir, built.name)
         with replacing_path(out_file) as partial:
@@ -395,14 +419,30 @@ def compile_native_loop(platform: str, out_dir: str | os.PathLike, linux_glibc: 
 def documentation_html(model_description, fmi_version: int = 2) -> str:
     """documentation/index.html: what the model is and every variable with its unit and meaning."""
     rows = "\n".join(
-        "<tr>" + "".join(f"<td>{html.escape(str(cell))}</td>" for cell in (
-            v.name, v.valueReference, v.causality, v.variability, v.unit or "",
-            "" if v.start is None else v.start, v.description or "")) + "</tr>"
+        "<tr>"
+        + "".join(
+            f"<td>{html.escape(str(cell))}</td>"
+            for cell in (
+                v.name,
+                v.valueReference,
+                v.causality,
+                v.variability,
+                v.unit or "",
+                "" if v.start is None else v.start,
+                v.description or "",
+            )
+        )
+        + "</tr>"
         for v in model_description.modelVariables
     )
-    interfaces = " and ".join(name for name, present in (
-        ("Model Exchange", model_description.modelExchange), ("Co-Simulation", model_description.coSimulation))
-        if present)
+    interfaces = " and ".join(
+        name
+        for name, present in (
+            ("Model Exchange", model_description.modelExchange),
+            ("Co-Simulation", model_description.coSimulation),
+        )
+        if present
+    )
     name = html.escape(model_description.modelName)
     return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>{name} FMU</title>
@@ -436,14 +476,16 @@ def check_platforms(names) -> None:
     """BuildError unless names are one or more of PLATFORMS."""
     unknown = [name for name in names if name not in PLATFORMS]
     if unknown or not names:
-        raise BuildError(f"unknown platform(s) {', '.join(unknown) or '(none given)'}: choose "
-                         f"among {', '.join(PLATFORMS)}")
+        raise BuildError(
+            f"unknown platform(s) {', '.join(unknown) or '(none given)'}: choose among {', '.join(PLATFORMS)}"
+        )
 
 
 def available_platforms(fmi_version: int = 2, linux_glibc: str | None = None) -> tuple[str, ...]:
     """Every platform whose tools are present (zig for the Linux ones with linux_glibc); for each
     missing one, a PlatformSkipped warning naming the package that installs it. The machine's
-    own platform is never skipped."""
+    own platform is never skipped.
+    """
     present = []
     for name, platform in PLATFORMS.items():
         try:
@@ -459,19 +501,24 @@ def available_platforms(fmi_version: int = 2, linux_glibc: str | None = None) ->
 
 def _stamped_model_description(xml: Path, fmi_version: int = 2) -> str:
     """The model description as the FMU carries it (for FMI 3.0 generated from the FMI 2.0 one):
-    generationTool names this package's version."""
+    generationTool names this package's version.
+    """
     text = xml.read_text(encoding="utf-8") if fmi_version == 2 else fmi3.model_description(xml)
-    text, count = re.subn(r'generationTool="[^"]*"', f'generationTool="pendulum_fmu {__version__}"',
-                          text, count=1)
+    text, count = re.subn(r'generationTool="[^"]*"', f'generationTool="pendulum_fmu {__version__}"', text, count=1)
     if count != 1:
         raise BuildError(f"{xml}: no generationTool attribute to stamp the version into")
     return text
 
 
-def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, *, model_dir: Path = PENDULUM_DIR,
-              model_description_file: Path = MODEL_DESCRIPTION,
-              platforms: tuple[str, ...] | None = None, fmi_version: int = 2,
-              linux_glibc: str | None = None) -> Path:
+def build_fmu(
+    out_file: str | os.PathLike = DEFAULT_FMU,
+    *,
+    model_dir: Path = PENDULUM_DIR,
+    model_description_file: Path = MODEL_DESCRIPTION,
+    platforms: tuple[str, ...] | None = None,
+    fmi_version: int = 2,
+    linux_glibc: str | None = None,
+) -> Path:
     """Build an FMU (binaries/, sources/, documentation/) of a model over the FMI plumbing.
 
     Everything is compiled in a private temporary folder and the zip is renamed into place
@@ -528,32 +575,32 @@ def build_fmu(out_file: str | os.PathLike = DEFAULT_FMU, *, model_dir: Path = PE
     identifier = model_description.coSimulation.modelIdentifier
     with tempfile.TemporaryDirectory(prefix="pendulum_fmu_build_") as tmp:
         tmp = Path(tmp)
-        generated = tmp / "generated"
-        generate_variables(model_description, generated)
         sources = tmp / "sources"
         sources.mkdir()
         _copy_sources(model_dir, sources, fmi_version)
-        for path in generated.iterdir():
-            shutil.copy2(path, sources)
+        _generate_variables(model_description_file, sources)  # as CMake generates them for the binaries
         _check_source_files(model_description, model_description_file, sources, fmi_version)
         if fmi_version == 3:
             (sources / "buildDescription.xml").write_text(fmi3.build_description(model_description_file))
-        definitions = {"MODEL_DIR": model_dir.resolve(), "GENERATED_DIR": generated,
-                       "MODEL_IDENTIFIER": identifier, "FMI_VERSION": fmi_version}
+        definitions = {
+            "MODEL_DIR": model_dir.resolve(),
+            "MODEL_DESCRIPTION": Path(model_description_file).resolve(),
+            "FMI_VERSION": fmi_version,
+        }
         binaries = {}
         for name in platforms:
             platform = PLATFORMS[name]
-            slices = {target.name: cmake_build(target, tmp / name / target.name, "fmu", definitions,
-                                               linux_glibc=linux_glibc)
-                      for target in platform.targets}
+            slices = {
+                target.name: cmake_build(target, tmp / name / target.name, "fmu", definitions, linux_glibc=linux_glibc)
+                for target in platform.targets
+            }
             if fmi_version == 3:
                 binaries.update({f"binaries/{folder}/{binary.name}": binary for folder, binary in slices.items()})
             else:
                 binary = _merged(list(slices.values()), tmp / name / f"{identifier}{platform.suffix}")
                 binaries[f"binaries/{name}/{binary.name}"] = binary
         with replacing_path(out_file) as partial, zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as fmu:
-            fmu.writestr("modelDescription.xml",
-                         _stamped_model_description(Path(model_description_file), fmi_version))
+            fmu.writestr("modelDescription.xml", _stamped_model_description(Path(model_description_file), fmi_version))
             for name, binary in binaries.items():
                 fmu.write(binary, name)
             for source in sorted(sources.iterdir()):
@@ -570,9 +617,14 @@ def build_pid_controller(out_file: str | os.PathLike) -> Path:
 
 def build_inputs() -> list[Path]:
     """Every file a checkout's FMU is built from: when one is newer than the FMU, it is stale."""
-    package = Path(__file__).parent
-    return [MODEL_DESCRIPTION, CMAKE_LISTS, Path(__file__), package / "__init__.py", Path(fmi3.__file__),
-            *TOOLCHAINS.glob("*.cmake"), *(p for p in SOURCE_DIR.rglob("*") if p.is_file())]
+    return [
+        MODEL_DESCRIPTION,
+        CMAKE_LISTS,
+        ROOT / "pendulum_fmu" / "__init__.py",
+        *Path(__file__).parent.glob("*.py"),
+        *TOOLCHAINS.glob("*.cmake"),
+        *(p for p in SOURCE_DIR.rglob("*") if p.is_file()),
+    ]
 
 
 def fmu_is_stale(fmu: Path = DEFAULT_FMU) -> bool:
@@ -585,5 +637,6 @@ def fmu_is_stale(fmu: Path = DEFAULT_FMU) -> bool:
 
 def is_source_checkout() -> bool:
     """Whether this package sits beside the FMU's sources (a clone, an editable install, the
-    sdist being built), rather than installed from a wheel."""
+    sdist being built), rather than installed from a wheel.
+    """
     return SOURCE_DIR.is_dir() and MODEL_DESCRIPTION.is_file() and CMAKE_LISTS.is_file()

@@ -18,11 +18,13 @@ from pathlib import Path
 ADAPTERS = {2: "fmi2_functions.c", 3: "fmi3_functions.c"}
 FMI2_ADAPTER = ADAPTERS[2]
 # Capabilities both interfaces declare (FMI 2.0 name -> FMI 3.0 name).
-_COMMON_FLAGS = {"needsExecutionTool": "needsExecutionTool",
-                 "canBeInstantiatedOnlyOncePerProcess": "canBeInstantiatedOnlyOncePerProcess",
-                 "canGetAndSetFMUstate": "canGetAndSetFMUState",
-                 "canSerializeFMUstate": "canSerializeFMUState",
-                 "providesDirectionalDerivative": "providesDirectionalDerivatives"}
+_COMMON_FLAGS = {
+    "needsExecutionTool": "needsExecutionTool",
+    "canBeInstantiatedOnlyOncePerProcess": "canBeInstantiatedOnlyOncePerProcess",
+    "canGetAndSetFMUstate": "canGetAndSetFMUState",
+    "canSerializeFMUstate": "canSerializeFMUState",
+    "providesDirectionalDerivative": "providesDirectionalDerivatives",
+}
 
 
 def adapter_left_out(fmi_version: int) -> str:
@@ -32,7 +34,8 @@ def adapter_left_out(fmi_version: int) -> str:
 
 def with_adapter(fmi2_sources, fmi_version: int) -> list[str]:
     """The C files of the build for fmi_version: the FMI 2.0 list (as modelDescription.xml's
-    <SourceFiles> gives it) with fmi_version's adapter in place of the FMI 2.0 one."""
+    <SourceFiles> gives it) with fmi_version's adapter in place of the FMI 2.0 one.
+    """
     return [ADAPTERS[fmi_version] if name == FMI2_ADAPTER else name for name in fmi2_sources]
 
 
@@ -54,10 +57,12 @@ def _interface(fmi2_root: ET.Element, tag: str) -> dict[str, str] | None:
     attributes["providesAdjointDerivatives"] = attributes.get("providesDirectionalDerivatives", "false")
     if tag == "ModelExchange":
         attributes["needsCompletedIntegratorStep"] = str(
-            element.get("completedIntegratorStepNotNeeded") != "true").lower()
+            element.get("completedIntegratorStepNotNeeded") != "true"
+        ).lower()
     else:
         attributes["canHandleVariableCommunicationStepSize"] = element.get(
-            "canHandleVariableCommunicationStepSize", "false")
+            "canHandleVariableCommunicationStepSize", "false"
+        )
         attributes["maxOutputDerivativeOrder"] = element.get("maxOutputDerivativeOrder", "0")
         # Event mode, early return and intermediate update have nothing to do in the pendulum.
         attributes["hasEventMode"] = "false"
@@ -71,14 +76,22 @@ def model_description(fmi2_xml: str | Path) -> str:
     references = {str(index): v.get("valueReference") for index, v in enumerate(variables, start=1)}
     time_reference = str(len(variables))
     if time_reference in references.values():
-        raise ValueError(f"{fmi2_xml}: value references must be 0..{len(variables) - 1}, one per "
-                         "variable, so that `time` can take the next one")
+        raise ValueError(
+            f"{fmi2_xml}: value references must be 0..{len(variables) - 1}, one per "
+            "variable, so that `time` can take the next one"
+        )
 
-    root = ET.Element("fmiModelDescription", {
-        "fmiVersion": "3.0", "modelName": fmi2.get("modelName"),
-        "description": fmi2.get("description", ""), "instantiationToken": fmi2.get("guid"),
-        "generationTool": fmi2.get("generationTool", ""),
-        "variableNamingConvention": fmi2.get("variableNamingConvention", "flat")})
+    root = ET.Element(
+        "fmiModelDescription",
+        {
+            "fmiVersion": "3.0",
+            "modelName": fmi2.get("modelName"),
+            "description": fmi2.get("description", ""),
+            "instantiationToken": fmi2.get("guid"),
+            "generationTool": fmi2.get("generationTool", ""),
+            "variableNamingConvention": fmi2.get("variableNamingConvention", "flat"),
+        },
+    )
     for tag in ("ModelExchange", "CoSimulation"):
         attributes = _interface(fmi2, tag)
         if attributes:
@@ -94,16 +107,27 @@ def model_description(fmi2_xml: str | Path) -> str:
             root.append(element)
 
     model_variables = ET.SubElement(root, "ModelVariables")
-    ET.SubElement(model_variables, "Float64", {
-        "name": "time", "valueReference": time_reference, "causality": "independent",
-        "variability": "continuous", "description": "Simulation time", "unit": "s"})
+    ET.SubElement(
+        model_variables,
+        "Float64",
+        {
+            "name": "time",
+            "valueReference": time_reference,
+            "causality": "independent",
+            "variability": "continuous",
+            "description": "Simulation time",
+            "unit": "s",
+        },
+    )
     for variable in variables:
         real = variable.find("Real")
         if real is None:
             raise ValueError(f"{fmi2_xml}: variable {variable.get('name')!r} is not Real")
-        attributes = {key: variable.get(key) for key in ("name", "valueReference", "causality",
-                                                        "variability", "initial", "description")
-                      if variable.get(key) is not None}
+        attributes = {
+            key: variable.get(key)
+            for key in ("name", "valueReference", "causality", "variability", "initial", "description")
+            if variable.get(key) is not None
+        }
         attributes.update(real.attrib)
         if "derivative" in attributes:
             attributes["derivative"] = references[attributes["derivative"]]
@@ -111,13 +135,17 @@ def model_description(fmi2_xml: str | Path) -> str:
 
     structure = ET.SubElement(root, "ModelStructure")
     fmi2_structure = fmi2.find("ModelStructure")
-    for fmi2_tag, fmi3_tag in (("Outputs", "Output"), ("Derivatives", "ContinuousStateDerivative"),
-                               ("InitialUnknowns", "InitialUnknown")):
+    for fmi2_tag, fmi3_tag in (
+        ("Outputs", "Output"),
+        ("Derivatives", "ContinuousStateDerivative"),
+        ("InitialUnknowns", "InitialUnknown"),
+    ):
         for unknown in fmi2_structure.findall(f"{fmi2_tag}/Unknown"):
             attributes = {"valueReference": references[unknown.get("index")]}
             if unknown.get("dependencies") is not None:
                 attributes["dependencies"] = " ".join(
-                    references[index] for index in unknown.get("dependencies").split())
+                    references[index] for index in unknown.get("dependencies").split()
+                )
             if unknown.get("dependenciesKind") is not None:
                 attributes["dependenciesKind"] = unknown.get("dependenciesKind")
             ET.SubElement(structure, fmi3_tag, attributes)
@@ -130,8 +158,9 @@ def build_description(fmi2_xml: str | Path) -> str:
     """sources/buildDescription.xml: what a tool compiles to rebuild the FMU."""
     fmi2 = ET.parse(fmi2_xml).getroot()
     root = ET.Element("fmiBuildDescription", {"fmiVersion": "3.0"})
-    configuration = ET.SubElement(root, "BuildConfiguration", {
-        "modelIdentifier": fmi2.find("CoSimulation").get("modelIdentifier")})
+    configuration = ET.SubElement(
+        root, "BuildConfiguration", {"modelIdentifier": fmi2.find("CoSimulation").get("modelIdentifier")}
+    )
     file_set = ET.SubElement(configuration, "SourceFileSet", {"language": "C99"})
     for name in source_files(fmi2):
         ET.SubElement(file_set, "SourceFile", {"name": name})

@@ -1,0 +1,195 @@
+"""ClosedLoop.ssp: the export, the couplings' references, the masters and the judge.
+
+Every SSP master installable here is held to its coupling's reference, and the judge names it.
+"""
+
+import json
+import os
+import zipfile
+
+import fmpy
+import lxml.etree
+import numpy as np
+import pytest
+
+from pendulum_fmu.cli import main
+from pendulum_fmu.closed_loop import COUPLINGS, controller_defaults, sampled_loop_reference
+from pendulum_fmu.ssp import DEFAULT_SETPOINT, export_ssp, read_ssp
+from pendulum_fmu.ssp_judge import judge_coupling
+
+SCHEMAS = os.path.join(os.path.dirname(fmpy.__file__), "ssp", "schema")
+
+
+@pytest.fixture(scope="module")
+def ssp(tmp_path_factory):
+    return export_ssp(tmp_path_factory.mktemp("ssp") / "ClosedLoop.ssp", stop_time=2.0)
+
+
+def _reference(ssp_settings, coupling, applied=True):
+    return sampled_loop_reference(
+        ssp_settings.stop_time + ssp_settings.step_size,
+        ssp_settings.step_size,
+        controller=ssp_settings.controller if applied else None,
+        parameters=ssp_settings.pendulum if applied else None,
+        coupling=coupling,
+    )
+
+
+def test_export_validates_against_the_ssp_1_0_schemas_and_reads_back(ssp):
+    with zipfile.ZipFile(ssp) as archive:
+        names = set(archive.namelist())
+        documents = {
+            name: lxml.etree.fromstring(archive.read(name)) for name in names if name.endswith((".ssd", ".ssv"))
+        }
+    assert {"resources/Pendulum.fmu", "resources/PIDController.fmu"} <= names
+    assert sorted(documents) == ["SystemStructure.ssd", "resources/controller.ssv", "resources/pendulum.ssv"]
+    for name, document in documents.items():
+        schema = lxml.etree.XMLSchema(
+            file=os.path.join(
+                SCHEMAS,
+                "SystemStructureDescription.xsd" if name.endswith(".ssd") else "SystemStructureParameterValues.xsd",
+            )
+        )
+        assert schema.validate(document), (name, schema.error_log)
+    settings = read_ssp(ssp)
+    assert (settings.stop_time, settings.step_size) == (2.0, 1e-3)
+    assert settings.controller == {**controller_defaults(), "setpoint": DEFAULT_SETPOINT}
+    assert settings.pendulum == {"mass": 40.0, "length": 0.5, "inertia": 20.0, "gravity": 9.81, "damping": 0.0}
+
+
+def test_export_refuses_to_replace_an_ssp_unless_asked(tmp_path, capsys):
+    target = tmp_path / "ClosedLoop.ssp"
+    target.write_bytes(b"mine")
+    assert main(["export-ssp", str(target), "--controller", "setpoint=0.4"]) == 2
+    error = capsys.readouterr().err.strip()
+    assert "exists: pass --overwrite" in error and len(error.splitlines()) == 1
+    assert target.read_bytes() == b"mine"
+    assert main(["export-ssp", str(target), "--controller", "setpoint=0.4", "--overwrite"]) == 0
+    assert read_ssp(target).controller["setpoint"] == 0.4
+    assert [p.name for p in tmp_path.iterdir()] == ["ClosedLoop.ssp"]  # no temporary left
+
+
+@pytest.mark.parametrize("coupling", COUPLINGS)
+def test_each_couplings_reference_is_the_exact_sampled_double_integrator(coupling):
+    # Without gravity and damping the pendulum is J theta'' = u: a held torque moves it exactly
+    # by h omega + h^2 u / 2J per step, so the sampled loop has a closed form per coupling.
+    h, n, inertia = 1e-2, 200, 20.0 + 40.0 * 0.5**2
+    gains = {"setpoint": 0.3, "kp": 638.0, "ki": 810.0, "kd": 270.0}
+    theta = omega = integral = 0.0
+    sent = (0.0, 0.0)  # theta and omega a Jacobi master last exchanged
+    expected = [theta]
+    for k in range(n):
+        error_integral_after = integral + h * (gains["setpoint"] - theta)
+        measured, used_integral = {
+            "gauss-seidel-pendulum-first": ((theta, omega), integral),
+            "gauss-seidel-controller-first": ((theta, omega), error_integral_after),
+        }.get(coupling, (sent, integral))
+        u = gains["kp"] * (gains["setpoint"] - measured[0]) + gains["ki"] * used_integral - gains["kd"] * measured[1]
+        if coupling == "jacobi-first-exchange-missing" and k == 0:
+            u = 0.0
+        sent, integral = (theta, omega), error_integral_after
+        theta, omega = theta + h * omega + h * h * u / (2 * inertia), omega + h * u / inertia
+        expected.append(theta)
+    result = sampled_loop_reference(n * h, h, controller=gains, parameters={"gravity": 0.0}, coupling=coupling)
+    assert np.max(np.abs(result["theta"] - expected)) < 1e-12
+
+
+def test_libcosim_runs_the_ssp_as_it_is_jacobi_with_its_parameter_sets(ssp):
+    pytest.importorskip("libcosimpy")
+    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+
+    from pendulum_fmu.ssp_masters import run_libcosim
+
+    log_output_level(CosimLogLevel.WARNING)
+    time, theta = run_libcosim(ssp)
+    settings = read_ssp(ssp)
+    expected = _reference(settings, "jacobi")
+    assert np.allclose(time, expected["time"][:-1], rtol=0, atol=1e-12)
+    assert np.max(np.abs(theta - expected["theta"][:-1])) < 1e-12
+    verdict = judge_coupling(time, theta, settings)
+    assert (verdict.coupling, verdict.parameter_set_applied, verdict.problems) == ("jacobi", True, [])
+
+
+def test_fmpy_ssp_is_jacobi_without_the_first_exchange_and_ignores_the_bound_sets(ssp):
+    from pendulum_fmu.ssp_masters import run_fmpy_ssp
+
+    settings = read_ssp(ssp)
+    for given, applied in ((False, False), (True, True)):
+        time, theta = run_fmpy_ssp(ssp, parameter_set=given)
+        expected = _reference(settings, "jacobi-first-exchange-missing", applied)
+        # fmpy labels each row with the start of the step whose end it holds, one step past the stop.
+        assert len(time) == len(expected) - 1 == 2001
+        assert np.max(np.abs(theta - expected["theta"][1:])) < 1e-12
+        verdict = judge_coupling(time, theta, settings)
+        assert (verdict.coupling, verdict.parameter_set_applied, verdict.labelled_at_step_start) == (
+            "jacobi-first-exchange-missing",
+            applied,
+            True,
+        )
+        assert verdict.end_time == pytest.approx(2.001)
+        assert any("ran to 2.001 s" in problem for problem in verdict.problems)
+
+
+def test_fmucontainer_is_jacobi_and_ignores_the_parameter_bindings(ssp):
+    pytest.importorskip("fmu_manipulation_toolbox")
+    from pendulum_fmu.ssp_masters import run_fmucontainer
+
+    settings = read_ssp(ssp)
+    time, theta = run_fmucontainer(ssp)
+    expected = _reference(settings, "jacobi", applied=False)
+    assert np.allclose(time, expected["time"][:-1], rtol=0, atol=1e-9)
+    assert np.max(np.abs(theta - expected["theta"][:-1])) < 1e-12
+    verdict = judge_coupling(time, theta, settings)
+    assert (verdict.coupling, verdict.parameter_set_applied) == ("jacobi", False)
+    assert verdict.problems == ["the SSP's parameter sets were not applied: the FMUs ran on their own defaults"]
+
+
+def test_judge_names_a_wrong_step_and_an_early_stop_from_the_command_line(ssp, tmp_path, capsys):
+    settings = read_ssp(ssp)
+    # A Gauss-Seidel master at twice the SSP's step that stopped at 1 s (OMSimulator's CLI without
+    # --stopTime), its columns named its own way.
+    run = sampled_loop_reference(1.0, 2e-3, controller=settings.controller, coupling="gauss-seidel-pendulum-first")
+    result = tmp_path / "out.csv"
+    np.savetxt(
+        result, np.column_stack([run["time"], run["theta"]]), delimiter=",", header="t,phi", comments="", fmt="%.17g"
+    )
+    assert main(["judge", str(result), "--ssp", str(ssp), "--map", "time=t,theta=phi"]) == 1
+    printed = capsys.readouterr().out
+    assert "coupling: gauss-seidel-pendulum-first" in printed
+    assert "parameter set applied: yes" in printed
+    assert "step 0.002 s where the SSP asks 0.001 s" in printed
+    assert "ran to 1 s where the DefaultExperiment stops at 2 s" in printed
+    # A result of none of the couplings: the nearest is named, and it fails.
+    np.savetxt(
+        result,
+        np.column_stack([run["time"], run["theta"] * 1.001]),
+        delimiter=",",
+        header="t,phi",
+        comments="",
+        fmt="%.17g",
+    )
+    assert main(["judge", str(result), "--ssp", str(ssp), "--map", "time=t,theta=phi"]) == 1
+    assert "matches no coupling: nearest" in capsys.readouterr().out
+    not_an_ssp = tmp_path / "ClosedLoop.ssp"
+    not_an_ssp.write_text("time,theta\n")
+    assert main(["judge", str(result), "--ssp", str(not_an_ssp), "--map", "time=t,theta=phi"]) == 2
+    error = capsys.readouterr().err.strip()
+    assert "is not the closed loop's SSP" in error and len(error.splitlines()) == 1
+
+
+def test_the_kits_closed_loop_names_each_couplings_reference_as_that_coupling(tmp_path, capsys):
+    kit = tmp_path / "kit"
+    assert main(["scenarios", "--output-dir", str(kit), "--closed-loop"]) == 0
+    assert "wrote" in capsys.readouterr().out
+    settings = json.loads((kit / "ClosedLoop.json").read_text())
+    ssp_settings = read_ssp(kit / settings["ssp"])
+    assert (settings["stop_time"], settings["step_size"]) == (ssp_settings.stop_time, ssp_settings.step_size)
+    assert settings["controller"] == ssp_settings.controller and settings["pendulum"] == ssp_settings.pendulum
+    references = np.genfromtxt(kit / settings["reference"], delimiter=",", names=True, deletechars="")
+    assert references.dtype.names == ("time", *COUPLINGS)
+    for coupling in COUPLINGS:
+        # Each column, handed to the judge as a master's result, is that coupling and right.
+        verdict = judge_coupling(references["time"], references[coupling], ssp_settings)
+        assert (verdict.coupling, verdict.problems) == (coupling, [])
+    assert main(["scenarios", "--output-dir", str(kit), "--closed-loop"]) == 2
+    assert "--overwrite" in capsys.readouterr().err
