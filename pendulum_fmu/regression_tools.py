@@ -68,13 +68,15 @@ def _base(values: np.ndarray, smallest: float) -> float:
 def _range_max(values: np.ndarray, first: np.ndarray, end: np.ndarray) -> np.ndarray:
     """max(values[first:end]) for each pair (-inf where empty), by a sparse table.
 
-    The table holds log2(n) levels of maxima over 2**k points, so each query reads two entries.
+    The table holds log2(longest query) levels of maxima over 2**k points, so each query reads
+    two entries.
     """
+    length = end - first
     table = [values]
-    while 2 ** len(table) <= len(values):
+    # Levels up to the longest query only: a tube's window holds a small share of the points.
+    while 2 ** len(table) <= min(int(length.max(initial=0)), len(values)):
         half = 2 ** (len(table) - 1)
         table.append(np.maximum(table[-1][:-half], table[-1][half:]))
-    length = end - first
     level = np.floor(np.log2(np.maximum(length, 1))).astype(int)
     result = np.full(len(first), -np.inf)
     for k in np.unique(level[length > 0]):
