@@ -219,7 +219,9 @@ def _master_call(match: re.Match, names: dict[int, str], handles: dict[str, str]
     values = {}
     references = arguments.pop("vr", arguments.pop("valueReferences", None))
     numbers = arguments.pop("value", arguments.pop("values", None))
-    if references is not None and numbers is not None:
+    if "String" in function:  # callRecordFile: a file name, kept as the call's argument
+        arguments["file"] = numbers or ""
+    elif references is not None and numbers is not None:
         orders = _list(arguments.pop("order", "")) or None
         for position, (reference, value) in enumerate(zip(_list(references), _list(numbers), strict=False)):
             name = names.get(int(reference), f"vr{reference}")

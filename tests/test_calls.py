@@ -248,6 +248,40 @@ def test_a_step_late_on_a_short_run_fails_the_tube_after_the_jump(fmu, capsys, t
     assert tube["half_width"] == pytest.approx(2e-5, rel=1e-12)
 
 
+@pytest.mark.parametrize("fixture", ["fmu", "fmu3"])
+def test_the_record_file_a_parameter_names_is_read_by_the_judge(request, fixture, tmp_path, jump_csv):
+    """The start value callRecordFile set through fmpy, with the jump fed one step late (at 6 ms)."""
+    fmu = request.getfixturevalue(fixture)
+    record = tmp_path / "calls.log"
+    late = np.array([(0, 0), (0.006, 0), (0.006, 20), (0.01, 20)], dtype=[("time", float), ("torque", float)])
+    calls = []
+    simulate_fmu(str(fmu), stop_time=N_STEPS * STEP, step_size=STEP, output_interval=STEP, input=late,
+                 start_values={"callRecordFile": str(record)}, fmi_call_logger=calls.append)
+    # fmpy's own call log holds the fmi*SetString call too; the judge reads past it.
+    call_log = tmp_path / "fmpy_calls.log"
+    call_log.write_text("\n".join(calls) + "\n")
+    assert [line.split(" (t")[0] for line in reading(call_log, IntendedRun(jump_csv))["differences"]] == [
+        "input applied 1 step late from step 5"]
+    lines = record.read_text().splitlines()
+    prefix = "fmi2" if fixture == "fmu" else "fmi3"
+    assert lines[0].startswith(f'[pendulum-calls] instance="Pendulum" {prefix}SetString(file="{record}") ')
+    assert sum(f"{prefix}DoStep(" in line for line in lines) == N_STEPS
+    found = reading(record, IntendedRun(jump_csv))["differences"]
+    assert [line.split(" (t")[0] for line in found] == ["input applied 1 step late from step 5"]
+    assert main(["judge", "--calls", str(record), "--torque-file", str(jump_csv), "--fmu", str(fmu)]) == 1
+
+
+def test_a_record_file_that_cannot_be_opened_is_one_warning_and_the_run_completes(fmu, tmp_path, capsys):
+    missing = tmp_path / "no such folder" / "calls.log"
+    result = simulate_fmu(str(fmu), stop_time=N_STEPS * STEP, step_size=STEP, output_interval=STEP,
+                          start_values={"callRecordFile": str(missing), "torque": 20.0})
+    warnings = [line for line in capsys.readouterr().out.splitlines() if "callRecordFile" in line]
+    assert warnings == [f"[WARNING] fmi2SetString: callRecordFile {missing} cannot be opened for appending "
+                        "(No such file or directory): the FMU writes no record file"]
+    assert not missing.parent.exists()
+    assert result["time"].tolist() == pytest.approx([k * STEP for k in range(N_STEPS + 1)], abs=1e-15)
+
+
 LIBCOSIM_RUN = """
 import sys
 from libcosimpy.CosimExecution import CosimExecution
