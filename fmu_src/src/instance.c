@@ -71,6 +71,7 @@ void instance_record_call(const Instance *instance, const char *function, double
     instance_log(instance, STATUS_OK, LOG_CALLS, "%s", line);
 }
 
+#ifdef VR_CALLRECORDFILE
 /* Closes the record file there is, and opens the one `name` names (none when empty). */
 static Status record_to_file(Instance *instance, const char *function, const char *name) {
     if (instance->record_file) fclose(instance->record_file);
@@ -88,10 +89,12 @@ static Status record_to_file(Instance *instance, const char *function, const cha
     instance->log_categories |= RECORD_TO_FILE;
     return STATUS_OK;
 }
+#endif
 
 Status instance_set_string(Instance *instance, const char *function, const unsigned int vr[], size_t n,
                            const char *const value[]) {
     Status status = STATUS_OK;
+    (void)value; /* a model without String parameters refuses every one */
     for (size_t i = 0; i < n; i++) {
 #ifdef VR_CALLRECORDFILE
         if (vr[i] != VR_CALLRECORDFILE)
@@ -116,6 +119,7 @@ Status instance_set_string(Instance *instance, const char *function, const unsig
 
 Status instance_get_string(Instance *instance, const char *function, const unsigned int vr[], size_t n,
                            const char *value[]) {
+    (void)value; /* a model without String parameters refuses every one */
     for (size_t i = 0; i < n; i++) {
 #ifdef VR_CALLRECORDFILE
         if (vr[i] == VR_CALLRECORDFILE) {
