@@ -60,7 +60,8 @@ void instance_record_call(const Instance *instance, const char *function, double
         name[i] = instance->name[i] == '"' ? '\'' : instance->name[i];
         if (!name[i]) break;
     }
-    char line[1024];
+    /* Room for the arguments, the name and the rest; the logger's copy is cut at its own size. */
+    char line[sizeof(arguments) + MAX_INSTANCE_NAME + 256];
     snprintf(line, sizeof(line), CALL_RECORD_MARKER " instance=\"%s\" %s(%s) time=%.17g->%.17g status=%s",
              name, function, arguments, time_before, instance->data.time, status_names[status]);
     if (instance->record_file) {
