@@ -77,6 +77,9 @@ PENDULUM_DIR = MODELS["pendulum"].folder
 PID_CONTROLLER_DIR = MODELS["pid_controller"].folder
 ZIG = "zig"
 ZIG_PACKAGE = "pip install ziglang"
+# The glibc zig builds a Linux binary for where the cross gcc is missing: manylinux2014's, the
+# first with an aarch64 port, as the wheels' (build_wheels.py), so it loads on every later glibc.
+ZIG_GLIBC = "2.17"
 
 
 @dataclass(frozen=True)
@@ -96,11 +99,31 @@ class Target:
     def native(self) -> bool:
         return sys.platform == self.system and (not self.machines or host.machine() in self.machines)
 
-    def built_by_zig(self, linux_glibc: str | None = None) -> bool:
-        """Whether zig's C compiler builds it: a macOS target off a Mac, and a Linux target for a
-        glibc floor (cmake/linux.cmake).
+    @property
+    def zig_stands_in(self) -> bool:
+        """Whether zig's C compiler builds it in place of its missing cross gcc: Windows
+        (x86_64-windows-gnu, cmake/x86_64-windows.cmake) or Linux (for glibc ZIG_GLIBC,
+        cmake/linux.cmake) off a machine of its kind, so a source build needs no Debian cross gcc.
         """
-        return (self.cross_compiler == ZIG and not self.native) or bool(linux_glibc and self.system == "linux")
+        return not self.native and self.cross_compiler != ZIG and shutil.which(self.cross_compiler) is None
+
+    def built_by_zig(self, linux_glibc: str | None = None) -> bool:
+        """Whether zig's C compiler builds it: a macOS target off a Mac, a Linux target for a
+        glibc floor (cmake/linux.cmake), and a target whose cross gcc is missing.
+        """
+        return (
+            (self.cross_compiler == ZIG and not self.native)
+            or bool(linux_glibc and self.system == "linux")
+            or self.zig_stands_in
+        )
+
+    def glibc_floor(self, linux_glibc: str | None = None) -> str | None:
+        """The oldest glibc a Linux target is built for: linux_glibc, else ZIG_GLIBC where zig
+        stands in for the cross gcc; None (the build machine's or the cross gcc's) otherwise.
+        """
+        if self.system != "linux":
+            return None
+        return linux_glibc or (ZIG_GLIBC if self.zig_stands_in else None)
 
     def compiler(self, linux_glibc: str | None = None) -> list[str]:
         """The C compiler command: zig's (the ziglang package's `zig cc`) where it builds the
@@ -281,7 +304,7 @@ def _cmake() -> str:
 
 def check_toolchain(platform: Platform, fmi_version: int = 2, linux_glibc: str | None = None) -> None:
     """BuildError naming the package to install unless every tool that builds platform is here:
-    the cross-compiler of each target (zig for a Linux target with linux_glibc; $CC, when set, on
+    the cross-compiler of each target, or zig in its place (zig for a Linux target with linux_glibc; $CC, when set, on
     a machine of the target's kind: else CMake finds the machine's compiler itself). BuildError
     too when linux_glibc is not a glibc version.
     """
@@ -294,7 +317,11 @@ def check_toolchain(platform: Platform, fmi_version: int = 2, linux_glibc: str |
         compiler = target.compiler(linux_glibc)
         if not compiler or shutil.which(compiler[0]) is None:
             name = shlex.join(compiler) if compiler else "CC (empty)"
-            hint = ZIG_PACKAGE if zig else "set CC to an installed compiler" if target.native else target.package
+            if target.zig_stands_in and not (linux_glibc and target.system == "linux"):
+                # Neither the cross gcc nor zig, which stands in for it: either one installs it.
+                name, hint = target.cross_compiler, f"{target.package}, or {ZIG_PACKAGE}"
+            else:
+                hint = ZIG_PACKAGE if zig else "set CC to an installed compiler" if target.native else target.package
             raise BuildError(f"{platform.fmi2_folder}: C compiler {name} not found ({hint})")
 
 
@@ -350,8 +377,8 @@ def cmake_build(
             environment.pop(name, None)
     if target.built_by_zig(linux_glibc):
         configure.append(f"-DZIG={find_zig()}")
-    if linux_glibc and target.system == "linux":
-        configure.append(f"-DLINUX_GLIBC={linux_glibc}")
+    if target.glibc_floor(linux_glibc):
+        configure.append(f"-DLINUX_GLIBC={target.glibc_floor(linux_glibc)}")
     what = f"{cmake_target} for {target.name}"
     run_tool(configure, what, environment)
     run_tool([cmake, "--build", build, "--target", cmake_target, "--config", "Release"], what, environment)
