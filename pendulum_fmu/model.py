@@ -243,11 +243,9 @@ class FmuInstance:
 
     def __init__(self, slave, messages, model: FmuModel):
         self.slave, self.messages, self.model = slave, messages, model
-
-    @property
-    def fmi_version(self) -> int:
-        """2 or 3, the model's."""
-        return self.model.fmi_version
+        self.fmi_version = model.fmi_version  # 2 or 3
+        # Read on every run (the loops bind the FMI functions): plain attributes, not a pass-through.
+        self.dll, self.component = slave.dll, slave.component
 
     def __getattr__(self, name: str):
         # Only what the instance itself lacks: fmpy's calls and attributes (never the slave itself,
