@@ -15,6 +15,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import signal
 import socket
 import subprocess
 import sys
@@ -44,6 +45,15 @@ def free_port() -> int:
 def dask_processes(workers: int):
     """The address of a `dask scheduler` with `workers` single-threaded `dask worker`s, each its
     own process on localhost, started as a user starts them on a cluster; stopped on exit."""
+    with dask_process_handles(workers) as (address, _):
+        yield address
+
+
+@contextlib.contextmanager
+def dask_process_handles(workers: int, nanny: bool = True):
+    """(address, [the scheduler's process, each worker's]) of a cluster as dask_processes
+    starts it; nanny=False: each worker is the process that runs its tasks (no nanny restarts
+    it), for the fault tests to stop or kill."""
     from dask.distributed import Client
 
     port = free_port()
@@ -53,16 +63,23 @@ def dask_processes(workers: int):
                                    "--port", str(port), "--no-dashboard"], **quiet)]
     try:
         processes += [subprocess.Popen([sys.executable, "-m", "dask", "worker", address, "--host",
-                                        "127.0.0.1", "--nthreads", "1", "--no-dashboard"], **quiet)
+                                        "127.0.0.1", "--nthreads", "1", "--no-dashboard",
+                                        *(() if nanny else ("--no-nanny",))], **quiet)
                       for _ in range(workers)]
         with Client(address, timeout=60) as client:
             client.wait_for_workers(workers, timeout=60)
-        yield address
+        yield address, processes
     finally:
         for process in reversed(processes):
+            if process.poll() is None:
+                os.kill(process.pid, signal.SIGCONT)  # a stopped one, to let it end
             process.terminate()
         for process in processes:
-            process.wait(timeout=30)
+            try:
+                process.wait(timeout=30)
+            except subprocess.TimeoutExpired:  # a nanny slow to stop on a loaded machine
+                process.kill()
+                process.wait(timeout=30)
 
 
 def measure_client(address: str, cases: int, stop_time: float, fmu: str, output_dir: str) -> None:
@@ -141,19 +158,31 @@ def _median_study(results: list[dict]) -> dict:
     return {key: median([result[key] for result in results]) for key in results[0]}
 
 
-def scale_rows(fmu: BuiltFmu, quick: bool) -> list[Row]:
-    cases = 1024 if quick else 4096
+def _cpu_seconds(process: subprocess.Popen) -> float:
+    import psutil
+
+    times = psutil.Process(process.pid).cpu_times()
+    return times.user + times.system
+
+
+def scale_rows(fmu: BuiltFmu, quick: bool, cases: int | None = None) -> list[Row]:
+    """The part's rows; cases: of each 3-s study (default 1024 quick, else 4096), more where the
+    cores are many, so that 16 workers each run more than a few chunks' worth."""
+    cases = cases or (1024 if quick else 4096)
     rounds = 1 if quick else 3
     worker_counts = [n for n in (1, 2, 4, 8, 16) if n <= (os.cpu_count() or 1)]
     rows = [Row(PART, "machine", _load())]
     # Every cluster runs at once and the rounds alternate between them, so that a change in the
     # machine's speed (other jobs on a shared VM) falls on every worker count alike.
     with contextlib.ExitStack() as clusters:
-        addresses = {workers: clusters.enter_context(dask_processes(workers)) for workers in worker_counts}
+        handles = {workers: clusters.enter_context(dask_process_handles(workers))
+                   for workers in worker_counts}
         runs = {workers: [] for workers in worker_counts}
         for _ in range(rounds):
-            for workers, address in addresses.items():
+            for workers, (address, processes) in handles.items():
+                scheduler_cpu = _cpu_seconds(processes[0])
                 runs[workers].append(_study(address, cases, 3.0, fmu))
+                runs[workers][-1]["scheduler_cpu"] = _cpu_seconds(processes[0]) - scheduler_cpu
     results = {workers: _median_study(runs[workers]) for workers in worker_counts}
     rates = {workers: cases / result["seconds"] for workers, result in results.items()}
     # The figure is a fixed cost of a study (about a second), whatever its size or workers.
@@ -186,6 +215,7 @@ def scale_rows(fmu: BuiltFmu, quick: bool) -> list[Row]:
               if workers > 1 else []),
             Row(PART, f"{label}: client CPU per case (whole run, figure included)",
                 f"{per_case_cpu * 1e6:.0f} µs"),
+            Row(PART, f"{label}: scheduler CPU per case", f"{result['scheduler_cpu'] / cases * 1e6:.0f} µs"),
             Row(PART, f"{label}: client peak memory", f"{result['peak_rss'] / 1e6:.0f} MB"),
             Row(PART, f"{label}: bytes written per case", f"{result['bytes'] / cases / 1e3:.1f} kB"),
         ]

@@ -120,14 +120,22 @@ def model_description(fmi2_xml: str | Path) -> str:
         },
     )
     for variable in variables:
-        real = variable.find("Real")
-        if real is None:
-            raise ValueError(f"{fmi2_xml}: variable {variable.get('name')!r} is not Real")
         attributes = {
             key: variable.get(key)
             for key in ("name", "valueReference", "causality", "variability", "initial", "description")
             if variable.get(key) is not None
         }
+        string = variable.find("String")
+        if string is not None:
+            # FMI 3.0 gives a String's start value as an element.
+            start = string.get("start")
+            element = ET.SubElement(model_variables, "String", attributes)
+            if start is not None:
+                ET.SubElement(element, "Start", {"value": start})
+            continue
+        real = variable.find("Real")
+        if real is None:
+            raise ValueError(f"{fmi2_xml}: variable {variable.get('name')!r} is neither Real nor String")
         attributes.update(real.attrib)
         if "derivative" in attributes:
             attributes["derivative"] = references[attributes["derivative"]]

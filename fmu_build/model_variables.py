@@ -58,8 +58,8 @@ def generate_variables(xml: str | Path, out_dir: str | Path) -> list[Path]:
     Raises
     ------
     ModelDescriptionError
-        A variable that is not Real or whose value reference is not its index: the C code indexes
-        one array of Reals by value reference.
+        A variable that is neither Real nor a String parameter, or a Real whose value reference
+        is not its index: the C code indexes one array of Reals by value reference.
 
     Examples
     --------
@@ -67,13 +67,18 @@ def generate_variables(xml: str | Path, out_dir: str | Path) -> list[Path]:
     [PosixPath('build/generated/model_variables.h'), PosixPath('build/generated/model_variables.c')]
     """
     root = ET.parse(xml).getroot()
-    variables = []
-    for index, element in enumerate(root.iter("ScalarVariable")):
+    variables, strings = [], []
+    for element in root.iter("ScalarVariable"):
+        index = len(variables)
+        if element.find("String") is not None and element.get("causality") == "parameter":
+            # A String parameter the C code keeps by itself (instance.c: callRecordFile).
+            strings.append(f"#define VR_{element.get('name').upper()} {int(element.get('valueReference'))}")
+            continue
         real = element.find("Real")
         if real is None or int(element.get("valueReference")) != index:
             raise ModelDescriptionError(
-                f"{xml}: variable {element.get('name')!r} must be Real with valueReference {index}: "
-                "the C code indexes one array of Reals by value reference"
+                f"{xml}: variable {element.get('name')!r} must be Real with valueReference {index}, "
+                "or a String parameter: the C code indexes one array of Reals by value reference"
             )
         causality = element.get("causality", "local")
         variability = element.get("variability", "continuous")
@@ -97,6 +102,8 @@ def generate_variables(xml: str | Path, out_dir: str | Path) -> list[Path]:
 
 #define MODEL_GUID "{root.get("guid")}"
 #define N_VARIABLES {len(variables)}
+/* Every variable's value reference, String parameters included, is below this. */
+#define N_VALUE_REFERENCES {len(variables) + len(strings)}
 /* The inputs' value references: a step updates these, without a pass over every variable. */
 #define N_INPUTS {sum(v["causality"] == "input" for v in variables)}
 #define INPUT_REFERENCES {{{inputs}}}
@@ -104,6 +111,8 @@ def generate_variables(xml: str | Path, out_dir: str | Path) -> list[Path]:
 typedef enum {{
 {enum}
 }} ValueReference;
+/* String parameters, outside the Reals' array. */
+{chr(10).join(strings)}
 
 extern const VariableInfo model_variables[N_VARIABLES];
 

@@ -11,7 +11,10 @@
    the loop of run_schedule_python, the readable reference), so the two give bit-identical
    results: per step k, set the inputs, set their first derivatives (when rates are given), read
    the outputs, step from time[k] by time[k+1] - time[k]; after the last step read the outputs
-   once more. */
+   once more.
+
+   cs_loop_run_cases runs a chunk of cases (a parameter study's) in one call: each case a restart
+   with its own start values, then every step with no input set, into one preallocated array. */
 
 #include <stddef.h>
 
@@ -23,9 +26,9 @@
 #define CS_LOOP_EXPORT __attribute__((visibility("default")))
 #endif
 
-/* Changes whenever cs_loop_run's arguments do, so that Python never calls a stale build with
+/* Changes whenever cs_loop_run's or cs_loop_run_cases' arguments do, so that Python never calls a stale build with
    the wrong arguments (cs_loop.py checks it). */
-CS_LOOP_EXPORT int cs_loop_interface(void) { return 4; }
+CS_LOOP_EXPORT int cs_loop_interface(void) { return 6; }
 
 /* The FMU's functions, in this order (cs_loop.py passes them as an array of addresses). */
 typedef struct {
@@ -112,4 +115,46 @@ CS_LOOP_EXPORT int cs_loop_run(
           CALL_GET_OUTPUTS_AT_END);
 #undef CHECK
     return (int)worst;
+}
+
+/* Runs cases one after the other, each a restart of the instance (fmi2Reset, initialization at
+   time[0] with its start values, as cs_loop_run with start values) and then every step, with no
+   input set: what a parameter study's chunk of cases needs, with no call back into Python.
+
+   start_values[c*n_start + i]       start value i of case c (start_references[i])
+   case_outputs[k*n_outputs + j]     room for one case's outputs as cs_loop_run writes them
+                                     ((n_steps+1) * n_outputs values, the caller's)
+   outputs[(j*n_cases + c)*(n_steps+1) + k]
+                                     output j of case c at point k: each output's values of the
+                                     whole chunk are one contiguous series, a table column as it
+                                     is (a transpose here, of one case that is still in cache,
+                                     costs less than gathering a strided column afterwards)
+
+   Returns as cs_loop_run, for the cases run: it stops at the first case whose calls fail, with
+   *failed_case = its index among the cases given (its outputs not filled in), so that the
+   caller takes the FMU's messages for that case before it runs the rest (a restart starts with
+   fmi2Reset, so a refused case leaves nothing to the next): first_case is where to go on. */
+CS_LOOP_EXPORT int cs_loop_run_cases(
+    const CsFunctions *fmi, fmi2Component component,
+    const fmi2ValueReference *start_references, size_t n_start, const double *start_values,
+    const double *tolerance, const fmi2ValueReference *output_references, size_t n_outputs,
+    size_t n_cases, size_t first_case, size_t n_steps, const double *time,
+    double *case_outputs, double *outputs,
+    size_t *failed_case, size_t *failed_step, int *failed_call)
+{
+    int worst = fmi2OK, status;
+    size_t c, j, k, points = n_steps + 1;
+    for (c = first_case; c < n_cases; c++) {
+        status = cs_loop_run(fmi, component, start_references, n_start, start_values + c * n_start,
+                             tolerance, NULL, 0, output_references, n_outputs, n_steps, time,
+                             NULL, NULL, NULL, case_outputs, failed_step, failed_call);
+        if (status > fmi2Warning) { *failed_case = c; return status; }
+        if (status > worst) worst = status;
+        for (j = 0; j < n_outputs; j++) {
+            double *series = outputs + (j * n_cases + c) * points;
+            for (k = 0; k < points; k++)
+                series[k] = case_outputs[k * n_outputs + j];
+        }
+    }
+    return worst;
 }

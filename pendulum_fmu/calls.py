@@ -28,13 +28,17 @@ import json
 import math
 import re
 from dataclasses import asdict, dataclass, field
+from itertools import pairwise
 from pathlib import Path
 
 import numpy as np
 
 from .atomic_files import replacing
 from .errors import InvalidInput, MissingFile
-from .torque_schedule import TorqueSignal, schedule
+from .parameters import default_parameters
+from .reference import reference_schedule
+from .regression_tools import format_verdicts, regression_verdicts
+from .torque_schedule import TorqueSchedule, TorqueSignal, schedule
 
 MARKER = "[pendulum-calls]"
 INPUT = "torque"
@@ -215,7 +219,9 @@ def _master_call(match: re.Match, names: dict[int, str], handles: dict[str, str]
     values = {}
     references = arguments.pop("vr", arguments.pop("valueReferences", None))
     numbers = arguments.pop("value", arguments.pop("values", None))
-    if references is not None and numbers is not None:
+    if "String" in function:  # callRecordFile: a file name, kept as the call's argument
+        arguments["file"] = numbers or ""
+    elif references is not None and numbers is not None:
         orders = _list(arguments.pop("order", "")) or None
         for position, (reference, value) in enumerate(zip(_list(references), _list(numbers), strict=False)):
             name = names.get(int(reference), f"vr{reference}")
@@ -541,6 +547,32 @@ def _plan(record: InstanceCalls, intended: IntendedRun):
     )
 
 
+def _run_as_done(record: InstanceCalls, intended: IntendedRun) -> list[dict] | None:
+    """What regression tools would say about the master's run, reconstructed from its calls.
+
+    The run the steps made (their times, torques and derivatives, with the parameters and
+    start values the master set) and the intended run, both integrated exactly
+    (reference_schedule) at the master's communication points, compared on theta by
+    regression_tools. None where the steps do not make one run forward in time (a state
+    restored, a reset, steps that skip or overlap) or use second derivatives of the input.
+    """
+    steps = record.steps
+    contiguous = all(abs(b.time - (a.time + a.size)) <= TIME_TOLERANCE for a, b in pairwise(steps))
+    if len(steps) < 2 or not contiguous or any(step.torque_acceleration for step in steps):
+        return None
+    times = np.array([step.time for step in steps] + [steps[-1].time + steps[-1].size])
+    done = TorqueSchedule(times, np.array([step.torque for step in steps]),
+                          np.array([step.torque_rate for step in steps]))
+    set_by_master = record.set_before_start
+    parameters = {name: value for name, value in set_by_master.items() if name in default_parameters()}
+    as_done = reference_schedule(done, parameters=parameters, theta0=set_by_master.get("theta", 0.0),
+                                 omega0=set_by_master.get("omega", 0.0))
+    start = intended.start_values
+    meant = reference_schedule(_plan(record, intended), parameters=intended.parameters, at=times,
+                               theta0=start.get("theta0") or 0.0, omega0=start.get("omega0") or 0.0)
+    return regression_verdicts(times, meant["theta"], as_done["theta"])
+
+
 def _model_exchange(record: InstanceCalls) -> list[str]:
     """What a Model Exchange master's integrator was, from its calls.
 
@@ -629,7 +661,9 @@ def judge_calls(log: str | Path, intended: IntendedRun | None, variable_names: d
     dict
         {instance: {"steps": [...], "set_before_start": {...}, "events": [...],
         "differences": [...] or None, "intended_torque": the torque each step of the intended
-        run holds at its start, or None}}.
+        run holds at its start, or None, "regression_tools": csv-compare's tube and the FMI
+        cross-check's band on the run the steps made against the intended one
+        (regression_tools.regression_verdicts), or None}}.
 
     Raises
     ------
@@ -649,6 +683,7 @@ def judge_calls(log: str | Path, intended: IntendedRun | None, variable_names: d
             "intended_torque": None
             if intended is None or not record.steps
             else _plan(record, intended).torque.tolist(),
+            "regression_tools": None if intended is None else _run_as_done(record, intended),
         }
         for name, record in instances.items()
     }
@@ -685,6 +720,10 @@ def format_calls(judged: dict, steps_shown: int = 20) -> str:
             lines.extend(f"  {line}" for line in found)
         else:
             lines.append(f"instance {name}: the master did what the intended run asks ({len(result['steps'])} steps)")
+        if result.get("regression_tools"):
+            lines.append("  what regression tools would say, on theta of the run these steps make against the "
+                         "intended one:")
+            lines.extend(f"    {line}" for line in format_verdicts(result["regression_tools"]))
     return "\n".join(lines)
 
 

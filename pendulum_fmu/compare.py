@@ -187,7 +187,7 @@ def compare(torque: TorqueSignal, tools=None, *, output_dir: str | Path, step_si
     output_dir : str or Path
         Where to write trajectories.csv (every tool's torque, theta, omega, alpha),
         differences.csv (each tool against the reference: max and RMS of theta, omega, alpha,
-        max |torque received - signal|, wall time per step; and every pair of other tools) and
+        ``max |torque received - signal|``, wall time per step; and every pair of other tools) and
         comparison.png (the tools overlaid, and their differences on a log scale).
     step_size, start_time, stop_time, parameters, theta0, omega0, max_steps, fmu_path
         As simulate() takes them; fmu_path's parameters and defaults apply to every tool.

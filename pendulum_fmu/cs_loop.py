@@ -4,7 +4,7 @@ It drives any FMI 2.0 co-simulation instance that fmpy instantiated, through the
 exported FMI functions, for a whole case in one call: optionally a restart (fmi2Reset and
 initialization with new start values, as simulate.initialize does), then every step of a
 schedule (fmi2SetReal, fmi2SetRealInputDerivatives, fmi2GetReal, fmi2DoStep), writing into the
-caller's numpy buffers. `pip install` (or
+caller's numpy buffers; or a chunk of restarted cases in one call (Stepper.run_cases). `pip install` (or
 `pip install -e .` in a checkout) compiles it; without it `available()` is
 False and callers use the Python loop in simulate.py, which gives the same numbers bit for bit.
 """
@@ -33,12 +33,13 @@ _FMI_FUNCTIONS = ("fmi2Reset", "fmi2SetupExperiment", "fmi2EnterInitializationMo
 
 
 # What _cs_loop.c's cs_loop_interface() returns for the arguments this module passes.
-INTERFACE = 4
+INTERFACE = 6
 
 
 @lru_cache(maxsize=1)
 def _library():
-    """The compiled loop's run function, or None when it was not built (or is a stale build)."""
+    """The compiled loop's (run, run_cases) functions, or None when it was not built (or is a
+    stale build)."""
     # setup.py gives it the platform's plain extension name (_cs_loop.so, _cs_loop.pyd).
     path = Path(__file__).resolve().parent / f"_cs_loop{importlib.machinery.EXTENSION_SUFFIXES[-1]}"
     if not path.is_file():
@@ -51,7 +52,10 @@ def _library():
     run.argtypes = ([pointer] * 3 + [size] + [pointer] * 3 + [size, pointer, size, size]
                     + [pointer] * 7)
     run.restype = ctypes.c_int
-    return run
+    run_cases = library.cs_loop_run_cases
+    run_cases.argtypes = [pointer] * 3 + [size] + [pointer] * 3 + [size] * 4 + [pointer] * 6
+    run_cases.restype = ctypes.c_int
+    return run, run_cases
 
 
 def available() -> bool:
@@ -63,13 +67,16 @@ def drives(slave) -> bool:
     return available() and slave.fmi_version == 2
 
 
-def _address(array: np.ndarray | None, shape: tuple[int, ...], dtype, what: str) -> int | None:
-    if array is None:
-        return None
+def _checked(array: np.ndarray, shape: tuple[int, ...], dtype, what: str) -> np.ndarray:
+    """array, when it is C-contiguous of that shape and type (the C code's layout); else ValueError."""
     if array.shape != shape or array.dtype != dtype or not array.flags.c_contiguous:
         raise ValueError(f"{what} must be a C-contiguous {np.dtype(dtype)} array of shape {shape}, "
                          f"got {array.dtype} {array.shape}")
-    return array.ctypes.data
+    return array
+
+
+def _address(array: np.ndarray | None, shape: tuple[int, ...], dtype, what: str) -> int | None:
+    return None if array is None else _checked(array, shape, dtype, what).ctypes.data
 
 
 class Stepper:
@@ -103,8 +110,10 @@ class Stepper:
         # A restart's start values are copied here, whose address is bound once.
         self._start_values = np.empty(self.starts)
         self._start_values_address = self._start_values.ctypes.data
+        self._failed_case = ctypes.c_size_t()
+        self._case_outputs = np.empty((0, self.outputs))  # run_cases' room for one case, kept
         self._reports = ctypes.byref(self._failed_step), ctypes.byref(self._failed_call)
-        self._run = _library()
+        self._run, self._run_cases = _library()
 
     def run(self, time: np.ndarray, inputs: np.ndarray | None, input_rates: np.ndarray | None,
             outputs: np.ndarray, start_values: Sequence[float] | None = None,
@@ -141,8 +150,67 @@ class Stepper:
             _address(outputs, (steps + 1, self.outputs), np.float64, "outputs"),
             *self._reports)
         if status > 1:
-            call = self._failed_call.value
-            if call >= _RESTART:
-                raise self.messages.initialization_error(f"{_CALLS[call]} failed")
-            where = "at the end" if call == _AT_END else f"at t = {time[self._failed_step.value]:.17g}"
-            raise self.messages.error(status, f"{_CALLS[call]} {where}")
+            raise self._error(status, time)
+
+    def run_cases(self, time: np.ndarray, start_values: np.ndarray, outputs: np.ndarray,
+                  tolerance: float | None = None) -> list[str]:
+        """Run cases, each a restart with its own start values and no input set, in one call
+        into the native loop (one more after each case the FMU refuses).
+
+        Parameters
+        ----------
+        time : numpy.ndarray
+            The communication points (N + 1), shared by every case.
+        start_values : numpy.ndarray
+            (cases, start references), C-contiguous float64: a row per case.
+        outputs : numpy.ndarray
+            (outputs, cases, N + 1), C-contiguous float64, filled with each case's outputs at
+            every point: outputs[j] is output j of every case, one contiguous series (a table
+            column without a copy); a refused case's values are NaN.
+        tolerance : float, optional
+            The relative tolerance of every restart; None for the FMU's own.
+
+        Returns
+        -------
+        list of str
+            Per case "" when it ran, else why the FMU refused it: the message run() raises for
+            the same case.
+
+        Examples
+        --------
+        >>> messages = stepper.run_cases(points, start_values, outputs)  # doctest: +SKIP
+        """
+        cases, points = len(start_values), len(time)
+        start_values = _checked(start_values, (cases, self.starts), np.float64, "start_values")
+        outputs = _checked(outputs, (self.outputs, cases, points), np.float64, "outputs")
+        if self._case_outputs.shape != (points, self.outputs):
+            self._case_outputs = np.empty((points, self.outputs))
+        if tolerance is not None:
+            self._tolerance.value = tolerance
+        messages, first = [""] * cases, 0
+        while first < cases:
+            self.messages.lines.clear()  # so that a refusal's message is its case's own
+            status = self._run_cases(
+                *self._fmu, *self._start_references, start_values.ctypes.data,
+                None if tolerance is None else ctypes.addressof(self._tolerance),
+                *self._output_references, cases, first, points - 1,
+                _address(time, (points,), np.float64, "time"), self._case_outputs.ctypes.data,
+                outputs.ctypes.data, ctypes.byref(self._failed_case), *self._reports)
+            if status <= 1:
+                break
+            refused = self._failed_case.value
+            messages[refused] = str(self._error(status, time))
+            outputs[:, refused] = np.nan
+            first = refused + 1
+        self.messages.lines.clear()
+        return messages
+
+    def _error(self, status: int, time: np.ndarray) -> Exception:
+        """The error of a run that failed with status: the slave's MessageLog error with the FMU's
+        messages, the failing call and the time of its step, or FmuError("initialization failed:
+        ...") for a restart's call, as simulate.initialize raises."""
+        call = self._failed_call.value
+        if call >= _RESTART:
+            return self.messages.initialization_error(f"{_CALLS[call]} failed")
+        where = "at the end" if call == _AT_END else f"at t = {time[self._failed_step.value]:.17g}"
+        return self.messages.error(status, f"{_CALLS[call]} {where}")

@@ -8,7 +8,7 @@ OSError for a file, ...). The kinds that belong to one module live there:
 
     torque_schedule.TorqueFileError   a torque CSV that is not a signal
     simulate.FmuError                 an FMI call failed or the FMU refused a value
-    parameters.FmuFileError           a file given as an FMU that is none this package can run
+    model.FmuFileError                a file given as an FMU that is none this package can run
     compare_tools.ToolSpecError       a --tools list that names no runnable tool
     mapped_fmu.MapError               a --map, or an FMU that does not fit it
     judge.ResultFileError             a result file, or a kit's folder, that cannot be judged
@@ -22,6 +22,7 @@ OSError for a file, ...). The kinds that belong to one module live there:
     sweep.store.InUse                 an output folder another run holds
     sweep.store.StudyExists           an output folder holding a study the run was not asked to replace
     sweep.client.SchedulerUnreachable a dask scheduler that does not answer
+    sweep.client.SchedulerLost        a dask scheduler lost while a study ran
     BuildError                        an FMU that cannot be built (by a checkout's fmu_build/)
 """
 

@@ -38,6 +38,7 @@ from pathlib import Path
 import numpy as np
 
 from . import results
+from .regression_tools import format_verdicts, regression_verdicts
 from .atomic_files import replacing
 from .errors import InvalidInput
 from .mapped_fmu import as_map
@@ -137,6 +138,8 @@ class Judgement:
     # The variant the diagnosis names, at the result's times (None for agrees and unexplained).
     explanation: np.ndarray | None = field(default=None, repr=False)
     source: str = "result"
+    # csv-compare's tube and the FMI cross-check's band on theta (regression_tools.regression_verdicts).
+    regression_tools: list[dict] = field(default_factory=list)
 
     @property
     def passed(self) -> bool:
@@ -153,6 +156,7 @@ class Judgement:
                 "residual": self.residual, "max_abs_dtheta": self.max_abs_dtheta, **worst,
                 "worst_time": self.worst_time, "tolerance": self.tolerance, "points": len(self.result),
                 "candidates": self.candidates, "smallest_input_effect": self.smallest_input_effect,
+                "regression_tools": self.regression_tools,
                 "units": {"residual": "rad", "max_abs_dtheta": "rad", "max_abs_domega": "rad/s",
                           "max_abs_dalpha": "rad/s2", "worst_time": "s", "tolerance": "rad",
                           "candidates": "rad", "smallest_input_effect": "rad"}}
@@ -432,14 +436,14 @@ def judge(result, torque, *, start_time: float = 0.0, stop_time: float | None = 
     start_time, stop_time, step_size, ramp, parameters, theta0, omega0, max_steps, fmu_path
         The run's definition, as simulate() takes it.
     tolerance : float, optional
-        The largest |dtheta| (rad) that passes (default: DEFAULT_TOLERANCE, 1e-9 rad).
+        The largest ``|dtheta|`` (rad) that passes (default: DEFAULT_TOLERANCE, 1e-9 rad).
     mapping : str or dict, optional
         The result's column names and unit factors (--map), for a CSV.
 
     Returns
     -------
     Judgement
-        The verdict, the diagnosis and its residual, max |dtheta| and where, every candidate's
+        The verdict, the diagnosis and its residual, ``max |dtheta|`` and where, every candidate's
         residual and effect.
 
     Raises
@@ -506,7 +510,8 @@ def judge(result, torque, *, start_time: float = 0.0, stop_time: float | None = 
     return Judgement(verdict="pass" if raw <= tolerance else "fail", diagnosis=diagnosis, residual=residual,
                      max_abs_dtheta=raw, worst_time=worst_time, tolerance=tolerance, candidates=scores,
                      smallest_input_effect=smallest_input_effect, result=result, reference=correct,
-                     explanation=best_variant.get(diagnosis) if diagnosis != AGREES else None, source=source)
+                     explanation=best_variant.get(diagnosis) if diagnosis != AGREES else None, source=source,
+                     regression_tools=regression_verdicts(times, correct["theta"], result["theta"]))
 
 
 def format_judgement(judgement: Judgement) -> str:
@@ -533,6 +538,9 @@ def format_judgement(judgement: Judgement) -> str:
             lines.append(f"{name:<28} {'does not apply to this run':>24}")
         else:
             lines.append(f"{name:<28} {score['residual']:>12.2e} {score['effect']:>11.2e}")
+    if judgement.regression_tools:
+        lines.append("what regression tools would say, on theta against the reference:")
+        lines.extend(f"  {line}" for line in format_verdicts(judgement.regression_tools))
     return "\n".join(lines)
 
 

@@ -120,10 +120,10 @@ class FmuModel:
 
     @cached_property
     def default_parameters(self) -> dict[str, float]:
-        """{name: start value} of every parameter (shared: copy before changing); raises as
-        pendulum_variables."""
+        """{name: start value} of every Real parameter (shared: copy before changing); raises as
+        pendulum_variables. String parameters (callRecordFile) are no physical parameter."""
         return {name: float(v.start) for name, v in self.pendulum_variables.items()
-                if v.causality == "parameter"}
+                if v.causality == "parameter" and v.type in ("Real", "Float64")}
 
     @cached_property
     def outputs(self) -> tuple[str, ...]:

@@ -390,9 +390,12 @@ names what the master did differently, step by step. How to get it:
 - fmusim: `--logging-on --log-file NAME_calls.log`, or `--log-fmi-calls --fmi-log-file
   NAME_calls.log` (fmusim's own call log).
 - libcosim: `log_output_level(CosimLogLevel.TRACE)`; send its whole output.
-- OMSimulator: a release build drops the FMU's messages of status OK; send its `setLogFile` log
-  with the FMU's debug logging on if your build shows them.
-- Simulink (FMIKit), Dymola: turn on the FMU's debug logging and send the log they write.
+- OMSimulator: a release build drops the FMU's messages of status OK, so set the FMU's String
+  parameter `callRecordFile` to a path (`oms_setString(".../callRecordFile", "NAME_calls.log")`
+  before initialization). The FMU appends its record to that file itself.
+- Simulink (FMIKit), Dymola: set the FMU's parameter `callRecordFile` to `NAME_calls.log`, or
+  turn on the FMU's debug logging and send the log they write.
+- Any master: `callRecordFile` works whatever the master does with the FMU's messages.
 
 `{KIT_FMU}` carries the same files under `{LS_REF_FOLDER}` as related files of the FMI layered
 standard FMI-LS-REF {LS_REF_VERSION}: `fmi-ls-manifest.xml`, the experiments file

@@ -19,6 +19,7 @@ from pathlib import Path
 
 import fmpy
 import numpy as np
+from fmpy.fmi1 import printLogMessage
 from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
 from fmpy.fmi3 import FMU3Slave
 
@@ -48,6 +49,10 @@ def _log_to_instance(environment, instance_name, status, category, message):
     log = _logs.get(environment)
     if log is not None:
         log.log_fmi3(environment, status, category, message)
+    elif environment is None:
+        # An instance fmpy made with its default callbacks (the user's own FMU2Slave): fmpy's
+        # proxy now calls this logger for it too, so print its messages as fmpy's would.
+        printLogMessage(environment, instance_name, status, category, message)
 
 
 # One FMI 2.0 logger for every instance, never freed, which hands each message to its instance's

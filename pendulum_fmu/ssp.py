@@ -20,7 +20,7 @@ from pathlib import Path
 from xml.etree import ElementTree
 
 from .atomic_files import replacing
-from .build import build_fmu, build_pid_controller
+from ._checkout import build_tool
 from .closed_loop import WIRES, controller_defaults
 from .errors import InvalidInput, MissingFile, PendulumFmuError
 from .simulate import resolve_parameters
@@ -247,8 +247,8 @@ def export_ssp(
         raise SspExists(f"{out_file} exists: pass --overwrite to replace it, or name another file")
     with tempfile.TemporaryDirectory(prefix="pendulum_fmu_ssp_") as tmp:
         fmus = {
-            "pendulum": build_fmu(Path(tmp) / "Pendulum.fmu"),
-            "controller": build_pid_controller(Path(tmp) / "PIDController.fmu"),
+            "pendulum": build_tool().build_fmu(Path(tmp) / "Pendulum.fmu"),
+            "controller": build_tool().build_pid_controller(Path(tmp) / "PIDController.fmu"),
         }
         with replacing(out_file, "wb") as file, zipfile.ZipFile(file, "w", zipfile.ZIP_DEFLATED) as archive:
             archive.writestr("SystemStructure.ssd", system_structure_xml(stop_time, step_size))

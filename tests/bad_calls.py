@@ -41,6 +41,13 @@ def refs(*references):
     return (ctypes.c_uint * len(references))(*references)
 
 
+def strings(*values):
+    return (ctypes.c_char_p * len(values))(*values)
+
+
+CALL_RECORD_FILE = 9  # the String parameter callRecordFile's value reference; FMI 3.0 time has the next
+
+
 class Harness:
     """The FMU's library through ctypes, with a logger that keeps what the FMU says."""
 
@@ -431,6 +438,14 @@ def _no_instance(check):
 NAN, INF = float("nan"), float("inf")
 MAX_FMU_STATES = 10000  # fmu_src/include/instance.h: the FMU states one instance holds at most
 
+def _ready_then(call, *arguments, kind=CO_SIMULATION):
+    return lambda h: getattr(h, call)(h.ready(kind=kind), *(a() if callable(a) else a for a in arguments))
+
+
+def _instantiated_then(call, *arguments):
+    return lambda h: getattr(h, call)(h.instantiate(), *(a() if callable(a) else a for a in arguments))
+
+
 CASES = [
     # Non-finite values
     Case("non-finite values", "torque = NaN after initialization", "fmi2SetReal", ERROR, "torque = nan refused",
@@ -563,6 +578,20 @@ CASES = [
          ERROR, "implausible state: parameters no initialization would accept", _deserialize(_resealed(84, struct.pack("<d", -1.0)))),
     Case("FMU state blobs", "a machine state of 2^32 + 4, checksum made anew", "fmi2DeSerializeFMUstate", ERROR,
          "implausible state: unknown machine state", _deserialize(_resealed(12, struct.pack("<q", (1 << 32) | 4)))),
+    Case("record file", "callRecordFile = NULL", "fmi2SetString", ERROR, "callRecordFile is NULL",
+         _instantiated_then("fmi2SetString", refs(CALL_RECORD_FILE), 1, lambda: strings(None))),
+    Case("record file", "callRecordFile of 1024 bytes", "fmi2SetString", ERROR,
+         "callRecordFile is 1024 bytes long: at most 1023",
+         _instantiated_then("fmi2SetString", refs(CALL_RECORD_FILE), 1, lambda: strings(b"x" * 1024))),
+    Case("record file", "a String set at vr 0 (torque, a Real)", "fmi2SetString", ERROR,
+         "vr 0: no String variable has this value reference",
+         _instantiated_then("fmi2SetString", refs(TORQUE), 1, lambda: strings(b"record.log"))),
+    Case("record file", "callRecordFile set after initialization", "fmi2SetString", ERROR,
+         "callRecordFile is a fixed parameter",
+         _ready_then("fmi2SetString", refs(CALL_RECORD_FILE), 1, lambda: strings(b"record.log"))),
+    Case("record file", "callRecordFile in a folder that does not exist", "fmi2SetString", WARNING,
+         "cannot be opened for appending",
+         _instantiated_then("fmi2SetString", refs(CALL_RECORD_FILE), 1, lambda: strings(b"/no/such/folder/record.log"))),
     *_foreign_state_cases(Harness),
 ]
 
@@ -591,10 +620,6 @@ def _discarded_huge_step_fmi3(h):
     return status
 
 
-def _ready_then(call, *arguments, kind=CO_SIMULATION):
-    return lambda h: getattr(h, call)(h.ready(kind=kind), *(a() if callable(a) else a for a in arguments))
-
-
 def _flags(n):
     return [ctypes.byref(ctypes.c_bool()) for _ in range(n)]
 
@@ -611,7 +636,7 @@ CASES_FMI3 = [
     Case("non-finite values", "start angle theta = -inf", "fmi3SetFloat64", ERROR, "theta = -inf refused",
          lambda h: _unchanged_after(h, h.initializing(), THETA, -INF)),
     Case("non-finite values", "time set (the independent variable)", "fmi3SetFloat64", ERROR, "cannot set time",
-         lambda h: h.fmi3SetFloat64(h.ready(), refs(9), 1, reals(1.0), 1)),
+         lambda h: h.fmi3SetFloat64(h.ready(), refs(CALL_RECORD_FILE + 1), 1, reals(1.0), 1)),
     Case("physical nonsense", "mass = 0", "fmi3ExitInitializationMode", ERROR, "mass must be > 0", _exit_with_fmi3(mass=0.0)),
     Case("state machine", "fmi3DoStep before initialization", "fmi3DoStep", ERROR, "not allowed in state 'instantiated'",
          lambda h: h.step(h.instantiate(), 0.0, 0.001)),
@@ -639,6 +664,11 @@ CASES_FMI3 = [
                      lambda: reals(0.0), 1)),
     Case("state machine", "an Int32 variable read", "fmi3GetInt32", ERROR, "this FMU has no variables of this type",
          _ready_then("fmi3GetInt32", refs(0), 1, lambda: (ctypes.c_int32 * 1)(), 1)),
+    Case("record file", "callRecordFile = NULL", "fmi3SetString", ERROR, "callRecordFile is NULL",
+         _instantiated_then("fmi3SetString", refs(CALL_RECORD_FILE), 1, lambda: strings(None), 1)),
+    Case("record file", "callRecordFile of 1024 bytes", "fmi3SetString", ERROR,
+         "callRecordFile is 1024 bytes long: at most 1023",
+         _instantiated_then("fmi3SetString", refs(CALL_RECORD_FILE), 1, lambda: strings(b"x" * 1024), 1)),
     Case("counts", "nValues = 2 for one value reference", "fmi3SetFloat64", ERROR, "nValues = 2, expected 1",
          _ready_then("fmi3SetFloat64", refs(TORQUE), 1, lambda: reals(1.0, 2.0), 2)),
     Case("counts", "adjoint with nSensitivity = nUnknowns instead of nKnowns", "fmi3GetAdjointDerivative", ERROR,

@@ -216,6 +216,72 @@ def test_fmpy_simulate_command_line_late_first_jump(fmu, tmp_path):
     assert written["intended_torque"] == [20] * 10
 
 
+def test_a_master_one_step_late_at_10_ms_passes_the_tube_while_the_judge_names_it_late(fmu, tmp_path):
+    """The 5 s jump fed to fmpy's API at 5.01 s, steps of 10 ms over 10 s: its call log is read.
+
+    csv-compare's tube is 0.002 * 10 s = +-20 ms wide, two steps: it passes the late run.
+    """
+    intended = tmp_path / "jump_at_5_s.csv"
+    intended.write_text("time,torque\n0,0\n5,0\n5,20\n10,20\n")
+    late = np.array([(0, 0), (5.01, 0), (5.01, 20), (10, 20)], dtype=[("time", float), ("torque", float)])
+    calls = []
+    simulate_fmu(str(fmu), stop_time=10.0, step_size=0.01, output_interval=0.01, input=late,
+                 fmi_call_logger=calls.append)
+    log = tmp_path / "fmpy_calls.log"
+    log.write_text("\n".join(calls) + "\n")
+    result = reading(log, IntendedRun(intended))
+    assert [line.split(" (t")[0] for line in result["differences"]] == ["input applied 1 step late from step 500"]
+    tube, band = result["regression_tools"]
+    assert (tube["tool"], tube["passed"], tube["outside"], tube["points"]) == ("csv-compare tube", True, 0, 1001)
+    assert tube["half_width"] == pytest.approx(0.02, abs=1e-15)
+    assert (band["tool"], band["passed"]) == ("FMI cross-check band", True)
+
+
+@pytest.mark.parametrize("source", [0, 1], ids=["fmu-record", "fmpy-call-log"])
+def test_a_step_late_on_a_short_run_fails_the_tube_after_the_jump(fmu, capsys, tmp_path, jump_csv, source):
+    # 10 steps of 1 ms: the tube is +-0.002 * 10 ms = +-20 us, far inside a step, so every
+    # point after the late step (t = 6 .. 10 ms, 5 of 11) is outside: the late run has
+    # 1 ms less of 20 N.m, a difference of the order of the whole range of theta there.
+    log = drive(fmu, capsys, tmp_path, torque_of_step=lambda k: intended_torque(k - 1))[source]
+    tube, _ = reading(log, IntendedRun(jump_csv))["regression_tools"]
+    assert (tube["passed"], tube["outside"], tube["points"]) == (False, 5, 11)
+    assert tube["half_width"] == pytest.approx(2e-5, rel=1e-12)
+
+
+@pytest.mark.parametrize("fixture", ["fmu", "fmu3"])
+def test_the_record_file_a_parameter_names_is_read_by_the_judge(request, fixture, tmp_path, jump_csv):
+    """The start value callRecordFile set through fmpy, with the jump fed one step late (at 6 ms)."""
+    fmu = request.getfixturevalue(fixture)
+    record = tmp_path / "calls.log"
+    late = np.array([(0, 0), (0.006, 0), (0.006, 20), (0.01, 20)], dtype=[("time", float), ("torque", float)])
+    calls = []
+    simulate_fmu(str(fmu), stop_time=N_STEPS * STEP, step_size=STEP, output_interval=STEP, input=late,
+                 start_values={"callRecordFile": str(record)}, fmi_call_logger=calls.append)
+    # fmpy's own call log holds the fmi*SetString call too; the judge reads past it.
+    call_log = tmp_path / "fmpy_calls.log"
+    call_log.write_text("\n".join(calls) + "\n")
+    assert [line.split(" (t")[0] for line in reading(call_log, IntendedRun(jump_csv))["differences"]] == [
+        "input applied 1 step late from step 5"]
+    lines = record.read_text().splitlines()
+    prefix = "fmi2" if fixture == "fmu" else "fmi3"
+    assert lines[0].startswith(f'[pendulum-calls] instance="Pendulum" {prefix}SetString(file="{record}") ')
+    assert sum(f"{prefix}DoStep(" in line for line in lines) == N_STEPS
+    found = reading(record, IntendedRun(jump_csv))["differences"]
+    assert [line.split(" (t")[0] for line in found] == ["input applied 1 step late from step 5"]
+    assert main(["judge", "--calls", str(record), "--torque-file", str(jump_csv), "--fmu", str(fmu)]) == 1
+
+
+def test_a_record_file_that_cannot_be_opened_is_one_warning_and_the_run_completes(fmu, tmp_path, capsys):
+    missing = tmp_path / "no such folder" / "calls.log"
+    result = simulate_fmu(str(fmu), stop_time=N_STEPS * STEP, step_size=STEP, output_interval=STEP,
+                          start_values={"callRecordFile": str(missing), "torque": 20.0})
+    warnings = [line for line in capsys.readouterr().out.splitlines() if "callRecordFile" in line]
+    assert warnings == [f"[WARNING] fmi2SetString: callRecordFile {missing} cannot be opened for appending "
+                        "(No such file or directory): the FMU writes no record file"]
+    assert not missing.parent.exists()
+    assert result["time"].tolist() == pytest.approx([k * STEP for k in range(N_STEPS + 1)], abs=1e-15)
+
+
 LIBCOSIM_RUN = """
 import sys
 from libcosimpy.CosimExecution import CosimExecution

@@ -78,3 +78,46 @@ def test_native_restart_matches_a_fresh_instance_bit_for_bit(fmu):
             stepper.run(plan.time, None, None, restarted, start_values=np.array([-1.0, 0.0, 0.0, 0.0]))
     finally:
         slave.freeInstance()
+
+
+def test_a_chunk_in_one_call_matches_case_by_case_and_the_physics_bit_for_bit(fmu):
+    """run_cases (a chunk's cases in one call, as a sweep worker runs them) gives, for every case,
+    what a restart per call and a fresh instance in Python give, bit for bit; a case the FMU
+    refuses in the middle gets its own message and a NaN row, and the cases after it are still
+    right (each restart begins with fmi2Reset)."""
+    names = ("mass", "damping", "theta", "torque")
+    cases = np.array([[30.0, 2.0, 0.4, 12.0], [-1.0, 0.0, 0.0, 0.0], [55.0, 0.5, -0.2, 7.0],
+                      [1.0, 0.0, 0.1, -3.0]])
+    references = np.array([value_reference(n, fmu) for n in names], np.uint32)
+    outputs = np.array([value_reference(n, fmu) for n in OUTPUTS], np.uint32)
+    points = schedule(0.0, stop_time=0.2, step_size=1e-3).time
+    slave = simulate.open_fmu(fmu)
+    try:
+        stepper = cs_loop.Stepper(slave, np.empty(0, np.uint32), outputs, references)
+        chunk = np.empty((3, len(cases), len(points)))
+        messages = stepper.run_cases(points, cases, chunk)
+        chunk = chunk.transpose(1, 2, 0)  # (cases, points, outputs), as run() writes a case
+        assert messages[0] == messages[2] == messages[3] == ""
+        assert messages[1].startswith("initialization failed: ") and "mass must be > 0" in messages[1]
+        assert np.isnan(chunk[1]).all()
+        with pytest.raises(simulate.FmuError) as refused:
+            stepper.run(points, None, None, np.empty((len(points), 3)), start_values=cases[1])
+        assert messages[1] == str(refused.value)
+        for case in (0, 2, 3):
+            one_call = np.empty((len(points), 3))
+            stepper.run(points, None, None, one_call, start_values=cases[case])
+            assert np.array_equal(chunk[case], one_call), case
+            mass, damping, theta0, torque = cases[case]
+            parameters = {"mass": mass, "damping": damping}
+            plan = schedule(torque, stop_time=0.2, step_size=1e-3)
+            fresh = simulate.open_fmu(fmu, parameters=parameters, theta0=theta0)
+            try:
+                expected = simulate.run_schedule_python(fresh, plan)
+            finally:
+                fresh.freeInstance()
+            for column, name in enumerate(OUTPUTS):
+                assert np.array_equal(chunk[case, :, column], expected[name]), (case, name)
+            oracle = reference_schedule(plan, theta0=theta0, parameters=parameters)
+            assert np.max(np.abs(chunk[case, :, 0] - oracle["theta"])) < 1e-9, case
+    finally:
+        slave.freeInstance()

@@ -26,6 +26,6 @@ def test_every_exception_class_of_the_package_is_a_user_error():
                     and value.__module__.startswith("pendulum_fmu")):
                 defined[f"{value.__module__}.{name}"] = value
     assert {"pendulum_fmu.torque_schedule.TorqueFileError", "pendulum_fmu.simulate.FmuError",
-            "pendulum_fmu.parameters.FmuFileError",
+            "pendulum_fmu.model.FmuFileError",
             "pendulum_fmu.errors.BuildError", "pendulum_fmu.sweep.store.InUse"} <= set(defined)
     assert [name for name, value in defined.items() if not issubclass(value, PendulumFmuError)] == []

@@ -9,17 +9,22 @@ is only what the artefact installs.
 """
 
 import csv
+import importlib.metadata
 import io
 import os
+import re
 import subprocess
 import sys
 import sysconfig
+import tarfile
 import zipfile
 from pathlib import Path
 
 import numpy as np
 import pytest
 from fmpy import read_model_description
+from packaging.requirements import Requirement
+from readme_figures import measured_figures
 
 from pendulum_fmu import FMU_FILES, __version__
 from pendulum_fmu.reference import reference
@@ -85,8 +90,14 @@ def test_wheel_carries_the_fmu_for_every_platform_built(artefacts, tmp_path):
         assert "pendulum_fmu/data/Pendulum.fmu" in names
         assert not any(name.startswith(("fmu_src/", "fmu_build/", "tests/", "dist/")) for name in names)
         assert not any(name.startswith("pendulum_fmu/") and name.endswith(("/build.py", "/fmi3.py")) for name in names)
+        # The MIT text pyproject names travels with the wheel (license-files) and the sdist.
+        licence = next(name for name in names if name.endswith(".dist-info/licenses/LICENSE"))
+        assert wheel.read(licence) == (ROOT / "LICENSE").read_bytes()
         fmus = {version: zipfile.ZipFile(io.BytesIO(wheel.read(f"pendulum_fmu/data/{name}")))
                 for version, name in FMU_FILES.items()}
+    with tarfile.open(artefacts["sdist"]) as sdist:
+        [top] = {name.split("/")[0] for name in sdist.getnames()}
+        assert sdist.extractfile(f"{top}/LICENSE").read() == (ROOT / "LICENSE").read_bytes()
     # Every platform the docs promise, from this source build (zig, a build requirement, makes macOS's).
     assert {name for name in fmus[2].namelist() if name.startswith("binaries/")} == {
         "binaries/linux64/Pendulum.so", "binaries/win64/Pendulum.dll", "binaries/aarch64-linux/Pendulum.so",
@@ -145,3 +156,53 @@ def test_installed_package_runs_from_an_empty_folder(installed, tmp_path):
     assert "invalid choice: 'build'" in _run([cli, "build"], cwd=tmp_path, check=False).stderr
 
     assert _files_under(package) == before  # nothing written into site-packages
+
+
+# The set-up's sizes the install page states (benchmarks.install's measured block) hold for
+# this build within this fraction: they drift with every build change and dependency release.
+SIZE_TOLERANCE = 0.10
+INSTALL_BENCHMARK = ".venv/bin/python -m benchmarks.install"
+
+
+def _bytes_under(folder: Path) -> int:
+    return sum(path.stat().st_size for path in folder.rglob("*") if path.is_file() and not path.is_symlink())
+
+
+def _dependency_closure(name: str, extras=("",), found=None) -> dict:
+    """{normalized name: distribution} of name and everything it requires, installed here."""
+    found = {} if found is None else found
+    key = re.sub(r"[-_.]+", "-", name).lower()
+    if key not in found:
+        found[key] = distribution = importlib.metadata.distribution(name)
+        for text in distribution.requires or []:
+            requirement = Requirement(text)
+            if requirement.marker is None or any(requirement.marker.evaluate({"extra": extra})
+                                                 for extra in extras):
+                _dependency_closure(requirement.name, ("", *requirement.extras), found)
+    return found
+
+
+def _installed_bytes(distribution) -> int:
+    return sum(path.stat().st_size for path in map(distribution.locate_file, distribution.files or [])
+               if path.is_file())
+
+
+def test_the_documented_sizes_are_this_build_s(artefacts, installed):
+    """The wheel, the installed package and its environment are the sizes the install page states.
+
+    Each within SIZE_TOLERANCE. The environment `pip install` of the wheel makes is measured as
+    the fresh venv (pip) plus the package plus every distribution the wheel requires, as
+    installed in the test environment (which the fresh venv borrows through its .pth line).
+    """
+    venv, site_packages = installed
+    stated = measured_figures(INSTALL_BENCHMARK)
+    dependencies = {key: dist for key, dist in _dependency_closure("pendulum-fmu").items() if key != "pendulum-fmu"}
+    package = _bytes_under(site_packages / "pendulum_fmu")
+    measured = {
+        "wheel_kb": artefacts["wheel"].stat().st_size / 1e3,
+        "package_kb": package / 1e3,
+        "environment_mb": (_bytes_under(venv) + sum(map(_installed_bytes, dependencies.values()))) / 1e6,
+    }
+    drifted = {name: f"stated {stated[name]}, measured {value:.0f}" for name, value in measured.items()
+               if abs(value - float(stated[name])) > SIZE_TOLERANCE * value}
+    assert not drifted, f"docs/install.md's sizes drifted (rerun `{INSTALL_BENCHMARK}`): {drifted}"

@@ -1,4 +1,4 @@
-"""Every shell command the READMEs show runs exactly as written, as a newcomer would run it.
+"""Every shell command the READMEs and the docs pages show runs as written, as a newcomer runs it.
 
 What counts as a command: each line of an indented (4-space) code block and of a ```sh, ```bash,
 ```shell or ```console fenced block (console lines start with "$ "), lines ending in a backslash
@@ -7,11 +7,14 @@ Everything else a README shows as code goes in a fenced block with another langu
 ```python), so an indented block is always something to type.
 
 Each command runs with `bash -c` in a fresh shell (no virtual environment active, no venv on
-PATH), in document order, in one temporary copy of the repository per README, so its outputs
-never land in the checkout. The copy's `.venv` is a symlink to this interpreter's environment:
-that stands for "after the set-up command", which CI (.ci/run) runs itself. The few commands that
-cannot run here are listed in EXCLUDED, each with its reason; every entry must match a command,
-so the list stays what the READMEs need.
+PATH), in document order, in one temporary copy of the repository per README (the docs pages,
+which were the README's sections, share one copy and run in the README's old order), so its
+outputs never land in the checkout. The copy leaves out what the commands write when run in the
+clone (the section of .gitignore that lists them): the README's main job leaves `demo/`, which
+the same README's `demo --output-dir demo` would refuse. The copy's `.venv` is a symlink to this
+interpreter's environment: that stands for "after the set-up command", which CI (.ci/run) runs
+itself. The few commands that cannot run here are listed in EXCLUDED, each with its reason;
+every entry must match a command, so the list stays what the documents need.
 """
 
 import os
@@ -26,6 +29,13 @@ import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 READMES = ("README.md", "examples/README.md")
+# The docs pages with commands, in the order the README held them.
+DOCS_PAGES = tuple(f"docs/{name}.md" for name in (
+    "install", "fmu", "fmi3", "torque_signals", "python_api", "command_line", "comparing", "judging",
+    "scenario_kit", "masters", "sweeps", "robustness_overview", "benchmarks", "layout"))
+DOCUMENTS = READMES + DOCS_PAGES
+# The heading of the .gitignore section that lists what the documents' commands write.
+OUTPUTS_SECTION = "# What the README's commands write when run in a clone"
 
 # The set-up commands: CI runs them; here the .venv symlink stands for them, and what follows
 # them on the line runs.
@@ -109,7 +119,7 @@ def to_run(command: str):
 
 
 def readme_commands():
-    for readme in READMES:
+    for readme in DOCUMENTS:
         for index, command in enumerate(commands_in((ROOT / readme).read_text(encoding="utf-8"))):
             yield pytest.param(readme, command, id=f"{readme}:{index}:{command[:60]}")
 
@@ -138,20 +148,59 @@ def test_every_exclusion_matches_a_command():
     assert not unused, f"exclusions that match no README command (remove them): {unused}"
 
 
+def command_outputs(gitignore: str) -> set[str]:
+    """The top-level names .gitignore's OUTPUTS_SECTION lists (`/demo/` -> `demo`)."""
+    lines = gitignore.splitlines()
+    section = lines[lines.index(OUTPUTS_SECTION) + 1:]
+    listed = section[:next((n for n, line in enumerate(section) if not line.startswith("/")), len(section))]
+    return {line.strip("/").split("/")[0] for line in listed}
+
+
+def copy_of_the_clone(root: Path, target: Path) -> Path:
+    """The clone at root copied to target as its commands meet it fresh.
+
+    The copy holds neither the build's outputs nor what the documents' commands wrote into the
+    clone; its `.venv` stands for the set-up (this interpreter's environment).
+    """
+    left_out = command_outputs((root / ".gitignore").read_text(encoding="utf-8"))
+
+    def ignored(folder, names):
+        at_top = Path(folder) == root
+        return shutil.ignore_patterns(".venv", ".git", "dist", "build", "out", "__pycache__", "*.egg-info",
+                                      ".pytest_cache")(folder, names) | \
+            {name for name in names if at_top and name in left_out}
+
+    shutil.copytree(root, target, symlinks=True, ignore=ignored)
+    (target / ".venv").symlink_to(sys.prefix, target_is_directory=True)
+    return target
+
+
 @pytest.fixture(scope="module")
 def copies(tmp_path_factory):
-    """One copy of the repository per README, made when its first command runs."""
+    """One copy of the repository per README (one for all the docs pages), made on first use."""
     made = {}
 
-    def copy_for(readme):
-        if readme not in made:
-            target = tmp_path_factory.mktemp("readme") / "pendulum-fmu"
-            shutil.copytree(ROOT, target, symlinks=True, ignore=shutil.ignore_patterns(
-                ".venv", ".git", "dist", "build", "out", "__pycache__", "*.egg-info", ".pytest_cache"))
-            (target / ".venv").symlink_to(sys.prefix, target_is_directory=True)
-            made[readme] = target
-        return made[readme]
+    def copy_for(document):
+        key = "docs" if document in DOCS_PAGES else document
+        if key not in made:
+            made[key] = copy_of_the_clone(ROOT, tmp_path_factory.mktemp("readme") / "pendulum-fmu")
+        return made[key]
     return copy_for
+
+
+def test_the_copy_leaves_out_what_the_main_job_wrote(tmp_path):
+    clone = tmp_path / "clone"
+    (clone / "demo").mkdir(parents=True)
+    (clone / "demo" / "gravity_effect.png").write_bytes(b"from the main job")
+    (clone / "docs" / "demo").mkdir(parents=True)  # a folder of that name deeper down is a source
+    (clone / "Pendulum.fmu").write_bytes(b"from the quick start")
+    (clone / "README.md").write_text("# a README\n", encoding="utf-8")
+    gitignore = (ROOT / ".gitignore").read_text(encoding="utf-8")
+    (clone / ".gitignore").write_text(gitignore, encoding="utf-8")
+    copy = copy_of_the_clone(clone, tmp_path / "copy")
+    assert sorted(path.name for path in copy.iterdir()) == [".gitignore", ".venv", "README.md", "docs"]
+    assert (copy / "docs" / "demo").is_dir()
+    assert {"demo", "Pendulum.fmu", "torque.csv", "study"} <= command_outputs(gitignore)
 
 
 def fresh_shell_environment():

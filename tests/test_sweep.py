@@ -3,8 +3,10 @@ references, resume, failures, fsspec URLs, a cluster of separate processes, sign
 concurrent runs, and the studies refused before anything starts."""
 
 import glob
+import json
 import logging
 import os
+import re
 import signal
 import socket
 import subprocess
@@ -19,6 +21,7 @@ import pyarrow.csv
 import pyarrow.dataset as ds
 import pytest
 from dask.distributed import Client, LocalCluster
+from fsspec.implementations.local import LocalFileSystem
 
 import benchmarks.scale
 
@@ -27,7 +30,8 @@ from pendulum_fmu.cli import main
 from pendulum_fmu.errors import InvalidInput
 from pendulum_fmu.reference import reference
 from pendulum_fmu.sweep import OUTPUTS, Study, run_sweep, sweep_grid
-from pendulum_fmu.sweep.store import StudyExists
+from pendulum_fmu.sweep.store import Store, StudyExists
+from pendulum_fmu.sweep.worker import Task, run_chunk
 
 # The module; the package's attribute of that name is its function.
 simulate = import_module("pendulum_fmu.simulate")
@@ -168,6 +172,57 @@ def test_resume_runs_only_the_chunks_not_written(tmp_path, threads_scheduler):
     assert not list(tmp_path.glob("**/.*"))
 
 
+def _stale_task(output_dir) -> Task:
+    """The task a worker of the run that last wrote output_dir holds: its store and run token."""
+    manifest = json.loads((output_dir / "study.json").read_text())
+    study = manifest["study"]
+    return Task(fmu=str(default_fmu()), store=Store(LocalFileSystem(), str(output_dir), "parquet"),
+                stop_time=study["stop_time"], step_size=study["step_size"],
+                outputs=tuple(study["outputs"]), stride=study["stride"], run=manifest["run"])
+
+
+def test_a_stale_workers_part_never_enters_the_study_that_replaced_its_own(tmp_path, threads_scheduler):
+    # Issue 32: a worker stopped mid-study writes its chunk after the study was replaced by
+    # another (--overwrite, another grid) in the same folder.
+    old_cases = sweep_grid([10.0, 20.0], [9.81], {"damping": [0.0, 0.5]})
+    new_cases = sweep_grid([10.0, 20.0], [9.81], {"damping": [0.0, 0.25]})
+    run_sweep(Study(old_cases, stop_time=STOP_TIME), output_dir=tmp_path, scheduler=threads_scheduler,
+              progress=False)
+    stale = _stale_task(tmp_path)
+    new = run_sweep(Study(new_cases, stop_time=STOP_TIME), output_dir=tmp_path, overwrite=True,
+                    scheduler=threads_scheduler, progress=False)
+    assert new.chunks == 4 and _stale_task(tmp_path).run != stale.run
+    parts = {p: p.read_bytes() for p in tmp_path.glob("*/part-*")}
+    cases, trajectories = _table(tmp_path / "cases"), _table(tmp_path / "trajectories")
+    # The stopped worker continues: chunk 1 of the old study, case 1, damping 0.5.
+    assert run_chunk(1, 1, old_cases.columns(1, 2), stale)[:3] == (1, 1, 0)
+    assert len(list(tmp_path.glob("*/_part-000001.*.staged"))) == 2  # it did write
+    # No reader takes it: the folder's tables, the package's reading of the cases, a resume.
+    assert {p: p.read_bytes() for p in tmp_path.glob("*/part-*")} == parts
+    for name, table in (("cases", cases), ("trajectories", trajectories)):
+        again = _table(tmp_path / name)
+        assert all(np.array_equal(again[k], table[k]) for k in table), name
+    expected = _exact({"torque": 10.0, "damping": 0.25})
+    assert cases["damping"][1] == 0.25 and cases["final_theta"][1] == expected["theta"][-1]
+    assert np.array_equal(trajectories["theta"][trajectories["case"] == 1], expected["theta"])
+    assert Store(LocalFileSystem(), str(tmp_path), "parquet").read_cases(["torque", "gravity", "damping"])[
+        "final_theta"].to_pylist() == cases["final_theta"].tolist()
+    resumed = run_sweep(Study(new_cases, stop_time=STOP_TIME), output_dir=tmp_path, resume=True,
+                        scheduler=threads_scheduler, progress=False)
+    assert resumed.chunks_run == 0 and {p: p.read_bytes() for p in tmp_path.glob("*/part-*")} == parts
+    assert not list(tmp_path.glob("*/_part-*"))  # and the stale parts are gone
+
+
+def test_a_run_commits_only_the_parts_staged_under_its_own_token(tmp_path):
+    store = Store(LocalFileSystem(), str(tmp_path), "parquet")
+    store.write_table("cases", 0, {"case": np.arange(3)}, "other-run")
+    with pytest.raises(FileNotFoundError):
+        store.commit(0, "this-run", ("cases",))
+    assert store.done_chunks() == set()
+    store.commit(0, "other-run", ("cases",))
+    assert store.done_chunks() == {0} and _table(tmp_path / "cases")["case"].tolist() == [0, 1, 2]
+
+
 def test_output_to_a_file_url(tmp_path):
     result = run_sweep(Study(sweep_grid([3.0, 6.0]), stop_time=0.1), output_dir=tmp_path.as_uri(),
                         workers=1, progress=False)
@@ -197,6 +252,32 @@ def test_many_cases_draw_quantile_bands(tmp_path, threads_scheduler):
                         scheduler=threads_scheduler, progress=False)
     assert not (tmp_path / "trajectories").exists()  # no outputs: the cases table alone
     assert result.figure.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_the_command_names_only_what_it_wrote_and_one_duration(tmp_path, capsys, monkeypatch):
+    # Issue 28 item 5: --outputs none printed `wrote .../trajectories`; the progress line and the
+    # summary gave two durations for one run.
+    drawn = []
+
+    class Terminal:  # stderr as a terminal: the bar redrawn in place, and left on screen
+        def write(self, text):
+            drawn.append(text)
+
+        def flush(self):
+            pass
+
+        def isatty(self):
+            return True
+
+    monkeypatch.setattr(sys, "stderr", Terminal())
+    assert main(["sweep", "--torque", "2", "4", "--stop-time", "0.1", "--outputs", "none",
+                 "--workers", "1", "--output-dir", str(tmp_path)]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert re.fullmatch(r"2 cases in \d+\.\d s", out[0]), out
+    assert out[1:] == [f"wrote {tmp_path / 'cases'}", f"wrote {tmp_path / 'sweep.png'}"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cases", "study.json", "sweep.png"]
+    bar = "".join(drawn)
+    assert "2/2 cases, 0 failed" in bar and not re.search(r"\d s\b", bar), bar
 
 
 # --- a folder that holds a study: refused, resumed, or replaced once the new one is whole ----
@@ -329,8 +410,10 @@ def test_a_study_on_a_scheduler_and_workers_started_as_processes(tmp_path, dask_
                     reference(float(torque), stop_time=0.2, step_size=STEP_SIZE)["theta"][-1])
         assert abs(table["final_theta"][number] - expected) < 1e-10
     with Client(dask_processes) as client:
-        # Both workers ran chunks, each unzipping the FMU once.
-        assert list(client.run(lambda: len(simulate._extracted)).values()) == [1, 1]
+        # Both workers ran chunks, each unzipping the FMU once (into its one model object).
+        assert list(client.run(lambda: sum(
+            1 for held in __import__("gc").get_objects()
+            if type(held).__name__ == "FmuModel" and "_unzipped" in vars(held))).values()) == [1, 1]
 
 
 def test_a_chunk_whose_worker_dies_is_run_again(tmp_path, dask_processes):
@@ -357,6 +440,87 @@ def test_a_chunk_whose_worker_dies_is_run_again(tmp_path, dask_processes):
     assert table["case"].tolist() == list(range(256)) and set(table["status"]) == {"ok"}
     assert table["final_theta"][255] == simulate.simulate(40.0, stop_time=10.0)["theta"][-1]
     assert not list(tmp_path.glob("**/.*"))
+
+
+def test_a_scheduler_killed_mid_study_is_one_line_and_resume_on_a_new_one_finishes(tmp_path):
+    # Issue 32, fault 2: the cluster's failure, not ours: exit 2 (as for an unreachable
+    # scheduler), one line naming --resume, none of dask's log.
+    torques = list(map(str, np.linspace(1.0, 40.0, 128)))  # 64 chunks of 2 cases
+    arguments = ("--torque", *torques, "--stop-time", "300", "--outputs", "theta",
+                 "--output-interval", "1")
+    with benchmarks.scale.dask_process_handles(1) as (address, processes):
+        sweep = subprocess.Popen(_sweep_command(tmp_path, *arguments, "--scheduler", address),
+                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        deadline = time.monotonic() + 120
+        while not list(tmp_path.glob("cases/part-*")):
+            assert sweep.poll() is None and time.monotonic() < deadline, sweep.communicate()
+            time.sleep(0.01)
+        processes[0].kill()
+        out, err = sweep.communicate(timeout=120)
+    assert sweep.returncode == 2 and out == "", (out, err)
+    lines = [line for line in err.splitlines() if not line.startswith("sweep: ")]  # progress
+    assert lines == [f"pendulum-fmu sweep: error: the dask scheduler at {address} was lost "
+                     "mid-study (scheduler-connection-lost); the chunks that finished are kept in "
+                     f"{tmp_path}: start a scheduler and run the same command with --resume to "
+                     "run the rest"], err
+    written = len(list(tmp_path.glob("cases/part-*")))
+    assert 0 < written < 64
+    with benchmarks.scale.dask_processes(1) as address:
+        resumed = subprocess.run(_sweep_command(tmp_path, *arguments, "--scheduler", address,
+                                                "--resume"), capture_output=True, text=True, timeout=300)
+    assert resumed.returncode == 0, resumed.stderr
+    assert f"({64 - written} of 64 chunks run;" in resumed.stdout
+    table, trajectories = _table(tmp_path / "cases"), _table(tmp_path / "trajectories")
+    assert table["case"].tolist() == list(range(128)) and set(table["status"]) == {"ok"}
+    assert np.array_equal(np.unique(trajectories["case"]), np.arange(128))
+    for number in (0, 127):  # a chunk of the first run, and one of the resumed run
+        expected = simulate.simulate(float(torques[number]), stop_time=300.0)
+        assert table["final_theta"][number] == expected["theta"][-1]
+
+
+@pytest.mark.skipif(not hasattr(signal, "SIGSTOP"), reason="no SIGSTOP on this platform")
+def test_a_worker_stopped_mid_study_and_continued_after_an_overwrite_changes_nothing(tmp_path, monkeypatch):
+    # Issue 32, fault 1 with the real fault: a worker (no nanny) stopped with SIGSTOP mid-study;
+    # the study finishes without it; another grid replaces it (--overwrite); the worker is
+    # continued and writes its old chunk into the folder.
+    monkeypatch.setenv("DASK_DISTRIBUTED__SCHEDULER__WORKER_TTL", "2s")  # a stopped worker is dropped
+    torques = list(np.linspace(1.0, 40.0, 128))  # 64 chunks of 4 cases, a few s in all
+    options = dict(stop_time=600.0, outputs=["theta"], output_interval=1.0)
+    old = Study(sweep_grid(torques, [9.81], {"damping": [0.0, 0.5]}), **options)
+    new = Study(sweep_grid(torques, [9.81], {"damping": [0.0, 0.25]}), **options)
+    with benchmarks.scale.dask_process_handles(2, nanny=False) as (address, processes):
+        stopped = psutil.Process(processes[1].pid)
+        results = []
+        first = threading.Thread(target=lambda: results.append(run_sweep(
+            old, output_dir=tmp_path, scheduler=address, progress=False)))
+        first.start()
+        deadline = time.monotonic() + 120
+        while not (list(tmp_path.glob("cases/part-*")) and stopped.cpu_percent(0.1) > 30):
+            assert first.is_alive() and time.monotonic() < deadline
+        stopped.suspend()  # mid-chunk: it was computing
+        first.join(timeout=300)
+        assert results[0].cases == 256 and results[0].failed == 0
+        stale_run = _stale_task(tmp_path).run
+        run_sweep(new, output_dir=tmp_path, overwrite=True, scheduler=address, progress=False)
+        parts = {p: p.read_bytes() for p in tmp_path.glob("*/part-*")}
+        stopped.resume()
+        deadline = time.monotonic() + 60
+        while not list(tmp_path.glob(f"cases/_part-*.{stale_run}.staged")):
+            assert time.monotonic() < deadline, list(tmp_path.glob("*/_*"))
+            time.sleep(0.05)
+    assert {p: p.read_bytes() for p in tmp_path.glob("*/part-*")} == parts
+    table, trajectories = _table(tmp_path / "cases"), _table(tmp_path / "trajectories")
+    assert table["case"].tolist() == list(range(256)) and set(table["damping"]) == {0.0, 0.25}
+    assert len(trajectories["case"]) == 256 * 601
+    # The new study's cases are its own: their damping's trajectory, to the bit (every part is
+    # unchanged above; a sample of the damping-0.25 cases against simulate() here).
+    for number in range(1, 256, 16):
+        expected = simulate.simulate(torques[number // 2], parameters={"damping": 0.25}, stop_time=600.0)
+        assert np.array_equal(trajectories["theta"][trajectories["case"] == number],
+                              expected["theta"][::1000]), number
+    again = run_sweep(new, output_dir=tmp_path, resume=True, workers=1, progress=False)
+    assert again.chunks_run == 0 and {p: p.read_bytes() for p in tmp_path.glob("*/part-*")} == parts
+    assert not list(tmp_path.glob("*/_part-*"))
 
 
 def test_an_unreachable_silent_or_wrong_scheduler_is_one_line_within_the_timeout(tmp_path, capsys):

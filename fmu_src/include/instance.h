@@ -7,6 +7,7 @@
    called, so every message speaks the master's language. */
 
 #include <stddef.h>
+#include <stdio.h>
 #include <stdint.h>
 
 #include "model.h"
@@ -87,6 +88,11 @@ typedef enum {
     LOG_ALL = 1 << 3,
     LOG_CALLS = 1 << 4                   /* the call record: one line per call received */
 } LogCategory;
+/* Beside the categories: the call record goes to the file callRecordFile names. */
+#define RECORD_TO_FILE (1 << 5)
+#define RECORD_BITS (LOG_CALLS | RECORD_TO_FILE)
+/* The longest callRecordFile, with its terminating zero. */
+#define MAX_RECORD_FILE_NAME 1024
 
 typedef struct {
     InstanceData data;
@@ -96,7 +102,10 @@ typedef struct {
     int ignored_orders_logged;           /* the one message about input derivatives of order > 2 */
     InterfaceType type;                  /* fixed at instantiation */
     Logger logger;
-    int log_categories;                  /* LogCategory bits switched on by the master */
+    int log_categories;                  /* LogCategory bits switched on by the master, and RECORD_TO_FILE */
+    /* The call record's file (the String parameter callRecordFile; not part of an FMU state). */
+    char record_file_name[MAX_RECORD_FILE_NAME];
+    FILE *record_file;
     char name[MAX_INSTANCE_NAME];
     /* The FMU states this instance handed out and has not freed (fmu_state.c): a state the master
        passes back is looked up here by its address before anything in it is read. */
@@ -136,7 +145,7 @@ Status instance_error(const Instance *instance, const char *function, const char
 #define NOINLINE __attribute__((noinline))
 #endif
 static inline int instance_recording(const Instance *instance) {
-    return instance->log_categories & LOG_CALLS;
+    return instance->log_categories & RECORD_BITS;
 }
 /* For the adapters' entry points, whose locals are `instance` and `function`: the time before
    the call, kept for its line, and the line itself, formatted only when the record is on. */
@@ -154,15 +163,23 @@ static inline int instance_recording(const Instance *instance) {
    (the core's function inlined into it, its only caller; a tail call) and a step pays one test. */
 #define WITHOUT_RECORD(status_type, call)                                              \
     const double time_before = instance->data.time;                                    \
-    instance->log_categories &= ~LOG_CALLS;                                            \
+    const int recording = instance->log_categories & RECORD_BITS;                      \
+    instance->log_categories &= ~RECORD_BITS;                                          \
     const status_type status = (call);                                                 \
-    instance->log_categories |= LOG_CALLS;
+    instance->log_categories |= recording;
 /* `format` describes the arguments; the line adds the FMU's time before and after the call and
    the status it returned. */
 void instance_record_call(const Instance *instance, const char *function, double time_before,
                           Status status, const char *format, ...);
 /* The arguments are values by variable name (vr given: "torque=20"), input derivatives by name
    and order (order given too: "der(torque,1)=5"), or a state vector (vr NULL: "x[0]=0.1"). */
+/* The String parameters (callRecordFile): set by value reference, each value a file name that
+   is opened for appending at once (a file that cannot be opened: a warning, and no record file);
+   get returns the name as set. */
+Status instance_set_string(Instance *instance, const char *function, const unsigned int vr[], size_t n,
+                           const char *const value[]);
+Status instance_get_string(Instance *instance, const char *function, const unsigned int vr[], size_t n,
+                           const char *value[]);
 void instance_record_values(const Instance *instance, const char *function, double time_before,
                             Status status, const unsigned int vr[], const int order[], size_t n,
                             const double value[]);

@@ -227,7 +227,8 @@ fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
     return STATUS(instance_set_real(instance, function, vr, nvr, value));
 }
 
-/* The model has Real variables only: any Integer, Boolean or String reference is unknown. */
+/* The model has Real variables and String parameters only: any Integer or Boolean reference is
+   unknown. */
 #define NO_VARIABLES_OF_TYPE(name, type)                                                   \
     fmi2Status name(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, type value) { \
         (void)value;                                                                     \
@@ -240,10 +241,25 @@ fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
 
 NO_VARIABLES_OF_TYPE(fmi2GetInteger, fmi2Integer *)
 NO_VARIABLES_OF_TYPE(fmi2GetBoolean, fmi2Boolean *)
-NO_VARIABLES_OF_TYPE(fmi2GetString, fmi2String *)
 NO_VARIABLES_OF_TYPE(fmi2SetInteger, const fmi2Integer *)
 NO_VARIABLES_OF_TYPE(fmi2SetBoolean, const fmi2Boolean *)
-NO_VARIABLES_OF_TYPE(fmi2SetString, const fmi2String *)
+
+fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2String value[]) {
+    ENTER(fmi2GetString)
+    REQUIRE_ARRAY(vr, nvr)
+    REQUIRE_ARRAY(value, nvr)
+    return STATUS(instance_get_string(instance, function, vr, nvr, value));
+}
+
+fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2String value[]) {
+    ENTER(fmi2SetString)
+    KEEP_TIME
+    REQUIRE_ARRAY(vr, nvr)
+    REQUIRE_ARRAY(value, nvr)
+    const Status status = instance_set_string(instance, function, vr, nvr, value);
+    RECORD(status, "file=\"%s\"", instance->record_file_name)
+    return STATUS(status);
+}
 
 fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
     ENTER(fmi2GetFMUstate)

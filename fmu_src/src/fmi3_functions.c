@@ -13,7 +13,7 @@
 
 /* The independent variable `time` has the value reference after the model's variables: the
    FMI 3.0 model description (fmu_build/fmi3.py) numbers it so. */
-#define VR_TIME N_VARIABLES
+#define VR_TIME N_VALUE_REFERENCES
 
 #define ANY_STATE (CO_SIMULATION_STATES | MODEL_EXCHANGE_STATES)
 #define RUNNING (STATE_STEP_COMPLETE | STATE_EVENT_MODE | STATE_CONTINUOUS_TIME_MODE)
@@ -318,8 +318,8 @@ fmi3Status fmi3SetFloat64(fmi3Instance c, const fmi3ValueReference valueReferenc
     return STATUS(instance_set_real(instance, function, valueReferences, nValueReferences, values));
 }
 
-/* The model has Float64 variables only (FLOAT64_ONLY 1 in its config.h): any reference of
-   another type is unknown. */
+/* The model has Float64 variables (FLOAT64_ONLY 1 in its config.h) and String parameters only:
+   any reference of another type is unknown. */
 #if !FLOAT64_ONLY
 #error "FLOAT64_ONLY 0: the FMI plumbing has getters and setters for Float64 variables only"
 #endif
@@ -345,7 +345,15 @@ NO_VARIABLES_OF_TYPE(fmi3GetUInt32, fmi3UInt32 *)
 NO_VARIABLES_OF_TYPE(fmi3GetInt64, fmi3Int64 *)
 NO_VARIABLES_OF_TYPE(fmi3GetUInt64, fmi3UInt64 *)
 NO_VARIABLES_OF_TYPE(fmi3GetBoolean, fmi3Boolean *)
-NO_VARIABLES_OF_TYPE(fmi3GetString, fmi3String *)
+
+fmi3Status fmi3GetString(fmi3Instance c, const fmi3ValueReference valueReferences[], size_t nValueReferences,
+                         fmi3String values[], size_t nValues) {
+    ENTER(fmi3GetString)
+    REQUIRE_ARRAY(valueReferences, nValueReferences)
+    REQUIRE_ARRAY(values, nValues)
+    REQUIRE_COUNT(nValues, nValueReferences)
+    return STATUS(instance_get_string(instance, function, valueReferences, nValueReferences, values));
+}
 NO_VARIABLES_OF_TYPE(fmi3SetFloat32, const fmi3Float32 *)
 NO_VARIABLES_OF_TYPE(fmi3SetInt8, const fmi3Int8 *)
 NO_VARIABLES_OF_TYPE(fmi3SetUInt8, const fmi3UInt8 *)
@@ -356,7 +364,18 @@ NO_VARIABLES_OF_TYPE(fmi3SetUInt32, const fmi3UInt32 *)
 NO_VARIABLES_OF_TYPE(fmi3SetInt64, const fmi3Int64 *)
 NO_VARIABLES_OF_TYPE(fmi3SetUInt64, const fmi3UInt64 *)
 NO_VARIABLES_OF_TYPE(fmi3SetBoolean, const fmi3Boolean *)
-NO_VARIABLES_OF_TYPE(fmi3SetString, const fmi3String *)
+
+fmi3Status fmi3SetString(fmi3Instance c, const fmi3ValueReference valueReferences[], size_t nValueReferences,
+                         const fmi3String values[], size_t nValues) {
+    ENTER(fmi3SetString)
+    KEEP_TIME
+    REQUIRE_ARRAY(valueReferences, nValueReferences)
+    REQUIRE_ARRAY(values, nValues)
+    REQUIRE_COUNT(nValues, nValueReferences)
+    const Status status = instance_set_string(instance, function, valueReferences, nValueReferences, values);
+    RECORD(status, "file=\"%s\"", instance->record_file_name)
+    return STATUS(status);
+}
 
 fmi3Status fmi3GetBinary(fmi3Instance c, const fmi3ValueReference valueReferences[],
                          size_t nValueReferences, size_t valueSizes[], fmi3Binary values[],

@@ -1,3 +1,4 @@
+#include <errno.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -59,10 +60,78 @@ void instance_record_call(const Instance *instance, const char *function, double
         name[i] = instance->name[i] == '"' ? '\'' : instance->name[i];
         if (!name[i]) break;
     }
-    instance_log(instance, STATUS_OK, LOG_CALLS,
-                 CALL_RECORD_MARKER " instance=\"%s\" %s(%s) time=%.17g->%.17g status=%s",
-                 name, function, arguments, time_before, instance->data.time,
-                 status_names[status]);
+    /* Room for the arguments, the name and the rest; the logger's copy is cut at its own size. */
+    char line[sizeof(arguments) + MAX_INSTANCE_NAME + 256];
+    snprintf(line, sizeof(line), CALL_RECORD_MARKER " instance=\"%s\" %s(%s) time=%.17g->%.17g status=%s",
+             name, function, arguments, time_before, instance->data.time, status_names[status]);
+    if (instance->record_file) {
+        /* Flushed per line, so that the record is whole up to a master's crash. */
+        fprintf(instance->record_file, "%s\n", line);
+        fflush(instance->record_file);
+    }
+    instance_log(instance, STATUS_OK, LOG_CALLS, "%s", line);
+}
+
+#ifdef VR_CALLRECORDFILE
+/* Closes the record file there is, and opens the one `name` names (none when empty). */
+static Status record_to_file(Instance *instance, const char *function, const char *name) {
+    if (instance->record_file) fclose(instance->record_file);
+    instance->record_file = NULL;
+    instance->log_categories &= ~RECORD_TO_FILE;
+    strcpy(instance->record_file_name, name);
+    if (!name[0]) return STATUS_OK;
+    instance->record_file = fopen(name, "a");
+    if (!instance->record_file) {
+        instance_log(instance, STATUS_WARNING, LOG_STATUS_WARNING,
+                     "%s: callRecordFile %s cannot be opened for appending (%s): the FMU writes no "
+                     "record file", function, name, strerror(errno));
+        return STATUS_WARNING;
+    }
+    instance->log_categories |= RECORD_TO_FILE;
+    return STATUS_OK;
+}
+#endif
+
+Status instance_set_string(Instance *instance, const char *function, const unsigned int vr[], size_t n,
+                           const char *const value[]) {
+    Status status = STATUS_OK;
+    (void)value; /* a model without String parameters refuses every one */
+    for (size_t i = 0; i < n; i++) {
+#ifdef VR_CALLRECORDFILE
+        if (vr[i] != VR_CALLRECORDFILE)
+#endif
+            return instance_error(instance, function, "vr %u: no String variable has this value "
+                                  "reference", vr[i]);
+#ifdef VR_CALLRECORDFILE
+        if (!value[i])
+            return instance_error(instance, function, "callRecordFile is NULL: pass \"\" for no "
+                                  "record file");
+        if (strlen(value[i]) >= MAX_RECORD_FILE_NAME)
+            return instance_error(instance, function, "callRecordFile is %lu bytes long: at most %d",
+                                  (unsigned long)strlen(value[i]), MAX_RECORD_FILE_NAME - 1);
+        if (!(instance->data.machine_state & (STATE_INSTANTIATED | STATE_INITIALIZATION_MODE)))
+            return instance_error(instance, function, "callRecordFile is a fixed parameter: set it "
+                                  "before initialization ends");
+        if (record_to_file(instance, function, value[i]) == STATUS_WARNING) status = STATUS_WARNING;
+#endif
+    }
+    return status;
+}
+
+Status instance_get_string(Instance *instance, const char *function, const unsigned int vr[], size_t n,
+                           const char *value[]) {
+    (void)value; /* a model without String parameters refuses every one */
+    for (size_t i = 0; i < n; i++) {
+#ifdef VR_CALLRECORDFILE
+        if (vr[i] == VR_CALLRECORDFILE) {
+            value[i] = instance->record_file_name;
+            continue;
+        }
+#endif
+        return instance_error(instance, function, "vr %u: no String variable has this value reference",
+                              vr[i]);
+    }
+    return STATUS_OK;
 }
 
 void instance_record_values(const Instance *instance, const char *function, double time_before,
@@ -178,6 +247,7 @@ Instance *instance_create(const char *function, const char *name, const char *to
 void instance_free(Instance *instance) {
     if (!instance) return; /* both standards: freeing NULL is ignored */
     instance_free_states(instance);
+    if (instance->record_file) fclose(instance->record_file);
     free(instance);
 }
 

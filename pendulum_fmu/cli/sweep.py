@@ -161,7 +161,8 @@ def run(args) -> int:
         )
     )
     for path in (result.trajectories, result.cases_table, result.figure):
-        print(f"wrote {path}")
+        if path is not None:  # no trajectories with --outputs none
+            print(f"wrote {path}")
     if result.failed:
         # The other cases ran and are written; a script still learns that some did not.
         print(

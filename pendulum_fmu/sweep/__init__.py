@@ -15,6 +15,9 @@ A study goes to an output directory, a local path or any fsspec URL every worker
                                       "failed") and message (why the FMU refused the case)
     sweep.png                         the figure
     .sweep.lock                       there while a run writes a local folder: a second run is refused
+    */_part-000000.<run>.staged       a chunk's part as its worker wrote it, before the run's client
+                                      moves it into place: hidden from the readers, removed when
+                                      the run ends, and never taken from another run (see store.py)
 
 With format "csv" the same files are CSV. One line of pyarrow reads either table, e.g.
 pyarrow.parquet.read_table("out/trajectories"); pandas, dask.dataframe and DuckDB read the same

@@ -24,6 +24,11 @@ class SchedulerUnreachable(PendulumFmuError, ConnectionError):
     """The dask scheduler did not answer; the message names the address."""
 
 
+class SchedulerLost(PendulumFmuError, ConnectionError):
+    """The dask scheduler went away while the study ran (killed, its host lost); the message
+    says what the output folder keeps and names --resume."""
+
+
 @contextlib.contextmanager
 def dask_client(scheduler: str | None, workers: int | None, connect_timeout: float):
     """A dask client: on a local cluster of `workers` processes started (and closed) here, or on
@@ -51,8 +56,21 @@ def dask_client(scheduler: str | None, workers: int | None, connect_timeout: flo
             f"no dask scheduler answered at {scheduler} within {connect_timeout:g} s"
             f"{f' ({reason})' if reason else ''}; check the address (start one with `dask "
             "scheduler`), raise --connect-timeout, or leave out --scheduler for a local cluster")
-    with client:
+    with _quiet(logging.getLogger("distributed.client")), client:
         yield client
+
+
+@contextlib.contextmanager
+def _quiet(logger: logging.Logger):
+    """The logger silenced: a lost scheduler has the client log each failed reconnection with its
+    traceback (tens of lines), where the sweep reports the loss in one line (SchedulerLost);
+    a local cluster's logs are silenced alike (silence_logs)."""
+    level = logger.level
+    logger.setLevel(logging.CRITICAL + 1)
+    try:
+        yield
+    finally:
+        logger.setLevel(level)
 
 
 def _first_line(error: BaseException) -> str:
@@ -152,7 +170,9 @@ def progress_bar(total: int, done: int, enabled: bool):
     elsewhere (a log) a plain line every few seconds, and the last count."""
     from tqdm import tqdm
 
-    counts = "{n_fmt}/{total_fmt} cases{postfix}, {elapsed_s:.1f} s"
+    # No time: the run's one duration, cluster and figure included, is the summary's (run_sweep's
+    # seconds), which a second, shorter one here would contradict.
+    counts = "{n_fmt}/{total_fmt} cases{postfix}"
     # miniters=1: every update counts and only the interval thins them out, so tqdm's monitor
     # thread never redraws a bar on its own.
     if sys.stderr.isatty():
@@ -176,7 +196,8 @@ class Totals:
 
 def run_chunks(client, task: Task, chunks: Iterable[tuple[int, int, dict]], bar) -> Totals:
     """Run each chunk (its index, the number of its first case, its values) on a worker,
-    advancing the bar as each finishes."""
+    committing its parts (only those of this run: task.run) and advancing the bar as each
+    finishes."""
     totals = Totals()
     futures = [client.submit(run_chunk, index, first, values, task, pure=False)
                for index, first, values in chunks]
@@ -187,7 +208,8 @@ def run_chunks(client, task: Task, chunks: Iterable[tuple[int, int, dict]], bar)
         future.add_done_callback(finished.put)
     for _ in futures:
         future = finished.get()
-        _, count, failed, written, cpu, stepping = future.result()
+        index, count, failed, written, cpu, stepping = future.result()
+        task.store.commit(index, task.run, task.tables())
         totals.failed += failed
         totals.bytes += written
         totals.worker_cpu_seconds += cpu

@@ -6,6 +6,8 @@ import math
 import numbers
 import os
 import time
+from concurrent.futures import CancelledError
+import uuid
 from pathlib import Path
 
 import numpy as np
@@ -13,7 +15,7 @@ import numpy as np
 from ..errors import InvalidInput, MissingDependency, WrongType
 from ..parameters import fmu_file, pendulum_variables
 from ..torque_schedule import DEFAULT_MAX_CASES
-from .client import dask_client, progress_bar, run_chunks
+from .client import SchedulerLost, dask_client, progress_bar, run_chunks
 from .figure import draw
 from .grid import columns
 from .store import Held, Store, StudyExists
@@ -111,22 +113,27 @@ def run_sweep(study: Study, *, output_dir: str | os.PathLike, resume: bool = Fal
         chunk_cases = _chunk_cases(target.held(), definition, study, resume, overwrite, url)
         # A study that replaces another is written apart and moved into place once whole.
         store = target.staging() if overwrite else target
+        # This run's token: only parts staged under it are committed (see store.py).
         task = Task(fmu=fmu, store=store, stop_time=float(study.stop_time),
-                    step_size=float(study.step_size), outputs=study.outputs, stride=study.stride)
+                    step_size=float(study.step_size), outputs=study.outputs, stride=study.stride,
+                    run=uuid.uuid4().hex)
         try:
             try:
                 with dask_client(scheduler, workers, connect_timeout) as client:
-                    store.start(definition, chunk_cases)
+                    store.start(definition, chunk_cases, task.run)
                     chunks = range(math.ceil(len(cases) / chunk_cases))
                     done = store.done_chunks()
                     pending = [index for index in chunks if index not in done]
                     finished = sum(min(chunk_cases, len(cases) - i * chunk_cases) for i in done)
                     with progress_bar(len(cases), finished, progress) as bar:
-                        totals = run_chunks(client, task, (
-                            (index, index * chunk_cases,
-                             columns(cases, study.names, index * chunk_cases,
-                                     min(len(cases), (index + 1) * chunk_cases)))
-                            for index in pending), bar)
+                        try:
+                            totals = run_chunks(client, task, (
+                                (index, index * chunk_cases,
+                                 columns(cases, study.names, index * chunk_cases,
+                                         min(len(cases), (index + 1) * chunk_cases)))
+                                for index in pending), bar)
+                        except CancelledError as error:  # this run cancels none: the cluster did
+                            raise _lost(scheduler, error, url, overwrite) from None
             finally:
                 # After a local cluster closed, so that none of its workers writes any more (a
                 # remote cluster's may still finish the chunk they were running).
@@ -145,13 +152,27 @@ def run_sweep(study: Study, *, output_dir: str | os.PathLike, resume: bool = Fal
     where = (Path(target.root).joinpath if isinstance(target.filesystem, LocalFileSystem)
              else f"{url.rstrip('/')}/".__add__)
     return SweepResult(
-        output_dir=where(""), trajectories=where("trajectories"), cases_table=where("cases"),
+        output_dir=where(""), trajectories=where("trajectories") if study.outputs else None,
+        cases_table=where("cases"),
         figure=where("sweep.png"), cases=len(cases),
         failed=int(np.sum(table["status"].to_numpy(zero_copy_only=False) == "failed")),
         chunks=len(chunks), chunks_run=len(pending), bytes=totals.bytes,
         seconds=time.perf_counter() - started, figure_seconds=drawn - drawing,
         worker_cpu_seconds=totals.worker_cpu_seconds,
         worker_stepping_seconds=totals.worker_stepping_seconds)
+
+
+def _lost(scheduler: str | None, error: CancelledError, url: str, overwrite: bool) -> SchedulerLost:
+    """The one line for a scheduler lost mid-study: what the folder keeps, and how to go on."""
+    which = f"the dask scheduler at {scheduler}" if scheduler else "the local dask cluster's scheduler"
+    reason = getattr(error, "reason", None) or "its work was cancelled"
+    if overwrite:
+        kept = (f"{url} holds what it held before (the new study was not finished and is not "
+                "kept): start a scheduler and run the same command again")
+    else:
+        kept = (f"the chunks that finished are kept in {url}: start a scheduler and run the same "
+                "command with --resume to run the rest")
+    return SchedulerLost(f"{which} was lost mid-study ({reason}); {kept}")
 
 
 def _chunk_cases(held: Held, definition: dict, study: Study, resume: bool, overwrite: bool,

@@ -2,8 +2,17 @@
 table read back.
 
 A local path or any fsspec URL every worker can write to. A chunk is done when its cases part
-exists: its worker writes the trajectories part first. What an interrupted run leaves of the
-chunks it did not finish is removed, so only whole chunks stay.
+exists. What an interrupted run leaves of the chunks it did not finish is removed, so only whole
+chunks stay.
+
+Writes are fenced: each run of a study has a token of its own (study.json's "run"), which every
+task carries. A worker writes a chunk's parts under staged names that hold the token
+(_part-000006.<run>.staged: hidden from pyarrow's, pandas' and dask's readers, and matching no
+*.parquet glob); only the run's client, which holds the folder, renames its own run's staged
+parts into place (part-000006.parquet), the trajectories first. So a part written by a worker
+of another run (one stopped, then continued after its study was finished, replaced or resumed)
+never becomes part of a study, and every reader, resume included, lists only parts a client
+committed. A run removes the staged parts it finds, of any run, when it ends.
 
 A study that a run replaces (overwrite) stays whole until the new one is: the new study is
 written into a hidden folder inside the output folder and moved into place at the end, with
@@ -29,6 +38,8 @@ SUMMARIES = ("final_theta", "final_omega", "final_alpha", "max_abs_theta")
 ENTRIES = ("study.json", "trajectories", "cases", "sweep.png")
 # There while a run writes the study (see Store.only_run); hidden, and never part of a table.
 LOCK_FILE = ".sweep.lock"
+# What a worker writes and only its run's client moves into place (see the module's doc).
+STAGED_GLOB = "_part-*.staged"
 
 
 class InUse(PendulumFmuError, OSError):
@@ -66,22 +77,27 @@ class Store:
     def part(self, table: str, index: int) -> str:
         return f"{self.root}/{table}/part-{index:06d}.{self.format}"
 
-    def write_table(self, name: str, index: int, columns: dict, split: tuple = ()) -> int:
-        """Write one part of a table; returns its size in bytes. split: float columns stored
-        byte-stream-split, as smooth series compress best."""
+    def staged(self, table: str, index: int, run: str) -> str:
+        """Where a worker of run writes a chunk's part, for the run's client to commit."""
+        return f"{self.root}/{table}/_part-{index:06d}.{run}.staged"
+
+    def write_table(self, name: str, index: int, columns: dict, run: str, split: tuple = ()) -> int:
+        """Write one part of a table, staged for run (see commit); returns its size in bytes.
+        split: float columns stored byte-stream-split, as smooth series compress best."""
         import pyarrow as pa
 
         arrays = {column: pa.array(values) for column, values in columns.items()}
         # Not nullable (no value is ever missing): the writer then has no definition levels to write.
         table = pa.table(list(arrays.values()), schema=pa.schema(
             [pa.field(column, array.type, nullable=False) for column, array in arrays.items()]))
-        with replacing_on(self.filesystem, self.part(name, index)) as file:
+        with replacing_on(self.filesystem, self.staged(name, index, run)) as file:
             if self.format == "parquet":
                 import pyarrow.parquet as pq
 
-                # Measured on trajectories (benchmarks/scale.py): LZ4 after byte-stream-split is as
-                # small as zstd level 1 (57 kB for a 3-s case) and writes in a quarter of the time;
-                # dictionaries only where values repeat within a column (case numbers, status).
+                # Measured on trajectories (python -m benchmarks.chunk_cost, docs/sweep_performance.md):
+                # LZ4 after byte-stream-split is within 2 % of zstd's size (57 kB for a 3-s case)
+                # for about two thirds of its CPU, and 23 % smaller than LZ4 alone; dictionaries
+                # only where values repeat within a column (case numbers, status).
                 pq.write_table(table, file, compression="lz4",
                                use_dictionary=[c for c in table.column_names if c not in split],
                                column_encoding={c: "BYTE_STREAM_SPLIT" for c in split})
@@ -90,6 +106,12 @@ class Store:
 
                 pyarrow.csv.write_csv(table, file)  # shortest round-trip digits: reads back exact
             return file.tell()
+
+    def commit(self, index: int, run: str, tables: tuple[str, ...]) -> None:
+        """Move run's staged parts of a chunk into place: the chunk is then done. Only the parts
+        staged under this run's token: a part another run staged stays out of the study."""
+        for table in tables:  # the cases part last: it marks the chunk done
+            self.filesystem.mv(self.staged(table, index, run), self.part(table, index))
 
     def parts(self, table: str) -> dict[int, str]:
         """{chunk index: path} of a table's parts."""
@@ -107,8 +129,10 @@ class Store:
 
     def remove_unfinished(self) -> None:
         """What interrupted chunks leave: the temporaries of writes cut short (a killed worker, see
-        atomic_files.py), and trajectory parts whose chunk did not get to write its cases part."""
-        self.remove((TEMPORARY_GLOB, f"trajectories/{TEMPORARY_GLOB}", f"cases/{TEMPORARY_GLOB}"))
+        atomic_files.py), the staged parts no client committed (of this run or any other), and
+        trajectory parts whose chunk did not get to commit its cases part."""
+        self.remove((TEMPORARY_GLOB, *(f"{table}/{pattern}" for table in ("trajectories", "cases")
+                                       for pattern in (TEMPORARY_GLOB, STAGED_GLOB))))
         done = self.done_chunks()
         for index, path in self.parts("trajectories").items():
             if index not in done:
@@ -127,10 +151,12 @@ class Store:
         entries = tuple(name for name in ENTRIES if fs.exists(f"{self.root}/{name}"))
         return Held(manifest, entries, len(self.done_chunks()) if entries else 0)
 
-    def start(self, definition: dict, chunk_cases: int) -> None:
-        """Write study.json: what the study is, and its cases per chunk."""
+    def start(self, definition: dict, chunk_cases: int, run: str) -> None:
+        """Write study.json: what the study is, its cases per chunk, and the token of the run
+        now writing it."""
         with replacing_on(self.filesystem, f"{self.root}/study.json") as file:
-            file.write(json.dumps({"study": definition, "chunk_cases": chunk_cases}, indent=1).encode())
+            file.write(json.dumps({"study": definition, "chunk_cases": chunk_cases, "run": run},
+                                  indent=1).encode())
 
     def staging(self) -> Store:
         """A new hidden folder inside this one, where a study that replaces this one is written."""

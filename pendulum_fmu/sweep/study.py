@@ -150,7 +150,8 @@ class SweepResult:
     """
 
     output_dir: Path | str
-    trajectories: Path | str  # a folder of a file per chunk: case, time and the outputs kept
+    # A folder of a file per chunk: case, time and the outputs kept; None with no outputs.
+    trajectories: Path | str | None
     cases_table: Path | str  # a folder of a file per chunk: a row per case (its values, summaries, status)
     figure: Path | str  # sweep.png
     cases: int

@@ -1,9 +1,10 @@
 """What a dask worker does with a chunk of cases: simulate each, write the chunk's two parts.
 
 A worker thread steps its cases through its thread's FMU instance (simulate.simulator),
-restarted between cases, each
-case in one call into the native loop (cs_loop.py); the FMI 3.0 FMU, or a machine without the
-native loop, runs the same case through fmpy's calls.
+restarted between cases, the whole chunk in one call into the native loop (cs_loop.py), into one
+preallocated (outputs, cases, points) array, whose series are the trajectories table's columns as
+they are; the FMI 3.0 FMU, or a machine without the native
+loop, runs each case through fmpy's calls.
 """
 
 from __future__ import annotations
@@ -32,6 +33,11 @@ class Task:
     step_size: float
     outputs: tuple[str, ...]
     stride: int  # keep every stride-th communication point (and the last)
+    run: str  # the token of the run: the parts are staged under it (see store.py)
+
+    def tables(self) -> tuple[str, ...]:
+        """The tables a chunk writes a part of, in the order they are committed."""
+        return ("trajectories", "cases") if self.outputs else ("cases",)
 
 
 class Runner:
@@ -57,15 +63,22 @@ class Runner:
         return np.column_stack([np.broadcast_to(given.get(name, default), count)
                                 for name, default in self.defaults.items()]).astype(float)
 
-    def run(self, start_values: np.ndarray, points: np.ndarray, outputs: np.ndarray) -> None:
-        """theta, omega and alpha of one case (its row of start_values) at every communication
-        point into outputs (points x 3). FmuError when the FMU refuses the case; the next case's
-        restart starts from fmi2Reset, whatever state the refusal left."""
-        self.simulator.slave.messages.lines.clear()
+    def run_cases(self, start_values: np.ndarray, points: np.ndarray, outputs: np.ndarray) -> list[str]:
+        """theta, omega and alpha of each case (a row of start_values) at every communication
+        point into outputs (3 x cases x points). Returns per case "" or why the FMU refused it
+        (its values then NaN); the next case's restart starts from fmi2Reset, whatever state the
+        refusal left."""
         if self.stepper is not None:
-            self.stepper.run(points, None, None, outputs, start_values=start_values)
-        else:
-            self._run_python(dict(zip(self.defaults, start_values.tolist())), points, outputs)
+            return self.stepper.run_cases(points, start_values, outputs)
+        messages = [""] * len(start_values)
+        for case, values in enumerate(start_values.tolist()):
+            self.simulator.slave.messages.lines.clear()
+            try:
+                self._run_python(dict(zip(self.defaults, values)), points, outputs[:, case])
+            except FmuError as error:
+                messages[case] = str(error)
+                outputs[:, case] = np.nan
+        return messages
 
     def _run_python(self, start: dict[str, float], points: np.ndarray, outputs: np.ndarray) -> None:
         """The same case through fmpy's calls: FMI 3.0 FMUs, or no native loop."""
@@ -76,7 +89,7 @@ class Runner:
         plan = TorqueSchedule(time=points, torque=np.full(len(points) - 1, torque),
                               torque_rate=np.zeros(len(points) - 1))
         run = run_schedule_python(slave, plan)
-        outputs[:] = np.column_stack([run[name] for name in OUTPUTS])
+        outputs[:] = [run[name] for name in OUTPUTS]
 
 
 _runners = threading.local()
@@ -97,7 +110,8 @@ def kept_points(points: int, stride: int) -> np.ndarray:
 
 
 def run_chunk(index: int, first: int, values: dict[str, np.ndarray], task: Task) -> tuple:
-    """Simulate a chunk of cases on a worker and write its parts.
+    """Simulate a chunk of cases on a worker and write its parts, staged for the run's client to
+    commit.
 
     values: the chunk's cases, one array per name; first: the number of its first case.
     Returns (index, cases, failed, bytes written, CPU seconds of this thread, of which stepping).
@@ -105,33 +119,44 @@ def run_chunk(index: int, first: int, values: dict[str, np.ndarray], task: Task)
     cpu = time.thread_time()
     points = communication_points(0.0, task.stop_time, task.step_size)
     count = len(next(iter(values.values())))
-    recorded = np.empty((count, len(points), len(OUTPUTS)))
-    messages = [""] * count
+    recorded = np.empty((len(OUTPUTS), count, len(points)))
     runner = _runner(task.fmu)
     start_values = runner.start_values(values, count)
     stepping = time.thread_time()
-    for i in range(count):
-        try:
-            runner.run(start_values[i], points, recorded[i])
-        except FmuError as error:
-            messages[i] = str(error)
-            recorded[i] = np.nan
+    messages = runner.run_cases(start_values, points, recorded)
     stepping = time.thread_time() - stepping
     ok = np.array([not message for message in messages], bool)
     numbers = first + np.arange(count)
     written = 0
     if task.outputs:
         keep = kept_points(len(points), task.stride)
-        kept = recorded if ok.all() else recorded[ok]  # a copy only when a case failed
+        kept = recorded if ok.all() else recorded[:, ok]  # a copy only when a case failed
         if len(keep) < len(points):
-            kept = kept[:, keep]
+            kept = kept[:, :, keep]
+        # Each output's series of the chunk is contiguous: pyarrow takes its buffer as it is.
         written += task.store.write_table("trajectories", index, {
-            "case": np.repeat(numbers[ok], len(keep)), "time": np.tile(points[keep], int(ok.sum())),
-            **{name: kept[:, :, OUTPUTS.index(name)].ravel() for name in task.outputs}},
-            split=("time", *task.outputs))
-    final = recorded[:, -1]
-    summaries = [*final.T, np.max(np.abs(recorded[:, :, 0]), axis=1)]
+            "case": np.repeat(numbers[ok], len(keep)),
+            "time": _tiled(points[keep], int(ok.sum())),
+            **{name: kept[OUTPUTS.index(name)].reshape(-1) for name in task.outputs}},
+            task.run, split=("time", *task.outputs))
+    theta = recorded[OUTPUTS.index("theta")]
+    # max |theta| as |max(max, -min)|: two passes and no temporary the size of the chunk (the
+    # outer abs only for theta all -0.0, where abs first gives 0.0).
+    summaries = [*recorded[:, :, -1], np.abs(np.maximum(theta.max(axis=1), -theta.min(axis=1)))]
     written += task.store.write_table("cases", index, {
         "case": numbers, **values, **dict(zip(SUMMARIES, summaries)),
-        "status": np.where(ok, "ok", "failed").tolist(), "message": messages})
+        "status": np.where(ok, "ok", "failed").tolist(), "message": messages}, task.run)
     return index, count, count - int(ok.sum()), written, time.thread_time() - cpu, stepping
+
+
+_tiled_times = threading.local()
+
+
+def _tiled(times: np.ndarray, cases: int) -> np.ndarray:
+    """The time column of a chunk of cases: times once per case. Kept per thread for the last
+    shape asked, as a study's chunks all have one (but its last), so it is built once per study."""
+    last = getattr(_tiled_times, "column", None)
+    if last is None or len(last) != len(times) * cases or not np.array_equal(last[:len(times)], times):
+        last = _tiled_times.column = np.tile(times, cases)
+        last.flags.writeable = False
+    return last

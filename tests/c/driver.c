@@ -185,7 +185,7 @@ static fmi3Instance ready3(const char *name, int co_simulation) {
 /* The FMI 3.0 entry points: refused calls, every truncation and single-byte corruption of a
    serialized state, and the same numbers as FMI 2.0 for the same held torque. */
 static void bad_calls_fmi3(void) {
-    const fmi3ValueReference theta = VR_THETA, mass = VR_MASS, torque_vr = VR_TORQUE, time_vr = N_VARIABLES;
+    const fmi3ValueReference theta = VR_THETA, mass = VR_MASS, torque_vr = VR_TORQUE, time_vr = N_VALUE_REFERENCES;
     double value = NAN, one = 1.0, x[2] = {0, 0};
     fmi3Boolean event, terminate, early;
     fmi3Float64 last;

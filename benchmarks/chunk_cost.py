@@ -1,0 +1,113 @@
+"""What a sweep worker's CPU per case goes to, in one process, and the Parquet encoding by measurement.
+
+    .venv/bin/python -m benchmarks.chunk_cost
+
+Runs chunks of 64 3-s cases at 1 ms steps through sweep.worker.run_chunk (what a dask worker
+runs per chunk: stepping, building and writing the parts) with every output and with none, and
+the same cases through the native loop alone, a restart per call (the C loop plus a few
+microseconds of ctypes: the floor a case can cost). Then the chunk's trajectories table written
+with each compression (none, lz4, zstd) with and without byte-stream-split on its float columns:
+size and CPU per case, the figures the store's choice (sweep/store.py) rests on (the case
+numbers dictionary-encoded in each, the floats plain or split). CPU is this
+thread's (time.thread_time), the least of 5 rounds; the machine's load is printed, as it slows
+every figure.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+import tempfile
+import time
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
+from fsspec.implementations.local import LocalFileSystem
+
+from pendulum_fmu import default_fmu
+from pendulum_fmu.sweep.store import Store
+from pendulum_fmu.sweep.study import OUTPUTS
+from pendulum_fmu.sweep.worker import Task, _runner, run_chunk
+from pendulum_fmu.torque_schedule import communication_points
+
+CHUNKS, CASES, STOP_TIME, STEP_SIZE = 10, 64, 3.0, 1e-3
+ROUNDS = 5  # each figure the least of this many: other work on a shared machine only adds
+COMPRESSIONS = ("none", "lz4", "zstd")
+
+
+def _values() -> dict[str, np.ndarray]:
+    return {"torque": np.linspace(1.0, 40.0, CASES), "gravity": np.full(CASES, 9.81)}
+
+
+def chunk_cpu(outputs: tuple[str, ...]) -> tuple[float, float, float]:
+    """(CPU, of which stepping, bytes written) per case of run_chunk, over CHUNKS chunks: the
+    round of least CPU."""
+    rounds = []
+    with tempfile.TemporaryDirectory(prefix="pendulum-chunk-cost-") as folder:
+        task = Task(str(default_fmu()), Store(LocalFileSystem(), folder, "parquet"), STOP_TIME,
+                    STEP_SIZE, outputs, 1, "benchmark")
+        run_chunk(0, 0, _values(), task)  # the FMU unzipped and instantiated once, as on a worker
+        for _ in range(ROUNDS):
+            chunks = [run_chunk(index, 0, _values(), task)[3:] for index in range(CHUNKS)]
+            written, cpu, stepping = (sum(column) / (CHUNKS * CASES) for column in zip(*chunks))
+            rounds.append((cpu, stepping, written))
+    return min(rounds)
+
+
+def native_loop_cpu() -> float:
+    """CPU per case of the same cases through Stepper.run, a restart per call, nothing written."""
+    runner = _runner(str(default_fmu()))
+    points = communication_points(0.0, STOP_TIME, STEP_SIZE)
+    start_values = runner.start_values(_values(), CASES)
+    outputs = np.empty((len(points), len(OUTPUTS)))
+    rounds = []
+    for _ in range(ROUNDS):
+        started = time.thread_time()
+        for _ in range(CHUNKS):
+            for case in start_values:
+                runner.stepper.run(points, None, None, outputs, start_values=case)
+        rounds.append((time.thread_time() - started) / (CHUNKS * CASES))
+    return min(rounds)
+
+
+def encodings() -> list[tuple[str, bool, float, float]]:
+    """(compression, byte-stream-split, bytes per case, write CPU per case) of a chunk's
+    trajectories table (case, time, theta, omega, alpha), written as sweep/store.py writes it
+    but for these two choices."""
+    runner = _runner(str(default_fmu()))
+    points = communication_points(0.0, STOP_TIME, STEP_SIZE)
+    recorded = np.empty((len(OUTPUTS), CASES, len(points)))
+    runner.run_cases(runner.start_values(_values(), CASES), points, recorded)
+    table = pa.table({"case": np.repeat(np.arange(CASES), len(points)), "time": np.tile(points, CASES),
+                      **{name: recorded[j].reshape(-1) for j, name in enumerate(OUTPUTS)}})
+    floats = ["time", *OUTPUTS]
+    rows = []
+    for compression in COMPRESSIONS:
+        for split in (False, True):
+            cpu = float("inf")
+            for _ in range(ROUNDS):
+                sink, started = io.BytesIO(), time.thread_time()
+                pq.write_table(table, sink, compression=compression, use_dictionary=["case"],
+                               column_encoding={c: "BYTE_STREAM_SPLIT" for c in floats} if split else None)
+                cpu = min(cpu, (time.thread_time() - started) / CASES)
+            rows.append((compression, split, sink.tell() / CASES, cpu))
+    return rows
+
+
+def main() -> None:
+    print(f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}; {CHUNKS} chunks of "
+          f"{CASES} 3-s cases at 1 ms, CPU of this thread per case, least of {ROUNDS} rounds")
+    floor = native_loop_cpu()
+    print(f"native loop alone, a restart per call: {floor * 1e3:.3f} ms")
+    for label, outputs in (("all outputs", OUTPUTS), ("--outputs none", ())):
+        cpu, stepping, written = chunk_cpu(outputs)
+        print(f"run_chunk, {label}: {cpu * 1e3:.3f} ms ({stepping * 1e3:.3f} ms stepping), "
+              f"{cpu / floor:.2f} x the native loop, {written / 1e3:.1f} kB written")
+    print("trajectories part: compression, byte-stream-split, kB per case, write CPU per case")
+    for compression, split, size, cpu in encodings():
+        print(f"  {compression:5} {'on ' if split else 'off'} {size / 1e3:7.1f} kB {cpu * 1e3:7.3f} ms")
+
+
+if __name__ == "__main__":
+    main()
