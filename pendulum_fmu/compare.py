@@ -21,6 +21,7 @@ import numpy as np
 from .atomic_files import check_writable, replacing
 from .compare_tools import ToolSpecError, installed_defaults, parse_tools
 from .errors import InvalidInput, WrongType
+from .model import fmu_model
 from .plot import case_title, plot_comparison
 from .reference import reference
 from .simulate import resolve_parameters
@@ -38,6 +39,7 @@ def run_tools(plan: TorqueSchedule, tools, *, parameters: dict | None = None, th
     """{tool label: result array} for the same schedule, parameters and start values; tools as
     --tools gives them (see compare_tools.py), mapping the --map of other FMUs. "reference" here is
     reference_schedule: the schedule's own torques through scipy."""
+    fmu_path = fmu_model(fmu_path)  # read once, passed to every tool
     parsed = parse_tools(tools, mapping=mapping, fmu_path=fmu_path)
     # Every tool gets the whole set, so the defaults are fmu_path's for all of them.
     parameters = resolve_parameters(parameters, fmu_path)
@@ -52,12 +54,13 @@ def check_tolerance(tolerance: float) -> float:
 
 
 def differences(run: np.ndarray, judge: np.ndarray) -> dict[str, float]:
-    """max and RMS |run - judge| of theta, omega and alpha, and max |torque difference|."""
+    """max and RMS |run - judge| of each output (theta, omega, alpha: the fields after time and
+    torque), and max |torque difference|."""
     row = {}
     # A tool whose numbers run past the largest double (a --map factor of 1e308) differs by inf:
     # that is its verdict, and numpy's overflow warnings on the way say nothing more.
     with np.errstate(over="ignore", invalid="ignore"):
-        for name in ("theta", "omega", "alpha"):
+        for name in run.dtype.names[2:]:
             difference = np.abs(run[name] - judge[name])
             row[f"{name}_max"] = float(np.max(difference))
             row[f"{name}_rms"] = float(np.sqrt(np.mean(difference ** 2)))
@@ -66,7 +69,7 @@ def differences(run: np.ndarray, judge: np.ndarray) -> dict[str, float]:
 
 
 COLUMNS = ("tool", "against", "theta_max", "theta_rms", "omega_max", "omega_rms", "alpha_max",
-           "alpha_rms", "torque_max", "seconds_per_step")
+           "alpha_rms", "torque_max", "seconds_per_step")  # and the differences of any other output
 
 
 def format_table(rows: list[dict]) -> str:
@@ -82,10 +85,11 @@ def format_table(rows: list[dict]) -> str:
 
 
 def write_trajectories(runs: dict[str, np.ndarray], path: str | Path) -> Path:
-    """One CSV: time, then torque, theta, omega, alpha of each tool (torque_fmu, theta_fmu, ...)."""
+    """One CSV: time, then torque, theta, omega, alpha (every field after time) of each tool
+    (torque_fmu, theta_fmu, ...)."""
     columns = {"time": next(iter(runs.values()))["time"]}
     for tool, run in runs.items():
-        for name in ("torque", "theta", "omega", "alpha"):
+        for name in run.dtype.names[1:]:
             columns[f"{name}_{tool}"] = run[name]
     with replacing(path, newline="") as file:
         writer = csv.writer(file)
@@ -97,7 +101,8 @@ def write_trajectories(runs: dict[str, np.ndarray], path: str | Path) -> Path:
 
 def write_differences(rows: list[dict], path: str | Path) -> Path:
     with replacing(path, newline="") as file:
-        writer = csv.DictWriter(file, fieldnames=COLUMNS)
+        fields = [*COLUMNS, *(key for key in (rows[0] if rows else {}) if key not in COLUMNS)]
+        writer = csv.DictWriter(file, fieldnames=fields)
         writer.writeheader()
         writer.writerows(rows)
     return Path(path)
@@ -227,6 +232,7 @@ def compare(torque: TorqueSignal, tools=None, *, output_dir: str | Path, step_si
     """
     if not isinstance(output_dir, str | os.PathLike):
         raise WrongType(f"output_dir is a folder's path, not {output_dir!r}")
+    fmu_path = fmu_model(fmu_path)  # read once, passed to every tool
     parsed = parse_tools(installed_defaults() if tools is None else tools, mapping=mapping, fmu_path=fmu_path)
     if len(parsed) < 2:
         raise ToolSpecError(f"compare needs at least two tools, got {parsed[0].label}: "

@@ -9,6 +9,10 @@ mapped_fmu.py). Every tool has the same runner:
 
     tool.run(plan, parameters=..., theta0=..., omega0=...) -> results array (results.py)
 
+A tool returns the time, the torque and the outputs it computes; Tool.run hands back the outputs
+asked for (the FMU's, FmuModel.outputs, unless told otherwise), one it cannot compute as NaN with a
+one-line warning (errors.NotComputed), never zeros.
+
 A tool whose Python package is missing is refused when the list names it, with the pip command
 that installs it; of the default list, compare runs the tools that are installed and warns
 (errors.Skipped) which it left out.
@@ -27,8 +31,10 @@ from typing import Callable, Sequence
 
 import numpy as np
 
+from . import results
 from .engines import MODES, check_mode
 from .errors import InvalidInput, Skipped, WrongType
+from .model import FmuModel, fmu_model
 from .reference import reference_schedule
 from .simulate import simulate_plan
 from .torque_schedule import TorqueSchedule
@@ -40,27 +46,57 @@ class ToolSpecError(InvalidInput):
 
 @dataclass(frozen=True)
 class Tool:
-    """A tool as compare runs it: its label in tables and figures, and its runner."""
+    """A tool as compare runs it: its label in tables and figures, its runner, and the FMU (a
+    path, a model or None for the default) whose outputs it is asked for."""
 
     label: str
     runner: Callable[..., np.ndarray]
+    fmu: str | Path | FmuModel | None = None
 
     def run(self, plan: TorqueSchedule, *, parameters: dict | None = None, theta0: float = 0.0,
-            omega0: float = 0.0) -> np.ndarray:
-        return self.runner(plan, parameters=parameters, theta0=theta0, omega0=omega0)
+            omega0: float = 0.0, outputs: Sequence[str] | None = None) -> np.ndarray:
+        """The tool's result for a schedule, with exactly the outputs asked for.
+
+        Parameters
+        ----------
+        plan : TorqueSchedule
+            The schedule.
+        parameters : dict, optional
+            The pendulum's parameters (the FMU's defaults for those not given).
+        theta0, omega0 : float, optional
+            Start angle (rad) and rate (rad/s).
+        outputs : sequence of str, optional
+            The outputs asked for (default: the FMU's, FmuModel.outputs).
+
+        Returns
+        -------
+        numpy.ndarray
+            A result array (results.py): time, torque, then outputs in that order.
+
+        Warns
+        -----
+        NotComputed
+            One line naming the outputs the tool cannot compute; their columns are NaN.
+        """
+        run = self.runner(plan, parameters=parameters, theta0=theta0, omega0=omega0)
+        asked = fmu_model(self.fmu).outputs if outputs is None else tuple(outputs)
+        return results.with_outputs(run, asked, self.label)
 
 
 def run_fmu(plan: TorqueSchedule, *, parameters: dict | None = None, theta0: float = 0.0,
-            omega0: float = 0.0, mode: str = "accurate", fmu_path: str | Path | None = None) -> np.ndarray:
+            omega0: float = 0.0, mode: str = "accurate",
+            fmu_path: str | Path | FmuModel | None = None) -> np.ndarray:
     """This project's FMU (the checkout's, or fmu_path) through fmpy; ramps are passed on."""
     check_mode(mode, "fmu")
     return simulate_plan(plan, parameters=parameters, theta0=theta0, omega0=omega0, fmu_path=fmu_path)
 
 
 def run_reference(plan: TorqueSchedule, *, parameters: dict | None = None, theta0: float = 0.0,
-                  omega0: float = 0.0, mode: str = "accurate") -> np.ndarray:
+                  omega0: float = 0.0, mode: str = "accurate",
+                  fmu_path: str | Path | FmuModel | None = None) -> np.ndarray:
+    """The schedule's own torques through scipy (reference.py); fmu_path's defaults apply."""
     check_mode(mode, "reference")
-    return reference_schedule(plan, parameters=parameters, theta0=theta0, omega0=omega0)
+    return reference_schedule(plan, parameters=parameters, theta0=theta0, omega0=omega0, fmu_path=fmu_path)
 
 
 @dataclass(frozen=True)
@@ -124,19 +160,19 @@ def installed_defaults() -> list[str]:
     return [name for name in DEFAULT_TOOLS if name not in missing]
 
 
-def _mapped_fmu(label: str, path: str, mapping: str | None) -> Tool:
+def _mapped_fmu(label: str, path: str, mapping: str | None, fmu: str | Path | FmuModel | None) -> Tool:
     from .mapped_fmu import MappedFmu
 
     if not _LABEL.match(label) or label.split(":")[0] in KINDS:
         raise ToolSpecError(f"--tools {label}={path}: the label must be a name (letters, digits, "
                             f"_ . -) other than {', '.join(KINDS)}")
     try:
-        return Tool(label, MappedFmu(path, mapping, label=label).run)
+        return Tool(label, MappedFmu(path, mapping, label=label).run, fmu)
     except ValueError as error:
         raise ToolSpecError(str(error)) from None
 
 
-def _named(item: str, fmu_path: str | Path | None) -> Tool:
+def _named(item: str, fmu_path: str | Path | FmuModel | None) -> Tool:
     name, _, mode = item.partition(":")
     kind = KINDS[name]
     mode = mode or "accurate"
@@ -145,14 +181,13 @@ def _named(item: str, fmu_path: str | Path | None) -> Tool:
                             f"{', '.join(kind.modes)}, not {mode!r}")
     if not installed(name):
         raise ToolSpecError(f"--tools {name}: {kind.package} is not installed; install it with: {install_hint(name)}")
-    runner = partial(kind.load(), mode=mode)
-    if name == "fmu":
-        runner = partial(runner, fmu_path=fmu_path)
-    return Tool(name if mode == "accurate" else f"{name}:{mode}", runner)
+    # Every runner takes the FMU whose defaults (and, for fmu, whose binary) apply.
+    runner = partial(kind.load(), mode=mode, fmu_path=fmu_path)
+    return Tool(name if mode == "accurate" else f"{name}:{mode}", runner, fmu_path)
 
 
 def parse_tools(spec: str | Sequence[str], *, mapping: str | None = None,
-                fmu_path: str | Path | None = None) -> list[Tool]:
+                fmu_path: str | Path | FmuModel | None = None) -> list[Tool]:
     """The tools of a --tools list (a comma-separated string or its items), in order.
 
     mapping is the --map for the tools given as LABEL=PATH; fmu_path the FMU that "fmu" runs.
@@ -176,7 +211,7 @@ def parse_tools(spec: str | Sequence[str], *, mapping: str | None = None,
     tools: list[Tool] = []
     for item in items:
         label, equals, path = (part.strip() for part in item.partition("="))
-        tool = _mapped_fmu(label, path, mapping) if equals else _named(item, fmu_path)
+        tool = _mapped_fmu(label, path, mapping, fmu_path) if equals else _named(item, fmu_path)
         if any(tool.label == other.label for other in tools):
             raise ToolSpecError(f"--tools names {tool.label} twice")
         tools.append(tool)

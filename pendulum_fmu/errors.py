@@ -82,6 +82,13 @@ class PlatformSkipped(UserWarning):
     """
 
 
+class NotComputed(UserWarning):
+    """A tool was asked for an output it cannot compute (one the FMU has and the tool does not
+    model): its column is NaN, never zeros. The message is one line naming the tool and the
+    outputs; the command line prints it as that line and goes on.
+    """
+
+
 class Skipped(UserWarning):
     """A part of the run left out because this machine lacks what it needs (a tool's package); the
     message is one line saying which part and how to get it. The command line prints it as that

@@ -32,11 +32,11 @@ from fmpy.fmi3 import FMU3Slave
 
 from .engines import check_held, check_mode, held_results
 from .errors import InvalidInput, WrongType
-from .parameters import START_VALUES, FmuFileError, default_parameters, model_description, variables
-from .simulate import RECORDED, FmuError, MessageLog, _unzipped, fmi2_library, instantiate, resolve_parameters
+from .model import fmu_model
+from .parameters import START_VALUES, FmuFileError, default_parameters
+from .simulate import FmuError, MessageLog, fmi2_library, instantiate, resolve_parameters
 from .torque_schedule import TorqueSchedule
 
-OUTPUTS = RECORDED[1:]  # theta, omega, alpha
 REQUIRED = ("torque", "theta")
 # accurate: the tolerance the FMU or CVode is asked for; default: what it uses when not asked.
 TOLERANCE = {"accurate": 1e-12, "default": None}
@@ -56,7 +56,8 @@ class Mapped:
 
 
 def quantities() -> tuple[str, ...]:
-    return ("torque", *OUTPUTS, *START_VALUES, *default_parameters())
+    """What a map may name: the torque, the pendulum FMU's outputs, start values and parameters."""
+    return ("torque", *fmu_model().outputs, *START_VALUES, *default_parameters())
 
 
 def parse_map(text: str | None, allowed: tuple[str, ...] | None = None) -> dict[str, Mapped]:
@@ -113,9 +114,10 @@ class MappedFmu:
         if not self.path.is_file():
             raise MapError(f"{label}: no FMU at {self.path}")
         try:
-            self.description = model_description(self.path)
+            self.model = fmu_model(self.path)
         except FmuFileError as error:  # not a zip, no model description, not FMI 2.0 or 3.0
             raise MapError(f"{label}: {error}") from None
+        self.description = self.model.description
         available = [name for name, present in (("CoSimulation", self.description.coSimulation),
                                                  ("ModelExchange", self.description.modelExchange))
                      if present]
@@ -123,7 +125,7 @@ class MappedFmu:
         if self.interface not in available:
             raise MapError(f"{label}: {self.path} has no {self.interface} interface "
                            f"(it has {', '.join(available)})")
-        self.variables = variables(self.path)  # shared, read only
+        self.variables = self.model.variables  # shared, read only
         self.mapping = self._complete(as_map(mapping))
 
     def _complete(self, given: dict[str, Mapped]) -> dict[str, Mapped]:
@@ -168,19 +170,19 @@ class MappedFmu:
         start = self._start_values(parameters, theta0, omega0)
         step = self._co_simulation if self.interface == "CoSimulation" else self._model_exchange
         raw = step(plan, start, TOLERANCE[mode])
-        out = held_results(plan)
-        for name in OUTPUTS:
-            mapped = self.mapping.get(name)
-            out[name] = raw[name] * mapped.factor if mapped else np.nan
+        out = held_results(plan)  # an output the map does not name stays NaN
+        for name, values in raw.items():
+            out[name] = values * self.mapping[name].factor
         return out
 
     def _output_variables(self) -> dict[str, str]:
-        return {name: self.mapping[name].variable for name in OUTPUTS if name in self.mapping}
+        """{pendulum output: the FMU's variable} of the outputs the map names."""
+        return {name: self.mapping[name].variable for name in fmu_model().outputs if name in self.mapping}
 
     def _co_simulation(self, plan, start, tolerance):
         """Hold each step's torque, read the outputs at each communication point."""
         fmi3 = self.description.fmiVersion == "3.0"
-        folder, _ = _unzipped(self.path)
+        folder = self.model.folder
         identifier = self.description.coSimulation.modelIdentifier
         arguments = dict(guid=self.description.guid, unzipDirectory=folder, modelIdentifier=identifier,
                          instanceName=self.label)
@@ -243,7 +245,7 @@ class MappedFmu:
         signal["time"], signal[torque.variable] = times, values / torque.factor
         outputs = self._output_variables()
         try:
-            raw = simulate_fmu(_unzipped(self.path)[0], model_description=self.description,
+            raw = simulate_fmu(self.model.folder, model_description=self.description,
                                fmi_type="ModelExchange", solver="CVode",
                                relative_tolerance=tolerance, start_time=float(plan.time[0]),
                                stop_time=float(plan.time[-1]),

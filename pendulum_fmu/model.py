@@ -127,8 +127,15 @@ class FmuModel:
 
     @cached_property
     def outputs(self) -> tuple[str, ...]:
-        """The names of the FMU's output variables, in modelDescription.xml's order."""
+        """The names of the FMU's output variables, in modelDescription.xml's order: the one place
+        that names what a result records besides time and the inputs."""
         return tuple(name for name, v in self.variables.items() if v.causality == "output")
+
+    @cached_property
+    def recorded(self) -> tuple[str, ...]:
+        """What a run records at every communication point, read back from the FMU: its inputs
+        (the torque it received), then its outputs, in modelDescription.xml's order."""
+        return tuple(name for name, v in self.variables.items() if v.causality in ("input", "output"))
 
     def value_reference(self, name: str) -> int:
         """The value reference of a pendulum variable; raises as pendulum_variables, KeyError
@@ -207,3 +214,42 @@ def fmu_model(fmu: str | os.PathLike | FmuModel | None = None) -> FmuModel:
     path = fmu_file(fmu)
     version = file_version(path)
     return _read(str(path.resolve()), version, str(path))
+
+
+class FmuInstance:
+    """One FMI instance of a model: fmpy's FMU2Slave or FMU3Slave, the log of what the FMU says,
+    and the model whose value references and parameters apply.
+
+    fmpy's calls (doStep, getReal, setFloat64, terminate, freeInstance, dll, component, ...) pass
+    through to the slave, so an instance is used as the slave would be.
+
+    Parameters
+    ----------
+    slave : fmpy.fmi2.FMU2Slave or fmpy.fmi3.FMU3Slave
+        Instantiated with messages as its logger.
+    messages : pendulum_fmu.simulate.MessageLog
+        Keeps what the FMU logs (and its logger callback alive as long as the instance).
+    model : FmuModel
+        The FMU the slave was made from.
+
+    Examples
+    --------
+    >>> from pendulum_fmu.simulate import open_fmu
+    >>> instance = open_fmu()
+    >>> instance.model.fmi_version, instance.fmi_version
+    (2, 2)
+    >>> instance.terminate(); instance.freeInstance()
+    """
+
+    def __init__(self, slave, messages, model: FmuModel):
+        self.slave, self.messages, self.model = slave, messages, model
+        self.fmi_version = model.fmi_version  # 2 or 3
+        # Read on every run (the loops bind the FMI functions): plain attributes, not a pass-through.
+        self.dll, self.component = slave.dll, slave.component
+
+    def __getattr__(self, name: str):
+        # Only what the instance itself lacks: fmpy's calls and attributes (never the slave itself,
+        # which an instance not yet initialized, as when copied, lacks).
+        if name == "slave":
+            raise AttributeError(name)
+        return getattr(self.slave, name)

@@ -25,15 +25,20 @@ from fmpy.fmi3 import FMU3Slave
 
 from . import cs_loop, default_fmu, results
 from .errors import InvalidInput, PendulumFmuError
-from .model import fmu_model
+from .model import FmuInstance, fmu_model
 from .parameters import (default_parameters, file_version, fmu_file, merged_parameters, merged_with,
                          model_description, pendulum_variables, start_value, value_reference)
 from .torque_schedule import TorqueSignal, TorqueSchedule, schedule
 
 _STATUS = ["OK", "WARNING", "DISCARD", "ERROR", "FATAL", "PENDING"]
-# What a result records at every communication point, read back from the FMU after the step's
-# input was set: the torque it received, and the outputs.
-RECORDED = ("torque", "theta", "omega", "alpha")
+
+
+def __getattr__(name: str):
+    # RECORDED, what a result of the default FMU records at every communication point (the torque
+    # it received, then its outputs), is its model's (FmuModel.recorded), read on first use.
+    if name == "RECORDED":
+        return fmu_model().recorded
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 class FmuError(PendulumFmuError, RuntimeError):
@@ -143,11 +148,13 @@ def fmi2_library(folder: str, model_identifier: str) -> str | None:
 def open_fmu(fmu_path: str | Path | None = None, *, parameters: dict | None = None,
              theta0: float = 0.0, omega0: float = 0.0, tolerance: float | None = None,
              start_time: float = 0.0, instance_name: str = "pendulum"):
-    """An initialized FMU2Slave or FMU3Slave (in step mode, the FMI version read from the FMU's
-    model description; slave.fmi_version says which) with its message log as slave.messages.
+    """An initialized FmuInstance (in step mode, the FMI version read from the FMU's model
+    description; instance.fmi_version says which), with its message log as instance.messages and
+    its model as instance.model; fmpy's calls pass through to its FMU2Slave or FMU3Slave.
 
-    fmu_path defaults to pendulum_fmu.default_fmu() (FMI 2.0); parameters and value references
-    are that FMU's own. The caller frees it with slave.terminate(); slave.freeInstance().
+    fmu_path (a path, a model.FmuModel, or None for pendulum_fmu.default_fmu()) names the FMU;
+    parameters and value references are that FMU's own. The caller frees it with
+    instance.terminate(); instance.freeInstance().
 
     Raises
     ------
@@ -157,8 +164,7 @@ def open_fmu(fmu_path: str | Path | None = None, *, parameters: dict | None = No
     FmuError
         The FMU refused the parameters or start values; the message carries what it logged.
     """
-    fmu_path = fmu_file(fmu_path)
-    slave = _instantiated(fmu_path, instance_name)
+    slave = _instantiated(fmu_model(fmu_path), instance_name)
     try:
         initialize(slave, parameters=parameters, theta0=theta0, omega0=omega0,
                    tolerance=tolerance, start_time=start_time)
@@ -168,9 +174,8 @@ def open_fmu(fmu_path: str | Path | None = None, *, parameters: dict | None = No
     return slave
 
 
-def _instantiated(fmu_path: Path, instance_name: str):
-    """An instantiated FMU2Slave or FMU3Slave, not yet initialized (see open_fmu)."""
-    model = fmu_model(fmu_path)
+def _instantiated(model, instance_name: str) -> FmuInstance:
+    """An instantiated FmuInstance of a model, not yet initialized (see open_fmu)."""
     model.pendulum_variables  # FmuFileError when it is no pendulum FMU this machine runs
     folder, description, fmi_version = model.folder, model.description, model.fmi_version
     messages = MessageLog(fmi_version)
@@ -180,21 +185,18 @@ def _instantiated(fmu_path: Path, instance_name: str):
         slave = FMU3Slave(**arguments)
     else:
         slave = FMU2Slave(**arguments, libraryPath=fmi2_library(folder, arguments["modelIdentifier"]))
-    instantiate(slave, messages, fmu_path)
-    slave.fmi_version = fmi_version
-    slave.messages = messages  # keeps the logger callback alive as long as the slave
-    slave.fmu_path = model  # whose parameters and value references apply, parsed once
-    return slave
+    instantiate(slave, messages, model.path)
+    return FmuInstance(slave, messages, model)
 
 
-def initialize(slave: FMU2Slave | FMU3Slave, *, parameters: dict | None = None, theta0: float = 0.0,
+def initialize(slave: FmuInstance, *, parameters: dict | None = None, theta0: float = 0.0,
                omega0: float = 0.0, tolerance: float | None = None, start_time: float = 0.0) -> None:
     """Set the parameters and start values of an instantiated (or reset) slave from open_fmu and
     leave it in step mode; FmuError says why the FMU refused."""
     # The FMU checks the parameters itself, here as everywhere (resolve_parameters).
-    start = {**merged_with(slave.fmu_path.default_parameters, parameters), "theta": start_value("theta0", theta0, "rad"),
+    start = {**merged_with(slave.model.default_parameters, parameters), "theta": start_value("theta0", theta0, "rad"),
              "omega": start_value("omega0", omega0, "rad/s")}
-    references = [slave.fmu_path.value_reference(n) for n in start]
+    references = [slave.model.value_reference(n) for n in start]
     try:
         if slave.fmi_version == 3:
             slave.enterInitializationMode(tolerance=tolerance, startTime=start_time)
@@ -208,7 +210,7 @@ def initialize(slave: FMU2Slave | FMU3Slave, *, parameters: dict | None = None, 
         raise slave.messages.initialization_error(str(error)) from None
 
 
-def run_schedule(slave: FMU2Slave | FMU3Slave, plan: TorqueSchedule) -> np.ndarray:
+def run_schedule(slave: FmuInstance, plan: TorqueSchedule) -> np.ndarray:
     """Feed a schedule to an initialized slave (from open_fmu); returns the result array (see
     results.py).
 
@@ -217,36 +219,38 @@ def run_schedule(slave: FMU2Slave | FMU3Slave, plan: TorqueSchedule) -> np.ndarr
     """
     if not cs_loop.drives(slave):
         return run_schedule_python(slave, plan)
-    return _stepped(_stepper(slave), plan)
+    return _stepped(_stepper(slave), plan, slave.model.recorded)
 
 
 def _stepper(slave, start_names: tuple[str, ...] = ()) -> cs_loop.Stepper:
-    """The native loop bound to a slave: the torque in, RECORDED out, a restart setting
-    start_names."""
+    """The native loop bound to an instance: the torque in, its model's recorded variables out,
+    a restart setting start_names."""
     def references(names):
-        return np.array([slave.fmu_path.value_reference(name) for name in names], np.uint32)
-    return cs_loop.Stepper(slave, references(["torque"]), references(RECORDED), references(start_names))
+        return np.array([slave.model.value_reference(name) for name in names], np.uint32)
+    return cs_loop.Stepper(slave, references(["torque"]), references(slave.model.recorded),
+                           references(start_names))
 
 
-def _stepped(stepper: cs_loop.Stepper, plan: TorqueSchedule, **restart) -> np.ndarray:
-    """The result array of a schedule through the native loop; restart: Stepper.run's
-    start_values and tolerance."""
-    recorded = np.empty((len(plan.time), len(RECORDED)))
+def _stepped(stepper: cs_loop.Stepper, plan: TorqueSchedule, recorded_names: tuple[str, ...],
+             **restart) -> np.ndarray:
+    """The result array of a schedule through the native loop, which records recorded_names;
+    restart: Stepper.run's start_values and tolerance."""
+    recorded = np.empty((len(plan.time), len(recorded_names)))
     rates = np.ascontiguousarray(plan.torque_rate)[:, None] if np.count_nonzero(plan.torque_rate) else None
     stepper.run(plan.time, np.ascontiguousarray(plan.torque)[:, None], rates, recorded, **restart)
-    return _result(plan, recorded)
+    return _result(plan, recorded_names, recorded)
 
 
-def _result(plan: TorqueSchedule, recorded: np.ndarray) -> np.ndarray:
-    """The result array of a schedule from the RECORDED columns at every point."""
-    out = results.empty(len(plan.time))
+def _result(plan: TorqueSchedule, recorded_names: tuple[str, ...], recorded: np.ndarray) -> np.ndarray:
+    """The result array of a schedule from the columns recorded_names at every point."""
+    out = results.empty(len(plan.time), recorded_names)
     out["time"] = plan.time
-    for name, column in zip(RECORDED, recorded.T):
+    for name, column in zip(recorded_names, recorded.T):
         out[name] = column
     return out
 
 
-def run_schedule_python(slave: FMU2Slave | FMU3Slave, plan: TorqueSchedule) -> np.ndarray:
+def run_schedule_python(slave: FmuInstance, plan: TorqueSchedule) -> np.ndarray:
     """run_schedule in Python: the reference the native loop is checked against, and the loop for
     FMI 3.0.
 
@@ -263,17 +267,19 @@ def run_schedule_python(slave: FMU2Slave | FMU3Slave, plan: TorqueSchedule) -> n
              ("fmi2SetReal", "fmi2GetReal", "fmi2SetRealInputDerivatives", "fmi2DoStep"))
     set_real, get_real, set_rate, do_step = (dll[name] if name else None for name in names)
     component = ctypes.c_void_p(slave.component)
-    torque_vr = (ctypes.c_uint * 1)(slave.fmu_path.value_reference("torque"))
-    recorded_vr = (ctypes.c_uint * 4)(*(slave.fmu_path.value_reference(n) for n in RECORDED))
-    one, four = ctypes.c_size_t(1), ctypes.c_size_t(4)
+    recorded_names = slave.model.recorded
+    count = len(recorded_names)
+    torque_vr = (ctypes.c_uint * 1)(slave.model.value_reference("torque"))
+    recorded_vr = (ctypes.c_uint * count)(*(slave.model.value_reference(n) for n in recorded_names))
+    one, recorded_count = ctypes.c_size_t(1), ctypes.c_size_t(count)
     first_order = (ctypes.c_int * 1)(1)
     no_rollback = ctypes.c_int(1)
-    torque, rate, recorded = (ctypes.c_double * 1)(), (ctypes.c_double * 1)(), (ctypes.c_double * 4)()
+    torque, rate, recorded = (ctypes.c_double * 1)(), (ctypes.c_double * 1)(), (ctypes.c_double * count)()
     recorded_bytes = memoryview(recorded).cast("B")
     time, step = ctypes.c_double(), ctypes.c_double()
     # FMI 3.0 getters and setters also take the number of values, and fmi3DoStep reports back.
     torque_arguments = (component, torque_vr, one, torque) + ((one,) if fmi3 else ())
-    get_recorded = (component, recorded_vr, four, recorded) + ((four,) if fmi3 else ())
+    get_recorded = (component, recorded_vr, recorded_count, recorded) + ((recorded_count,) if fmi3 else ())
     step_report = ((ctypes.byref(ctypes.c_bool()), ctypes.byref(ctypes.c_bool()),
                     ctypes.byref(ctypes.c_bool()), ctypes.byref(ctypes.c_double())) if fmi3 else ())
     step_arguments = (component, time, step, ctypes.c_bool(True) if fmi3 else no_rollback) + step_report
@@ -304,7 +310,7 @@ def run_schedule_python(slave: FMU2Slave | FMU3Slave, plan: TorqueSchedule) -> n
         raise messages.error(status, f"{names[1]} at the end")
     rows.frombytes(recorded_bytes)
 
-    return _result(plan, np.frombuffer(rows).reshape(-1, len(RECORDED)))
+    return _result(plan, recorded_names, np.frombuffer(rows).reshape(-1, count))
 
 
 def simulate(torque: TorqueSignal = 20.0, *, start_time: float = 0.0, stop_time: float | None = None,
@@ -433,8 +439,8 @@ class Simulator:
 
     def __init__(self, fmu_path: Path, version: tuple):
         self.fmu_path, self.version = fmu_path, version
-        self.slave = _instantiated(fmu_path, "pendulum")
-        self.defaults = default_parameters(self.slave.fmu_path)
+        self.slave = _instantiated(fmu_model(fmu_path), "pendulum")
+        self.defaults = default_parameters(self.slave.model)
         self.stepper = (_stepper(self.slave, (*self.defaults, *self.START_STATES))
                         if cs_loop.drives(self.slave) else None)
 
@@ -449,7 +455,8 @@ class Simulator:
             initialize(self.slave, parameters=parameters, theta0=theta0, omega0=omega0,
                        tolerance=tolerance, start_time=float(plan.time[0]))
             return run_schedule_python(self.slave, plan)
-        return _stepped(self.stepper, plan, start_values=start, tolerance=tolerance)
+        return _stepped(self.stepper, plan, self.slave.model.recorded, start_values=start,
+                        tolerance=tolerance)
 
     def close(self) -> None:
         self.slave.freeInstance()

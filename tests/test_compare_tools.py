@@ -4,6 +4,7 @@ import csv
 import shutil
 import subprocess
 import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -13,7 +14,7 @@ from pendulum_fmu import compare_tools
 from fmu_build import MODEL_DESCRIPTION, PENDULUM_DIR, SOURCE_DIR, build_fmu
 from pendulum_fmu.cli import main
 from pendulum_fmu.compare import run_tools
-from pendulum_fmu.errors import Skipped
+from pendulum_fmu.errors import NotComputed, Skipped
 from pendulum_fmu.mapped_fmu import MapError, Mapped, MappedFmu, parse_map
 from pendulum_fmu.reference import reference_schedule
 from pendulum_fmu.torque_schedule import schedule
@@ -202,3 +203,24 @@ def test_the_default_tools_leave_out_what_is_not_installed_with_a_warning(monkey
     monkeypatch.setattr(compare_tools, "installed", lambda name: name != "opensim")
     with pytest.warns(Skipped, match=r'^skipped opensim \(opensim is not installed: pip install "\.\[opensim\]"'):
         assert compare_tools.installed_defaults() == ["fmu", "reference"]
+
+
+@pytest.mark.parametrize("tool", ["fmu", "reference", "theirs", "mujoco"])
+def test_a_tool_asked_for_an_output_it_cannot_compute_says_so(tool, renamed_fmu):
+    """An output added to the set a tool is asked for (energy, which no tool computes) comes back
+    as a NaN column with a one-line warning naming the tool, never zeros; the outputs it does
+    compute stay the same numbers, checked against scipy's."""
+    if tool == "mujoco":
+        pytest.importorskip("mujoco")
+    spec = f"theirs={renamed_fmu}" if tool == "theirs" else tool
+    (parsed,) = compare_tools.parse_tools(spec, mapping=FULL_MAP if tool == "theirs" else None)
+    with pytest.warns(NotComputed, match=rf"^{tool} cannot compute energy: its column is NaN") as caught:
+        run = parsed.run(PLAN, outputs=("theta", "omega", "alpha", "energy"))
+    assert len(caught) == 1 and "\n" not in str(caught[0].message)
+    assert run.dtype.names == ("time", "torque", "theta", "omega", "alpha", "energy")
+    assert np.all(np.isnan(run["energy"]))
+    assert max_error(run, reference_schedule(PLAN)) < 1e-8
+    # Asked for what it computes (the FMU's outputs, the default), it says nothing.
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", NotComputed)
+        assert parsed.run(PLAN).dtype.names == ("time", "torque", "theta", "omega", "alpha")

@@ -25,7 +25,7 @@ def _fresh_fmpy_run(fmu, plan, parameters, theta0, omega0, tolerance, tmp_path):
     """The schedule through a new fmpy FMU2Slave, driven call by call as a master would."""
     description = read_model_description(str(fmu))
     refs = {v.name: v.valueReference for v in description.modelVariables}
-    start = {v.name: float(v.start) for v in description.modelVariables if v.causality == "parameter"}
+    start = {v.name: float(v.start) for v in description.modelVariables if v.causality == "parameter" and v.type == "Real"}
     start.update(parameters or {}, theta=theta0, omega=omega0)
     slave = FMU2Slave(guid=description.guid, unzipDirectory=extract(str(fmu), str(tmp_path / "fresh")),
                       modelIdentifier=description.coSimulation.modelIdentifier, instanceName="fresh")

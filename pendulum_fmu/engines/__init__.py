@@ -1,10 +1,12 @@
 """Robotics physics engines as compare tools: one module per engine, each with the same runner.
 
-    run(plan, *, parameters, theta0, omega0, mode="accurate") -> results array
+    run(plan, *, parameters, theta0, omega0, mode="accurate", fmu_path=None) -> results array
 
 Every runner builds the pendulum of the FMU (mass, length, inertia of the head about its own
-centre, gravity, damping) in its engine, holds plan.torque[k] over step k, and fills a
-results.empty(N+1) array with the convention of results.py. mode "accurate" sets the engine's
+centre, gravity, damping) in its engine, holds plan.torque[k] over step k, and fills the outputs
+it computes (theta, omega, alpha) in a results.empty(N+1) array with the convention of results.py;
+an output of the FMU it does not compute stays NaN. fmu_path (a path, a model or None) is the FMU
+whose defaults fill the parameters not given. mode "accurate" sets the engine's
 best integrator tight; "default" keeps the engine's own integrator and settings, stepping once per
 communication step, so a comparison shows the price of the defaults. docs/engines.md says what
 each adapter sets and why. The engine modules import their engine, so import them only when used.
@@ -12,12 +14,14 @@ each adapter sets and why. The engine modules import their engine, so import the
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Callable
 
 import numpy as np
 
 from .. import results
 from ..errors import InvalidInput
+from ..model import FmuModel
 from ..simulate import resolve_parameters
 from ..torque_schedule import TorqueSchedule
 
@@ -60,10 +64,11 @@ def runner(tool: str, simulate: Callable[..., np.ndarray], setups: dict) -> Call
     setup) and its setup per mode."""
 
     def run(plan: TorqueSchedule, *, parameters: dict | None = None, theta0: float = 0.0,
-            omega0: float = 0.0, mode: str = "accurate") -> np.ndarray:
+            omega0: float = 0.0, mode: str = "accurate",
+            fmu_path: str | Path | FmuModel | None = None) -> np.ndarray:
         check_held(plan, tool)
         check_mode(mode, tool)
-        return simulate(plan, resolve_parameters(parameters), theta0, omega0, setups[mode])
+        return simulate(plan, resolve_parameters(parameters, fmu_path), theta0, omega0, setups[mode])
 
     run.__doc__ = f"The schedule through {tool} in mode accurate or default; see docs/engines.md."
     return run

@@ -183,9 +183,9 @@ def simulate(plan: TorqueSchedule, parameters: dict[str, float], theta0: float, 
     """The schedule through OpenSim at the Manager's accuracy (None: its own), as a results array."""
     run = opensim_simulate(plan.time, plan.torque, theta0=theta0, omega0=omega0, accuracy=accuracy,
                            **parameters)
-    out = results.empty(len(plan.time))
-    for name in results.FIELDS:
-        out[name] = run[name]
+    out = results.empty(len(plan.time))  # an output OpenSim does not compute stays NaN
+    for name, values in run.items():
+        out[name] = values
     return out
 
 
