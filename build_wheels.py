@@ -56,7 +56,7 @@ class WheelPlatform:
     binaries it loads."""
 
     platform: str
-    system: str   # linux, macos or windows
+    system: str  # linux, macos or windows
     machine: str  # the platform tag's machine: x86_64, aarch64, universal2, amd64
 
     @property
@@ -64,8 +64,12 @@ class WheelPlatform:
         return "_cs_loop.pyd" if self.system == "windows" else "_cs_loop.so"
 
 
-WHEELS = (WheelPlatform("linux64", "linux", "x86_64"), WheelPlatform("aarch64-linux", "linux", "aarch64"),
-          WheelPlatform("darwin64", "macos", "universal2"), WheelPlatform("win64", "windows", "amd64"))
+WHEELS = (
+    WheelPlatform("linux64", "linux", "x86_64"),
+    WheelPlatform("aarch64-linux", "linux", "aarch64"),
+    WheelPlatform("darwin64", "macos", "universal2"),
+    WheelPlatform("win64", "windows", "amd64"),
+)
 
 
 class WheelhouseError(RuntimeError):
@@ -110,8 +114,9 @@ def _extract_fmu_binaries(wheel: Path, out_dir: Path) -> None:
     with zipfile.ZipFile(wheel) as archive:
         for fmi_version, name in FMU_FILES.items():
             with zipfile.ZipFile(archive.open(f"pendulum_fmu/data/{name}")) as fmu:
-                binaries = [entry for entry in fmu.namelist()
-                            if entry.startswith("binaries/") and not entry.endswith("/")]
+                binaries = [
+                    entry for entry in fmu.namelist() if entry.startswith("binaries/") and not entry.endswith("/")
+                ]
                 fmu.extractall(out_dir / name, binaries)
             wanted = {folder for platform in PLATFORMS.values() for folder in _fmu_folders(platform, fmi_version)}
             missing = wanted - {entry.split("/")[1] for entry in binaries}
@@ -125,9 +130,12 @@ def _fmu_folders(platform, fmi_version: int) -> tuple[str, ...]:
 
 def fmu_binaries_for(platform: str, extracted: Path) -> list[Path]:
     """The binaries of both FMUs that a wheel for platform loads, from _extract_fmu_binaries."""
-    return sorted(binary for fmi_version, name in FMU_FILES.items()
-                  for folder in _fmu_folders(PLATFORMS[platform], fmi_version)
-                  for binary in (extracted / name / "binaries" / folder).iterdir())
+    return sorted(
+        binary
+        for fmi_version, name in FMU_FILES.items()
+        for folder in _fmu_folders(PLATFORMS[platform], fmi_version)
+        for binary in (extracted / name / "binaries" / folder).iterdir()
+    )
 
 
 def _objdump(binary: Path, *options: str) -> str:
@@ -160,8 +168,9 @@ def manylinux_tag(wheel: Path, machine: str, binaries: list[Path]) -> str:
         shown = " ".join(_run([sys.executable, "-m", "auditwheel", "show", shown_wheel], "auditwheel show").split())
     policy = re.search(r'platform tag: "manylinux_(\d+)_(\d+)_', shown)
     if policy is None:
-        raise WheelhouseError(f"auditwheel finds {wheel.name} with its FMU binaries consistent with no "
-                              f"manylinux tag: {shown}")
+        raise WheelhouseError(
+            f"auditwheel finds {wheel.name} with its FMU binaries consistent with no manylinux tag: {shown}"
+        )
     glibc = (int(policy[1]), int(policy[2]))
     tag = f"manylinux_{glibc[0]}_{glibc[1]}_{machine}"
     return f"{tag}.{LEGACY_MANYLINUX[glibc]}_{machine}" if glibc in LEGACY_MANYLINUX else tag
@@ -176,16 +185,26 @@ def macos_tag(binaries: list[Path]) -> str:
             if architecture == "x86_64":
                 x86_64.append(minimum)
             elif architecture != "arm64" or minimum > (11, 0):
-                raise WheelhouseError(f"{binary.name}: a {architecture} slice for macOS {minimum}: a "
-                                      "universal2 wheel holds x86_64 and arm64 (macOS 11.0) slices")
+                raise WheelhouseError(
+                    f"{binary.name}: a {architecture} slice for macOS {minimum}: a "
+                    "universal2 wheel holds x86_64 and arm64 (macOS 11.0) slices"
+                )
     major, minor = max(x86_64)
     return f"macosx_{major}_{minor}_universal2"
 
 
 def _build_base_wheel(out_dir: Path) -> Path:
     """This machine's wheel, the FMUs inside, built as pip would (an isolated environment)."""
-    command = [sys.executable, "-m", "build", "--wheel", "--outdir", out_dir,
-               f"--config-setting=--build-option=--linux-glibc={MANYLINUX_GLIBC}", ROOT]
+    command = [
+        sys.executable,
+        "-m",
+        "build",
+        "--wheel",
+        "--outdir",
+        out_dir,
+        f"--config-setting=--build-option=--linux-glibc={MANYLINUX_GLIBC}",
+        ROOT,
+    ]
     result = subprocess.run([str(part) for part in command], capture_output=True, text=True, env=_zig_on_path())
     if result.returncode != 0:
         raise WheelhouseError(f"python -m build --wheel failed:\n{result.stdout[-4000:]}{result.stderr[-4000:]}")
@@ -195,8 +214,9 @@ def _build_base_wheel(out_dir: Path) -> Path:
 
 def _retagged(wheel: Path, platform_tag: str) -> Path:
     """wheel tags: the wheel under another platform tag (the old file removed)."""
-    printed = _run([sys.executable, "-m", "wheel", "tags", "--platform-tag", platform_tag, "--remove", wheel],
-                   "wheel tags")
+    printed = _run(
+        [sys.executable, "-m", "wheel", "tags", "--platform-tag", platform_tag, "--remove", wheel], "wheel tags"
+    )
     return wheel.parent / printed.strip()
 
 
@@ -256,8 +276,11 @@ def build_wheels(output_dir: str | os.PathLike = ROOT / "wheelhouse") -> list[Pa
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="build_wheels.py", description=__doc__.split("\n\n")[0])
-    parser.add_argument("--output-dir", default=str(ROOT / "wheelhouse"),
-                        help="folder the wheels are written into (default: wheelhouse/ of this checkout)")
+    parser.add_argument(
+        "--output-dir",
+        default=str(ROOT / "wheelhouse"),
+        help="folder the wheels are written into (default: wheelhouse/ of this checkout)",
+    )
     args = parser.parse_args(argv)
     try:
         build_wheels(args.output_dir)

@@ -48,8 +48,7 @@ class BuildPyWithFmu(build_py):
                 fmu = build_fmu(data / name, fmi_version=fmi_version, linux_glibc=_linux_glibc(self))
             # A platform this machine cannot build for: one line each, what to install in it.
             for warning in skipped:
-                print(f"pendulum_fmu {__version__}: FMI {fmi_version}.0 FMU without {warning.message}",
-                      file=sys.stderr)
+                print(f"pendulum_fmu {__version__}: FMI {fmi_version}.0 FMU without {warning.message}", file=sys.stderr)
             print(f"pendulum_fmu {__version__}: built {fmu} ({', '.join(fmu_platforms(fmu))})")
 
 
@@ -71,9 +70,15 @@ class BuildNativeLoop(build_ext):
 
 
 class PlatformWheel(bdist_wheel):
-    user_options = [*bdist_wheel.user_options,
-                    ("linux-glibc=", None, "build the Linux binaries with zig for this oldest glibc, such as 2.17 "
-                                           "(default: with gcc, for the build machine's glibc)")]
+    user_options = [
+        *bdist_wheel.user_options,
+        (
+            "linux-glibc=",
+            None,
+            "build the Linux binaries with zig for this oldest glibc, such as 2.17 "
+            "(default: with gcc, for the build machine's glibc)",
+        ),
+    ]
 
     def initialize_options(self):
         super().initialize_options()

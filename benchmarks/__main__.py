@@ -26,18 +26,38 @@ DEFAULT_FIGURE = Path(__file__).resolve().parent / "accuracy_cost.png"
 
 
 def parse_arguments(argv):
-    parser = argparse.ArgumentParser(prog="python -m benchmarks", description=__doc__,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--quick", action="store_true",
-                        help="5 repetitions instead of 21, and 4 tolerances instead of 10")
-    parser.add_argument("--skip", action="append", choices=PARTS, default=[], metavar="PART",
-                        help=f"leave a part out (repeatable): {', '.join(PARTS)}")
-    parser.add_argument("--only", action="append", choices=PARTS, default=[], metavar="PART",
-                        help="run only this part (repeatable); the others are left out")
-    parser.add_argument("--markdown", type=Path, metavar="FILE",
-                        help="also write the tables as markdown to FILE (for the README)")
-    parser.add_argument("--figure", type=Path, default=DEFAULT_FIGURE, metavar="FILE",
-                        help="where the accuracy/cost figure goes (default: %(default)s)")
+    parser = argparse.ArgumentParser(
+        prog="python -m benchmarks", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    parser.add_argument(
+        "--quick", action="store_true", help="5 repetitions instead of 21, and 4 tolerances instead of 10"
+    )
+    parser.add_argument(
+        "--skip",
+        action="append",
+        choices=PARTS,
+        default=[],
+        metavar="PART",
+        help=f"leave a part out (repeatable): {', '.join(PARTS)}",
+    )
+    parser.add_argument(
+        "--only",
+        action="append",
+        choices=PARTS,
+        default=[],
+        metavar="PART",
+        help="run only this part (repeatable); the others are left out",
+    )
+    parser.add_argument(
+        "--markdown", type=Path, metavar="FILE", help="also write the tables as markdown to FILE (for the README)"
+    )
+    parser.add_argument(
+        "--figure",
+        type=Path,
+        default=DEFAULT_FIGURE,
+        metavar="FILE",
+        help="where the accuracy/cost figure goes (default: %(default)s)",
+    )
     return parser.parse_args(argv)
 
 

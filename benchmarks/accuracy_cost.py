@@ -19,7 +19,7 @@ from .tutorial import ORACLE_MAX_STEP, ORACLE_TOLERANCE, STOP_TIME, oracle_theta
 PART = "3 accuracy"
 DEFAULT_TOLERANCE = 1e-10  # the FMU's, when fmi2SetupExperiment defines none
 STEP_SIZES = (1e-4, 1e-3, 1e-2, 1e-1)
-ALL_TOLERANCES = tuple(10.0 ** -n for n in range(4, 14))
+ALL_TOLERANCES = tuple(10.0**-n for n in range(4, 14))
 QUICK_TOLERANCES = (1e-4, 1e-7, 1e-10, 1e-13)
 
 
@@ -48,8 +48,7 @@ def measure(master: Path, fmu: BuiltFmu, tolerances: tuple[float, ...]) -> list[
         tolerance, h = case
         theta = theta_trajectory(master, fmu, round(STOP_TIME / h), h, tolerance)
         cost = instructions_per_step(master, fmu, h, tolerance)
-        return Point(tolerance, h, float(np.max(np.abs(theta - oracle[h]))),
-                     cost.instructions_per_step)
+        return Point(tolerance, h, float(np.max(np.abs(theta - oracle[h]))), cost.instructions_per_step)
 
     cases = [(tolerance, h) for h in STEP_SIZES for tolerance in tolerances]
     # Each case is a few valgrind processes, one after the other: a case per core keeps every
@@ -70,16 +69,28 @@ def grid(points: list[Point], oracle_error: float) -> Table:
     cells = []
     for tolerance in sorted({p.tolerance for p in points}, reverse=True):
         name = f"{tolerance:.0e}" + (" (default)" if tolerance == DEFAULT_TOLERANCE else "")
-        cells.append((name, *(f"{error_label(by_case[(tolerance, h)].max_theta_error, oracle_error)} / "
-                              f"{count(by_case[(tolerance, h)].instructions_per_step)}"
-                              for h in STEP_SIZES)))
-    return Table(f"Accuracy against cost: max |theta error| (rad) against the scipy oracle (DOP853 at "
-                 f"{ORACLE_TOLERANCE:g}, steps <= {ORACLE_MAX_STEP * 1e3:g} ms; <= its own error where "
-                 f"it cannot resolve one) / instructions per step", header, cells)
+        cells.append(
+            (
+                name,
+                *(
+                    f"{error_label(by_case[(tolerance, h)].max_theta_error, oracle_error)} / "
+                    f"{count(by_case[(tolerance, h)].instructions_per_step)}"
+                    for h in STEP_SIZES
+                ),
+            )
+        )
+    return Table(
+        f"Accuracy against cost: max |theta error| (rad) against the scipy oracle (DOP853 at "
+        f"{ORACLE_TOLERANCE:g}, steps <= {ORACLE_MAX_STEP * 1e3:g} ms; <= its own error where "
+        f"it cannot resolve one) / instructions per step",
+        header,
+        cells,
+    )
 
 
 def plot(points: list[Point], oracle_error: float, figure_path: Path) -> Path:
     import matplotlib
+
     matplotlib.use("Agg")  # files only: the benchmark may run without a display
     import matplotlib.pyplot as plt
 
@@ -88,22 +99,43 @@ def plot(points: list[Point], oracle_error: float, figure_path: Path) -> Path:
     # so their points pile up, and each must stay visible under the others.
     for h, marker, size in zip(STEP_SIZES, "soD^", (12, 9, 6, 4)):
         line = sorted((p for p in points if p.step_size == h), key=lambda p: p.tolerance)
-        drawn = axes.loglog([p.instructions_per_step for p in line],
-                            [p.max_theta_error for p in line], marker=marker, markersize=size,
-                            markerfacecolor="none", label=f"step {step_label(h)}")
+        drawn = axes.loglog(
+            [p.instructions_per_step for p in line],
+            [p.max_theta_error for p in line],
+            marker=marker,
+            markersize=size,
+            markerfacecolor="none",
+            label=f"step {step_label(h)}",
+        )
         default = [p for p in line if p.tolerance == DEFAULT_TOLERANCE]
-        axes.loglog([p.instructions_per_step for p in default],
-                    [p.max_theta_error for p in default], "*", markersize=15,
-                    color=drawn[0].get_color(), markeredgecolor="black", zorder=3)
-    axes.plot([], [], "*", color="grey", markeredgecolor="black", markersize=15,
-              label=f"default tolerance {DEFAULT_TOLERANCE:g}")
-    axes.axhline(oracle_error, color="grey", linestyle=":",
-                 label="the oracle's own error: nothing below it is resolved")
+        axes.loglog(
+            [p.instructions_per_step for p in default],
+            [p.max_theta_error for p in default],
+            "*",
+            markersize=15,
+            color=drawn[0].get_color(),
+            markeredgecolor="black",
+            zorder=3,
+        )
+    axes.plot(
+        [],
+        [],
+        "*",
+        color="grey",
+        markeredgecolor="black",
+        markersize=15,
+        label=f"default tolerance {DEFAULT_TOLERANCE:g}",
+    )
+    axes.axhline(
+        oracle_error, color="grey", linestyle=":", label="the oracle's own error: nothing below it is resolved"
+    )
     axes.set_xlabel("instructions per communication step (callgrind, fmi2DoStep)")
     axes.set_ylabel(f"max |theta error| over {STOP_TIME:g} s (rad)")
     tolerances = sorted({p.tolerance for p in points})
-    axes.set_title(f"Pendulum FMU, tutorial case: one point per tolerance, {tolerances[-1]:.0e} "
-                   f"to {tolerances[0]:.0e}", fontsize=10)
+    axes.set_title(
+        f"Pendulum FMU, tutorial case: one point per tolerance, {tolerances[-1]:.0e} to {tolerances[0]:.0e}",
+        fontsize=10,
+    )
     axes.grid(True, which="both", alpha=0.3)
     axes.legend(fontsize=8)
     figure.tight_layout()
@@ -112,8 +144,7 @@ def plot(points: list[Point], oracle_error: float, figure_path: Path) -> Path:
     return figure_path
 
 
-def accuracy_cost_rows(master: Path, fmu: BuiltFmu, quick: bool,
-                       figure_path: Path) -> tuple[list[Row], Table | None]:
+def accuracy_cost_rows(master: Path, fmu: BuiltFmu, quick: bool, figure_path: Path) -> tuple[list[Row], Table | None]:
     """Rows for the main table (each step size at the default tolerance) and the full grid."""
     missing = valgrind_missing()
     if missing:
@@ -121,11 +152,21 @@ def accuracy_cost_rows(master: Path, fmu: BuiltFmu, quick: bool,
     points = measure(master, fmu, QUICK_TOLERANCES if quick else ALL_TOLERANCES)
     error_of_oracle = oracle_error()
     plot(points, error_of_oracle, figure_path)
-    rows = [Row(PART, f"step {step_label(p.step_size)}, default tolerance: max |theta error| rad "
-                      "/ instructions per step", f"{error_label(p.max_theta_error, error_of_oracle)} / "
-                                                 f"{count(p.instructions_per_step)}")
-            for p in points if p.tolerance == DEFAULT_TOLERANCE]
-    rows.append(Row(PART, "the oracle's own error: against Radau on the same terms, max |theta "
-                          "difference| rad", f"{error_of_oracle:.1e}"))
+    rows = [
+        Row(
+            PART,
+            f"step {step_label(p.step_size)}, default tolerance: max |theta error| rad / instructions per step",
+            f"{error_label(p.max_theta_error, error_of_oracle)} / {count(p.instructions_per_step)}",
+        )
+        for p in points
+        if p.tolerance == DEFAULT_TOLERANCE
+    ]
+    rows.append(
+        Row(
+            PART,
+            "the oracle's own error: against Radau on the same terms, max |theta difference| rad",
+            f"{error_of_oracle:.1e}",
+        )
+    )
     rows.append(Row(PART, "figure", str(figure_path)))
     return rows, grid(points, error_of_oracle)

@@ -39,8 +39,7 @@ def unzipped(fmu: Path, out_dir: Path) -> BuiltFmu:
     description = read_model_description(str(fmu))
     unzip_dir = Path(extract(str(fmu), str(out_dir / f"{fmu.stem}_unzipped")))
     references = {v.name: v.valueReference for v in description.modelVariables}
-    return BuiltFmu(fmu, unzip_dir, description.guid, description.coSimulation.modelIdentifier,
-                    references)
+    return BuiltFmu(fmu, unzip_dir, description.guid, description.coSimulation.modelIdentifier, references)
 
 
 def build_pendulum_fmu(out_dir: Path) -> BuiltFmu:
@@ -76,7 +75,19 @@ def build_bare_master(out_dir: Path, source: Path, platform: str = "linux64") ->
     check_toolchain(chosen)
     [target] = chosen.targets  # the masters run here, where no universal binary is needed
     master = out_dir / f"{source.stem}_{platform}{'.exe' if chosen.windows else ''}"
-    command = [*target.compiler(), "-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", f"-I{FMI_HEADERS}",
-               f"-I{HERE}", str(source), *([] if chosen.windows else ["-ldl"]), "-o", str(master)]
+    command = [
+        *target.compiler(),
+        "-std=c99",
+        "-O2",
+        "-Wall",
+        "-Wextra",
+        "-Werror",
+        f"-I{FMI_HEADERS}",
+        f"-I{HERE}",
+        str(source),
+        *([] if chosen.windows else ["-ldl"]),
+        "-o",
+        str(master),
+    ]
     run_tool(command, source.name)
     return master

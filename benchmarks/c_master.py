@@ -15,11 +15,19 @@ class MasterError(RuntimeError):
     """The master (or the tool running it) failed; the message carries its output."""
 
 
-def master_command(master: Path, fmu: BuiltFmu, steps: int, step_size: float,
-                   tolerance: float | None, trajectory: Path | None = None) -> list[str]:
+def master_command(
+    master: Path, fmu: BuiltFmu, steps: int, step_size: float, tolerance: float | None, trajectory: Path | None = None
+) -> list[str]:
     """The command line; tolerance None leaves it undefined so the FMU uses its default."""
-    return [str(master), str(fmu.library), fmu.guid, str(steps), repr(step_size),
-            repr(tolerance or 0.0), *([str(trajectory)] if trajectory else [])]
+    return [
+        str(master),
+        str(fmu.library),
+        fmu.guid,
+        str(steps),
+        repr(step_size),
+        repr(tolerance or 0.0),
+        *([str(trajectory)] if trajectory else []),
+    ]
 
 
 def run(command: list[str]) -> None:
@@ -28,8 +36,7 @@ def run(command: list[str]) -> None:
         raise MasterError(f"{' '.join(command)} failed:\n{result.stderr[-2000:]}")
 
 
-def theta_trajectory(master: Path, fmu: BuiltFmu, steps: int, step_size: float,
-                     tolerance: float | None) -> np.ndarray:
+def theta_trajectory(master: Path, fmu: BuiltFmu, steps: int, step_size: float, tolerance: float | None) -> np.ndarray:
     """theta at t = 0, h, ..., steps*h, as the master saw it."""
     with tempfile.TemporaryDirectory() as scratch:
         path = Path(scratch) / "theta.txt"

@@ -28,15 +28,20 @@ def valgrind_missing() -> str | None:
     return None if shutil.which("valgrind") else "valgrind not found (apt-get install valgrind)"
 
 
-def count_instructions(master: Path, fmu: BuiltFmu, steps: int, step_size: float,
-                       tolerance: float | None, only_in: tuple[str, ...]) -> int:
+def count_instructions(
+    master: Path, fmu: BuiltFmu, steps: int, step_size: float, tolerance: float | None, only_in: tuple[str, ...]
+) -> int:
     """Instructions of one master run; with only_in, just those inside those functions and what
     they call (callgrind's --toggle-collect)."""
     with tempfile.TemporaryDirectory() as scratch:
         profile = Path(scratch) / "callgrind.out"
-        command = ["valgrind", "--tool=callgrind", f"--callgrind-out-file={profile}",
-                   *(f"--toggle-collect={function}" for function in only_in),
-                   *master_command(master, fmu, steps, step_size, tolerance)]
+        command = [
+            "valgrind",
+            "--tool=callgrind",
+            f"--callgrind-out-file={profile}",
+            *(f"--toggle-collect={function}" for function in only_in),
+            *master_command(master, fmu, steps, step_size, tolerance),
+        ]
         run(command)
         totals = re.search(r"^totals:\s*(\d+)", profile.read_text(), re.MULTILINE)
         if not totals:
@@ -46,16 +51,19 @@ def count_instructions(master: Path, fmu: BuiltFmu, steps: int, step_size: float
 
 @dataclass(frozen=True)
 class StepCost:
-    steps: int                  # steps in the difference
+    steps: int  # steps in the difference
     instructions_per_step: float
 
 
-def instructions_per_step(master: Path, fmu: BuiltFmu, step_size: float,
-                          tolerance: float | None = None,
-                          only_in: tuple[str, ...] = ("fmi2DoStep",)) -> StepCost:
+def instructions_per_step(
+    master: Path,
+    fmu: BuiltFmu,
+    step_size: float,
+    tolerance: float | None = None,
+    only_in: tuple[str, ...] = ("fmi2DoStep",),
+) -> StepCost:
     """Steady-state instructions per communication step: (long run - short run) / extra steps."""
     short_steps, long_steps = round(SHORT_RUN / step_size), round(LONG_RUN / step_size)
-    short, long = (count_instructions(master, fmu, n, step_size, tolerance, only_in)
-                   for n in (short_steps, long_steps))
+    short, long = (count_instructions(master, fmu, n, step_size, tolerance, only_in) for n in (short_steps, long_steps))
     extra = long_steps - short_steps
     return StepCost(extra, (long - short) / extra)

@@ -45,8 +45,15 @@ def chunk_cpu(outputs: tuple[str, ...]) -> tuple[float, float, float]:
     round of least CPU."""
     rounds = []
     with tempfile.TemporaryDirectory(prefix="pendulum-chunk-cost-") as folder:
-        task = Task(str(default_fmu()), Store(LocalFileSystem(), folder, "parquet"), STOP_TIME,
-                    STEP_SIZE, outputs, 1, "benchmark")
+        task = Task(
+            str(default_fmu()),
+            Store(LocalFileSystem(), folder, "parquet"),
+            STOP_TIME,
+            STEP_SIZE,
+            outputs,
+            1,
+            "benchmark",
+        )
         run_chunk(0, 0, _values(), task)  # the FMU unzipped and instantiated once, as on a worker
         for _ in range(ROUNDS):
             chunks = [run_chunk(index, 0, _values(), task)[3:] for index in range(CHUNKS)]
@@ -79,8 +86,13 @@ def encodings() -> list[tuple[str, bool, float, float]]:
     points = communication_points(0.0, STOP_TIME, STEP_SIZE)
     recorded = np.empty((len(OUTPUTS), CASES, len(points)))
     runner.run_cases(runner.start_values(_values(), CASES), points, recorded)
-    table = pa.table({"case": np.repeat(np.arange(CASES), len(points)), "time": np.tile(points, CASES),
-                      **{name: recorded[j].reshape(-1) for j, name in enumerate(OUTPUTS)}})
+    table = pa.table(
+        {
+            "case": np.repeat(np.arange(CASES), len(points)),
+            "time": np.tile(points, CASES),
+            **{name: recorded[j].reshape(-1) for j, name in enumerate(OUTPUTS)},
+        }
+    )
     floats = ["time", *OUTPUTS]
     rows = []
     for compression in COMPRESSIONS:
@@ -88,22 +100,31 @@ def encodings() -> list[tuple[str, bool, float, float]]:
             cpu = float("inf")
             for _ in range(ROUNDS):
                 sink, started = io.BytesIO(), time.thread_time()
-                pq.write_table(table, sink, compression=compression, use_dictionary=["case"],
-                               column_encoding={c: "BYTE_STREAM_SPLIT" for c in floats} if split else None)
+                pq.write_table(
+                    table,
+                    sink,
+                    compression=compression,
+                    use_dictionary=["case"],
+                    column_encoding={c: "BYTE_STREAM_SPLIT" for c in floats} if split else None,
+                )
                 cpu = min(cpu, (time.thread_time() - started) / CASES)
             rows.append((compression, split, sink.tell() / CASES, cpu))
     return rows
 
 
 def main() -> None:
-    print(f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}; {CHUNKS} chunks of "
-          f"{CASES} 3-s cases at 1 ms, CPU of this thread per case, least of {ROUNDS} rounds")
+    print(
+        f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}; {CHUNKS} chunks of "
+        f"{CASES} 3-s cases at 1 ms, CPU of this thread per case, least of {ROUNDS} rounds"
+    )
     floor = native_loop_cpu()
     print(f"native loop alone, a restart per call: {floor * 1e3:.3f} ms")
     for label, outputs in (("all outputs", OUTPUTS), ("--outputs none", ())):
         cpu, stepping, written = chunk_cpu(outputs)
-        print(f"run_chunk, {label}: {cpu * 1e3:.3f} ms ({stepping * 1e3:.3f} ms stepping), "
-              f"{cpu / floor:.2f} x the native loop, {written / 1e3:.1f} kB written")
+        print(
+            f"run_chunk, {label}: {cpu * 1e3:.3f} ms ({stepping * 1e3:.3f} ms stepping), "
+            f"{cpu / floor:.2f} x the native loop, {written / 1e3:.1f} kB written"
+        )
     print("trajectories part: compression, byte-stream-split, kB per case, write CPU per case")
     for compression, split, size, cpu in encodings():
         print(f"  {compression:5} {'on ' if split else 'off'} {size / 1e3:7.1f} kB {cpu * 1e3:7.3f} ms")

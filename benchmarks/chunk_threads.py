@@ -30,8 +30,7 @@ CHUNKS, CASES = 20, 64
 def main() -> None:
     values = {"torque": np.linspace(1.0, 40.0, CASES), "gravity": np.full(CASES, 9.81)}
     with tempfile.TemporaryDirectory(prefix="pendulum-chunk-threads-") as folder:
-        task = Task(str(default_fmu()), Store(LocalFileSystem(), folder, "parquet"), 3.0, 1e-3,
-                    OUTPUTS, 1, "benchmark")
+        task = Task(str(default_fmu()), Store(LocalFileSystem(), folder, "parquet"), 3.0, 1e-3, OUTPUTS, 1, "benchmark")
         run_chunk(0, 0, values, task)  # the FMU unzipped and instantiated once, as on a worker
         for pool in ("default", "one thread"):
             if pool == "one thread":
@@ -43,9 +42,11 @@ def main() -> None:
             cases = CHUNKS * CASES
             process = (time.process_time() - process) / cases
             thread = (time.thread_time() - thread) / cases
-            print(f"pyarrow pool {pool} ({pa.cpu_count()} threads): {process * 1e3:.3f} ms CPU per case "
-                  f"in the process, {thread * 1e3:.3f} ms on the calling thread, "
-                  f"{max(process - thread, 0.0) * 1e3:.3f} ms on others")
+            print(
+                f"pyarrow pool {pool} ({pa.cpu_count()} threads): {process * 1e3:.3f} ms CPU per case "
+                f"in the process, {thread * 1e3:.3f} ms on the calling thread, "
+                f"{max(process - thread, 0.0) * 1e3:.3f} ms on others"
+            )
 
 
 if __name__ == "__main__":

@@ -53,7 +53,9 @@ def traced(argv: list[str]) -> tuple[set[str], Counter]:
 
 if __name__ == "__main__":
     files, moves = traced(sys.argv[1:])
-    print(f"{len(files)} files, {sum(moves.values())} cross-file moves "
-          f"({len(moves)} distinct) for pendulum-fmu {' '.join(sys.argv[1:])}")
+    print(
+        f"{len(files)} files, {sum(moves.values())} cross-file moves "
+        f"({len(moves)} distinct) for pendulum-fmu {' '.join(sys.argv[1:])}"
+    )
     for (caller, callee), count in moves.most_common():
         print(f"  {count:4d}  {caller} -> {callee}")

@@ -40,6 +40,7 @@ def fixed_cost_rows(fmu: BuiltFmu, repetitions: int) -> list[Row]:
     def calls(function):
         def run():
             return timed(lambda: [function() for _ in range(CALLS)])[0] / CALLS
+
         return run
 
     contenders = {
@@ -50,25 +51,34 @@ def fixed_cost_rows(fmu: BuiltFmu, repetitions: int) -> list[Row]:
     opensim = importlib.util.find_spec("opensim") is not None
     if opensim:
         from pendulum_fmu.engines.opensim import opensim_simulate
-        contenders["opensim 1 s"] = lambda: timed(lambda: opensim_simulate(one_second.time,
-                                                                           one_second.torque))[0]
+
+        contenders["opensim 1 s"] = lambda: timed(lambda: opensim_simulate(one_second.time, one_second.torque))[0]
     seconds = {name: median(values) for name, values in interleaved(contenders, repetitions).items()}
     fixed = seconds["simulate 1 step"]
     case = f"median of {repetitions}"
     rows = [
-        Row(PART, f"simulate() of one 1 ms step, after the first call in the process, {case} "
-                  f"(of {CALLS} calls each)", f"{microseconds(fixed)} = {1 / fixed:,.0f} calls/s",
-            f"<= {microseconds(TARGET_FIXED_COST)}", fixed <= TARGET_FIXED_COST),
-        Row(PART, "the same step through a fresh instance per call (open_fmu, run_schedule, free)",
-            f"{microseconds(seconds['fresh 1 step'])}"),
+        Row(
+            PART,
+            f"simulate() of one 1 ms step, after the first call in the process, {case} (of {CALLS} calls each)",
+            f"{microseconds(fixed)} = {1 / fixed:,.0f} calls/s",
+            f"<= {microseconds(TARGET_FIXED_COST)}",
+            fixed <= TARGET_FIXED_COST,
+        ),
+        Row(
+            PART,
+            "the same step through a fresh instance per call (open_fmu, run_schedule, free)",
+            f"{microseconds(seconds['fresh 1 step'])}",
+        ),
         Row(PART, f"simulate() of 1 s in 1 ms steps, {case}", microseconds(seconds["simulate 1 s"])),
     ]
     if not opensim:
         return rows + [skipped(PART, "OpenSim 4.6 on 1 s", "the opensim package is not installed")]
     lead = seconds["opensim 1 s"] / seconds["simulate 1 s"]
     return rows + [
-        Row(PART, f"OpenSim opensim_simulate() of 1 s in 1 ms steps, end to end, {case}",
-            microseconds(seconds["opensim 1 s"])),
-        Row(PART, "OpenSim / simulate() time on 1 s", ratio(lead), f">= {OPENSIM_TARGET:g}",
-            lead >= OPENSIM_TARGET),
+        Row(
+            PART,
+            f"OpenSim opensim_simulate() of 1 s in 1 ms steps, end to end, {case}",
+            microseconds(seconds["opensim 1 s"]),
+        ),
+        Row(PART, "OpenSim / simulate() time on 1 s", ratio(lead), f">= {OPENSIM_TARGET:g}", lead >= OPENSIM_TARGET),
     ]

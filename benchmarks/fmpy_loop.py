@@ -12,8 +12,9 @@ from .timing import timed
 
 def open_slave(fmu: BuiltFmu) -> FMU2Slave:
     """An instance in step mode with the FMU's own defaults: no parameter set, no tolerance."""
-    slave = FMU2Slave(guid=fmu.guid, unzipDirectory=str(fmu.unzip_dir),
-                      modelIdentifier=fmu.model_identifier, instanceName="benchmark")
+    slave = FMU2Slave(
+        guid=fmu.guid, unzipDirectory=str(fmu.unzip_dir), modelIdentifier=fmu.model_identifier, instanceName="benchmark"
+    )
     slave.instantiate()
     slave.setupExperiment(startTime=0.0)
     slave.enterInitializationMode()

@@ -30,13 +30,13 @@ TEMPLATE = (
     "{install_s} s and leaves a {environment_mb} MB environment, of which the package is "
     "{package_kb} kB and the largest parts are {largest}; `[opensim]` adds {opensim_s} s and "
     "{opensim_mb} MB. From that install, `pendulum-fmu simulate --torque 20` runs in {simulate_s} "
-    "s and `pendulum-fmu demo` in {demo_s} s.")
+    "s and `pendulum-fmu demo` in {demo_s} s."
+)
 
 
 def render(figures: dict) -> str:
     """TEMPLATE filled in, wrapped as the README's prose is."""
-    return textwrap.fill(TEMPLATE.format(**figures), width=98, break_long_words=False,
-                         break_on_hyphens=False)
+    return textwrap.fill(TEMPLATE.format(**figures), width=98, break_long_words=False, break_on_hyphens=False)
 
 
 def _size(path: Path) -> int:
@@ -47,8 +47,7 @@ def _size(path: Path) -> int:
 
 
 # A user's fresh shell: no package on the path but what the new environment installs.
-_FRESH = {name: value for name, value in os.environ.items()
-          if name not in ("PYTHONPATH", "PYTHONHOME", "VIRTUAL_ENV")}
+_FRESH = {name: value for name, value in os.environ.items() if name not in ("PYTHONPATH", "PYTHONHOME", "VIRTUAL_ENV")}
 
 
 def _timed(command: list[str], **options) -> float:
@@ -81,7 +80,9 @@ def measure() -> dict:
         scratch = Path(scratch)
         wheels, venv, work = scratch / "wheels", scratch / "venv", scratch / "work"
         work.mkdir()
-        figures["wheel_s"] = f"{_timed([sys.executable, '-m', 'pip', 'wheel', '--no-deps', '-w', str(wheels), str(REPOSITORY)]):.0f}"
+        figures["wheel_s"] = (
+            f"{_timed([sys.executable, '-m', 'pip', 'wheel', '--no-deps', '-w', str(wheels), str(REPOSITORY)]):.0f}"
+        )
         wheel = next(wheels.glob("pendulum_fmu-*.whl"))
         figures["wheel_kb"] = f"{wheel.stat().st_size / 1e3:.0f}"
         subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True, env=_FRESH)
@@ -91,8 +92,14 @@ def measure() -> dict:
         before = _size(venv)
         figures["environment_mb"] = f"{before / 1e6:.0f}"
         figures["package_kb"] = f"{_size(site / 'pendulum_fmu') / 1e3:.0f}"
-        parts = sorted(((_size(p), p.name) for p in site.iterdir() if p.is_dir() and not p.name.endswith(
-            (".dist-info", "__pycache__"))), reverse=True)[:3]
+        parts = sorted(
+            (
+                (_size(p), p.name)
+                for p in site.iterdir()
+                if p.is_dir() and not p.name.endswith((".dist-info", "__pycache__"))
+            ),
+            reverse=True,
+        )[:3]
         figures["largest"] = ", ".join(f"{name} ({size / 1e6:.0f} MB)" for size, name in parts)
         program = str(venv / "bin" / "pendulum-fmu")
         figures["simulate_s"] = f"{_timed([program, 'simulate', '--torque', '20'], cwd=work):.1f}"

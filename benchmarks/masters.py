@@ -24,26 +24,37 @@ from fmpy.fmi2 import FMU2Model, FMU2Slave
 OUTPUTS = ("theta", "omega", "alpha")
 # (scenario, the mistake a master makes on purpose, the diagnosis it must get)
 WRONG_MASTERS = [
-    ("random_steps", "late", "input one step late"), ("decimal_steps", "late", "input one step late"),
+    ("random_steps", "late", "input one step late"),
+    ("decimal_steps", "late", "input one step late"),
     ("ramp", "late", "input one step late"),
-    ("steps_on_grid", "early", "input one step early"), ("ramp", "early", "input one step early"),
+    ("steps_on_grid", "early", "input one step early"),
+    ("ramp", "early", "input one step early"),
     ("random_steps", "ramped", "input interpolated linearly"),
     ("steps_on_grid", "ramped", "input interpolated linearly"),
     ("ramp", "held", "input held"),
-    ("random_steps", "drift", "time grid drift"), ("decimal_steps", "drift", "time grid drift"),
+    ("random_steps", "drift", "time grid drift"),
+    ("decimal_steps", "drift", "time grid drift"),
     ("resume", "not_restored", "state not restored"),
-    ("constant_torque", "euler", "integration error"), ("random_steps", "euler", "integration error"),
-    ("constant_torque", "heun", "integration error"), ("random_steps", "heun", "integration error"),
-    ("random_steps", "late_once", "unexplained"), ("steps_on_grid", "scaled", "unexplained"),
+    ("constant_torque", "euler", "integration error"),
+    ("random_steps", "euler", "integration error"),
+    ("constant_torque", "heun", "integration error"),
+    ("random_steps", "heun", "integration error"),
+    ("random_steps", "late_once", "unexplained"),
+    ("steps_on_grid", "scaled", "unexplained"),
     ("constant_torque", "scaled", "unexplained"),
 ]
 # In words, for the table.
 MISTAKES = {
-    "late": "input one step late", "early": "input one step early",
-    "ramped": "input derivatives where the signal holds", "held": "no input derivatives on a ramp",
-    "drift": "time summed in single precision", "not_restored": "resumed without restoring the state",
-    "euler": "Model Exchange, explicit Euler at the step", "heun": "Model Exchange, Heun at the step",
-    "late_once": "only the first change one step late", "scaled": "1 % too much torque",
+    "late": "input one step late",
+    "early": "input one step early",
+    "ramped": "input derivatives where the signal holds",
+    "held": "no input derivatives on a ramp",
+    "drift": "time summed in single precision",
+    "not_restored": "resumed without restoring the state",
+    "euler": "Model Exchange, explicit Euler at the step",
+    "heun": "Model Exchange, Heun at the step",
+    "late_once": "only the first change one step late",
+    "scaled": "1 % too much torque",
 }
 
 
@@ -95,8 +106,7 @@ class Kit:
         start = [self.signal.after(t) for t in times[:-1]]
         if not self.settings["ramp"]:
             return start, [0.0] * len(start)
-        return start, [(self.signal.before(t1) - u) / (t1 - t0)
-                       for u, t0, t1 in zip(start, times[:-1], times[1:])]
+        return start, [(self.signal.before(t1) - u) / (t1 - t0) for u, t0, t1 in zip(start, times[:-1], times[1:])]
 
     def start_values(self) -> dict[str, float]:
         s = self.settings
@@ -112,8 +122,12 @@ class Kit:
 
 
 def _slave(kit: Kit, start_time: float, name: str) -> FMU2Slave:
-    slave = FMU2Slave(guid=kit.description.guid, unzipDirectory=kit.unzipped,
-                      modelIdentifier=kit.description.coSimulation.modelIdentifier, instanceName=name)
+    slave = FMU2Slave(
+        guid=kit.description.guid,
+        unzipDirectory=kit.unzipped,
+        modelIdentifier=kit.description.coSimulation.modelIdentifier,
+        instanceName=name,
+    )
     slave.instantiate()
     slave.setupExperiment(tolerance=kit.settings["relative_tolerance"], startTime=start_time)
     slave.enterInitializationMode()
@@ -129,8 +143,10 @@ def co_simulation(kit: Kit, mistake: str | None = None) -> Path:
     times = kit.times
     if mistake == "drift":
         # Time summed in single precision, as a master with a float clock does.
-        clock = np.cumsum(np.r_[np.float32(kit.settings["start_time"]),
-                                np.full(len(times) - 2, np.float32(kit.step))], dtype=np.float32)
+        clock = np.cumsum(
+            np.r_[np.float32(kit.settings["start_time"]), np.full(len(times) - 2, np.float32(kit.step))],
+            dtype=np.float32,
+        )
         times = np.r_[clock.astype(float), kit.settings["stop_time"]]
     torque, slope = kit.torques(times)
     if mistake == "late":  # step k gets what step k - 1 should
@@ -139,7 +155,7 @@ def co_simulation(kit: Kit, mistake: str | None = None) -> Path:
         torque, slope = torque[1:] + [torque[-1]], slope[1:] + [0.0]
     elif mistake == "late_once":  # only the first change of the torque reaches the FMU a step late
         k = next(k for k in range(1, len(torque)) if torque[k] != torque[k - 1])
-        torque = torque[:k] + [torque[k - 1]] + torque[k + 1:]
+        torque = torque[:k] + [torque[k - 1]] + torque[k + 1 :]
     elif mistake == "scaled":  # a unit slip: 1 % too much torque
         torque = [1.01 * u for u in torque]
     elif mistake == "ramped":  # a slope towards the next step's value where the signal holds
@@ -175,8 +191,12 @@ def co_simulation(kit: Kit, mistake: str | None = None) -> Path:
 def model_exchange(kit: Kit, method: str) -> Path:
     """A master that integrates the Model Exchange interface itself, one solver step per
     communication step, holding each step's torque: explicit Euler, or Heun (second order)."""
-    model = FMU2Model(guid=kit.description.guid, unzipDirectory=kit.unzipped,
-                      modelIdentifier=kit.description.modelExchange.modelIdentifier, instanceName="me")
+    model = FMU2Model(
+        guid=kit.description.guid,
+        unzipDirectory=kit.unzipped,
+        modelIdentifier=kit.description.modelExchange.modelIdentifier,
+        instanceName="me",
+    )
     model.instantiate()
     model.setupExperiment(startTime=kit.times[0])
     model.enterInitializationMode()
@@ -231,8 +251,10 @@ def main() -> int:
     # residual: of the diagnosis (for integration error without a variant, the difference
     # itself); others: the smallest residual of every other candidate; both as fractions of
     # max|dtheta|. input: max|dtheta| over the smallest difference an input-timing mistake makes.
-    print(f"{'scenario':<16} {'mistake made':<43} {'diagnosis':<28} {'max|dtheta|':>11} {'residual':>9} "
-          f"{'others':>8} {'input':>8}")
+    print(
+        f"{'scenario':<16} {'mistake made':<43} {'diagnosis':<28} {'max|dtheta|':>11} {'residual':>9} "
+        f"{'others':>8} {'input':>8}"
+    )
     with tempfile.TemporaryDirectory() as folder:
         write_scenarios(folder)
         for name, mistake, _ in WRONG_MASTERS:
@@ -240,12 +262,15 @@ def main() -> int:
             settings.pop("output")
             judgement = judge(run(Path(folder), name, mistake), **settings)
             raw = judgement.max_abs_dtheta
-            others = min(s["residual"] for c, s in judgement.candidates.items()
-                         if s is not None and c != judgement.diagnosis)
+            others = min(
+                s["residual"] for c, s in judgement.candidates.items() if s is not None and c != judgement.diagnosis
+            )
             input_effect = judgement.smallest_input_effect
-            print(f"{name:<16} {MISTAKES[mistake]:<43} {judgement.diagnosis:<28} {raw:>11.2e} "
-                  f"{judgement.residual / raw:>9.1e} {others / raw:>8.1e} "
-                  f"{'' if input_effect is None else f'{raw / input_effect:.1e}':>8}")
+            print(
+                f"{name:<16} {MISTAKES[mistake]:<43} {judgement.diagnosis:<28} {raw:>11.2e} "
+                f"{judgement.residual / raw:>9.1e} {others / raw:>8.1e} "
+                f"{'' if input_effect is None else f'{raw / input_effect:.1e}':>8}"
+            )
     return 0
 
 

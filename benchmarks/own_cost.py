@@ -26,12 +26,24 @@ def own_cost_rows(master: Path, pendulum: BuiltFmu, null: BuiltFmu) -> list[Row]
     whole_step = instructions_per_step(master, pendulum, STEP, only_in=())
     null_step = instructions_per_step(master, null, STEP, only_in=())
     return [
-        Row(PART, f"instructions per 1 ms fmi2DoStep (callgrind, C master, tutorial case, default "
-                  f"tolerance, {do_step.steps} steps)", count(do_step.instructions_per_step),
-            f"<= {TARGET_DO_STEP:,}", do_step.instructions_per_step <= TARGET_DO_STEP),
-        Row(PART, "instructions per 1 ms fmi2SetReal + fmi2DoStep + fmi2GetReal",
-            count(with_set_and_get.instructions_per_step), f"<= {TARGET_WITH_SET_AND_GET:,}",
-            with_set_and_get.instructions_per_step <= TARGET_WITH_SET_AND_GET),
-        Row(PART, "instructions per C master step (the calls and the loop): Pendulum / null FMU",
-            f"{count(whole_step.instructions_per_step)} / {count(null_step.instructions_per_step)}"),
+        Row(
+            PART,
+            f"instructions per 1 ms fmi2DoStep (callgrind, C master, tutorial case, default "
+            f"tolerance, {do_step.steps} steps)",
+            count(do_step.instructions_per_step),
+            f"<= {TARGET_DO_STEP:,}",
+            do_step.instructions_per_step <= TARGET_DO_STEP,
+        ),
+        Row(
+            PART,
+            "instructions per 1 ms fmi2SetReal + fmi2DoStep + fmi2GetReal",
+            count(with_set_and_get.instructions_per_step),
+            f"<= {TARGET_WITH_SET_AND_GET:,}",
+            with_set_and_get.instructions_per_step <= TARGET_WITH_SET_AND_GET,
+        ),
+        Row(
+            PART,
+            "instructions per C master step (the calls and the loop): Pendulum / null FMU",
+            f"{count(whole_step.instructions_per_step)} / {count(null_step.instructions_per_step)}",
+        ),
     ]

@@ -40,8 +40,7 @@ def opensim_rows(fmu: BuiltFmu, repetitions: int) -> list[Row]:
         return seconds
 
     def fmu_run():
-        seconds, out = timed(lambda: simulate(TORQUE, stop_time=STOP_TIME, step_size=STEP,
-                                              fmu_path=fmu.path))
+        seconds, out = timed(lambda: simulate(TORQUE, stop_time=STOP_TIME, step_size=STEP, fmu_path=fmu.path))
         theta["fmu"] = out["theta"]
         return seconds
 
@@ -53,10 +52,20 @@ def opensim_rows(fmu: BuiltFmu, repetitions: int) -> list[Row]:
     return [
         Row(part, f"OpenSim opensim_simulate(), {case}", f"{microseconds(opensim_step)}/step"),
         Row(part, f"Pendulum FMU simulate(), {case}", f"{microseconds(fmu_step)}/step"),
-        Row(part, "OpenSim / FMU time", ratio(opensim_step / fmu_step), f">= {OPENSIM_TARGET:g}",
-            opensim_step / fmu_step >= OPENSIM_TARGET),
-        Row(part, "max |theta error| rad: OpenSim / FMU", f"{opensim_error:.1e} / {fmu_error:.1e}",
-            "FMU <= OpenSim", fmu_error <= opensim_error),
+        Row(
+            part,
+            "OpenSim / FMU time",
+            ratio(opensim_step / fmu_step),
+            f">= {OPENSIM_TARGET:g}",
+            opensim_step / fmu_step >= OPENSIM_TARGET,
+        ),
+        Row(
+            part,
+            "max |theta error| rad: OpenSim / FMU",
+            f"{opensim_error:.1e} / {fmu_error:.1e}",
+            "FMU <= OpenSim",
+            fmu_error <= opensim_error,
+        ),
     ]
 
 
@@ -68,6 +77,7 @@ def pythonfmu_rows(pendulum: BuiltFmu, out_dir: Path, repetitions: int) -> list[
     part = "peer PythonFMU"
     try:
         from .pythonfmu_pendulum.build import build_pythonfmu_pendulum
+
         fmu_path = build_pythonfmu_pendulum(out_dir / "pythonfmu")
     except ImportError as error:
         return [skipped(part, "PythonFMU pendulum against ours", f"{error}")]
@@ -78,10 +88,10 @@ def pythonfmu_rows(pendulum: BuiltFmu, out_dir: Path, repetitions: int) -> list[
         def run():
             seconds, theta[name] = timed_tutorial_loop(fmu)
             return seconds
+
         return run
 
-    seconds = interleaved({"pythonfmu": contender("pythonfmu", peer),
-                           "ours": contender("ours", pendulum)}, repetitions)
+    seconds = interleaved({"pythonfmu": contender("pythonfmu", peer), "ours": contender("ours", pendulum)}, repetitions)
     peer_step = median(seconds["pythonfmu"]) / STEPS
     ours_step = median(seconds["ours"]) / STEPS
     loop = f"fmpy FMU2Slave loop, {STEPS} x 1 ms, median of {repetitions}"
@@ -89,8 +99,18 @@ def pythonfmu_rows(pendulum: BuiltFmu, out_dir: Path, repetitions: int) -> list[
     return [
         Row(part, f"PythonFMU pendulum, {loop}", f"{microseconds(peer_step)}/step"),
         Row(part, f"Pendulum FMU, {loop}", f"{microseconds(ours_step)}/step"),
-        Row(part, "PythonFMU / ours time", ratio(peer_step / ours_step), f">= {PYTHONFMU_TARGET:g}",
-            peer_step / ours_step >= PYTHONFMU_TARGET),
-        Row(part, "max |theta error| rad: PythonFMU / ours", f"{peer_error:.1e} / {ours_error:.1e}",
-            "ours <= PythonFMU", ours_error <= peer_error),
+        Row(
+            part,
+            "PythonFMU / ours time",
+            ratio(peer_step / ours_step),
+            f">= {PYTHONFMU_TARGET:g}",
+            peer_step / ours_step >= PYTHONFMU_TARGET,
+        ),
+        Row(
+            part,
+            "max |theta error| rad: PythonFMU / ours",
+            f"{peer_error:.1e} / {ours_error:.1e}",
+            "ours <= PythonFMU",
+            ours_error <= peer_error,
+        ),
     ]

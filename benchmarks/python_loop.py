@@ -58,10 +58,10 @@ def python_loop_rows(fmu: BuiltFmu, repetitions: int) -> list[Row]:
             seconds, out = _timed_on_fresh_instance(loop, fmu, plan)
             theta[name] = out["theta"]
             return seconds
+
         return run
 
-    contenders = {"ours": contender("ours", run_schedule_python),
-                  "fmpy": contender("fmpy", fmpy_schedule_loop)}
+    contenders = {"ours": contender("ours", run_schedule_python), "fmpy": contender("fmpy", fmpy_schedule_loop)}
     if cs_loop.available():
         contenders["native"] = contender("native", run_schedule)
     seconds = interleaved(contenders, repetitions)
@@ -72,13 +72,26 @@ def python_loop_rows(fmu: BuiltFmu, repetitions: int) -> list[Row]:
     fmpy_step = median(seconds["fmpy"]) / tutorial.STEPS
     ours_over_fmpy = ours_step / fmpy_step
     return [
-        Row(PART, f"the Python loop, run_schedule_python (setReal, getReal x3, doStep), {tutorial.STEPS} "
-                  f"x 1 ms, median of {repetitions}", f"{microseconds(ours_step)}/step"),
+        Row(
+            PART,
+            f"the Python loop, run_schedule_python (setReal, getReal x3, doStep), {tutorial.STEPS} "
+            f"x 1 ms, median of {repetitions}",
+            f"{microseconds(ours_step)}/step",
+        ),
         Row(PART, "fmpy FMU2Slave wrappers making the same calls", f"{microseconds(fmpy_step)}/step"),
-        Row(PART, "Python loop / fmpy", ratio(ours_over_fmpy), f"<= {TARGET_RATIO:.2f}",
-            ours_over_fmpy <= TARGET_RATIO),
+        Row(
+            PART, "Python loop / fmpy", ratio(ours_over_fmpy), f"<= {TARGET_RATIO:.2f}", ours_over_fmpy <= TARGET_RATIO
+        ),
         Row(PART, "theta arrays identical (asserted)", "yes"),
-    ] + ([Row(PART, "native loop (cs_loop: the same calls from C, one call per run)",
-              f"{microseconds(median(seconds['native']) / tutorial.STEPS)}/step"),
-          Row(PART, "native / Python loop", ratio(median(seconds["native"]) / median(seconds["ours"])))]
-         if "native" in seconds else [])
+    ] + (
+        [
+            Row(
+                PART,
+                "native loop (cs_loop: the same calls from C, one call per run)",
+                f"{microseconds(median(seconds['native']) / tutorial.STEPS)}/step",
+            ),
+            Row(PART, "native / Python loop", ratio(median(seconds["native"]) / median(seconds["ours"]))),
+        ]
+        if "native" in seconds
+        else []
+    )

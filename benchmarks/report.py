@@ -59,8 +59,10 @@ def gcc_version() -> str:
 
 
 def machine() -> str:
-    return (f"{cpu_model()}, {os.cpu_count()} cores; Python {platform.python_version()}; "
-            f"{gcc_version()}; {platform.system()} {platform.release()}")
+    return (
+        f"{cpu_model()}, {os.cpu_count()} cores; Python {platform.python_version()}; "
+        f"{gcc_version()}; {platform.system()} {platform.release()}"
+    )
 
 
 @dataclass(frozen=True)
@@ -71,8 +73,11 @@ class Table:
 
 
 def main_table(rows: list[Row]) -> Table:
-    return Table(f"Machine: {machine()}", ("part", "measure", "value", "target", ""),
-                 [(r.part, r.measure, r.value, r.target, r.verdict) for r in rows])
+    return Table(
+        f"Machine: {machine()}",
+        ("part", "measure", "value", "target", ""),
+        [(r.part, r.measure, r.value, r.target, r.verdict) for r in rows],
+    )
 
 
 def as_text(table: Table) -> str:
@@ -86,5 +91,13 @@ def as_text(table: Table) -> str:
 def as_markdown(table: Table) -> str:
     def line(cells):
         return "| " + " | ".join(c.replace("|", "\\|") for c in cells) + " |"
-    return "\n".join([table.title, "", line(table.header), line(("---",) * len(table.header)),
-                      *(line(cells) for cells in table.cells)])
+
+    return "\n".join(
+        [
+            table.title,
+            "",
+            line(table.header),
+            line(("---",) * len(table.header)),
+            *(line(cells) for cells in table.cells),
+        ]
+    )

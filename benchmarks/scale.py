@@ -59,13 +59,32 @@ def dask_process_handles(workers: int, nanny: bool = True):
     port = free_port()
     address = f"tcp://127.0.0.1:{port}"
     quiet = dict(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    processes = [subprocess.Popen([sys.executable, "-m", "dask", "scheduler", "--host", "127.0.0.1",
-                                   "--port", str(port), "--no-dashboard"], **quiet)]
+    processes = [
+        subprocess.Popen(
+            [sys.executable, "-m", "dask", "scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard"],
+            **quiet,
+        )
+    ]
     try:
-        processes += [subprocess.Popen([sys.executable, "-m", "dask", "worker", address, "--host",
-                                        "127.0.0.1", "--nthreads", "1", "--no-dashboard",
-                                        *(() if nanny else ("--no-nanny",))], **quiet)
-                      for _ in range(workers)]
+        processes += [
+            subprocess.Popen(
+                [
+                    sys.executable,
+                    "-m",
+                    "dask",
+                    "worker",
+                    address,
+                    "--host",
+                    "127.0.0.1",
+                    "--nthreads",
+                    "1",
+                    "--no-dashboard",
+                    *(() if nanny else ("--no-nanny",)),
+                ],
+                **quiet,
+            )
+            for _ in range(workers)
+        ]
         with Client(address, timeout=60) as client:
             client.wait_for_workers(workers, timeout=60)
         yield address, processes
@@ -99,17 +118,31 @@ def measure_client(address: str, cases: int, stop_time: float, fmu: str, output_
 
     # A small study first: the workers import the package and unzip the FMU once in their lives,
     # and this process imports what drawing needs; neither is a cost per case.
-    sweep.run_sweep(sweep.Study(sweep.sweep_grid([1.0, 2.0]), stop_time=0.01, fmu_path=fmu),
-                    output_dir=f"{output_dir}/warm-up", scheduler=address, progress=False)
+    sweep.run_sweep(
+        sweep.Study(sweep.sweep_grid([1.0, 2.0]), stop_time=0.01, fmu_path=fmu),
+        output_dir=f"{output_dir}/warm-up",
+        scheduler=address,
+        progress=False,
+    )
     before = cpu()
-    result = sweep.run_sweep(sweep.Study(grid, stop_time=stop_time, fmu_path=fmu), output_dir=output_dir,
-                             scheduler=address, progress=False)
+    result = sweep.run_sweep(
+        sweep.Study(grid, stop_time=stop_time, fmu_path=fmu), output_dir=output_dir, scheduler=address, progress=False
+    )
     client_cpu = cpu() - before
-    print(json.dumps({"seconds": result.seconds, "cpu": client_cpu, "figure": result.figure_seconds,
-                      "bytes": result.bytes, "failed": result.failed,
-                      "worker_cpu": result.worker_cpu_seconds,
-                      "worker_stepping": result.worker_stepping_seconds,
-                      "peak_rss": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024}))
+    print(
+        json.dumps(
+            {
+                "seconds": result.seconds,
+                "cpu": client_cpu,
+                "figure": result.figure_seconds,
+                "bytes": result.bytes,
+                "failed": result.failed,
+                "worker_cpu": result.worker_cpu_seconds,
+                "worker_stepping": result.worker_stepping_seconds,
+                "peak_rss": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024,
+            }
+        )
+    )
 
 
 def simulate_repeatedly(fmu: str, cases: int) -> None:
@@ -138,10 +171,11 @@ def _control_speedup(fmu: BuiltFmu, processes: int, cases: int = 200) -> float:
 
 def _study(address: str, cases: int, stop_time: float, fmu: BuiltFmu) -> dict:
     with tempfile.TemporaryDirectory(prefix="pendulum-scale-") as out:
-        code = (f"from benchmarks.scale import measure_client; measure_client({address!r}, {cases}, "
-                f"{stop_time}, {str(fmu.path)!r}, {out!r})")
-        done = subprocess.run([sys.executable, "-c", code], cwd=REPOSITORY, capture_output=True,
-                              text=True, check=True)
+        code = (
+            f"from benchmarks.scale import measure_client; measure_client({address!r}, {cases}, "
+            f"{stop_time}, {str(fmu.path)!r}, {out!r})"
+        )
+        done = subprocess.run([sys.executable, "-c", code], cwd=REPOSITORY, capture_output=True, text=True, check=True)
         result = json.loads(done.stdout.strip().splitlines()[-1])
     if result["failed"]:
         raise RuntimeError(f"{result['failed']} cases failed in the scale benchmark")
@@ -149,8 +183,10 @@ def _study(address: str, cases: int, stop_time: float, fmu: BuiltFmu) -> dict:
 
 
 def _load() -> str:
-    return (f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f} before the part "
-            f"(other work on the machine slows every figure)")
+    return (
+        f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f} before the part "
+        f"(other work on the machine slows every figure)"
+    )
 
 
 def _median_study(results: list[dict]) -> dict:
@@ -175,8 +211,7 @@ def scale_rows(fmu: BuiltFmu, quick: bool, cases: int | None = None) -> list[Row
     # Every cluster runs at once and the rounds alternate between them, so that a change in the
     # machine's speed (other jobs on a shared VM) falls on every worker count alike.
     with contextlib.ExitStack() as clusters:
-        handles = {workers: clusters.enter_context(dask_process_handles(workers))
-                   for workers in worker_counts}
+        handles = {workers: clusters.enter_context(dask_process_handles(workers)) for workers in worker_counts}
         runs = {workers: [] for workers in worker_counts}
         for _ in range(rounds):
             for workers, (address, processes) in handles.items():
@@ -186,8 +221,7 @@ def scale_rows(fmu: BuiltFmu, quick: bool, cases: int | None = None) -> list[Row
     results = {workers: _median_study(runs[workers]) for workers in worker_counts}
     rates = {workers: cases / result["seconds"] for workers, result in results.items()}
     # The figure is a fixed cost of a study (about a second), whatever its size or workers.
-    running_rates = {workers: cases / (result["seconds"] - result["figure"])
-                     for workers, result in results.items()}
+    running_rates = {workers: cases / (result["seconds"] - result["figure"]) for workers, result in results.items()}
     worker_cpu = {workers: result["worker_cpu"] / cases for workers, result in results.items()}
     for workers, result in results.items():
         stepping = result["worker_stepping"] / cases
@@ -197,24 +231,57 @@ def scale_rows(fmu: BuiltFmu, quick: bool, cases: int | None = None) -> list[Row
         running_efficiency = running_rates[workers] / (workers * running_rates[1])
         per_case_cpu = result["cpu"] / cases
         rows += [
-            Row(PART, f"{label}: cases/s end to end", f"{rates[workers]:.0f} ({per_worker:.0f} per worker)",
-                f">= {RATE_TARGET} per worker", per_worker >= RATE_TARGET),
-            Row(PART, f"{label}: parallel efficiency", f"{efficiency:.0%}",
-                f">= {EFFICIENCY_TARGET:.0%}" if workers > 1 else "", efficiency >= EFFICIENCY_TARGET if workers > 1 else None),
-            Row(PART, f"{label}: the same without the figure ({result['figure']:.2f} s): cases/s, "
-                "efficiency", f"{running_rates[workers]:.0f}, {running_efficiency:.0%}"),
-            *([Row(PART, f"control: {workers} plain processes running simulate() (no dask, no files), "
-                   "speed-up over one", f"{_control_speedup(fmu, workers):.2f} of {workers}")]
-              if workers > 1 else []),
-            Row(PART, f"{label}: worker CPU per case (stepping and writing)",
+            Row(
+                PART,
+                f"{label}: cases/s end to end",
+                f"{rates[workers]:.0f} ({per_worker:.0f} per worker)",
+                f">= {RATE_TARGET} per worker",
+                per_worker >= RATE_TARGET,
+            ),
+            Row(
+                PART,
+                f"{label}: parallel efficiency",
+                f"{efficiency:.0%}",
+                f">= {EFFICIENCY_TARGET:.0%}" if workers > 1 else "",
+                efficiency >= EFFICIENCY_TARGET if workers > 1 else None,
+            ),
+            Row(
+                PART,
+                f"{label}: the same without the figure ({result['figure']:.2f} s): cases/s, efficiency",
+                f"{running_rates[workers]:.0f}, {running_efficiency:.0%}",
+            ),
+            *(
+                [
+                    Row(
+                        PART,
+                        f"control: {workers} plain processes running simulate() (no dask, no files), speed-up over one",
+                        f"{_control_speedup(fmu, workers):.2f} of {workers}",
+                    )
+                ]
+                if workers > 1
+                else []
+            ),
+            Row(
+                PART,
+                f"{label}: worker CPU per case (stepping and writing)",
                 f"{worker_cpu[workers] * 1e3:.2f} ms ({stepping * 1e3:.2f} ms of it running the case "
                 f"through FMI), so at most {1 / worker_cpu[workers]:.0f} cases/s per core",
-                f">= {RATE_TARGET} cases/s", 1 / worker_cpu[workers] >= RATE_TARGET),
-            *([Row(PART, f"{label}: worker CPU per case at 1 worker / at {workers} (work added by "
-                   "workers: none at 100 %)", f"{worker_cpu[1] / worker_cpu[workers]:.0%}")]
-              if workers > 1 else []),
-            Row(PART, f"{label}: client CPU per case (whole run, figure included)",
-                f"{per_case_cpu * 1e6:.0f} µs"),
+                f">= {RATE_TARGET} cases/s",
+                1 / worker_cpu[workers] >= RATE_TARGET,
+            ),
+            *(
+                [
+                    Row(
+                        PART,
+                        f"{label}: worker CPU per case at 1 worker / at {workers} (work added by "
+                        "workers: none at 100 %)",
+                        f"{worker_cpu[1] / worker_cpu[workers]:.0%}",
+                    )
+                ]
+                if workers > 1
+                else []
+            ),
+            Row(PART, f"{label}: client CPU per case (whole run, figure included)", f"{per_case_cpu * 1e6:.0f} µs"),
             Row(PART, f"{label}: scheduler CPU per case", f"{result['scheduler_cpu'] / cases * 1e6:.0f} µs"),
             Row(PART, f"{label}: client peak memory", f"{result['peak_rss'] / 1e6:.0f} MB"),
             Row(PART, f"{label}: bytes written per case", f"{result['bytes'] / cases / 1e3:.1f} kB"),
@@ -226,13 +293,26 @@ def scale_rows(fmu: BuiltFmu, quick: bool, cases: int | None = None) -> list[Row
     label = f"{many:,} 10-ms cases on {workers} worker(s)"
     rows += [
         Row(PART, f"{label}: cases/s end to end", f"{many / result['seconds']:.0f}"),
-        Row(PART, f"{label}: client CPU per case", f"{result['cpu'] / many * 1e6:.0f} µs",
-            f"<= {CLIENT_CPU_TARGET * 1e6:.0f} µs", result["cpu"] / many <= CLIENT_CPU_TARGET),
-        Row(PART, f"{label}: client peak memory", f"{result['peak_rss'] / 1e6:.0f} MB",
+        Row(
+            PART,
+            f"{label}: client CPU per case",
+            f"{result['cpu'] / many * 1e6:.0f} µs",
+            f"<= {CLIENT_CPU_TARGET * 1e6:.0f} µs",
+            result["cpu"] / many <= CLIENT_CPU_TARGET,
+        ),
+        Row(
+            PART,
+            f"{label}: client peak memory",
+            f"{result['peak_rss'] / 1e6:.0f} MB",
             f"<= {CLIENT_MEMORY_TARGET / 1e6:.0f} MB at 100,000" if many == 100_000 else "",
-            result["peak_rss"] <= CLIENT_MEMORY_TARGET if many == 100_000 else None),
-        Row(PART, f"{label}: figure from the cases table", f"{result['figure']:.2f} s",
+            result["peak_rss"] <= CLIENT_MEMORY_TARGET if many == 100_000 else None,
+        ),
+        Row(
+            PART,
+            f"{label}: figure from the cases table",
+            f"{result['figure']:.2f} s",
             f"<= {FIGURE_TARGET:g} s at 100,000" if many == 100_000 else "",
-            result["figure"] <= FIGURE_TARGET if many == 100_000 else None),
+            result["figure"] <= FIGURE_TARGET if many == 100_000 else None,
+        ),
     ]
     return rows

@@ -18,8 +18,7 @@ from pendulum_fmu.reference import reference
 from pendulum_fmu.simulate import simulate
 
 
-def random_step_rows(rng: np.random.Generator, stop_time: float = 4.0,
-                     running_sum: bool = False) -> list[tuple]:
+def random_step_rows(rng: np.random.Generator, stop_time: float = 4.0, running_sum: bool = False) -> list[tuple]:
     """A random step signal: levels held for random decimal durations (ms resolution). With
     running_sum the times are what a tool accumulating durations writes (0.39100000000000029).
     tests/test_torque_schedule_exactness.py draws its signals here too."""
@@ -46,17 +45,20 @@ def write_rows(path: Path, rows) -> Path:
 CASES = [
     # (label, rows, simulate arguments)
     ("jump at 0.027 s, 9 ms steps", [(0, 10), (0.027, 10), (0.027, -20), (2, -20)], dict(step_size=0.009)),
-    ("jumps at 0.33 and 0.45 s, 30 ms steps",
-     [(0, 5), (0.33, 5), (0.33, -30), (0.45, -30), (0.45, 25), (1.5, 25)], dict(step_size=0.03)),
+    (
+        "jumps at 0.33 and 0.45 s, 30 ms steps",
+        [(0, 5), (0.33, 5), (0.33, -30), (0.45, -30), (0.45, 25), (1.5, 25)],
+        dict(step_size=0.03),
+    ),
     ("first row a jump, 1 ms steps", [(0, 0), (0, 20), (1, 20)], dict(step_size=1e-3)),
-    ("4 s random steps, decimal times, 1 ms", random_step_rows(np.random.default_rng(1)),
-     dict(step_size=1e-3)),
-    ("4 s random steps, running-sum times, 1 ms",
-     random_step_rows(np.random.default_rng(1), running_sum=True), dict(step_size=1e-3)),
-    ("kink at 0.3915 s, ramp, 10 ms steps", [(0, 0), (0.3915, 20), (1, -5), (2, 10)],
-     dict(step_size=0.01, ramp=True)),
-    ("kink at 0.3915 s, ramp, 100 ms steps", [(0, 0), (0.3915, 20), (1, -5), (2, 10)],
-     dict(step_size=0.1, ramp=True)),
+    ("4 s random steps, decimal times, 1 ms", random_step_rows(np.random.default_rng(1)), dict(step_size=1e-3)),
+    (
+        "4 s random steps, running-sum times, 1 ms",
+        random_step_rows(np.random.default_rng(1), running_sum=True),
+        dict(step_size=1e-3),
+    ),
+    ("kink at 0.3915 s, ramp, 10 ms steps", [(0, 0), (0.3915, 20), (1, -5), (2, 10)], dict(step_size=0.01, ramp=True)),
+    ("kink at 0.3915 s, ramp, 100 ms steps", [(0, 0), (0.3915, 20), (1, -5), (2, 10)], dict(step_size=0.1, ramp=True)),
 ]
 
 
@@ -64,8 +66,10 @@ def run_case(rows, arguments, folder: Path) -> tuple[float, float]:
     csv = write_rows(folder / "signal.csv", rows)
     run = simulate(csv, tolerance=1e-12, **arguments)
     oracle = reference(csv, at=run["time"], **arguments)
-    return (float(np.max(np.abs(run["theta"] - oracle["theta"]))),
-            float(np.max(np.abs(run["torque"][:-1] - oracle["torque"][:-1]))))
+    return (
+        float(np.max(np.abs(run["theta"] - oracle["theta"]))),
+        float(np.max(np.abs(run["torque"][:-1] - oracle["torque"][:-1]))),
+    )
 
 
 def main() -> int:

@@ -55,12 +55,16 @@ def main(argv=None):
     parser.add_argument("--output-dir", default="out/closed_loop_pd", help="where the figure goes")
     args = parser.parse_args(argv)
     time, theta, omega, torque = run(args.setpoint, args.kp, args.kd, args.stop_time)
-    print(f"theta({time[-1]:g} s) = {theta[-1]:.6f} rad (set-point {args.setpoint} rad); "
-          f"2 % settling time {settling_time(time, theta, args.setpoint):.3f} s; "
-          f"final torque {torque[-1]:.3f} N.m")
+    print(
+        f"theta({time[-1]:g} s) = {theta[-1]:.6f} rad (set-point {args.setpoint} rad); "
+        f"2 % settling time {settling_time(time, theta, args.setpoint):.3f} s; "
+        f"final torque {torque[-1]:.3f} N.m"
+    )
     result = np.zeros(len(time), dtype=[("time", "f8"), ("theta", "f8"), ("omega", "f8")])
     result["time"], result["theta"], result["omega"] = time, theta, omega
-    print(f"wrote {plot_overlay({'PD-controlled pendulum': result}, f'{args.output_dir}/closed_loop.png', 'Closed loop: PD controller in a Python master')}")
+    print(
+        f"wrote {plot_overlay({'PD-controlled pendulum': result}, f'{args.output_dir}/closed_loop.png', 'Closed loop: PD controller in a Python master')}"
+    )
 
 
 if __name__ == "__main__":

@@ -18,8 +18,9 @@ def run(torque_file=None, stop_time=3.0, output_dir="out/compare_with_opensim", 
         output_dir.mkdir(parents=True, exist_ok=True)
         torque_file = output_dir / "torque.csv"
         torque_file.write_text(STEPWISE_TORQUE)
-    comparison = compare(torque_file, ("fmu", "reference", "opensim"), output_dir=output_dir,
-                         stop_time=stop_time, tolerance=tol)
+    comparison = compare(
+        torque_file, ("fmu", "reference", "opensim"), output_dir=output_dir, stop_time=stop_time, tolerance=tol
+    )
     print(format_table(comparison.differences))
     print(f"worst difference {comparison.worst:.2e} (tolerance {tol:g}); wrote {comparison.figure}")
     return comparison
@@ -27,8 +28,12 @@ def run(torque_file=None, stop_time=3.0, output_dir="out/compare_with_opensim", 
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("--torque-file", type=Path, default=None,
-                        help="time,torque CSV in fmpy's convention (default: a built-in step signal)")
+    parser.add_argument(
+        "--torque-file",
+        type=Path,
+        default=None,
+        help="time,torque CSV in fmpy's convention (default: a built-in step signal)",
+    )
     parser.add_argument("--stop-time", type=float, default=3.0, help="s (default: %(default)s)")
     parser.add_argument("--output-dir", default="out/compare_with_opensim", help="where results go")
     parser.add_argument("--tol", type=float, default=1e-9, help="rad (default: %(default)s)")

@@ -17,14 +17,18 @@ def run(torque=20.0, stop_time=3.0, step_size=1e-3, output_dir="out/constant_tor
     for gravity, title in ((0.0, "No Gravity"), (9.81, "With Gravity")):
         arguments = dict(stop_time=stop_time, step_size=step_size, parameters={"gravity": gravity})
         fmu, oracle = simulate(torque, **arguments), reference(torque, **arguments)
-        print(f"{title}: max |theta_fmu - theta_scipy| = {np.max(np.abs(fmu['theta'] - oracle['theta'])):.2e} rad, "
-              f"theta({stop_time:g} s) = {fmu['theta'][-1]:.10f} rad")
+        print(
+            f"{title}: max |theta_fmu - theta_scipy| = {np.max(np.abs(fmu['theta'] - oracle['theta'])):.2e} rad, "
+            f"theta({stop_time:g} s) = {fmu['theta'][-1]:.10f} rad"
+        )
         if gravity == 0.0:
             parabola = 0.5 * torque / total_inertia(default_parameters()) * fmu["time"] ** 2
             print(f"  against theta = tau t^2 / (2 I): {np.max(np.abs(fmu['theta'] - parabola)):.2e} rad")
-        figure = plot_overlay({"FMU": fmu, "Rigid-body ODE (scipy)": oracle},
-                              f"{output_dir}/{title.lower().replace(' ', '_')}.png",
-                              rf"Constant Torque $\tau = {torque:g}$ N.m — {title}")
+        figure = plot_overlay(
+            {"FMU": fmu, "Rigid-body ODE (scipy)": oracle},
+            f"{output_dir}/{title.lower().replace(' ', '_')}.png",
+            rf"Constant Torque $\tau = {torque:g}$ N.m — {title}",
+        )
         print(f"  wrote {figure}")
         runs[gravity] = fmu, oracle
     return runs

@@ -15,12 +15,28 @@ from pendulum_fmu.torque_schedule import schedule, write_torque_csv
 
 def run(stop_time=3.0, output_dir="out/fmpy_command_line"):
     output_dir = Path(output_dir)
-    plan = schedule(lambda t: 20.0 if t < stop_time / 3 else (-10.0 if t < 2 * stop_time / 3 else 5.0),
-                    stop_time=stop_time, step_size=stop_time / 6)
+    plan = schedule(
+        lambda t: 20.0 if t < stop_time / 3 else (-10.0 if t < 2 * stop_time / 3 else 5.0),
+        stop_time=stop_time,
+        step_size=stop_time / 6,
+    )
     torque_csv = write_torque_csv(output_dir / "torque.csv", plan)
     result_csv = output_dir / "result.csv"
-    command = [sys.executable, "-m", "fmpy", "simulate", str(default_fmu()), "--input-file", str(torque_csv),
-               "--output-interval", "0.001", "--stop-time", str(stop_time), "--output-file", str(result_csv)]
+    command = [
+        sys.executable,
+        "-m",
+        "fmpy",
+        "simulate",
+        str(default_fmu()),
+        "--input-file",
+        str(torque_csv),
+        "--output-interval",
+        "0.001",
+        "--stop-time",
+        str(stop_time),
+        "--output-file",
+        str(result_csv),
+    ]
     print(" ".join(command[1:]))
     subprocess.run(command, check=True)
     result = np.genfromtxt(result_csv, delimiter=",", names=True)

@@ -7,12 +7,19 @@ from pendulum_fmu.simulate import simulate
 
 
 def run(torque=20.0, stop_time=3.0, output_dir="out/gravity_overlay"):
-    runs = {"No gravity": simulate(torque, stop_time=stop_time, parameters={"gravity": 0.0}),
-            "With gravity": simulate(torque, stop_time=stop_time)}
+    runs = {
+        "No gravity": simulate(torque, stop_time=stop_time, parameters={"gravity": 0.0}),
+        "With gravity": simulate(torque, stop_time=stop_time),
+    }
     for label, run_ in runs.items():
-        print(f"{label}: theta({stop_time:g} s) = {run_['theta'][-1]:.6f} rad, max omega = {run_['omega'].max():.6f} rad/s")
-    figure = plot_overlay(runs, f"{output_dir}/gravity_overlay.png",
-                          rf"Effect of Gravity on Torque-Driven Pendulum ($\tau = {torque:g}$ N.m)")
+        print(
+            f"{label}: theta({stop_time:g} s) = {run_['theta'][-1]:.6f} rad, max omega = {run_['omega'].max():.6f} rad/s"
+        )
+    figure = plot_overlay(
+        runs,
+        f"{output_dir}/gravity_overlay.png",
+        rf"Effect of Gravity on Torque-Driven Pendulum ($\tau = {torque:g}$ N.m)",
+    )
     print(f"wrote {figure}")
     return runs
 

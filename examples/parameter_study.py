@@ -9,19 +9,31 @@ from pendulum_fmu.errors import PendulumFmuError
 from pendulum_fmu.sweep import Study, run_sweep, sweep_grid
 
 
-def run(torques=(5.0, 10.0, 20.0, 40.0), stop_time=3.0, output_dir="out/parameter_study", scheduler=None,
-        overwrite=False):
+def run(
+    torques=(5.0, 10.0, 20.0, 40.0), stop_time=3.0, output_dir="out/parameter_study", scheduler=None, overwrite=False
+):
     """Returns the trajectories with each case's torque joined in, as numpy columns."""
-    result = run_sweep(Study(sweep_grid(torques, [9.81]), stop_time=stop_time), output_dir=output_dir,
-                       scheduler=scheduler, overwrite=overwrite)
+    result = run_sweep(
+        Study(sweep_grid(torques, [9.81]), stop_time=stop_time),
+        output_dir=output_dir,
+        scheduler=scheduler,
+        overwrite=overwrite,
+    )
     cases = pq.read_table(result.cases_table).sort_by("case")
     for case in cases.to_pylist():
-        print(f"torque {case['torque']:5g} N.m: max |theta| = {case['max_abs_theta']:.6f} rad, "
-              f"theta({stop_time:g} s) = {case['final_theta']:.6f} rad")
-    trajectories = (pq.read_table(result.trajectories).join(cases.select(["case", "torque"]), "case")
-                    .sort_by([("case", "ascending"), ("time", "ascending")]))
-    print(f"{result.cases} cases in {result.seconds:.1f} s; wrote {result.trajectories}, "
-          f"{result.cases_table} and {result.figure}")
+        print(
+            f"torque {case['torque']:5g} N.m: max |theta| = {case['max_abs_theta']:.6f} rad, "
+            f"theta({stop_time:g} s) = {case['final_theta']:.6f} rad"
+        )
+    trajectories = (
+        pq.read_table(result.trajectories)
+        .join(cases.select(["case", "torque"]), "case")
+        .sort_by([("case", "ascending"), ("time", "ascending")])
+    )
+    print(
+        f"{result.cases} cases in {result.seconds:.1f} s; wrote {result.trajectories}, "
+        f"{result.cases_table} and {result.figure}"
+    )
     return {name: trajectories[name].to_numpy() for name in trajectories.column_names}
 
 
@@ -31,8 +43,9 @@ def main(argv=None):
     parser.add_argument("--stop-time", type=float, default=3.0, help="s (default: %(default)s)")
     parser.add_argument("--output-dir", default="out/parameter_study", help="where the table and figure go")
     parser.add_argument("--scheduler", default=None, help="address of a dask.distributed scheduler")
-    parser.add_argument("--overwrite", action="store_true",
-                        help="replace the study --output-dir holds (else such a folder is refused)")
+    parser.add_argument(
+        "--overwrite", action="store_true", help="replace the study --output-dir holds (else such a folder is refused)"
+    )
     args = parser.parse_args(argv)
     try:
         run(args.torque, args.stop_time, args.output_dir, args.scheduler, args.overwrite)

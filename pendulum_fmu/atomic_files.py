@@ -73,15 +73,17 @@ def _temporary_beside(path: Path, suffix: str) -> tuple[int, str]:
     of a shared folder)."""
     for folder in (path.parent, *path.parent.parents):
         if folder.exists() and not folder.is_dir():
-            raise CannotWrite(f"cannot write {path}: {folder} is a file, not a folder; "
-                              "choose another output path")
+            raise CannotWrite(f"cannot write {path}: {folder} is a file, not a folder; choose another output path")
     make_folder(path.parent, path)
     try:
-        descriptor, temporary = tempfile.mkstemp(prefix=f".{path.name[:_NAME_IN_TEMPORARY]}.",
-                                                 suffix=suffix[:_NAME_IN_TEMPORARY], dir=path.parent)
+        descriptor, temporary = tempfile.mkstemp(
+            prefix=f".{path.name[:_NAME_IN_TEMPORARY]}.", suffix=suffix[:_NAME_IN_TEMPORARY], dir=path.parent
+        )
     except OSError as error:
-        raise CannotWrite(f"cannot write {path}: no file can be created in {path.parent} "
-                          f"({error.strerror}); choose another output path") from None
+        raise CannotWrite(
+            f"cannot write {path}: no file can be created in {path.parent} "
+            f"({error.strerror}); choose another output path"
+        ) from None
     try:
         permissions = stat.S_IMODE(path.stat().st_mode)
     except OSError:
@@ -110,8 +112,10 @@ def make_folder(folder: Path, target, choice: str = "output path") -> None:
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as error:
-        raise CannotWrite(f"cannot write {target}: the folder {error.filename} cannot be created "
-                          f"({error.strerror}); choose another {choice}") from None
+        raise CannotWrite(
+            f"cannot write {target}: the folder {error.filename} cannot be created "
+            f"({error.strerror}); choose another {choice}"
+        ) from None
 
 
 def _cannot_write(path: Path, error: OSError) -> CannotWrite:
@@ -159,8 +163,10 @@ def _check_writable(path: Path) -> None:
         # The name itself, which the temporary's shorter one did not try.
         longest = _longest_name(path.parent)
         if len(os.fsencode(path.name)) > longest:
-            raise CannotWrite(f"cannot write {path}: its name is longer than the {longest} bytes "
-                              "this file system allows; choose a shorter name")
+            raise CannotWrite(
+                f"cannot write {path}: its name is longer than the {longest} bytes "
+                "this file system allows; choose a shorter name"
+            )
     finally:
         for folder in made:  # deepest first
             with contextlib.suppress(OSError):

@@ -561,15 +561,22 @@ def _run_as_done(record: InstanceCalls, intended: IntendedRun) -> list[dict] | N
     if len(steps) < 2 or not contiguous or any(step.torque_acceleration for step in steps):
         return None
     times = np.array([step.time for step in steps] + [steps[-1].time + steps[-1].size])
-    done = TorqueSchedule(times, np.array([step.torque for step in steps]),
-                          np.array([step.torque_rate for step in steps]))
+    done = TorqueSchedule(
+        times, np.array([step.torque for step in steps]), np.array([step.torque_rate for step in steps])
+    )
     set_by_master = record.set_before_start
     parameters = {name: value for name, value in set_by_master.items() if name in default_parameters()}
-    as_done = reference_schedule(done, parameters=parameters, theta0=set_by_master.get("theta", 0.0),
-                                 omega0=set_by_master.get("omega", 0.0))
+    as_done = reference_schedule(
+        done, parameters=parameters, theta0=set_by_master.get("theta", 0.0), omega0=set_by_master.get("omega", 0.0)
+    )
     start = intended.start_values
-    meant = reference_schedule(_plan(record, intended), parameters=intended.parameters, at=times,
-                               theta0=start.get("theta0") or 0.0, omega0=start.get("omega0") or 0.0)
+    meant = reference_schedule(
+        _plan(record, intended),
+        parameters=intended.parameters,
+        at=times,
+        theta0=start.get("theta0") or 0.0,
+        omega0=start.get("omega0") or 0.0,
+    )
     return regression_verdicts(times, meant["theta"], as_done["theta"])
 
 
@@ -721,8 +728,9 @@ def format_calls(judged: dict, steps_shown: int = 20) -> str:
         else:
             lines.append(f"instance {name}: the master did what the intended run asks ({len(result['steps'])} steps)")
         if result.get("regression_tools"):
-            lines.append("  what regression tools would say, on theta of the run these steps make against the "
-                         "intended one:")
+            lines.append(
+                "  what regression tools would say, on theta of the run these steps make against the intended one:"
+            )
             lines.extend(f"    {line}" for line in format_verdicts(result["regression_tools"]))
     return "\n".join(lines)
 

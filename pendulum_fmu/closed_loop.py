@@ -29,9 +29,11 @@ from .parameters import total_inertia
 from .simulate import resolve_parameters
 
 # Pendulum output -> controller input, and back.
-WIRES = (("pendulum", "theta", "controller", "theta"),
-         ("pendulum", "omega", "controller", "omega"),
-         ("controller", "torque", "pendulum", "torque"))
+WIRES = (
+    ("pendulum", "theta", "controller", "theta"),
+    ("pendulum", "omega", "controller", "omega"),
+    ("controller", "torque", "pendulum", "torque"),
+)
 
 
 def controller_defaults() -> dict[str, float]:
@@ -79,28 +81,47 @@ def create_closed_loop_fmu(out_file: str | Path, *, step_size: float = 1e-3) -> 
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         build = build_tool()
-        files = {"pendulum": build.build_fmu(tmp / "Pendulum.fmu"),
-                 "controller": build.build_pid_controller(tmp / "PIDController.fmu")}
+        files = {
+            "pendulum": build.build_fmu(tmp / "Pendulum.fmu"),
+            "controller": build.build_pid_controller(tmp / "PIDController.fmu"),
+        }
         components, variables = {}, {}
         for name, path in files.items():
             description = read_model_description(str(path))
             components[name] = Component(name=name, filename=path, modelDescription=description)
             variables[name] = {v.name: v for v in description.modelVariables}
-        exported = {name: ModelVariable(type="Real", variability="continuous", causality="output",
-                                        initial="calculated", name=name) for name in ("theta", "torque")}
+        exported = {
+            name: ModelVariable(
+                type="Real", variability="continuous", causality="output", initial="calculated", name=name
+            )
+            for name in ("theta", "torque")
+        }
         container = ModelDescription(
-            fmiVersion="2.0", modelName="PendulumClosedLoop", instantiationToken="",
+            fmiVersion="2.0",
+            modelName="PendulumClosedLoop",
+            instantiationToken="",
             defaultExperiment=DefaultExperiment(stopTime="6", stepSize=str(step_size)),
             coSimulation=CoSimulation(fixedInternalStepSize=step_size),
-            modelVariables=[ModelVariable(type="Real", variability="continuous",
-                                          causality="independent", name="time"), *exported.values()])
+            modelVariables=[
+                ModelVariable(type="Real", variability="continuous", causality="independent", name="time"),
+                *exported.values(),
+            ],
+        )
         configuration = Configuration(
-            parallelDoStep=False, modelDescription=container, components=list(components.values()),
-            connections=[Connection(components[a], [_connector(variables[a][out])],
-                                    components[b], [_connector(variables[b][into])])
-                         for a, out, b, into in WIRES],
-            variableMappings={exported["theta"]: [(components["pendulum"], variables["pendulum"]["theta"])],
-                              exported["torque"]: [(components["controller"], variables["controller"]["torque"])]})
+            parallelDoStep=False,
+            modelDescription=container,
+            components=list(components.values()),
+            connections=[
+                Connection(
+                    components[a], [_connector(variables[a][out])], components[b], [_connector(variables[b][into])]
+                )
+                for a, out, b, into in WIRES
+            ],
+            variableMappings={
+                exported["theta"]: [(components["pendulum"], variables["pendulum"]["theta"])],
+                exported["torque"]: [(components["controller"], variables["controller"]["torque"])],
+            },
+        )
         work = tmp / "container"
         work.mkdir()
         # fmpy renames its zip to the name given: made here, then copied into place whole (the
@@ -115,20 +136,25 @@ def create_closed_loop_fmu(out_file: str | Path, *, step_size: float = 1e-3) -> 
 # (t_k to t_(k+1)): the controller's law on which theta and omega, with its error integral to when.
 COUPLINGS = {
     "gauss-seidel-pendulum-first": "the pendulum steps first; its theta and omega reach the controller "
-                                   "before the controller's torque is read (theta_k, integral to t_k)",
+    "before the controller's torque is read (theta_k, integral to t_k)",
     "gauss-seidel-controller-first": "the controller steps first on theta_k and its torque, integral "
-                                     "to t_(k+1), drives the pendulum over the same step",
+    "to t_(k+1), drives the pendulum over the same step",
     "jacobi": "both step on what was exchanged at t_k: the torque read after the controller's last "
-              "step (theta_(k-1), integral to t_k); the first from the initial exchange",
+    "step (theta_(k-1), integral to t_k); the first from the initial exchange",
     "jacobi-first-exchange-missing": "as jacobi, but nothing is exchanged before the first step: the "
-                                     "pendulum's first step holds torque 0",
+    "pendulum's first step holds torque 0",
 }
 
 
-def sampled_loop_reference(stop_time: float = 6.0, step_size: float = 1e-3, *,
-                           controller: dict | None = None, parameters: dict | None = None,
-                           coupling: str = "gauss-seidel-pendulum-first",
-                           rtol: float = 1e-12) -> np.ndarray:
+def sampled_loop_reference(
+    stop_time: float = 6.0,
+    step_size: float = 1e-3,
+    *,
+    controller: dict | None = None,
+    parameters: dict | None = None,
+    coupling: str = "gauss-seidel-pendulum-first",
+    rtol: float = 1e-12,
+) -> np.ndarray:
     """time, theta, omega, torque of the sampled loop under one master's coupling.
 
     Each step a torque from the PID law (written here in Python, not the controller FMU's code)
@@ -177,8 +203,9 @@ def sampled_loop_reference(stop_time: float = 6.0, step_size: float = 1e-3, *,
     previous = state  # theta, omega at the last communication point, what a Jacobi master last sent
 
     def law(measured, error_integral):
-        return (gains["kp"] * (gains["setpoint"] - measured[0]) + gains["ki"] * error_integral
-                - gains["kd"] * measured[1])
+        return (
+            gains["kp"] * (gains["setpoint"] - measured[0]) + gains["ki"] * error_integral - gains["kd"] * measured[1]
+        )
 
     for k in range(n + 1):
         next_integral = integral + step_size * (gains["setpoint"] - state[0])
@@ -193,8 +220,15 @@ def sampled_loop_reference(stop_time: float = 6.0, step_size: float = 1e-3, *,
         out[k] = (k * step_size, state[0], state[1], torque)
         if k == n:
             break
-        rhs = lambda t, y, u=torque: (y[1], (u - gravity_moment * np.sin(y[0])  # noqa: E731
-                                              - p["damping"] * y[1]) * inverse_inertia)
+        rhs = lambda t, y, u=torque: (
+            y[1],
+            (
+                u
+                - gravity_moment * np.sin(y[0])  # noqa: E731
+                - p["damping"] * y[1]
+            )
+            * inverse_inertia,
+        )
         integral, previous = next_integral, state
         state = solve_ivp(rhs, (0.0, step_size), state, method="DOP853", rtol=rtol, atol=rtol).y[:, -1]
     return out

@@ -33,9 +33,16 @@ REFERENCE = "reference"
 TORQUE_ROUNDING = 1e-9
 
 
-def run_tools(plan: TorqueSchedule, tools, *, parameters: dict | None = None, theta0: float = 0.0,
-              omega0: float = 0.0, fmu_path: str | Path | None = None,
-              mapping: str | None = None) -> dict[str, np.ndarray]:
+def run_tools(
+    plan: TorqueSchedule,
+    tools,
+    *,
+    parameters: dict | None = None,
+    theta0: float = 0.0,
+    omega0: float = 0.0,
+    fmu_path: str | Path | None = None,
+    mapping: str | None = None,
+) -> dict[str, np.ndarray]:
     """{tool label: result array} for the same schedule, parameters and start values; tools as
     --tools gives them (see compare_tools.py), mapping the --map of other FMUs. "reference" here is
     reference_schedule: the schedule's own torques through scipy."""
@@ -43,8 +50,7 @@ def run_tools(plan: TorqueSchedule, tools, *, parameters: dict | None = None, th
     parsed = parse_tools(tools, mapping=mapping, fmu_path=fmu_path)
     # Every tool gets the whole set, so the defaults are fmu_path's for all of them.
     parameters = resolve_parameters(parameters, fmu_path)
-    return {tool.label: tool.run(plan, parameters=parameters, theta0=theta0, omega0=omega0)
-            for tool in parsed}
+    return {tool.label: tool.run(plan, parameters=parameters, theta0=theta0, omega0=omega0) for tool in parsed}
 
 
 def check_tolerance(tolerance: float) -> float:
@@ -63,24 +69,38 @@ def differences(run: np.ndarray, judge: np.ndarray) -> dict[str, float]:
         for name in run.dtype.names[2:]:
             difference = np.abs(run[name] - judge[name])
             row[f"{name}_max"] = float(np.max(difference))
-            row[f"{name}_rms"] = float(np.sqrt(np.mean(difference ** 2)))
+            row[f"{name}_rms"] = float(np.sqrt(np.mean(difference**2)))
         row["torque_max"] = float(np.max(np.abs(run["torque"] - judge["torque"])))
     return row
 
 
-COLUMNS = ("tool", "against", "theta_max", "theta_rms", "omega_max", "omega_rms", "alpha_max",
-           "alpha_rms", "torque_max", "seconds_per_step")  # and the differences of any other output
+COLUMNS = (
+    "tool",
+    "against",
+    "theta_max",
+    "theta_rms",
+    "omega_max",
+    "omega_rms",
+    "alpha_max",
+    "alpha_rms",
+    "torque_max",
+    "seconds_per_step",
+)  # and the differences of any other output
 
 
 def format_table(rows: list[dict]) -> str:
     width = max([12, *(len(row["tool"]) + 1 for row in rows), *(len(row["against"]) + 1 for row in rows)])
-    lines = [f"{'tool':<{width}} {'against':<{width}} {'max|dtheta| rad':>15} {'rms dtheta':>10} "
-             f"{'max|domega| rad/s':>17} {'max|dalpha|':>11} {'max|dtorque| N.m':>16} {'s/step':>8}"]
+    lines = [
+        f"{'tool':<{width}} {'against':<{width}} {'max|dtheta| rad':>15} {'rms dtheta':>10} "
+        f"{'max|domega| rad/s':>17} {'max|dalpha|':>11} {'max|dtorque| N.m':>16} {'s/step':>8}"
+    ]
     for row in rows:
         per_step = row.get("seconds_per_step")
-        lines.append(f"{row['tool']:<{width}} {row['against']:<{width}} {row['theta_max']:>15.3e} "
-                     f"{row['theta_rms']:>10.2e} {row['omega_max']:>17.3e} {row['alpha_max']:>11.2e} "
-                     f"{row['torque_max']:>16.2e} {'' if per_step is None else f'{per_step:8.1e}':>8}")
+        lines.append(
+            f"{row['tool']:<{width}} {row['against']:<{width}} {row['theta_max']:>15.3e} "
+            f"{row['theta_rms']:>10.2e} {row['omega_max']:>17.3e} {row['alpha_max']:>11.2e} "
+            f"{row['torque_max']:>16.2e} {'' if per_step is None else f'{per_step:8.1e}':>8}"
+        )
     return "\n".join(lines)
 
 
@@ -94,8 +114,7 @@ def write_trajectories(runs: dict[str, np.ndarray], path: str | Path) -> Path:
     with replacing(path, newline="") as file:
         writer = csv.writer(file)
         writer.writerow(columns)
-        writer.writerows(zip(*(map(repr, np.asarray(values, dtype=float).tolist())
-                               for values in columns.values())))
+        writer.writerows(zip(*(map(repr, np.asarray(values, dtype=float).tolist()) for values in columns.values())))
     return Path(path)
 
 
@@ -152,8 +171,7 @@ class Comparison:
     @property
     def torque_worst(self) -> float:
         """The largest difference between the torque a tool received and the signal."""
-        return max((row["torque_max"] for row in self.differences if row["against"] == REFERENCE),
-                   default=0.0)
+        return max((row["torque_max"] for row in self.differences if row["against"] == REFERENCE), default=0.0)
 
     @property
     def torque_limit(self) -> float:
@@ -164,11 +182,24 @@ class Comparison:
         return self.worst <= self.tolerance and self.torque_worst <= self.torque_limit
 
 
-def compare(torque: TorqueSignal, tools=None, *, output_dir: str | Path, step_size: float = 1e-3,
-            start_time: float = 0.0, stop_time: float | None = None, ramp: bool = False,
-            parameters: dict | None = None, theta0: float = 0.0, omega0: float = 0.0,
-            tolerance: float = 1e-9, title: str | None = None, fmu_path: str | Path | None = None,
-            mapping: str | dict | None = None, max_steps: int | None = None) -> Comparison:
+def compare(
+    torque: TorqueSignal,
+    tools=None,
+    *,
+    output_dir: str | Path,
+    step_size: float = 1e-3,
+    start_time: float = 0.0,
+    stop_time: float | None = None,
+    ramp: bool = False,
+    parameters: dict | None = None,
+    theta0: float = 0.0,
+    omega0: float = 0.0,
+    tolerance: float = 1e-9,
+    title: str | None = None,
+    fmu_path: str | Path | None = None,
+    mapping: str | dict | None = None,
+    max_steps: int | None = None,
+) -> Comparison:
     """Run one signal through each tool and judge each against the reference.
 
     The reference is the independent oracle reading the signal itself; it always runs, as the
@@ -235,23 +266,32 @@ def compare(torque: TorqueSignal, tools=None, *, output_dir: str | Path, step_si
     fmu_path = fmu_model(fmu_path)  # read once, passed to every tool
     parsed = parse_tools(installed_defaults() if tools is None else tools, mapping=mapping, fmu_path=fmu_path)
     if len(parsed) < 2:
-        raise ToolSpecError(f"compare needs at least two tools, got {parsed[0].label}: "
-                            f"e.g. --tools fmu,{REFERENCE}")
+        raise ToolSpecError(f"compare needs at least two tools, got {parsed[0].label}: e.g. --tools fmu,{REFERENCE}")
     tolerance = check_tolerance(tolerance)
     shown = case_title(torque, parameters, theta0, omega0, fmu_path)  # the user's own parameters
     # Refused here before any tool runs; and every tool gets the whole set, so the defaults are
     # fmu_path's for all of them.
     parameters = resolve_parameters(parameters, fmu_path)
-    plan = schedule(torque, start_time=start_time, stop_time=stop_time, step_size=step_size, ramp=ramp,
-                    max_steps=max_steps)
+    plan = schedule(
+        torque, start_time=start_time, stop_time=stop_time, step_size=step_size, ramp=ramp, max_steps=max_steps
+    )
     output_dir = Path(output_dir)
     outputs = {name: output_dir / name for name in ("trajectories.csv", "differences.csv", "comparison.png")}
     check_writable(*outputs.values())
     steps = len(plan.time) - 1
     runs, seconds = {}, {}
-    runs[REFERENCE] = reference(torque, start_time=start_time, stop_time=stop_time, step_size=step_size,
-                                ramp=ramp, parameters=parameters, theta0=theta0, omega0=omega0,
-                                at=plan.time, fmu_path=fmu_path)
+    runs[REFERENCE] = reference(
+        torque,
+        start_time=start_time,
+        stop_time=stop_time,
+        step_size=step_size,
+        ramp=ramp,
+        parameters=parameters,
+        theta0=theta0,
+        omega0=omega0,
+        at=plan.time,
+        fmu_path=fmu_path,
+    )
     for tool in parsed:
         if tool.label != REFERENCE:  # the judge above takes the reference's place
             started = clock.perf_counter()
@@ -259,12 +299,18 @@ def compare(torque: TorqueSignal, tools=None, *, output_dir: str | Path, step_si
             seconds[tool.label] = (clock.perf_counter() - started) / steps
     judge = runs[REFERENCE]
     others = [tool for tool in runs if tool != REFERENCE]
-    rows = [{"tool": tool, "against": REFERENCE, **differences(runs[tool], judge),
-             "seconds_per_step": seconds[tool]} for tool in others]
-    rows += [{"tool": a, "against": b, **differences(runs[a], runs[b]), "seconds_per_step": None}
-             for a, b in itertools.combinations(others, 2)]
+    rows = [
+        {"tool": tool, "against": REFERENCE, **differences(runs[tool], judge), "seconds_per_step": seconds[tool]}
+        for tool in others
+    ]
+    rows += [
+        {"tool": a, "against": b, **differences(runs[a], runs[b]), "seconds_per_step": None}
+        for a, b in itertools.combinations(others, 2)
+    ]
     return Comparison(
-        runs=runs, differences=rows, tolerance=tolerance,
+        runs=runs,
+        differences=rows,
+        tolerance=tolerance,
         trajectories=write_trajectories(runs, outputs["trajectories.csv"]),
         table=write_differences(rows, outputs["differences.csv"]),
         figure=plot_comparison(runs, outputs["comparison.png"], title or f"{shown}; tools {', '.join(runs)}"),
@@ -274,7 +320,9 @@ def compare(torque: TorqueSignal, tools=None, *, output_dir: str | Path, step_si
 def format_comparison(comparison: Comparison) -> str:
     """The table of differences and the verdict, as the command line prints them."""
     verdict = "agree" if comparison.agree else "DIFFER"
-    return (f"{format_table(comparison.differences)}\n"
-            f"tools {verdict}: worst difference {comparison.worst:.3e} against tolerance "
-            f"{comparison.tolerance:g}; torque received vs the signal: {comparison.torque_worst:.3e} "
-            f"N.m (allowed {comparison.torque_limit:.1e})")
+    return (
+        f"{format_table(comparison.differences)}\n"
+        f"tools {verdict}: worst difference {comparison.worst:.3e} against tolerance "
+        f"{comparison.tolerance:g}; torque received vs the signal: {comparison.torque_worst:.3e} "
+        f"N.m (allowed {comparison.torque_limit:.1e})"
+    )

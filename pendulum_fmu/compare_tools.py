@@ -53,8 +53,15 @@ class Tool:
     runner: Callable[..., np.ndarray]
     fmu: str | Path | FmuModel | None = None
 
-    def run(self, plan: TorqueSchedule, *, parameters: dict | None = None, theta0: float = 0.0,
-            omega0: float = 0.0, outputs: Sequence[str] | None = None) -> np.ndarray:
+    def run(
+        self,
+        plan: TorqueSchedule,
+        *,
+        parameters: dict | None = None,
+        theta0: float = 0.0,
+        omega0: float = 0.0,
+        outputs: Sequence[str] | None = None,
+    ) -> np.ndarray:
         """The tool's result for a schedule, with exactly the outputs asked for.
 
         Parameters
@@ -83,17 +90,29 @@ class Tool:
         return results.with_outputs(run, asked, self.label)
 
 
-def run_fmu(plan: TorqueSchedule, *, parameters: dict | None = None, theta0: float = 0.0,
-            omega0: float = 0.0, mode: str = "accurate",
-            fmu_path: str | Path | FmuModel | None = None) -> np.ndarray:
+def run_fmu(
+    plan: TorqueSchedule,
+    *,
+    parameters: dict | None = None,
+    theta0: float = 0.0,
+    omega0: float = 0.0,
+    mode: str = "accurate",
+    fmu_path: str | Path | FmuModel | None = None,
+) -> np.ndarray:
     """This project's FMU (the checkout's, or fmu_path) through fmpy; ramps are passed on."""
     check_mode(mode, "fmu")
     return simulate_plan(plan, parameters=parameters, theta0=theta0, omega0=omega0, fmu_path=fmu_path)
 
 
-def run_reference(plan: TorqueSchedule, *, parameters: dict | None = None, theta0: float = 0.0,
-                  omega0: float = 0.0, mode: str = "accurate",
-                  fmu_path: str | Path | FmuModel | None = None) -> np.ndarray:
+def run_reference(
+    plan: TorqueSchedule,
+    *,
+    parameters: dict | None = None,
+    theta0: float = 0.0,
+    omega0: float = 0.0,
+    mode: str = "accurate",
+    fmu_path: str | Path | FmuModel | None = None,
+) -> np.ndarray:
     """The schedule's own torques through scipy (reference.py); fmu_path's defaults apply."""
     check_mode(mode, "reference")
     return reference_schedule(plan, parameters=parameters, theta0=theta0, omega0=omega0, fmu_path=fmu_path)
@@ -155,8 +174,12 @@ def installed_defaults() -> list[str]:
     """
     missing = [name for name in DEFAULT_TOOLS if not installed(name)]
     if missing:
-        warnings.warn("skipped " + "; ".join(f"{name} ({KINDS[name].package} is not installed: {install_hint(name)})"
-                                             for name in missing), Skipped, stacklevel=3)
+        warnings.warn(
+            "skipped "
+            + "; ".join(f"{name} ({KINDS[name].package} is not installed: {install_hint(name)})" for name in missing),
+            Skipped,
+            stacklevel=3,
+        )
     return [name for name in DEFAULT_TOOLS if name not in missing]
 
 
@@ -164,8 +187,9 @@ def _mapped_fmu(label: str, path: str, mapping: str | None, fmu: str | Path | Fm
     from .mapped_fmu import MappedFmu
 
     if not _LABEL.match(label) or label.split(":")[0] in KINDS:
-        raise ToolSpecError(f"--tools {label}={path}: the label must be a name (letters, digits, "
-                            f"_ . -) other than {', '.join(KINDS)}")
+        raise ToolSpecError(
+            f"--tools {label}={path}: the label must be a name (letters, digits, _ . -) other than {', '.join(KINDS)}"
+        )
     try:
         return Tool(label, MappedFmu(path, mapping, label=label).run, fmu)
     except ValueError as error:
@@ -177,8 +201,9 @@ def _named(item: str, fmu_path: str | Path | FmuModel | None) -> Tool:
     kind = KINDS[name]
     mode = mode or "accurate"
     if mode not in kind.modes:
-        raise ToolSpecError(f"--tools {item}: {name} has mode{'s' if len(kind.modes) > 1 else ''} "
-                            f"{', '.join(kind.modes)}, not {mode!r}")
+        raise ToolSpecError(
+            f"--tools {item}: {name} has mode{'s' if len(kind.modes) > 1 else ''} {', '.join(kind.modes)}, not {mode!r}"
+        )
     if not installed(name):
         raise ToolSpecError(f"--tools {name}: {kind.package} is not installed; install it with: {install_hint(name)}")
     # Every runner takes the FMU whose defaults (and, for fmu, whose binary) apply.
@@ -186,8 +211,9 @@ def _named(item: str, fmu_path: str | Path | FmuModel | None) -> Tool:
     return Tool(name if mode == "accurate" else f"{name}:{mode}", runner, fmu_path)
 
 
-def parse_tools(spec: str | Sequence[str], *, mapping: str | None = None,
-                fmu_path: str | Path | FmuModel | None = None) -> list[Tool]:
+def parse_tools(
+    spec: str | Sequence[str], *, mapping: str | None = None, fmu_path: str | Path | FmuModel | None = None
+) -> list[Tool]:
     """The tools of a --tools list (a comma-separated string or its items), in order.
 
     mapping is the --map for the tools given as LABEL=PATH; fmu_path the FMU that "fmu" runs.
@@ -195,19 +221,18 @@ def parse_tools(spec: str | Sequence[str], *, mapping: str | None = None,
     if isinstance(spec, str):
         spec = spec.split(",")
     if not (isinstance(spec, Sequence) and all(isinstance(item, str) for item in spec)):
-        raise WrongType(f"tools is a comma-separated string or a list of names, e.g. "
-                        f"'fmu,reference'; got {spec!r}")
+        raise WrongType(f"tools is a comma-separated string or a list of names, e.g. 'fmu,reference'; got {spec!r}")
     items = [item.strip() for item in spec]
     items = [item for item in items if item]
     if not items:
         raise ToolSpecError("--tools is empty: name at least one of " + ", ".join(KINDS))
     unknown = [item for item in items if "=" not in item and item.partition(":")[0] not in KINDS]
     if unknown:
-        raise ToolSpecError(f"unknown tool(s) {', '.join(unknown)}: choose from {', '.join(KINDS)}, "
-                            "or LABEL=path/to/Their.fmu")
+        raise ToolSpecError(
+            f"unknown tool(s) {', '.join(unknown)}: choose from {', '.join(KINDS)}, or LABEL=path/to/Their.fmu"
+        )
     if mapping and not any("=" in item for item in items):
-        raise ToolSpecError("--map applies to FMUs given as LABEL=path/to/Their.fmu in --tools, "
-                            "and there is none")
+        raise ToolSpecError("--map applies to FMUs given as LABEL=path/to/Their.fmu in --tools, and there is none")
     tools: list[Tool] = []
     for item in items:
         label, equals, path = (part.strip() for part in item.partition("="))

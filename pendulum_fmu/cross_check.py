@@ -71,28 +71,44 @@ def write_cross_check(output_dir: str | Path, fmu_path: str | Path | None = None
     description = model_description(fmu)
     model_name = description.coSimulation.modelIdentifier
     with zipfile.ZipFile(fmu) as archive:
-        platforms = sorted({name.split("/")[1] for name in archive.namelist()
-                            if name.startswith("binaries/") and name.count("/") == 2 and not name.endswith("/")})
-    folders = [Path(output_dir, "fmus", description.fmiVersion, "cs", platform, TOOL, __version__, model_name)
-               for platform in platforms]
+        platforms = sorted(
+            {
+                name.split("/")[1]
+                for name in archive.namelist()
+                if name.startswith("binaries/") and name.count("/") == 2 and not name.endswith("/")
+            }
+        )
+    folders = [
+        Path(output_dir, "fmus", description.fmiVersion, "cs", platform, TOOL, __version__, model_name)
+        for platform in platforms
+    ]
     check_writable(*(folder / f"{model_name}.fmu" for folder in folders))  # before the run
     rows = _input_rows()
     torque = TorqueTable(np.array([t for t, _ in rows]), np.array([u for _, u in rows]))
-    run = simulate(torque, start_time=START_TIME, stop_time=STOP_TIME, step_size=STEP_SIZE,
-                   tolerance=RELATIVE_TOLERANCE, fmu_path=fmu)
-    reference_rows = [[repr(float(t)), *(repr(float(v)) for v in values)]
-                      for t, *values in zip(run["time"], *(run[name] for name in OUTPUTS))]
+    run = simulate(
+        torque,
+        start_time=START_TIME,
+        stop_time=STOP_TIME,
+        step_size=STEP_SIZE,
+        tolerance=RELATIVE_TOLERANCE,
+        fmu_path=fmu,
+    )
+    reference_rows = [
+        [repr(float(t)), *(repr(float(v)) for v in values)]
+        for t, *values in zip(run["time"], *(run[name] for name in OUTPUTS))
+    ]
     computed_on = fmpy.platform_tuple  # this machine, as FMI 3.0 names platforms
     for folder in folders:
         # Each write below makes the folder, or says in one line why it cannot.
         with replacing_path(folder / f"{model_name}.fmu") as copy:
             shutil.copyfile(fmu, copy)
-        _write_csv(folder / f"{model_name}_in.csv", ("time", "torque"),
-                   ((repr(t), repr(u)) for t, u in rows))
+        _write_csv(folder / f"{model_name}_in.csv", ("time", "torque"), ((repr(t), repr(u)) for t, u in rows))
         _write_csv(folder / f"{model_name}_ref.csv", ("time", *OUTPUTS), reference_rows)
         with replacing(folder / f"{model_name}_ref.opt") as options:
-            options.write(f"StartTime, {START_TIME!r}\nStopTime, {STOP_TIME!r}\n"
-                          f"StepSize, {STEP_SIZE!r}\nRelTol, {RELATIVE_TOLERANCE!r}\n")
+            options.write(
+                f"StartTime, {START_TIME!r}\nStopTime, {STOP_TIME!r}\n"
+                f"StepSize, {STEP_SIZE!r}\nRelTol, {RELATIVE_TOLERANCE!r}\n"
+            )
         with replacing(folder / "ReadMe.md") as readme:
             readme.write(_readme(computed_on, model_name))
     return folders

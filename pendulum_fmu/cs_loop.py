@@ -21,15 +21,30 @@ import numpy as np
 
 # The call that failed, by the index _cs_loop.c reports: _AT_END the read after the last step,
 # from _RESTART on the restart's.
-_CALLS = ("fmi2SetReal", "fmi2SetRealInputDerivatives", "fmi2GetReal", "fmi2DoStep",
-          "fmi2GetReal", "fmi2Reset", "fmi2SetupExperiment",
-          "fmi2EnterInitializationMode", "fmi2SetReal of the start values",
-          "fmi2ExitInitializationMode")
+_CALLS = (
+    "fmi2SetReal",
+    "fmi2SetRealInputDerivatives",
+    "fmi2GetReal",
+    "fmi2DoStep",
+    "fmi2GetReal",
+    "fmi2Reset",
+    "fmi2SetupExperiment",
+    "fmi2EnterInitializationMode",
+    "fmi2SetReal of the start values",
+    "fmi2ExitInitializationMode",
+)
 _AT_END, _RESTART = 4, 5
 # In the order of CsFunctions in _cs_loop.c.
-_FMI_FUNCTIONS = ("fmi2Reset", "fmi2SetupExperiment", "fmi2EnterInitializationMode",
-                  "fmi2ExitInitializationMode", "fmi2SetReal", "fmi2SetRealInputDerivatives",
-                  "fmi2GetReal", "fmi2DoStep")
+_FMI_FUNCTIONS = (
+    "fmi2Reset",
+    "fmi2SetupExperiment",
+    "fmi2EnterInitializationMode",
+    "fmi2ExitInitializationMode",
+    "fmi2SetReal",
+    "fmi2SetRealInputDerivatives",
+    "fmi2GetReal",
+    "fmi2DoStep",
+)
 
 
 # What _cs_loop.c's cs_loop_interface() returns for the arguments this module passes.
@@ -49,8 +64,7 @@ def _library():
         return None
     run = library.cs_loop_run
     pointer, size = ctypes.c_void_p, ctypes.c_size_t
-    run.argtypes = ([pointer] * 3 + [size] + [pointer] * 3 + [size, pointer, size, size]
-                    + [pointer] * 7)
+    run.argtypes = [pointer] * 3 + [size] + [pointer] * 3 + [size, pointer, size, size] + [pointer] * 7
     run.restype = ctypes.c_int
     run_cases = library.cs_loop_run_cases
     run_cases.argtypes = [pointer] * 3 + [size] + [pointer] * 3 + [size] * 4 + [pointer] * 6
@@ -70,8 +84,9 @@ def drives(slave) -> bool:
 def _checked(array: np.ndarray, shape: tuple[int, ...], dtype, what: str) -> np.ndarray:
     """array, when it is C-contiguous of that shape and type (the C code's layout); else ValueError."""
     if array.shape != shape or array.dtype != dtype or not array.flags.c_contiguous:
-        raise ValueError(f"{what} must be a C-contiguous {np.dtype(dtype)} array of shape {shape}, "
-                         f"got {array.dtype} {array.shape}")
+        raise ValueError(
+            f"{what} must be a C-contiguous {np.dtype(dtype)} array of shape {shape}, got {array.dtype} {array.shape}"
+        )
     return array
 
 
@@ -86,8 +101,13 @@ class Stepper:
     microseconds.
     """
 
-    def __init__(self, slave, input_references: np.ndarray, output_references: np.ndarray,
-                 start_references: np.ndarray | None = None):
+    def __init__(
+        self,
+        slave,
+        input_references: np.ndarray,
+        output_references: np.ndarray,
+        start_references: np.ndarray | None = None,
+    ):
         self.inputs, self.outputs = len(input_references), len(output_references)
         self.messages = slave.messages
         if start_references is None:
@@ -96,17 +116,21 @@ class Stepper:
         # Kept alive for the addresses.
         self._references = input_references, output_references, start_references
         self._functions = (ctypes.c_void_p * len(_FMI_FUNCTIONS))(
-            *[ctypes.cast(slave.dll[name], ctypes.c_void_p) for name in _FMI_FUNCTIONS])
+            *[ctypes.cast(slave.dll[name], ctypes.c_void_p) for name in _FMI_FUNCTIONS]
+        )
         self._first_order = np.ones(self.inputs, np.int32)  # fmi2Integer is int
         self._failed_step, self._failed_call = ctypes.c_size_t(), ctypes.c_int()
         self._tolerance = ctypes.c_double()
         self._fmu = (ctypes.addressof(self._functions), slave.component)
-        self._input_references = _address(input_references, (self.inputs,), np.uint32,
-                                          "input_references"), self.inputs
-        self._output_references = _address(output_references, (self.outputs,), np.uint32,
-                                           "output_references"), self.outputs
-        self._start_references = (_address(start_references, (self.starts,), np.uint32,
-                                           "start_references"), self.starts)
+        self._input_references = _address(input_references, (self.inputs,), np.uint32, "input_references"), self.inputs
+        self._output_references = (
+            _address(output_references, (self.outputs,), np.uint32, "output_references"),
+            self.outputs,
+        )
+        self._start_references = (
+            _address(start_references, (self.starts,), np.uint32, "start_references"),
+            self.starts,
+        )
         # A restart's start values are copied here, whose address is bound once.
         self._start_values = np.empty(self.starts)
         self._start_values_address = self._start_values.ctypes.data
@@ -115,9 +139,15 @@ class Stepper:
         self._reports = ctypes.byref(self._failed_step), ctypes.byref(self._failed_call)
         self._run, self._run_cases = _library()
 
-    def run(self, time: np.ndarray, inputs: np.ndarray | None, input_rates: np.ndarray | None,
-            outputs: np.ndarray, start_values: Sequence[float] | None = None,
-            tolerance: float | None = None) -> None:
+    def run(
+        self,
+        time: np.ndarray,
+        inputs: np.ndarray | None,
+        input_rates: np.ndarray | None,
+        outputs: np.ndarray,
+        start_values: Sequence[float] | None = None,
+        tolerance: float | None = None,
+    ) -> None:
         """time: the communication points (N + 1). inputs, input_rates: (N, inputs) values and
         first derivatives of the inputs over each step (input_rates None: held,
         fmi2SetRealInputDerivatives is not called; inputs None when there are no inputs).
@@ -139,21 +169,26 @@ class Stepper:
         if tolerance is not None:
             self._tolerance.value = tolerance
         status = self._run(
-            *self._fmu, *self._start_references,
+            *self._fmu,
+            *self._start_references,
             None if start_values is None else self._start_values_address,
             None if tolerance is None else ctypes.addressof(self._tolerance),
-            *self._input_references, *self._output_references,
-            steps, _address(time, (steps + 1,), np.float64, "time"),
+            *self._input_references,
+            *self._output_references,
+            steps,
+            _address(time, (steps + 1,), np.float64, "time"),
             _address(inputs, (steps, self.inputs), np.float64, "inputs"),
             None if input_rates is None else self._first_order.ctypes.data,
             _address(input_rates, (steps, self.inputs), np.float64, "input_rates"),
             _address(outputs, (steps + 1, self.outputs), np.float64, "outputs"),
-            *self._reports)
+            *self._reports,
+        )
         if status > 1:
             raise self._error(status, time)
 
-    def run_cases(self, time: np.ndarray, start_values: np.ndarray, outputs: np.ndarray,
-                  tolerance: float | None = None) -> list[str]:
+    def run_cases(
+        self, time: np.ndarray, start_values: np.ndarray, outputs: np.ndarray, tolerance: float | None = None
+    ) -> list[str]:
         """Run cases, each a restart with its own start values and no input set, in one call
         into the native loop (one more after each case the FMU refuses).
 
@@ -191,11 +226,20 @@ class Stepper:
         while first < cases:
             self.messages.lines.clear()  # so that a refusal's message is its case's own
             status = self._run_cases(
-                *self._fmu, *self._start_references, start_values.ctypes.data,
+                *self._fmu,
+                *self._start_references,
+                start_values.ctypes.data,
                 None if tolerance is None else ctypes.addressof(self._tolerance),
-                *self._output_references, cases, first, points - 1,
-                _address(time, (points,), np.float64, "time"), self._case_outputs.ctypes.data,
-                outputs.ctypes.data, ctypes.byref(self._failed_case), *self._reports)
+                *self._output_references,
+                cases,
+                first,
+                points - 1,
+                _address(time, (points,), np.float64, "time"),
+                self._case_outputs.ctypes.data,
+                outputs.ctypes.data,
+                ctypes.byref(self._failed_case),
+                *self._reports,
+            )
             if status <= 1:
                 break
             refused = self._failed_case.value

@@ -61,14 +61,21 @@ def run_demo(output_dir: str | Path, workers: int | None = None, overwrite: bool
     out = Path(output_dir)
     held = [name for name in ENTRIES if (out / name).exists()]
     if held and not overwrite:
-        raise DemoExists(f"{out} already holds a demo's outputs ({', '.join(held)}): choose another "
-                         "output directory, or add --overwrite to run the demo again in their place")
+        raise DemoExists(
+            f"{out} already holds a demo's outputs ({', '.join(held)}): choose another "
+            "output directory, or add --overwrite to run the demo again in their place"
+        )
     tools = installed_defaults()  # warns which it skipped, and how to install them
     print(f"Tutorial case: constant torque {TORQUE:g} N.m, 3 s in 1 ms steps; tools: {', '.join(tools)}")
     runs, agree = {}, True
     for label, gravity, folder in (("No Gravity", 0.0, "no_gravity"), ("With Gravity", 9.81, "gravity")):
-        comparison = compare(TORQUE, tools, output_dir=out / folder, parameters={"gravity": gravity},
-                             title=rf"Constant Torque $\tau = {TORQUE:g}$ N.m — {label}")
+        comparison = compare(
+            TORQUE,
+            tools,
+            output_dir=out / folder,
+            parameters={"gravity": gravity},
+            title=rf"Constant Torque $\tau = {TORQUE:g}$ N.m — {label}",
+        )
         print(f"\n{label} (gravity = {gravity:g} m/s2)")
         print(format_comparison(comparison))
         fmu = comparison.runs["fmu"]
@@ -79,15 +86,25 @@ def run_demo(output_dir: str | Path, workers: int | None = None, overwrite: bool
         print(f"wrote {comparison.figure}")
         runs[label] = fmu
         agree &= comparison.agree
-    overlay = plot_overlay({rf"No gravity ($\tau = {TORQUE:g}$ N.m)": runs["No Gravity"],
-                            rf"With gravity ($\tau = {TORQUE:g}$ N.m)": runs["With Gravity"]},
-                           out / "gravity_effect.png", "Effect of Gravity on Torque-Driven Pendulum")
+    overlay = plot_overlay(
+        {
+            rf"No gravity ($\tau = {TORQUE:g}$ N.m)": runs["No Gravity"],
+            rf"With gravity ($\tau = {TORQUE:g}$ N.m)": runs["With Gravity"],
+        },
+        out / "gravity_effect.png",
+        "Effect of Gravity on Torque-Driven Pendulum",
+    )
     print(f"\nwrote {overlay}")
-    print(f"\nParameter study: torque {', '.join(f'{t:g}' for t in STUDY_TORQUES)} N.m with gravity, "
-          "on a local dask cluster")
+    print(
+        f"\nParameter study: torque {', '.join(f'{t:g}' for t in STUDY_TORQUES)} N.m with gravity, "
+        "on a local dask cluster"
+    )
     # Asked to overwrite, the study too is replaced (once the new one is whole).
-    result = run_sweep(Study(sweep_grid(STUDY_TORQUES, [9.81])), output_dir=out / "parameter_study",
-                       overwrite=overwrite, workers=workers)
-    print(f"{result.cases} cases in {result.seconds:.1f} s\nwrote {result.cases_table}\n"
-          f"wrote {result.figure}")
+    result = run_sweep(
+        Study(sweep_grid(STUDY_TORQUES, [9.81])),
+        output_dir=out / "parameter_study",
+        overwrite=overwrite,
+        workers=workers,
+    )
+    print(f"{result.cases} cases in {result.seconds:.1f} s\nwrote {result.cases_table}\nwrote {result.figure}")
     return agree

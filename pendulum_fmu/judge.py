@@ -152,14 +152,30 @@ class Judgement:
             given = self.result[name] if name in self.result.dtype.names else np.nan
             if np.all(np.isfinite(given)):
                 worst[f"max_abs_d{name}"] = float(np.max(np.abs(given - self.reference[name])))
-        return {"result": self.source, "verdict": self.verdict, "diagnosis": self.diagnosis,
-                "residual": self.residual, "max_abs_dtheta": self.max_abs_dtheta, **worst,
-                "worst_time": self.worst_time, "tolerance": self.tolerance, "points": len(self.result),
-                "candidates": self.candidates, "smallest_input_effect": self.smallest_input_effect,
-                "regression_tools": self.regression_tools,
-                "units": {"residual": "rad", "max_abs_dtheta": "rad", "max_abs_domega": "rad/s",
-                          "max_abs_dalpha": "rad/s2", "worst_time": "s", "tolerance": "rad",
-                          "candidates": "rad", "smallest_input_effect": "rad"}}
+        return {
+            "result": self.source,
+            "verdict": self.verdict,
+            "diagnosis": self.diagnosis,
+            "residual": self.residual,
+            "max_abs_dtheta": self.max_abs_dtheta,
+            **worst,
+            "worst_time": self.worst_time,
+            "tolerance": self.tolerance,
+            "points": len(self.result),
+            "candidates": self.candidates,
+            "smallest_input_effect": self.smallest_input_effect,
+            "regression_tools": self.regression_tools,
+            "units": {
+                "residual": "rad",
+                "max_abs_dtheta": "rad",
+                "max_abs_domega": "rad/s",
+                "max_abs_dalpha": "rad/s2",
+                "worst_time": "s",
+                "tolerance": "rad",
+                "candidates": "rad",
+                "smallest_input_effect": "rad",
+            },
+        }
 
 
 def read_result(path: str | Path, mapping: str | dict | None = None) -> np.ndarray:
@@ -203,11 +219,14 @@ def read_result(path: str | Path, mapping: str | dict | None = None) -> np.ndarr
         if name in header:
             columns[quantity] = (header.index(name), given.factor if given else 1.0)
         elif given:
-            raise ResultFileError(f"{path}:1: no column {name!r}, which --map names for {quantity} "
-                                  f"(header is {','.join(header)})")
+            raise ResultFileError(
+                f"{path}:1: no column {name!r}, which --map names for {quantity} (header is {','.join(header)})"
+            )
         elif quantity not in OPTIONAL:
-            raise ResultFileError(f"{path}:1: no column {quantity!r} (header is {','.join(header)}); "
-                                  f"name the result's {quantity} column with --map {quantity}=NAME")
+            raise ResultFileError(
+                f"{path}:1: no column {quantity!r} (header is {','.join(header)}); "
+                f"name the result's {quantity} column with --map {quantity}=NAME"
+            )
     data = numbered[1:]
     if not data:
         raise ResultFileError(f"{path}: no data rows after the header")
@@ -226,8 +245,10 @@ def read_result(path: str | Path, mapping: str | dict | None = None) -> np.ndarr
                 raise ResultFileError(f"{path}:{number}: {quantity} is {cell}; values must be finite")
             out[quantity][i] = value * factor
         if i and out["time"][i] < out["time"][i - 1]:
-            raise ResultFileError(f"{path}:{number}: time {out['time'][i]:.17g} goes backwards (previous "
-                                  f"row: {out['time'][i - 1]:.17g}); a result's times must not decrease")
+            raise ResultFileError(
+                f"{path}:{number}: time {out['time'][i]:.17g} goes backwards (previous "
+                f"row: {out['time'][i - 1]:.17g}); a result's times must not decrease"
+            )
     return out
 
 
@@ -240,21 +261,27 @@ def _check_span(result: np.ndarray, plan: TorqueSchedule, step_size: float, sour
     slack = float(event_tolerance(max(abs(start), abs(stop)), step_size))
     first, last = float(result["time"][0]), float(result["time"][-1])
     if first < start - slack:
-        raise ResultFileError(f"{source}: time {first:.17g} is before the run's start "
-                              f"time {start:g} s; give the run's --start-time")
+        raise ResultFileError(
+            f"{source}: time {first:.17g} is before the run's start time {start:g} s; give the run's --start-time"
+        )
     if last > stop + slack:
-        raise ResultFileError(f"{source}: time {last:.17g} is after the run's stop "
-                              f"time {stop:g} s; give the run's --stop-time")
+        raise ResultFileError(
+            f"{source}: time {last:.17g} is after the run's stop time {stop:g} s; give the run's --stop-time"
+        )
     # Half the first and the last step: a master's times may drift off the grid (a diagnosis of
     # its own), but a first or last row nearer another communication point is another run's.
     if first > start + (plan.time[1] - start) / 2:
-        raise ResultFileError(f"{source}: the result starts at {first:.17g} s, not at the run's start "
-                              f"time {start:g} s: write a row per communication point from the start "
-                              "(judging a file alone, give the run's --start-time)")
+        raise ResultFileError(
+            f"{source}: the result starts at {first:.17g} s, not at the run's start "
+            f"time {start:g} s: write a row per communication point from the start "
+            "(judging a file alone, give the run's --start-time)"
+        )
     if last < stop - (stop - plan.time[-2]) / 2:
-        raise ResultFileError(f"{source}: the result ends at {last:.17g} s, before the run's stop "
-                              f"time {stop:g} s, so it covers only part of the run: run it to the stop "
-                              "time (judging a file alone, give the run's --stop-time)")
+        raise ResultFileError(
+            f"{source}: the result ends at {last:.17g} s, before the run's stop "
+            f"time {stop:g} s, so it covers only part of the run: run it to the stop "
+            "time (judging a file alone, give the run's --stop-time)"
+        )
 
 
 def _plan_index(plan: TorqueSchedule, times: np.ndarray, step_size: float) -> np.ndarray | None:
@@ -275,8 +302,7 @@ def _late(plan: TorqueSchedule, start_torque: float) -> list[TorqueSchedule]:
     variants = []
     for first in dict.fromkeys((float(plan.torque[0]), start_torque)):
         first_rate = plan.torque_rate[0] if first == plan.torque[0] else 0.0
-        variants.append(_changed(plan, np.r_[first, plan.torque[:-1]],
-                                 np.r_[first_rate, plan.torque_rate[:-1]]))
+        variants.append(_changed(plan, np.r_[first, plan.torque[:-1]], np.r_[first_rate, plan.torque_rate[:-1]]))
     return variants
 
 
@@ -310,8 +336,7 @@ def _drifted(torque, times: np.ndarray, ramp: bool) -> list[TorqueSchedule]:
     start = _signal_values(torque, points[:-1], "after")
     if start is None or len(points) < 2:
         return []
-    rate = ((_signal_values(torque, points[1:], "before") - start) / np.diff(points) if ramp
-            else np.zeros(len(start)))
+    rate = (_signal_values(torque, points[1:], "before") - start) / np.diff(points) if ramp else np.zeros(len(start))
     return [TorqueSchedule(time=points, torque=start, torque_rate=rate)]
 
 
@@ -348,8 +373,14 @@ class _Run:
 
     def integrate(self, plan: TorqueSchedule, at: np.ndarray | None = None) -> np.ndarray:
         """The schedule from the run's initial state, exactly, at the result's times (or at)."""
-        return reference_schedule(plan, parameters=self.parameters, theta0=self.theta0, omega0=self.omega0,
-                                  at=self.times if at is None else at, fmu_path=self.fmu_path)
+        return reference_schedule(
+            plan,
+            parameters=self.parameters,
+            theta0=self.theta0,
+            omega0=self.omega0,
+            at=self.times if at is None else at,
+            fmu_path=self.fmu_path,
+        )
 
 
 def _not_restored(run: _Run, correct: np.ndarray, first_wrong: int) -> list[np.ndarray]:
@@ -366,8 +397,7 @@ def _not_restored(run: _Run, correct: np.ndarray, first_wrong: int) -> list[np.n
         off = abs(run.plan.time[k] - restart) > event_tolerance(restart, run.step_size)
         if off or k + 1 >= len(run.plan.time):
             continue
-        tail = TorqueSchedule(time=run.plan.time[k:], torque=run.plan.torque[k:],
-                              torque_rate=run.plan.torque_rate[k:])
+        tail = TorqueSchedule(time=run.plan.time[k:], torque=run.plan.torque[k:], torque_rate=run.plan.torque_rate[k:])
         variant = correct.copy()
         variant[first_wrong:] = run.integrate(tail, at=run.times[first_wrong:])
         variants.append(variant)
@@ -382,8 +412,15 @@ def _integration(run: _Run) -> list[np.ndarray]:
     return [_euler(run.plan, acceleration, run.theta0, run.omega0, semi)[index] for semi in (False, True)]
 
 
-def _candidates(run: _Run, torque, held: TorqueSchedule | None, correct: np.ndarray, result: np.ndarray,
-                tolerance: float, start_torque: float) -> dict[str, list[np.ndarray]]:
+def _candidates(
+    run: _Run,
+    torque,
+    held: TorqueSchedule | None,
+    correct: np.ndarray,
+    result: np.ndarray,
+    tolerance: float,
+    start_torque: float,
+) -> dict[str, list[np.ndarray]]:
     """{candidate: its variants at the result's times}; an empty list where it does not apply.
     held: for a ramp run, the same signal held over each step (schedule without ramp)."""
     plan, ramp = run.plan, held is not None
@@ -400,8 +437,9 @@ def _candidates(run: _Run, torque, held: TorqueSchedule | None, correct: np.ndar
     }
 
 
-def _diagnose(raw: float, tolerance: float, scores: dict[str, dict | None],
-              smallest_input_effect: float | None) -> tuple[str, float]:
+def _diagnose(
+    raw: float, tolerance: float, scores: dict[str, dict | None], smallest_input_effect: float | None
+) -> tuple[str, float]:
     """The candidate that explains the difference, or integration error, or unexplained."""
     applicable = {name: score for name, score in scores.items() if score is not None}
     best = min(applicable, key=lambda name: applicable[name]["residual"], default=None)
@@ -409,21 +447,38 @@ def _diagnose(raw: float, tolerance: float, scores: dict[str, dict | None],
         # Variants the same to the noise are the same run: from rest at an equilibrium, a first step
         # without torque and a restart from the initial state after it cannot be told apart. The
         # earlier in DIAGNOSES, the commoner mistake, names it.
-        tied = [name for name in DIAGNOSES if name in applicable
-                and applicable[name]["residual"] <= applicable[best]["residual"] + NOISE * tolerance]
+        tied = [
+            name
+            for name in DIAGNOSES
+            if name in applicable and applicable[name]["residual"] <= applicable[best]["residual"] + NOISE * tolerance
+        ]
         return tied[0], applicable[tied[0]]["residual"]
     euler = applicable.get(INTEGRATION)
-    if (euler is not None and raw <= euler["effect"]
-            and (smallest_input_effect is None or raw <= INTEGRATION_SMALL * smallest_input_effect)):
+    if (
+        euler is not None
+        and raw <= euler["effect"]
+        and (smallest_input_effect is None or raw <= INTEGRATION_SMALL * smallest_input_effect)
+    ):
         return INTEGRATION, raw
     return UNEXPLAINED, applicable[best]["residual"] if best is not None else raw
 
 
-def judge(result, torque, *, start_time: float = 0.0, stop_time: float | None = None,
-          step_size: float = 1e-3, ramp: bool = False, parameters: dict | None = None,
-          theta0: float = 0.0, omega0: float = 0.0, tolerance: float | None = None,
-          mapping: str | dict | None = None, fmu_path: str | Path | None = None,
-          max_steps: int | None = None) -> Judgement:
+def judge(
+    result,
+    torque,
+    *,
+    start_time: float = 0.0,
+    stop_time: float | None = None,
+    step_size: float = 1e-3,
+    ramp: bool = False,
+    parameters: dict | None = None,
+    theta0: float = 0.0,
+    omega0: float = 0.0,
+    tolerance: float | None = None,
+    mapping: str | dict | None = None,
+    fmu_path: str | Path | None = None,
+    max_steps: int | None = None,
+) -> Judgement:
     """Judge a result from any tool against the independent reference, and diagnose a failure.
 
     Parameters
@@ -474,15 +529,28 @@ def judge(result, torque, *, start_time: float = 0.0, stop_time: float | None = 
     if isinstance(result, (str, Path)):
         result = read_result(result, mapping)
     elif mapping:
-        raise InvalidInput("a map renames and scales a result file's columns: an array result is "
-                           "judged as it is, in the fields time and theta (rad); leave out mapping")
+        raise InvalidInput(
+            "a map renames and scales a result file's columns: an array result is "
+            "judged as it is, in the fields time and theta (rad); leave out mapping"
+        )
     parameters = resolve_parameters(parameters, fmu_path)
-    plan = schedule(torque, start_time=start_time, stop_time=stop_time, step_size=step_size, ramp=ramp,
-                    max_steps=max_steps)
+    plan = schedule(
+        torque, start_time=start_time, stop_time=stop_time, step_size=step_size, ramp=ramp, max_steps=max_steps
+    )
     _check_span(result, plan, step_size, source)
     times = np.asarray(result["time"], dtype=float)
-    correct = reference(torque, start_time=start_time, stop_time=stop_time, step_size=step_size, ramp=ramp,
-                        parameters=parameters, theta0=theta0, omega0=omega0, at=times, fmu_path=fmu_path)
+    correct = reference(
+        torque,
+        start_time=start_time,
+        stop_time=stop_time,
+        step_size=step_size,
+        ramp=ramp,
+        parameters=parameters,
+        theta0=theta0,
+        omega0=omega0,
+        at=times,
+        fmu_path=fmu_path,
+    )
     difference = np.abs(result["theta"] - correct["theta"])
     raw = float(np.max(difference))
     worst_time = float(times[int(np.argmax(difference))])
@@ -507,11 +575,21 @@ def judge(result, torque, *, start_time: float = 0.0, stop_time: float | None = 
         diagnosis, residual = AGREES, raw
     else:
         diagnosis, residual = _diagnose(raw, tolerance, scores, smallest_input_effect)
-    return Judgement(verdict="pass" if raw <= tolerance else "fail", diagnosis=diagnosis, residual=residual,
-                     max_abs_dtheta=raw, worst_time=worst_time, tolerance=tolerance, candidates=scores,
-                     smallest_input_effect=smallest_input_effect, result=result, reference=correct,
-                     explanation=best_variant.get(diagnosis) if diagnosis != AGREES else None, source=source,
-                     regression_tools=regression_verdicts(times, correct["theta"], result["theta"]))
+    return Judgement(
+        verdict="pass" if raw <= tolerance else "fail",
+        diagnosis=diagnosis,
+        residual=residual,
+        max_abs_dtheta=raw,
+        worst_time=worst_time,
+        tolerance=tolerance,
+        candidates=scores,
+        smallest_input_effect=smallest_input_effect,
+        result=result,
+        reference=correct,
+        explanation=best_variant.get(diagnosis) if diagnosis != AGREES else None,
+        source=source,
+        regression_tools=regression_verdicts(times, correct["theta"], result["theta"]),
+    )
 
 
 def format_judgement(judgement: Judgement) -> str:
@@ -528,11 +606,12 @@ def format_judgement(judgement: Judgement) -> str:
     str
         The lines, joined.
     """
-    lines = [f"{judgement.source}: {judgement.verdict}: {judgement.diagnosis} (residual "
-             f"{judgement.residual:.2e} rad)",
-             f"max |dtheta| = {judgement.max_abs_dtheta:.3e} rad at t = {judgement.worst_time!r} s "
-             f"(tolerance {judgement.tolerance:g} rad; {len(judgement.result)} points)",
-             f"{'candidate':<28} {'residual rad':>12} {'effect rad':>11}"]
+    lines = [
+        f"{judgement.source}: {judgement.verdict}: {judgement.diagnosis} (residual {judgement.residual:.2e} rad)",
+        f"max |dtheta| = {judgement.max_abs_dtheta:.3e} rad at t = {judgement.worst_time!r} s "
+        f"(tolerance {judgement.tolerance:g} rad; {len(judgement.result)} points)",
+        f"{'candidate':<28} {'residual rad':>12} {'effect rad':>11}",
+    ]
     for name, score in judgement.candidates.items():
         if score is None:
             lines.append(f"{name:<28} {'does not apply to this run':>24}")
@@ -562,18 +641,27 @@ def format_kit(verdicts: dict[str, Judgement | None]) -> str:
         if judgement is None:
             lines.append(f"{name:<18} not run: no {name}_out.csv")
         else:
-            lines.append(f"{name:<18} {judgement.verdict:<4}  {judgement.diagnosis:<28} max|dtheta| "
-                         f"{judgement.max_abs_dtheta:.2e} rad at t = {judgement.worst_time:.6g} s, "
-                         f"residual {judgement.residual:.1e} rad")
+            lines.append(
+                f"{name:<18} {judgement.verdict:<4}  {judgement.diagnosis:<28} max|dtheta| "
+                f"{judgement.max_abs_dtheta:.2e} rad at t = {judgement.worst_time:.6g} s, "
+                f"residual {judgement.residual:.1e} rad"
+            )
     judged = [judgement for judgement in verdicts.values() if judgement is not None]
     not_run = len(verdicts) - len(judged)
-    lines.append(f"{sum(j.passed for j in judged)} of {len(judged)} results pass"
-                 + (f"; {not_run} scenarios not run" if not_run else ""))
+    lines.append(
+        f"{sum(j.passed for j in judged)} of {len(judged)} results pass"
+        + (f"; {not_run} scenarios not run" if not_run else "")
+    )
     return "\n".join(lines)
 
 
-def judge_kit(folder: str | Path, *, tolerance: float | None = None, mapping: str | None = None,
-              fmu_path: str | Path | None = None) -> dict[str, Judgement | None]:
+def judge_kit(
+    folder: str | Path,
+    *,
+    tolerance: float | None = None,
+    mapping: str | None = None,
+    fmu_path: str | Path | None = None,
+) -> dict[str, Judgement | None]:
     """Judge every NAME_out.csv beside the settings NAME.json of a scenario kit (scenarios.py).
 
     Parameters
@@ -612,8 +700,10 @@ def judge_kit(folder: str | Path, *, tolerance: float | None = None, mapping: st
     folder = Path(folder)
     found = settings_files(folder)
     if not found:
-        raise ResultFileError(f"{folder}: no scenario settings (NAME.json) in this folder; write a kit "
-                              "with pendulum-fmu scenarios --output-dir FOLDER")
+        raise ResultFileError(
+            f"{folder}: no scenario settings (NAME.json) in this folder; write a kit "
+            "with pendulum-fmu scenarios --output-dir FOLDER"
+        )
     verdicts = {}
     for name, settings_path in found.items():
         settings = read_settings(settings_path)
@@ -625,9 +715,11 @@ def judge_kit(folder: str | Path, *, tolerance: float | None = None, mapping: st
             settings["tolerance"] = tolerance
         verdicts[name] = judge(output, mapping=mapping, fmu_path=fmu_path, **settings)
     if all(v is None for v in verdicts.values()):
-        raise ResultFileError(f"{folder}: no result to judge: run each scenario and write NAME_out.csv "
-                              f"(time,theta[,omega,alpha]) beside its NAME_in.csv, e.g. "
-                              f"{next(iter(found))}_out.csv")
+        raise ResultFileError(
+            f"{folder}: no result to judge: run each scenario and write NAME_out.csv "
+            f"(time,theta[,omega,alpha]) beside its NAME_in.csv, e.g. "
+            f"{next(iter(found))}_out.csv"
+        )
     return verdicts
 
 
@@ -657,5 +749,14 @@ def write_json(verdicts: dict[str, Judgement | None] | Judgement, path: str | Pa
     return Path(path)
 
 
-__all__ = ["DIAGNOSES", "Judgement", "ResultFileError", "format_judgement", "format_kit",
-           "judge", "judge_kit", "read_result", "write_json"]
+__all__ = [
+    "DIAGNOSES",
+    "Judgement",
+    "ResultFileError",
+    "format_judgement",
+    "format_kit",
+    "judge",
+    "judge_kit",
+    "read_result",
+    "write_json",
+]

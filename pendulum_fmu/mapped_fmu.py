@@ -98,18 +98,27 @@ def as_map(mapping, allowed: tuple[str, ...] | None = None) -> dict[str, Mapped]
         return parse_map(mapping, allowed)
     if isinstance(mapping, dict) and all(isinstance(value, Mapped) for value in mapping.values()):
         return dict(mapping)
-    if isinstance(mapping, dict) and all(isinstance(key, str) and isinstance(value, str)
-                                         for key, value in mapping.items()):
+    if isinstance(mapping, dict) and all(
+        isinstance(key, str) and isinstance(value, str) for key, value in mapping.items()
+    ):
         return parse_map(",".join(f"{key}={value}" for key, value in mapping.items()), allowed)
-    raise WrongType(f"a map is text such as 'time=t,theta=phi*0.0174532925' or a dict such as "
-                    f"{{'theta': 'phi*0.0174532925'}}, not {mapping!r}")
+    raise WrongType(
+        f"a map is text such as 'time=t,theta=phi*0.0174532925' or a dict such as "
+        f"{{'theta': 'phi*0.0174532925'}}, not {mapping!r}"
+    )
 
 
 class MappedFmu:
     """An FMU and its map, checked once; run() has the runner signature of every tool."""
 
-    def __init__(self, path: str | Path, mapping: dict[str, Mapped] | str | None = None, *,
-                 interface: str | None = None, label: str = "other"):
+    def __init__(
+        self,
+        path: str | Path,
+        mapping: dict[str, Mapped] | str | None = None,
+        *,
+        interface: str | None = None,
+        label: str = "other",
+    ):
         self.path, self.label = Path(path), label
         if not self.path.is_file():
             raise MapError(f"{label}: no FMU at {self.path}")
@@ -118,13 +127,17 @@ class MappedFmu:
         except FmuFileError as error:  # not a zip, no model description, not FMI 2.0 or 3.0
             raise MapError(f"{label}: {error}") from None
         self.description = self.model.description
-        available = [name for name, present in (("CoSimulation", self.description.coSimulation),
-                                                 ("ModelExchange", self.description.modelExchange))
-                     if present]
+        available = [
+            name
+            for name, present in (
+                ("CoSimulation", self.description.coSimulation),
+                ("ModelExchange", self.description.modelExchange),
+            )
+            if present
+        ]
         self.interface = interface or available[0]
         if self.interface not in available:
-            raise MapError(f"{label}: {self.path} has no {self.interface} interface "
-                           f"(it has {', '.join(available)})")
+            raise MapError(f"{label}: {self.path} has no {self.interface} interface (it has {', '.join(available)})")
         self.variables = self.model.variables  # shared, read only
         self.mapping = self._complete(as_map(mapping))
 
@@ -139,12 +152,15 @@ class MappedFmu:
                 mapped = Mapped(quantity)
             if mapped is None:
                 if quantity in REQUIRED:
-                    raise MapError(f"{self.label}: {self.path.name} has no variable {quantity!r}: "
-                                   f"name it with --map {quantity}=VARIABLE")
+                    raise MapError(
+                        f"{self.label}: {self.path.name} has no variable {quantity!r}: "
+                        f"name it with --map {quantity}=VARIABLE"
+                    )
                 continue
             if mapped.variable not in self.variables:
-                raise MapError(f"{self.label}: {self.path.name} has no variable {mapped.variable!r} "
-                               f"(mapped to {quantity})")
+                raise MapError(
+                    f"{self.label}: {self.path.name} has no variable {mapped.variable!r} (mapped to {quantity})"
+                )
             mapping[quantity] = mapped
         return mapping
 
@@ -157,14 +173,23 @@ class MappedFmu:
             mapped = self.mapping.get(quantity)
             if mapped is None:
                 if value != defaults.get(quantity, 0.0):
-                    raise MapError(f"{self.label}: {self.path.name} has no variable for {quantity} = "
-                                   f"{value:g}: map it with --map {quantity}=VARIABLE")
+                    raise MapError(
+                        f"{self.label}: {self.path.name} has no variable for {quantity} = "
+                        f"{value:g}: map it with --map {quantity}=VARIABLE"
+                    )
                 continue
             start[mapped.variable] = value / mapped.factor
         return start
 
-    def run(self, plan: TorqueSchedule, *, parameters: dict | None = None, theta0: float = 0.0,
-            omega0: float = 0.0, mode: str = "accurate") -> np.ndarray:
+    def run(
+        self,
+        plan: TorqueSchedule,
+        *,
+        parameters: dict | None = None,
+        theta0: float = 0.0,
+        omega0: float = 0.0,
+        mode: str = "accurate",
+    ) -> np.ndarray:
         check_held(plan, self.label)
         check_mode(mode, self.label)
         start = self._start_values(parameters, theta0, omega0)
@@ -184,16 +209,20 @@ class MappedFmu:
         fmi3 = self.description.fmiVersion == "3.0"
         folder = self.model.folder
         identifier = self.description.coSimulation.modelIdentifier
-        arguments = dict(guid=self.description.guid, unzipDirectory=folder, modelIdentifier=identifier,
-                         instanceName=self.label)
+        arguments = dict(
+            guid=self.description.guid, unzipDirectory=folder, modelIdentifier=identifier, instanceName=self.label
+        )
         try:
-            slave = (FMU3Slave(**arguments) if fmi3
-                     else FMU2Slave(**arguments, libraryPath=fmi2_library(folder, identifier)))
+            slave = (
+                FMU3Slave(**arguments) if fmi3 else FMU2Slave(**arguments, libraryPath=fmi2_library(folder, identifier))
+            )
         except Exception:  # fmpy's own: no binary of that name for this platform
             folder = fmpy.platform_tuple if fmi3 else fmpy.platform
-            raise FmuFileError(f"{self.label}: {self.path} cannot be loaded here: it has no "
-                               f"binaries/{folder}/{identifier}{fmpy.sharedLibraryExtension} (its "
-                               "modelIdentifier's binary for this platform)") from None
+            raise FmuFileError(
+                f"{self.label}: {self.path} cannot be loaded here: it has no "
+                f"binaries/{folder}/{identifier}{fmpy.sharedLibraryExtension} (its "
+                "modelIdentifier's binary for this platform)"
+            ) from None
         messages = MessageLog(3 if fmi3 else 2)
         outputs = self._output_variables()
         vr = {name: self.variables[name].valueReference for name in (*start, *outputs.values())}
@@ -218,8 +247,7 @@ class MappedFmu:
             else:
                 slave.enterInitializationMode()
             slave.exitInitializationMode()
-            for k, (t, h, u) in enumerate(zip(plan.time.tolist(), plan.step_size.tolist(),
-                                              plan.torque.tolist())):
+            for k, (t, h, u) in enumerate(zip(plan.time.tolist(), plan.step_size.tolist(), plan.torque.tolist())):
                 call = f"the step from t = {t:.17g}"
                 set_values(torque_vr, [u / torque.factor])
                 recorded[k] = get_values(output_vrs)
@@ -245,12 +273,19 @@ class MappedFmu:
         signal["time"], signal[torque.variable] = times, values / torque.factor
         outputs = self._output_variables()
         try:
-            raw = simulate_fmu(self.model.folder, model_description=self.description,
-                               fmi_type="ModelExchange", solver="CVode",
-                               relative_tolerance=tolerance, start_time=float(plan.time[0]),
-                               stop_time=float(plan.time[-1]),
-                               output_interval=float(plan.step_size.min()), input=signal,
-                               output=list(outputs.values()), start_values=start)
+            raw = simulate_fmu(
+                self.model.folder,
+                model_description=self.description,
+                fmi_type="ModelExchange",
+                solver="CVode",
+                relative_tolerance=tolerance,
+                start_time=float(plan.time[0]),
+                stop_time=float(plan.time[-1]),
+                output_interval=float(plan.step_size.min()),
+                input=signal,
+                output=list(outputs.values()),
+                start_values=start,
+            )
         except Exception as error:
             raise FmuError(f"{self.label}: Model Exchange simulation failed: {error}") from None
         # At a jump fmpy records the time twice; the row after the event is the one whose outputs

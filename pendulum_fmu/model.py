@@ -52,6 +52,7 @@ def fmu_file(fmu_path: str | os.PathLike | FmuModel | None) -> Path:
         return fmu_path.path
     if fmu_path is None:
         from . import default_fmu
+
         return default_fmu()
     # bool and int would pass for a file descriptor, which is no FMU's path.
     if not isinstance(fmu_path, (str, os.PathLike)):
@@ -105,25 +106,33 @@ class FmuModel:
         description, path = self.description, self.path
         missing = [name for name in PENDULUM_VARIABLES if name not in self.variables]
         if missing:
-            raise FmuFileError(f"{path} is not a pendulum FMU: it has no variable {', '.join(missing)} "
-                               f"(it is the model {description.modelName!r}); give the pendulum's FMU, "
-                               "or compare another model with compare --tools LABEL=path --map")
+            raise FmuFileError(
+                f"{path} is not a pendulum FMU: it has no variable {', '.join(missing)} "
+                f"(it is the model {description.modelName!r}); give the pendulum's FMU, "
+                "or compare another model with compare --tools LABEL=path --map"
+            )
         if description.coSimulation is None:
-            raise FmuFileError(f"{path} has no Co-Simulation interface, which this package runs: "
-                               "export it for Co-Simulation")
+            raise FmuFileError(
+                f"{path} has no Co-Simulation interface, which this package runs: export it for Co-Simulation"
+            )
         folder = fmpy.platform_tuple if self.fmi_version == 3 else fmpy.platform
         binary = f"binaries/{folder}/{description.coSimulation.modelIdentifier}{fmpy.sharedLibraryExtension}"
         if binary not in self._archive_names:
-            raise FmuFileError(f"{path} has no binary for this platform ({binary}): build it here with "
-                               "pendulum-fmu build, or give an FMU built for this platform")
+            raise FmuFileError(
+                f"{path} has no binary for this platform ({binary}): build it here with "
+                "pendulum-fmu build, or give an FMU built for this platform"
+            )
         return self.variables
 
     @cached_property
     def default_parameters(self) -> dict[str, float]:
         """{name: start value} of every Real parameter (shared: copy before changing); raises as
         pendulum_variables. String parameters (callRecordFile) are no physical parameter."""
-        return {name: float(v.start) for name, v in self.pendulum_variables.items()
-                if v.causality == "parameter" and v.type in ("Real", "Float64")}
+        return {
+            name: float(v.start)
+            for name, v in self.pendulum_variables.items()
+            if v.causality == "parameter" and v.type in ("Real", "Float64")
+        }
 
     @cached_property
     def outputs(self) -> tuple[str, ...]:
@@ -165,11 +174,13 @@ def _read(path: str, version: tuple, shown: str) -> FmuModel:
         with zipfile.ZipFile(path) as archive:
             names = frozenset(archive.namelist())
     except (zipfile.BadZipFile, OSError):
-        raise FmuFileError(f"{shown} is not an FMU (an FMU is a zip archive with a "
-                           "modelDescription.xml): check the path") from None
+        raise FmuFileError(
+            f"{shown} is not an FMU (an FMU is a zip archive with a modelDescription.xml): check the path"
+        ) from None
     if "modelDescription.xml" not in names:
-        raise FmuFileError(f"{shown} is not an FMU: the zip archive has no modelDescription.xml"
-                           + ("" if names else " (it is empty)"))
+        raise FmuFileError(
+            f"{shown} is not an FMU: the zip archive has no modelDescription.xml" + ("" if names else " (it is empty)")
+        )
     try:
         description = read_model_description(path)
     except Exception as error:  # lxml's and fmpy's own: the XML is broken or invalid
@@ -177,8 +188,10 @@ def _read(path: str, version: tuple, shown: str) -> FmuModel:
         problems = "; ".join(line.strip(" -") for line in str(error).splitlines() if line.strip(" -"))
         raise FmuFileError(f"{shown}: its modelDescription.xml cannot be read: {problems}") from None
     if description.fmiVersion not in FMI_VERSIONS:
-        raise FmuFileError(f"{shown} is an FMI {description.fmiVersion} FMU; this package runs "
-                           "FMI 2.0 and 3.0 FMUs: export the model as one of those")
+        raise FmuFileError(
+            f"{shown} is an FMI {description.fmiVersion} FMU; this package runs "
+            "FMI 2.0 and 3.0 FMUs: export the model as one of those"
+        )
     return FmuModel(Path(shown), version, description, names)
 
 

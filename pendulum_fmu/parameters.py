@@ -13,8 +13,16 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from .errors import InvalidInput, WrongType
-from .model import (FMI_VERSIONS, PENDULUM_VARIABLES, START_VALUES, FmuFileError, FmuModel,  # noqa: F401
-                    file_version, fmu_file, fmu_model)
+from .model import (
+    FMI_VERSIONS,
+    PENDULUM_VARIABLES,
+    START_VALUES,
+    FmuFileError,
+    FmuModel,  # noqa: F401
+    file_version,
+    fmu_file,
+    fmu_model,
+)
 
 Fmu = str | Path | FmuModel | None
 
@@ -69,8 +77,7 @@ def default_parameters(fmu_path: Fmu = None) -> dict[str, float]:
     return dict(fmu_model(fmu_path).default_parameters)
 
 
-def merged_parameters(overrides: dict[str, float] | None = None,
-                      fmu_path: Fmu = None) -> dict[str, float]:
+def merged_parameters(overrides: dict[str, float] | None = None, fmu_path: Fmu = None) -> dict[str, float]:
     """The FMU's defaults with overrides applied; unknown names and non-finite values are refused.
     What the FMU itself refuses is left to it: see simulate.resolve_parameters."""
     return merged_with(default_parameters(fmu_path), overrides)
@@ -80,8 +87,9 @@ def merged_with(defaults: dict[str, float], overrides: dict[str, float] | None) 
     """merged_parameters over given defaults (an FMU's default_parameters)."""
     parameters = dict(defaults)
     if not isinstance(overrides, Mapping | None):
-        raise WrongType(f"parameters is a dict {{name: value}}, e.g. {{'gravity': 0}}; got a "
-                        f"{type(overrides).__name__}")
+        raise WrongType(
+            f"parameters is a dict {{name: value}}, e.g. {{'gravity': 0}}; got a {type(overrides).__name__}"
+        )
     for name, value in (overrides or {}).items():
         if name not in parameters:
             raise InvalidInput(f"unknown parameter {name!r}: the parameters are {', '.join(parameters)}")

@@ -24,8 +24,13 @@ OMEGA_LABEL = r"Velocity $\omega$ in rad/s"
 TIME_LABEL = r"Time $t$ in s"
 
 
-def case_title(torque, parameters: dict[str, float] | None = None, theta0: float = 0.0,
-               omega0: float = 0.0, fmu_path: str | Path | None = None) -> str:
+def case_title(
+    torque,
+    parameters: dict[str, float] | None = None,
+    theta0: float = 0.0,
+    omega0: float = 0.0,
+    fmu_path: str | Path | None = None,
+) -> str:
     """'Torque-driven pendulum: torque 20 N.m, gravity 9.81 m/s2', then every parameter the user
     set and a start value other than 0, each with the unit the FMU declares.
 
@@ -37,8 +42,11 @@ def case_title(torque, parameters: dict[str, float] | None = None, theta0: float
         shown = [f"torque from {Path(torque).name}"]
     else:
         shown = ["a torque signal"]
-    values = {"gravity": merged_parameters(parameters, fmu_path)["gravity"], **(parameters or {}),
-              **{name: value for name, value in (("theta0", theta0), ("omega0", omega0)) if value}}
+    values = {
+        "gravity": merged_parameters(parameters, fmu_path)["gravity"],
+        **(parameters or {}),
+        **{name: value for name, value in (("theta0", theta0), ("omega0", omega0)) if value},
+    }
     shown += [f"{name} {value:g} {unit(name, fmu_path)}" for name, value in values.items()]
     return f"Torque-driven pendulum: {', '.join(shown)}"
 
@@ -59,8 +67,10 @@ def check_figure_path(path: str | Path) -> None:
     suffix = Path(path).suffix.lstrip(".").lower()
     formats = FigureCanvasBase.get_supported_filetypes()
     if suffix and suffix not in formats:
-        raise InvalidInput(f"{path}: a figure cannot be written as .{suffix}; end its name in .png, "
-                           f".pdf or .svg (or {', '.join('.' + name for name in sorted(formats))})")
+        raise InvalidInput(
+            f"{path}: a figure cannot be written as .{suffix}; end its name in .png, "
+            f".pdf or .svg (or {', '.join('.' + name for name in sorted(formats))})"
+        )
 
 
 # The largest magnitude a figure draws. matplotlib's margins, ticks and log decades overflow near
@@ -91,18 +101,20 @@ def _leave_out_undrawable(ax) -> None:
         extreme = next((v for v in map(_too_large, values) if v is not None), None)
         if extreme is not None:
             label = artist.get_label()
-            notes.append(f"{label if label and not label.startswith('_') else 'a line'} reaches "
-                         f"{extreme:.3g}: too large to draw")
+            notes.append(
+                f"{label if label and not label.startswith('_') else 'a line'} reaches {extreme:.3g}: too large to draw"
+            )
             artist.remove()
     for index, note in enumerate(dict.fromkeys(notes)):
-        ax.text(0.5, 0.88 - 0.12 * index, note, transform=ax.transAxes, ha="center", va="center",
-                fontsize=10)
+        ax.text(0.5, 0.88 - 0.12 * index, note, transform=ax.transAxes, ha="center", va="center", fontsize=10)
     if notes:
         ax.relim()
         ax.autoscale_view()
         # With nothing left to scale to, matplotlib keeps the limits the removed data set.
-        for limits, scale, set_limits in ((ax.get_xlim(), ax.get_xscale(), ax.set_xlim),
-                                          (ax.get_ylim(), ax.get_yscale(), ax.set_ylim)):
+        for limits, scale, set_limits in (
+            (ax.get_xlim(), ax.get_xscale(), ax.set_xlim),
+            (ax.get_ylim(), ax.get_yscale(), ax.set_ylim),
+        ):
             if _too_large(limits) is not None:
                 set_limits((1, 10) if scale == "log" else (0, 1))
 
@@ -159,11 +171,19 @@ def _draw_difference(ax, time: np.ndarray, difference: np.ndarray, label: str, i
     ax.set_yscale("log")
     identical = difference == 0
     if identical.all():
-        ax.text(0.5, 1 - 0.12 * index, f"{label}: identical at every point", transform=ax.transAxes,
-                ha="center", va="center", fontsize=10)
+        ax.text(
+            0.5,
+            1 - 0.12 * index,
+            f"{label}: identical at every point",
+            transform=ax.transAxes,
+            ha="center",
+            va="center",
+            fontsize=10,
+        )
         return
-    note = f" ({np.count_nonzero(identical)} of {len(difference)} points identical, not drawn)" \
-        if identical.any() else ""
+    note = (
+        f" ({np.count_nonzero(identical)} of {len(difference)} points identical, not drawn)" if identical.any() else ""
+    )
     (line,) = ax.plot(time, np.where(identical, np.nan, difference), label=label + note)
     gap = np.r_[True, identical, True]
     alone = ~identical & gap[:-2] & gap[2:]
@@ -185,8 +205,7 @@ def plot_comparison(runs: dict[str, np.ndarray], path: str | Path, title: str) -
         axes[1, 0].plot(run["time"], run["omega"], label=label, **style)
         if i:
             for row, name in enumerate(("theta", "omega")):
-                _draw_difference(axes[row, 1], run["time"], np.abs(run[name] - base[name]),
-                                 f"{label} - {labels[0]}", i)
+                _draw_difference(axes[row, 1], run["time"], np.abs(run[name] - base[name]), f"{label} - {labels[0]}", i)
     axes[0, 0].set_ylabel(THETA_LABEL)
     axes[1, 0].set_ylabel(OMEGA_LABEL)
     axes[0, 1].set_ylabel(r"$|\Delta\theta|$ in rad")
@@ -203,8 +222,7 @@ def plot_cases(runs: dict[str, np.ndarray], path: str | Path, title: str) -> Pat
     colors = plt.cm.viridis(np.linspace(0, 0.9, max(len(runs), 1)))
     labelled = len(runs) <= 12
     for color, (label, run) in zip(colors, runs.items()):
-        axes[0].plot(run["time"], run["theta"], color=color, linewidth=1.5,
-                     label=label if labelled else None)
+        axes[0].plot(run["time"], run["theta"], color=color, linewidth=1.5, label=label if labelled else None)
         axes[1].plot(run["time"], run["omega"], color=color, linewidth=1.5)
     axes[0].set_ylabel(THETA_LABEL)
     axes[1].set_ylabel(OMEGA_LABEL)
@@ -239,16 +257,20 @@ def _quantiles(x: np.ndarray, y: np.ndarray, quantiles) -> tuple[np.ndarray, lis
 
 
 @_drawing
-def plot_case_bands(values: dict[str, np.ndarray], summaries: dict[str, np.ndarray],
-                    path: str | Path, title: str, units: dict[str, str] | None = None) -> Path:
+def plot_case_bands(
+    values: dict[str, np.ndarray],
+    summaries: dict[str, np.ndarray],
+    path: str | Path,
+    title: str,
+    units: dict[str, str] | None = None,
+) -> Path:
     """For many cases: each summary (a row of panels) against each swept value (a column), as
     the median and the 5-95 % and 25-75 % bands over the cases sharing that value; where each
     value has one case there is nothing to spread, and the cases alone are drawn. One sort per
     panel, so 100,000 cases draw about as fast as 100. NaN summaries (failed cases) are left out.
     units: {swept name: unit} for the axes."""
     swept = {name: column for name, column in values.items() if len(np.unique(column)) > 1} or values
-    fig, axes = plt.subplots(len(summaries), len(swept), figsize=(4.5 * len(swept) + 1, 6),
-                             squeeze=False, sharey="row")
+    fig, axes = plt.subplots(len(summaries), len(swept), figsize=(4.5 * len(swept) + 1, 6), squeeze=False, sharey="row")
     labelled = set()
 
     def once(text):  # each legend entry on the first panel that draws it
@@ -272,12 +294,17 @@ def plot_case_bands(values: dict[str, np.ndarray], summaries: dict[str, np.ndarr
             if len(levels) == np.count_nonzero(keep):  # one case per value: no spread to show
                 ax.plot(levels, median, color="C0", marker=".", label=once("one case per value"))
                 continue
-            for (low, high), (q_low, q_high), alpha in zip(QUANTILE_BANDS, zip(bands[::2], bands[1::2]),
-                                                           (0.25, 0.45)):
-                ax.fill_between(levels, q_low, q_high, alpha=alpha, color="C0", linewidth=0,
-                                label=once(f"{low:.0%}-{high:.0%} of cases"))
-            ax.plot(levels, median, color="C0", marker="." if len(levels) < 30 else None,
-                    label=once("median"))
+            for (low, high), (q_low, q_high), alpha in zip(QUANTILE_BANDS, zip(bands[::2], bands[1::2]), (0.25, 0.45)):
+                ax.fill_between(
+                    levels,
+                    q_low,
+                    q_high,
+                    alpha=alpha,
+                    color="C0",
+                    linewidth=0,
+                    label=once(f"{low:.0%}-{high:.0%} of cases"),
+                )
+            ax.plot(levels, median, color="C0", marker="." if len(levels) < 30 else None, label=once("median"))
     return _finish(fig, axes, title, path)
 
 
@@ -302,24 +329,36 @@ def plot_judgement(judgement, path: str | Path, title: str) -> Path:
     fig, axes = plt.subplots(3, 1, figsize=(10, 8), sharex=True)
     axes[0].step(time, reference["torque"], where="post", linewidth=2, label="the run's torque")
     if variant is not None and not np.array_equal(variant["torque"], reference["torque"]):
-        axes[0].step(time, variant["torque"], where="post", linestyle="--", linewidth=1.5,
-                     label=f"applied if {judgement.diagnosis}")
+        axes[0].step(
+            time,
+            variant["torque"],
+            where="post",
+            linestyle="--",
+            linewidth=1.5,
+            label=f"applied if {judgement.diagnosis}",
+        )
     axes[0].set_ylabel(r"Torque $\tau$ in N.m")
     axes[1].plot(time, reference["theta"], linewidth=2, label="reference")
     axes[1].plot(time, result["theta"], linestyle="--", linewidth=1.5, label=judgement.source)
     axes[1].set_ylabel(THETA_LABEL)
-    zeros = _log_difference(axes[2], time, result["theta"] - reference["theta"],
-                            "|result - reference|", linewidth=1.5)
+    zeros = _log_difference(axes[2], time, result["theta"] - reference["theta"], "|result - reference|", linewidth=1.5)
     if variant is not None:
-        _log_difference(axes[2], time, variant["theta"] - reference["theta"],
-                        f"|{judgement.diagnosis} - reference|", linestyle="--", linewidth=1.5)
-    axes[2].axhline(judgement.tolerance, color="grey", linestyle=":",
-                    label=f"tolerance {judgement.tolerance:g} rad")
+        _log_difference(
+            axes[2],
+            time,
+            variant["theta"] - reference["theta"],
+            f"|{judgement.diagnosis} - reference|",
+            linestyle="--",
+            linewidth=1.5,
+        )
+    axes[2].axhline(judgement.tolerance, color="grey", linestyle=":", label=f"tolerance {judgement.tolerance:g} rad")
     axes[2].set_yscale("log")
     if zeros:
-        note = ("the result equals the reference exactly at every point (difference 0 rad)"
-                if zeros == len(time) else
-                f"difference exactly 0 rad at {zeros:,} of {len(time):,} points (not drawn)")
+        note = (
+            "the result equals the reference exactly at every point (difference 0 rad)"
+            if zeros == len(time)
+            else f"difference exactly 0 rad at {zeros:,} of {len(time):,} points (not drawn)"
+        )
         axes[2].text(0.01, 0.04, note, transform=axes[2].transAxes, fontsize=9)
     axes[2].set_ylabel(r"$|\Delta\theta|$ in rad")
     axes[2].set_xlabel(TIME_LABEL)
@@ -350,18 +389,22 @@ def plot_calls(judged: dict, path: str | Path, title: str) -> Path:
     for ax, (name, result) in zip(axes[:, 0], judged.items(), strict=True):
         steps = result["steps"]
         time = [step["time"] for step in steps]
-        ax.step(time, [step["torque"] for step in steps], where="post", linewidth=2,
-                label="torque at each step's start, as the master set it")
+        ax.step(
+            time,
+            [step["torque"] for step in steps],
+            where="post",
+            linewidth=2,
+            label="torque at each step's start, as the master set it",
+        )
         if result["intended_torque"] is not None:
             intended = result["intended_torque"][: len(time)]
-            ax.step(time[: len(intended)], intended, where="post", linestyle="--", linewidth=1.5,
-                    label="the intended run's")
+            ax.step(
+                time[: len(intended)], intended, where="post", linestyle="--", linewidth=1.5, label="the intended run's"
+            )
         found = result["differences"]
-        ax.set_title(f"instance {name}" + ("" if found is None else f": {len(found)} difference(s)"),
-                     fontsize=10)
+        ax.set_title(f"instance {name}" + ("" if found is None else f": {len(found)} difference(s)"), fontsize=10)
         if found:
-            ax.text(0.01, 0.04, "\n".join(found[:4]), transform=ax.transAxes, fontsize=7,
-                    verticalalignment="bottom")
+            ax.text(0.01, 0.04, "\n".join(found[:4]), transform=ax.transAxes, fontsize=7, verticalalignment="bottom")
         ax.set_ylabel(r"Torque $\tau$ in N.m")
         ax.set_xlabel(TIME_LABEL)
     return _finish(fig, axes, title, path)

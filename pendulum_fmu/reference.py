@@ -140,8 +140,15 @@ class _Pieces:
     """The torque as pieces [start, end) on which it is u0 + rate * (t - start), the
     communication points the signal defines, and the torque just after any time."""
 
-    def __init__(self, starts: list[Fraction], stop: Fraction, u0: list[float], rate: list[float],
-                 points: list[Fraction], value_after: Callable[[Fraction], float]):
+    def __init__(
+        self,
+        starts: list[Fraction],
+        stop: Fraction,
+        u0: list[float],
+        rate: list[float],
+        points: list[Fraction],
+        value_after: Callable[[Fraction], float],
+    ):
         self.starts, self.stop, self.u0, self.rate = starts, stop, u0, rate
         self.points, self.value_after = points, value_after
 
@@ -157,8 +164,14 @@ def _signal_pieces(torque, start: Fraction, stop: Fraction | None, step: Fractio
             points = sorted({start, stop} | {t for t in signal.times if start < t < stop})
             u0 = [signal.after(a) for a in points[:-1]]
             rate = [(signal.before(b) - signal.after(a)) / float(b - a) for a, b in zip(points, points[1:])]
-            return _Pieces(points[:-1], stop, u0, rate, _with_events(grid, signal.times, step),
-                           lambda t: signal.after(signal.latest_event_near(t, step)))
+            return _Pieces(
+                points[:-1],
+                stop,
+                u0,
+                rate,
+                _with_events(grid, signal.times, step),
+                lambda t: signal.after(signal.latest_event_near(t, step)),
+            )
         points = _with_events(grid, signal.jumps(), step)
         held = [signal.after(signal.latest_event_near(p, step)) for p in points[:-1]]
         return _Pieces(points[:-1], stop, held, [0.0] * len(held), points, _holding(points, held, step))
@@ -176,7 +189,7 @@ def _signal_pieces(torque, start: Fraction, stop: Fraction | None, step: Fractio
         rate = [(b - a) / float(t1 - t0) for a, b, t0, t1 in zip(values, values[1:], points, points[1:])]
     else:
         rate = [0.0] * (len(points) - 1)
-    u0 = values[:len(points) - 1]
+    u0 = values[: len(points) - 1]
     return _Pieces(points[:-1], points[-1], u0, rate, points, _holding(points, u0, step))
 
 
@@ -215,9 +228,18 @@ def equation_of_motion(parameters: dict[str, float]) -> Callable:
     return acceleration
 
 
-def _integrate(pieces: _Pieces, at: np.ndarray, parameters: dict | None, theta0: float, omega0: float,
-               rtol: float, atol: float, fmu_path: str | Path | None, method: str = "DOP853",
-               max_step: float = np.inf) -> np.ndarray:
+def _integrate(
+    pieces: _Pieces,
+    at: np.ndarray,
+    parameters: dict | None,
+    theta0: float,
+    omega0: float,
+    rtol: float,
+    atol: float,
+    fmu_path: str | Path | None,
+    method: str = "DOP853",
+    max_step: float = np.inf,
+) -> np.ndarray:
     theta0, omega0 = start_value("theta0", theta0, "rad"), start_value("omega0", omega0, "rad/s")
     for name, value in (("rtol", rtol), ("atol", atol)):
         if not (isinstance(value, numbers.Real) and 0 < value < math.inf):
@@ -237,8 +259,12 @@ def _integrate(pieces: _Pieces, at: np.ndarray, parameters: dict | None, theta0:
         # Merge pieces that continue one another (the same held torque), so solve_ivp restarts
         # only where the torque changes.
         last = first
-        while (last + 1 < len(starts) and pieces.rate[first] == 0 and pieces.rate[last + 1] == 0
-               and pieces.u0[last + 1] == pieces.u0[first]):
+        while (
+            last + 1 < len(starts)
+            and pieces.rate[first] == 0
+            and pieces.rate[last + 1] == 0
+            and pieces.u0[last + 1] == pieces.u0[first]
+        ):
             last += 1
         t0, t1, u0, rate = starts[first], ends[last], pieces.u0[first], pieces.rate[first]
         mine = np.flatnonzero((owner >= first) & (owner <= last))
@@ -249,9 +275,16 @@ def _integrate(pieces: _Pieces, at: np.ndarray, parameters: dict | None, theta0:
             # the derivative inf or NaN: solve_ivp then fails, and that failure is the error to
             # show, not numpy's warnings on the way to it.
             with np.errstate(over="ignore", invalid="ignore"):
-                solution = solve_ivp(lambda t, y: (y[1], acceleration(y[0], y[1], u0 + rate * (t - t0))),
-                                     (t0, t1), state, method=method, rtol=rtol, atol=atol, t_eval=times,
-                                     max_step=max_step)
+                solution = solve_ivp(
+                    lambda t, y: (y[1], acceleration(y[0], y[1], u0 + rate * (t - t0))),
+                    (t0, t1),
+                    state,
+                    method=method,
+                    rtol=rtol,
+                    atol=atol,
+                    t_eval=times,
+                    max_step=max_step,
+                )
             if not solution.success:
                 raise _failed(solution.message, t0, parameters, theta0, omega0, pieces)
             row = np.searchsorted(times, report)
@@ -272,23 +305,37 @@ def _integrate(pieces: _Pieces, at: np.ndarray, parameters: dict | None, theta0:
     return out
 
 
-def _failed(why: str, t: float, parameters: dict, theta0: float, omega0: float,
-            pieces: _Pieces) -> InvalidInput:
+def _failed(why: str, t: float, parameters: dict, theta0: float, omega0: float, pieces: _Pieces) -> InvalidInput:
     """The one-line error for an integration these values break, naming every value."""
-    values = ", ".join(f"{name} = {value:g}" for name, value in
-                       {**parameters, "theta0": theta0, "omega0": omega0}.items())
+    values = ", ".join(
+        f"{name} = {value:g}" for name, value in {**parameters, "theta0": theta0, "omega0": omega0}.items()
+    )
     torque = max(abs(u) for u in pieces.u0)
-    return InvalidInput(f"the reference cannot integrate the pendulum from t = {t:g} s with {values} "
-                        f"and torques up to {torque:g}: {why.rstrip('.')}; values near the largest "
-                        "double (mass*gravity*length, mass*length^2, the torque over the inertia) "
-                        "break it: give physically meaningful values")
+    return InvalidInput(
+        f"the reference cannot integrate the pendulum from t = {t:g} s with {values} "
+        f"and torques up to {torque:g}: {why.rstrip('.')}; values near the largest "
+        "double (mass*gravity*length, mass*length^2, the torque over the inertia) "
+        "break it: give physically meaningful values"
+    )
 
 
-def reference(torque=20.0, *, start_time: float = 0.0, stop_time: float | None = None,
-              step_size: float = 1e-3, ramp: bool = False, parameters: dict | None = None,
-              theta0: float = 0.0, omega0: float = 0.0, at: np.ndarray | None = None,
-              rtol: float = 1e-12, atol: float = 1e-12, fmu_path: str | Path | None = None,
-              method: str = "DOP853", max_step: float = np.inf) -> np.ndarray:
+def reference(
+    torque=20.0,
+    *,
+    start_time: float = 0.0,
+    stop_time: float | None = None,
+    step_size: float = 1e-3,
+    ramp: bool = False,
+    parameters: dict | None = None,
+    theta0: float = 0.0,
+    omega0: float = 0.0,
+    at: np.ndarray | None = None,
+    rtol: float = 1e-12,
+    atol: float = 1e-12,
+    fmu_path: str | Path | None = None,
+    method: str = "DOP853",
+    max_step: float = np.inf,
+) -> np.ndarray:
     """The trajectory under a signal as docs/signals.md defines it, through scipy's solve_ivp
     (DOP853 by default): the independent oracle, which reads the signal itself.
 
@@ -336,8 +383,10 @@ def reference(torque=20.0, *, start_time: float = 0.0, stop_time: float | None =
     True
     """
     if not (isinstance(torque, (str, Path, list, tuple, np.ndarray, int, float)) or callable(torque)):
-        raise InvalidInput(f"the reference takes a constant, a callable, a per-step array or a CSV path, "
-                         f"not a {type(torque).__name__}: it reads the signal itself")
+        raise InvalidInput(
+            f"the reference takes a constant, a callable, a per-step array or a CSV path, "
+            f"not a {type(torque).__name__}: it reads the signal itself"
+        )
     if isinstance(torque, (list, tuple, np.ndarray)) and ramp:
         raise InvalidInput("a per-step torque array is held over each step; ramp needs a CSV or a callable")
     step, start = _seconds("step size", step_size), _seconds("start time", start_time)
@@ -345,8 +394,9 @@ def reference(torque=20.0, *, start_time: float = 0.0, stop_time: float | None =
     pieces = _signal_pieces(torque, start, stop, step, ramp)
     if at is None:
         at = np.array([float(t) for t in pieces.points])
-    return _integrate(pieces, _times(at, pieces, step), parameters, theta0, omega0, rtol, atol, fmu_path,
-                      method, max_step)
+    return _integrate(
+        pieces, _times(at, pieces, step), parameters, theta0, omega0, rtol, atol, fmu_path, method, max_step
+    )
 
 
 def _times(at, pieces: _Pieces, step: Fraction) -> np.ndarray:
@@ -360,14 +410,21 @@ def _times(at, pieces: _Pieces, step: Fraction) -> np.ndarray:
     outside = times.ravel()[~((times.ravel() >= earliest) & (times.ravel() <= latest))]
     if times.ndim != 1 or len(outside):
         shown = float(outside[0]) if len(outside) else at
-        raise InvalidInput(f"at: {shown!r} is no time of the run, {float(start):g} to "
-                           f"{float(stop):g} s")
+        raise InvalidInput(f"at: {shown!r} is no time of the run, {float(start):g} to {float(stop):g} s")
     return times
 
 
-def reference_schedule(plan, *, parameters: dict | None = None, theta0: float = 0.0,
-                       omega0: float = 0.0, at: np.ndarray | None = None, rtol: float = 1e-12,
-                       atol: float = 1e-12, fmu_path: str | Path | None = None) -> np.ndarray:
+def reference_schedule(
+    plan,
+    *,
+    parameters: dict | None = None,
+    theta0: float = 0.0,
+    omega0: float = 0.0,
+    at: np.ndarray | None = None,
+    rtol: float = 1e-12,
+    atol: float = 1e-12,
+    fmu_path: str | Path | None = None,
+) -> np.ndarray:
     """Integrate exactly the torques of a schedule, reported at its communication points (or at
     the times `at`): the judge of a tool that was fed that schedule, and the judge's variants of
     a run with a mistake made (judge.py).
@@ -392,11 +449,18 @@ def reference_schedule(plan, *, parameters: dict | None = None, theta0: float = 
         Parameters the FMU refuses, or values with which solve_ivp fails.
     """
     if not isinstance(plan, TorqueSchedule):
-        raise WrongType(f"plan is a TorqueSchedule (torque_schedule.schedule(...)), not a "
-                        f"{type(plan).__name__}")
+        raise WrongType(f"plan is a TorqueSchedule (torque_schedule.schedule(...)), not a {type(plan).__name__}")
     points = [Fraction(float(t)) for t in plan.time]
     u0, rate = plan.torque.tolist(), plan.torque_rate.tolist()
     # The schedule's points are the tools' own: no tolerance beyond rounding.
     pieces = _Pieces(points[:-1], points[-1], u0, rate, points, _holding(points, u0, Fraction(0)))
-    return _integrate(pieces, np.asarray(plan.time if at is None else at, dtype=float), parameters,
-                      theta0, omega0, rtol, atol, fmu_path)
+    return _integrate(
+        pieces,
+        np.asarray(plan.time if at is None else at, dtype=float),
+        parameters,
+        theta0,
+        omega0,
+        rtol,
+        atol,
+        fmu_path,
+    )

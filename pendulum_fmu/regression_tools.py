@@ -184,12 +184,19 @@ def cross_check_band(t_ref, y_ref, t, y) -> ToolVerdict:
     samples, window = 1000, 21  # fmpy.cross_check.validate_signal's defaults, the rules' band
     with warnings.catch_warnings():  # fmpy imports scipy.ndimage.filters, deprecated in scipy 1.x
         warnings.simplefilter("ignore", DeprecationWarning)
-        band_time, _, _, outside = validate_signal(t=t, y=y, t_ref=t_ref, y_ref=y_ref,
-                                                   t_start=t_ref[0], t_stop=t_ref[-1])
+        band_time, _, _, outside = validate_signal(
+            t=t, y=y, t_ref=t_ref, y_ref=y_ref, t_start=t_ref[0], t_stop=t_ref[-1]
+        )
     half_height = 0.1 * _base(np.interp(band_time, t_ref, y_ref), 5.0)
     count = int(np.count_nonzero(outside))
-    return ToolVerdict("FMI cross-check band", count <= CROSS_CHECK_OUTSIDE_SHARE * len(y), count, len(y),
-                       float((window // 2) * (band_time[-1] - band_time[0]) / (samples - 1)), half_height)
+    return ToolVerdict(
+        "FMI cross-check band",
+        count <= CROSS_CHECK_OUTSIDE_SHARE * len(y),
+        count,
+        len(y),
+        float((window // 2) * (band_time[-1] - band_time[0]) / (samples - 1)),
+        half_height,
+    )
 
 
 def regression_verdicts(times, reference, result) -> list[dict]:
@@ -214,8 +221,13 @@ def regression_verdicts(times, reference, result) -> list[dict]:
     >>> [v["passed"] for v in regression_verdicts(t, t**2, (t - 0.01) ** 2)]
     [True, True]
     """
-    return [asdict(verdict) for verdict in (csv_compare_tube(times, reference, times, result),
-                                             cross_check_band(times, reference, times, result))]
+    return [
+        asdict(verdict)
+        for verdict in (
+            csv_compare_tube(times, reference, times, result),
+            cross_check_band(times, reference, times, result),
+        )
+    ]
 
 
 def format_verdicts(verdicts: list[dict]) -> list[str]:
@@ -236,9 +248,19 @@ def format_verdicts(verdicts: list[dict]) -> list[str]:
     ...                   "half_width": 0.02, "half_height": 0.5}])
     ['csv-compare tube: pass (0 of 11 points outside; +-0.02 s, +-0.5 rad)']
     """
-    return [f"{v['tool']}: {'pass' if v['passed'] else 'fail'} ({v['outside']} of {v['points']} points "
-            f"outside; +-{v['half_width']:.3g} s, +-{v['half_height']:.3g} rad)" for v in verdicts]
+    return [
+        f"{v['tool']}: {'pass' if v['passed'] else 'fail'} ({v['outside']} of {v['points']} points "
+        f"outside; +-{v['half_width']:.3g} s, +-{v['half_height']:.3g} rad)"
+        for v in verdicts
+    ]
 
 
-__all__ = ["CSV_COMPARE_TOLERANCE", "ToolVerdict", "cross_check_band", "csv_compare_tube", "format_verdicts",
-           "regression_verdicts", "tube_envelopes"]
+__all__ = [
+    "CSV_COMPARE_TOLERANCE",
+    "ToolVerdict",
+    "cross_check_band",
+    "csv_compare_tube",
+    "format_verdicts",
+    "regression_verdicts",
+    "tube_envelopes",
+]

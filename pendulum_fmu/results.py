@@ -28,6 +28,7 @@ from .errors import NotComputed
 @lru_cache(maxsize=1)
 def _default_recorded() -> tuple[str, ...]:
     from .model import fmu_model
+
     return fmu_model().recorded
 
 
@@ -39,6 +40,7 @@ def __getattr__(name: str):
         return dtype(_default_recorded())
     if name == "UNITS":
         from .model import fmu_model
+
         return {"time": "s", **{field: fmu_model().unit(field) for field in _default_recorded()}}
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
@@ -118,13 +120,15 @@ def with_outputs(run: np.ndarray, outputs: Sequence[str], tool: str) -> np.ndarr
     >>> with_outputs(run, ("theta",), "reference") is run
     True
     """
-    missing = [name for name in outputs
-               if name not in (run.dtype.names or ()) or np.all(np.isnan(run[name]))]
+    missing = [name for name in outputs if name not in (run.dtype.names or ()) or np.all(np.isnan(run[name]))]
     if missing:
-        warnings.warn(f"{tool} cannot compute {', '.join(missing)}: "
-                      f"{'its column is' if len(missing) == 1 else 'their columns are'} NaN "
-                      f"(leave {tool} out of --tools to compare {', '.join(missing)})",
-                      NotComputed, stacklevel=2)
+        warnings.warn(
+            f"{tool} cannot compute {', '.join(missing)}: "
+            f"{'its column is' if len(missing) == 1 else 'their columns are'} NaN "
+            f"(leave {tool} out of --tools to compare {', '.join(missing)})",
+            NotComputed,
+            stacklevel=2,
+        )
     recorded = ("torque", *outputs)
     if run.dtype.names == ("time", *recorded) and not missing:
         return run
@@ -157,6 +161,12 @@ def write_csv(run: np.ndarray, path: str | os.PathLike) -> Path:
         path cannot be written.
     """
     with replacing(path) as file:
-        np.savetxt(file, run.view(np.float64).reshape(len(run), -1), delimiter=",",
-                   header=",".join(run.dtype.names), comments="", fmt="%.17g")
+        np.savetxt(
+            file,
+            run.view(np.float64).reshape(len(run), -1),
+            delimiter=",",
+            header=",".join(run.dtype.names),
+            comments="",
+            fmt="%.17g",
+        )
     return Path(path)

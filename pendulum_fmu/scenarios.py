@@ -97,36 +97,80 @@ def _random_steps(seed: int, stop_time: float, amplitude: float) -> tuple[tuple[
 
 
 SCENARIOS = (
-    Scenario("constant_torque", "The OpenSim tutorial's case: 20 N.m from rest, gravity on, 3 s in 1 ms "
-             "steps.", ((0.0, 20.0), (3.0, 20.0)), stop_time=3.0, step_size=1e-3),
-    Scenario("steps_on_grid", "Jumps on communication points (0, 40 N.m from 0.5 s, -40 from 1.5 s, 10 "
-             "from 2.5 s), gravity off so theta is a parabola between jumps, from theta = 0.2 rad and "
-             "omega = -0.5 rad/s; 1 ms steps. At a jump, the step that starts there holds the value "
-             "after it.",
-             ((0.0, 0.0), (0.5, 0.0), (0.5, 40.0), (1.5, 40.0), (1.5, -40.0), (2.5, -40.0), (2.5, 10.0),
-              (3.0, 10.0)), stop_time=3.0, step_size=1e-3, parameters={"gravity": 0.0}, theta0=0.2,
-             omega0=-0.5),
-    Scenario("random_steps", "A random level in -40..40 N.m, jumping every 50 to 400 ms on the ms grid, "
-             "4 s in 1 ms steps, with damping 0.5 N.m.s/rad, from theta = 0.3 rad and omega = -0.5 "
-             "rad/s.", _random_steps(25, 4.0, 40.0), stop_time=4.0, step_size=1e-3,
-             parameters={"damping": 0.5}, theta0=0.3, omega0=-0.5),
-    Scenario("decimal_steps", "9 ms steps with jumps at 0.027, 0.333 and 0.45 s: decimals that are no "
-             "binary fractions (3 x 0.009 is 0.026999999999999996 in binary), so a master that "
-             "compares times for equality or sums its steps misses them; 0.9 s.",
-             ((0.0, 10.0), (0.027, 10.0), (0.027, -20.0), (0.333, -20.0), (0.333, 30.0), (0.45, 30.0),
-              (0.45, 5.0), (0.9, 5.0)), stop_time=0.9, step_size=0.009),
-    Scenario("ramp", "The torque is the CSV's own line, kinks on communication points: each 10 ms step "
-             "ramps, so a master sends the slope with fmi2SetRealInputDerivatives (order 1) before "
-             "each fmi2DoStep; 3 s.",
-             ((0.0, 0.0), (0.5, 40.0), (1.5, -40.0), (2.5, 20.0), (3.0, 20.0)), stop_time=3.0,
-             step_size=0.01, ramp=True),
-    Scenario("resume", "Stopped at 1.5 s and resumed through a saved FMU state: take the state there "
-             "(fmi2GetFMUstate, and fmi2SerializeFMUstate to keep it), free the instance, restore the "
-             "state into a new one (fmi2DeSerializeFMUstate, fmi2SetFMUstate) and go on to 3 s, setting "
-             "the torque again: it jumps from 20 to -20 N.m at 1.5 s. From theta = -0.2 rad and omega = 1 "
-             "rad/s, 1 ms steps. The result equals an uninterrupted run.",
-             ((0.0, 20.0), (1.5, 20.0), (1.5, -20.0), (3.0, -20.0)), stop_time=3.0, step_size=1e-3,
-             theta0=-0.2, omega0=1.0, resume_time=1.5),
+    Scenario(
+        "constant_torque",
+        "The OpenSim tutorial's case: 20 N.m from rest, gravity on, 3 s in 1 ms steps.",
+        ((0.0, 20.0), (3.0, 20.0)),
+        stop_time=3.0,
+        step_size=1e-3,
+    ),
+    Scenario(
+        "steps_on_grid",
+        "Jumps on communication points (0, 40 N.m from 0.5 s, -40 from 1.5 s, 10 "
+        "from 2.5 s), gravity off so theta is a parabola between jumps, from theta = 0.2 rad and "
+        "omega = -0.5 rad/s; 1 ms steps. At a jump, the step that starts there holds the value "
+        "after it.",
+        ((0.0, 0.0), (0.5, 0.0), (0.5, 40.0), (1.5, 40.0), (1.5, -40.0), (2.5, -40.0), (2.5, 10.0), (3.0, 10.0)),
+        stop_time=3.0,
+        step_size=1e-3,
+        parameters={"gravity": 0.0},
+        theta0=0.2,
+        omega0=-0.5,
+    ),
+    Scenario(
+        "random_steps",
+        "A random level in -40..40 N.m, jumping every 50 to 400 ms on the ms grid, "
+        "4 s in 1 ms steps, with damping 0.5 N.m.s/rad, from theta = 0.3 rad and omega = -0.5 "
+        "rad/s.",
+        _random_steps(25, 4.0, 40.0),
+        stop_time=4.0,
+        step_size=1e-3,
+        parameters={"damping": 0.5},
+        theta0=0.3,
+        omega0=-0.5,
+    ),
+    Scenario(
+        "decimal_steps",
+        "9 ms steps with jumps at 0.027, 0.333 and 0.45 s: decimals that are no "
+        "binary fractions (3 x 0.009 is 0.026999999999999996 in binary), so a master that "
+        "compares times for equality or sums its steps misses them; 0.9 s.",
+        (
+            (0.0, 10.0),
+            (0.027, 10.0),
+            (0.027, -20.0),
+            (0.333, -20.0),
+            (0.333, 30.0),
+            (0.45, 30.0),
+            (0.45, 5.0),
+            (0.9, 5.0),
+        ),
+        stop_time=0.9,
+        step_size=0.009,
+    ),
+    Scenario(
+        "ramp",
+        "The torque is the CSV's own line, kinks on communication points: each 10 ms step "
+        "ramps, so a master sends the slope with fmi2SetRealInputDerivatives (order 1) before "
+        "each fmi2DoStep; 3 s.",
+        ((0.0, 0.0), (0.5, 40.0), (1.5, -40.0), (2.5, 20.0), (3.0, 20.0)),
+        stop_time=3.0,
+        step_size=0.01,
+        ramp=True,
+    ),
+    Scenario(
+        "resume",
+        "Stopped at 1.5 s and resumed through a saved FMU state: take the state there "
+        "(fmi2GetFMUstate, and fmi2SerializeFMUstate to keep it), free the instance, restore the "
+        "state into a new one (fmi2DeSerializeFMUstate, fmi2SetFMUstate) and go on to 3 s, setting "
+        "the torque again: it jumps from 20 to -20 N.m at 1.5 s. From theta = -0.2 rad and omega = 1 "
+        "rad/s, 1 ms steps. The result equals an uninterrupted run.",
+        ((0.0, 20.0), (1.5, 20.0), (1.5, -20.0), (3.0, -20.0)),
+        stop_time=3.0,
+        step_size=1e-3,
+        theta0=-0.2,
+        omega0=1.0,
+        resume_time=1.5,
+    ),
 )
 
 
@@ -136,13 +180,25 @@ def _csv_text(header: tuple[str, ...], rows) -> str:
 
 def _settings(scenario: Scenario, parameters: dict) -> dict:
     name = scenario.name
-    return {"name": name, "description": scenario.description, "fmu": KIT_FMU,
-            "input": f"{name}_in.csv", "reference": f"{name}_ref.csv", "output": f"{name}_out.csv",
-            "start_time": scenario.start_time, "stop_time": scenario.stop_time,
-            "step_size": scenario.step_size, "ramp": scenario.ramp, "resume_time": scenario.resume_time,
-            "parameters": parameters, "theta0": scenario.theta0, "omega0": scenario.omega0,
-            "relative_tolerance": RELATIVE_TOLERANCE, "tolerance": JUDGE_TOLERANCE,
-            "units": {**results.UNITS, "step_size": "s", "tolerance": "rad"}}
+    return {
+        "name": name,
+        "description": scenario.description,
+        "fmu": KIT_FMU,
+        "input": f"{name}_in.csv",
+        "reference": f"{name}_ref.csv",
+        "output": f"{name}_out.csv",
+        "start_time": scenario.start_time,
+        "stop_time": scenario.stop_time,
+        "step_size": scenario.step_size,
+        "ramp": scenario.ramp,
+        "resume_time": scenario.resume_time,
+        "parameters": parameters,
+        "theta0": scenario.theta0,
+        "omega0": scenario.omega0,
+        "relative_tolerance": RELATIVE_TOLERANCE,
+        "tolerance": JUDGE_TOLERANCE,
+        "units": {**results.UNITS, "step_size": "s", "tolerance": "rad"},
+    }
 
 
 def read_settings(path: str | Path) -> dict:
@@ -174,8 +230,9 @@ def read_settings(path: str | Path) -> dict:
     except OSError as error:
         raise InvalidInput(f"{path}: cannot read: {error.strerror}") from None
     if not isinstance(settings, dict):
-        raise InvalidInput(f"{path}: not a scenario's settings: it holds a JSON {_json_kind(settings)}, "
-                           f"not an object; {_AGAIN}")
+        raise InvalidInput(
+            f"{path}: not a scenario's settings: it holds a JSON {_json_kind(settings)}, not an object; {_AGAIN}"
+        )
     missing = [key for key in SETTINGS_READ if key not in settings]
     if missing:
         raise InvalidInput(f"{path}: not a scenario's settings: no {', '.join(map(repr, missing))}; {_AGAIN}")
@@ -183,19 +240,36 @@ def read_settings(path: str | Path) -> dict:
     start_time = field.number("start_time", "s")
     stop_time = field.number("stop_time", "s")
     if not stop_time > start_time:
-        raise InvalidInput(f"{path}: stop_time {stop_time!r} is not after start_time {start_time!r}; "
-                           f"correct it, or {_AGAIN}")
-    return {"torque": path.parent / field.file_name("input"), "output": field.file_name("output"),
-            "start_time": start_time, "stop_time": stop_time,
-            "step_size": field.number("step_size", "s", positive=True), "ramp": field.boolean("ramp"),
-            "parameters": field.parameters("parameters"), "theta0": field.number("theta0", "rad"),
-            "omega0": field.number("omega0", "rad/s"),
-            "tolerance": field.number("tolerance", "rad", positive=True)}
+        raise InvalidInput(
+            f"{path}: stop_time {stop_time!r} is not after start_time {start_time!r}; correct it, or {_AGAIN}"
+        )
+    return {
+        "torque": path.parent / field.file_name("input"),
+        "output": field.file_name("output"),
+        "start_time": start_time,
+        "stop_time": stop_time,
+        "step_size": field.number("step_size", "s", positive=True),
+        "ramp": field.boolean("ramp"),
+        "parameters": field.parameters("parameters"),
+        "theta0": field.number("theta0", "rad"),
+        "omega0": field.number("omega0", "rad/s"),
+        "tolerance": field.number("tolerance", "rad", positive=True),
+    }
 
 
 # The fields read_settings takes from NAME.json.
-SETTINGS_READ = ("input", "output", "start_time", "stop_time", "step_size", "ramp", "parameters",
-                 "theta0", "omega0", "tolerance")
+SETTINGS_READ = (
+    "input",
+    "output",
+    "start_time",
+    "stop_time",
+    "step_size",
+    "ramp",
+    "parameters",
+    "theta0",
+    "omega0",
+    "tolerance",
+)
 _AGAIN = "write the kit again with pendulum-fmu scenarios --output-dir FOLDER --overwrite"
 
 
@@ -225,8 +299,12 @@ class _FieldChecker:
     def number(self, key: str, unit: str, positive: bool = False) -> float:
         value = self.settings[key]
         # bool is an int in Python, but true is no time or angle.
-        if (isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value)
-                or (positive and value <= 0)):
+        if (
+            isinstance(value, bool)
+            or not isinstance(value, (int, float))
+            or not math.isfinite(value)
+            or (positive and value <= 0)
+        ):
             self._refuse(key, f"{'a positive' if positive else 'a'} finite number ({unit})")
         return float(value)
 
@@ -247,8 +325,10 @@ class _FieldChecker:
             self._refuse(key, "an object {name: value}")
         for name, number in value.items():
             if isinstance(number, bool) or not isinstance(number, (int, float)) or not math.isfinite(number):
-                raise InvalidInput(f"{self.path}: parameters: {name} is {json.dumps(number)}; it must be "
-                                   f"a finite number: correct it, or {_AGAIN}")
+                raise InvalidInput(
+                    f"{self.path}: parameters: {name} is {json.dumps(number)}; it must be "
+                    f"a finite number: correct it, or {_AGAIN}"
+                )
         return {name: float(number) for name, number in value.items()}
 
 
@@ -266,8 +346,7 @@ def settings_files(folder: str | Path) -> dict[str, Path]:
         {scenario: its NAME.json}, by name.
     """
     folder = Path(folder)
-    return {path.stem: path for path in sorted(folder.glob("*.json"))
-            if (folder / f"{path.stem}_in.csv").is_file()}
+    return {path.stem: path for path in sorted(folder.glob("*.json")) if (folder / f"{path.stem}_in.csv").is_file()}
 
 
 def _ssv(scenario: Scenario, parameters: dict) -> bytes:
@@ -291,21 +370,36 @@ def _xml(root: ElementTree.Element) -> bytes:
 
 def _description(scenario: Scenario) -> str:
     how = "ramped with first-order input derivatives" if scenario.ramp else "held over each step"
-    resume = (f"; stop at {scenario.resume_time:g} s and resume from the saved FMU state"
-              if scenario.resume_time is not None else "")
+    resume = (
+        f"; stop at {scenario.resume_time:g} s and resume from the saved FMU state"
+        if scenario.resume_time is not None
+        else ""
+    )
     return f"{scenario.description} Torque {how}{resume}; settings in {scenario.name}.json."
 
 
 def _experiments() -> bytes:
-    root = ElementTree.Element("Experiments", {
-        "name": "pendulum-fmu scenarios",
-        "description": f"Runs that test a master with this FMU (pendulum_fmu {__version__}): judge a "
-                       "result with pendulum-fmu judge"})
+    root = ElementTree.Element(
+        "Experiments",
+        {
+            "name": "pendulum-fmu scenarios",
+            "description": f"Runs that test a master with this FMU (pendulum_fmu {__version__}): judge a "
+            "result with pendulum-fmu judge",
+        },
+    )
     for scenario in SCENARIOS:
-        experiment = ElementTree.SubElement(root, "Experiment", {
-            "name": scenario.name, "description": _description(scenario),
-            "startTime": repr(scenario.start_time), "stopTime": repr(scenario.stop_time),
-            "stepSize": repr(scenario.step_size), "tolerance": repr(RELATIVE_TOLERANCE)})
+        experiment = ElementTree.SubElement(
+            root,
+            "Experiment",
+            {
+                "name": scenario.name,
+                "description": _description(scenario),
+                "startTime": repr(scenario.start_time),
+                "stopTime": repr(scenario.stop_time),
+                "stepSize": repr(scenario.step_size),
+                "tolerance": repr(RELATIVE_TOLERANCE),
+            },
+        )
         ElementTree.SubElement(experiment, "Parameters", {"source": f"{scenario.name}.ssv"})
         ElementTree.SubElement(experiment, "Stimuli", {"source": f"{scenario.name}_in.csv"})
         ElementTree.SubElement(experiment, "References", {"source": f"{scenario.name}_ref.csv"})
@@ -315,28 +409,49 @@ def _experiments() -> bytes:
 def _manifest() -> bytes:
     namespace = "http://fmi-standard.org/fmi-ls-manifest"
     ElementTree.register_namespace("fmi-ls", namespace)
-    root = ElementTree.Element("fmiReferences", {
-        f"{{{namespace}}}fmi-ls-name": LS_REF_NAME, f"{{{namespace}}}fmi-ls-version": LS_REF_VERSION,
-        f"{{{namespace}}}fmi-ls-description": "Layered Standard providing information on related files "
-                                               "included in an FMU."})
-    ElementTree.SubElement(root, "Related", {
-        "type": EXPERIMENTS_TYPE, "source": EXPERIMENTS_FILE, "role": "experiment/validation",
-        "description": "Scenarios that test a master with this FMU, each with its stimuli and reference"})
+    root = ElementTree.Element(
+        "fmiReferences",
+        {
+            f"{{{namespace}}}fmi-ls-name": LS_REF_NAME,
+            f"{{{namespace}}}fmi-ls-version": LS_REF_VERSION,
+            f"{{{namespace}}}fmi-ls-description": "Layered Standard providing information on related files "
+            "included in an FMU.",
+        },
+    )
+    ElementTree.SubElement(
+        root,
+        "Related",
+        {
+            "type": EXPERIMENTS_TYPE,
+            "source": EXPERIMENTS_FILE,
+            "role": "experiment/validation",
+            "description": "Scenarios that test a master with this FMU, each with its stimuli and reference",
+        },
+    )
     for scenario in SCENARIOS:
-        for suffix, kind, role, what in ((".ssv", "application/x-ssp-parameter-set", "parameter",
-                                          "parameters and initial state"),
-                                         (".json", "application/json", "configuration", "settings"),
-                                         ("_ref.csv", "text/csv", "result", "reference result")):
-            related = ElementTree.SubElement(root, "Related", {
-                "type": kind, "source": f"{scenario.name}{suffix}", "role": role,
-                "description": f"{scenario.name}: {what}"})
+        for suffix, kind, role, what in (
+            (".ssv", "application/x-ssp-parameter-set", "parameter", "parameters and initial state"),
+            (".json", "application/json", "configuration", "settings"),
+            ("_ref.csv", "text/csv", "result", "reference result"),
+        ):
+            related = ElementTree.SubElement(
+                root,
+                "Related",
+                {
+                    "type": kind,
+                    "source": f"{scenario.name}{suffix}",
+                    "role": role,
+                    "description": f"{scenario.name}: {what}",
+                },
+            )
             ElementTree.SubElement(related, "Label", {"name": f"scenario:{scenario.name}"})
     return _xml(root)
 
 
 def _readme(steps: dict[str, int]) -> str:
-    rows = "\n".join(f"| `{s.name}` | {s.description} | {steps[s.name]:,} | {'ramp' if s.ramp else 'held'} |"
-                     for s in SCENARIOS)
+    rows = "\n".join(
+        f"| `{s.name}` | {s.description} | {steps[s.name]:,} | {'ramp' if s.ramp else 'held'} |" for s in SCENARIOS
+    )
     return f"""# Scenarios for a master running the pendulum FMU (pendulum_fmu {__version__})
 
 Each scenario is a run of `{KIT_FMU}` (FMI 2.0, Co-Simulation or Model Exchange) under a torque
@@ -422,21 +537,25 @@ def kit_files() -> tuple[str, ...]:
     tuple of str
         The FMU, ReadMe.md, and per scenario NAME_in.csv, NAME_ref.csv and NAME.json.
     """
-    return (KIT_FMU, "ReadMe.md", *(f"{s.name}{suffix}" for s in SCENARIOS
-                                     for suffix in ("_in.csv", "_ref.csv", ".json")))
+    return (
+        KIT_FMU,
+        "ReadMe.md",
+        *(f"{s.name}{suffix}" for s in SCENARIOS for suffix in ("_in.csv", "_ref.csv", ".json")),
+    )
 
 
 def _check_replaceable(folder: Path, overwrite: bool) -> None:
     held = [name for name in kit_files() if (folder / name).exists()]
     if held and not overwrite:
         shown = ", ".join(held[:3]) + (f" and {len(held) - 3} more" if len(held) > 3 else "")
-        raise KitExists(f"{folder} already holds a scenario kit ({shown}): choose another output "
-                        "directory, or add --overwrite to write the kit again in its place (the "
-                        "results NAME_out.csv beside it are kept)")
+        raise KitExists(
+            f"{folder} already holds a scenario kit ({shown}): choose another output "
+            "directory, or add --overwrite to write the kit again in its place (the "
+            "results NAME_out.csv beside it are kept)"
+        )
 
 
-def write_scenarios(output_dir: str | Path, fmu_path: str | Path | None = None,
-                    overwrite: bool = False) -> list[Path]:
+def write_scenarios(output_dir: str | Path, fmu_path: str | Path | None = None, overwrite: bool = False) -> list[Path]:
     """Write the scenario kit (see the module's docstring).
 
     The kit is written into a hidden folder inside output_dir and moved into place once whole, so
@@ -477,8 +596,9 @@ def write_scenarios(output_dir: str | Path, fmu_path: str | Path | None = None,
     fmu = fmu_file(fmu_path)
     version = model_description(fmu).fmiVersion
     if version != "2.0":
-        raise InvalidInput(f"{fmu} is FMI {version}: the kit is for the FMI 2.0 FMU (its ramp scenario "
-                           "needs input derivatives)")
+        raise InvalidInput(
+            f"{fmu} is FMI {version}: the kit is for the FMI 2.0 FMU (its ramp scenario needs input derivatives)"
+        )
     folder = Path(output_dir)
     _check_replaceable(folder, overwrite)
     # Refused now, not after the references are computed.
@@ -505,10 +625,17 @@ def _write_kit(folder: Path, fmu: Path) -> list[str]:
         files = {signal.name: _csv_text(("time", "torque"), scenario.rows)}
         _write(signal, files[signal.name])
         # The reference reads the input file itself, as a master does.
-        solution = reference(signal, start_time=scenario.start_time,
-                             stop_time=scenario.stop_time, step_size=scenario.step_size,
-                             ramp=scenario.ramp, parameters=parameters, theta0=scenario.theta0,
-                             omega0=scenario.omega0, fmu_path=fmu)
+        solution = reference(
+            signal,
+            start_time=scenario.start_time,
+            stop_time=scenario.stop_time,
+            step_size=scenario.step_size,
+            ramp=scenario.ramp,
+            parameters=parameters,
+            theta0=scenario.theta0,
+            omega0=scenario.omega0,
+            fmu_path=fmu,
+        )
         steps[name] = len(solution) - 1
         files[f"{name}_ref.csv"] = _csv_text(results.FIELDS, (tuple(row) for row in solution.tolist()))
         files[f"{name}.json"] = json.dumps(_settings(scenario, parameters), indent=2) + "\n"
@@ -519,8 +646,13 @@ def _write_kit(folder: Path, fmu: Path) -> list[str]:
             carried[LS_REF_FOLDER + file_name] = text.encode()
         carried[f"{LS_REF_FOLDER}{name}.ssv"] = _ssv(scenario, parameters)
     readme = _readme(steps)
-    carried.update({f"{LS_REF_FOLDER}fmi-ls-manifest.xml": _manifest(),
-                    LS_REF_FOLDER + EXPERIMENTS_FILE: _experiments(), LS_REF_DOCUMENTATION: readme.encode()})
+    carried.update(
+        {
+            f"{LS_REF_FOLDER}fmi-ls-manifest.xml": _manifest(),
+            LS_REF_FOLDER + EXPERIMENTS_FILE: _experiments(),
+            LS_REF_DOCUMENTATION: readme.encode(),
+        }
+    )
     _write(folder / "ReadMe.md", readme)
     written.append("ReadMe.md")
     with zipfile.ZipFile(fmu) as original, replacing_path(folder / KIT_FMU) as partial:

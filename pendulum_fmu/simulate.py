@@ -26,8 +26,17 @@ from fmpy.fmi3 import FMU3Slave
 from . import cs_loop, default_fmu, results
 from .errors import InvalidInput, PendulumFmuError
 from .model import FmuInstance, fmu_model
-from .parameters import (default_parameters, file_version, fmu_file, merged_parameters, merged_with,
-                         model_description, pendulum_variables, start_value, value_reference)
+from .parameters import (
+    default_parameters,
+    file_version,
+    fmu_file,
+    merged_parameters,
+    merged_with,
+    model_description,
+    pendulum_variables,
+    start_value,
+    value_reference,
+)
 from .torque_schedule import TorqueSignal, TorqueSchedule, schedule
 
 _STATUS = ["OK", "WARNING", "DISCARD", "ERROR", "FATAL", "PENDING"]
@@ -82,13 +91,13 @@ class MessageLog:
         try:
             # fmpy's C proxy formats printf-style arguments before they reach Python.
             from fmpy.logging import addLoggerProxy
+
             addLoggerProxy(ctypes.byref(self.callbacks))
         except Exception:
             pass
 
     def log_fmi3(self, environment, status, category, message):
-        self.lines.append(f"[{_STATUS[status] if 0 <= status < 6 else status}] "
-                          f"{message.decode('utf-8', 'replace')}")
+        self.lines.append(f"[{_STATUS[status] if 0 <= status < 6 else status}] {message.decode('utf-8', 'replace')}")
 
     def error(self, status: int, call: str) -> FmuError:
         detail = "; ".join(self.lines[-3:]) or "no message"
@@ -145,9 +154,16 @@ def fmi2_library(folder: str, model_identifier: str) -> str | None:
     return None
 
 
-def open_fmu(fmu_path: str | Path | None = None, *, parameters: dict | None = None,
-             theta0: float = 0.0, omega0: float = 0.0, tolerance: float | None = None,
-             start_time: float = 0.0, instance_name: str = "pendulum"):
+def open_fmu(
+    fmu_path: str | Path | None = None,
+    *,
+    parameters: dict | None = None,
+    theta0: float = 0.0,
+    omega0: float = 0.0,
+    tolerance: float | None = None,
+    start_time: float = 0.0,
+    instance_name: str = "pendulum",
+):
     """An initialized FmuInstance (in step mode, the FMI version read from the FMU's model
     description; instance.fmi_version says which), with its message log as instance.messages and
     its model as instance.model; fmpy's calls pass through to its FMU2Slave or FMU3Slave.
@@ -166,8 +182,9 @@ def open_fmu(fmu_path: str | Path | None = None, *, parameters: dict | None = No
     """
     slave = _instantiated(fmu_model(fmu_path), instance_name)
     try:
-        initialize(slave, parameters=parameters, theta0=theta0, omega0=omega0,
-                   tolerance=tolerance, start_time=start_time)
+        initialize(
+            slave, parameters=parameters, theta0=theta0, omega0=omega0, tolerance=tolerance, start_time=start_time
+        )
     except BaseException:
         slave.freeInstance()
         raise
@@ -179,8 +196,12 @@ def _instantiated(model, instance_name: str) -> FmuInstance:
     model.pendulum_variables  # FmuFileError when it is no pendulum FMU this machine runs
     folder, description, fmi_version = model.folder, model.description, model.fmi_version
     messages = MessageLog(fmi_version)
-    arguments = dict(guid=description.guid, unzipDirectory=folder, instanceName=instance_name,
-                     modelIdentifier=description.coSimulation.modelIdentifier)
+    arguments = dict(
+        guid=description.guid,
+        unzipDirectory=folder,
+        instanceName=instance_name,
+        modelIdentifier=description.coSimulation.modelIdentifier,
+    )
     if fmi_version == 3:
         slave = FMU3Slave(**arguments)
     else:
@@ -189,13 +210,23 @@ def _instantiated(model, instance_name: str) -> FmuInstance:
     return FmuInstance(slave, messages, model)
 
 
-def initialize(slave: FmuInstance, *, parameters: dict | None = None, theta0: float = 0.0,
-               omega0: float = 0.0, tolerance: float | None = None, start_time: float = 0.0) -> None:
+def initialize(
+    slave: FmuInstance,
+    *,
+    parameters: dict | None = None,
+    theta0: float = 0.0,
+    omega0: float = 0.0,
+    tolerance: float | None = None,
+    start_time: float = 0.0,
+) -> None:
     """Set the parameters and start values of an instantiated (or reset) slave from open_fmu and
     leave it in step mode; FmuError says why the FMU refused."""
     # The FMU checks the parameters itself, here as everywhere (resolve_parameters).
-    start = {**merged_with(slave.model.default_parameters, parameters), "theta": start_value("theta0", theta0, "rad"),
-             "omega": start_value("omega0", omega0, "rad/s")}
+    start = {
+        **merged_with(slave.model.default_parameters, parameters),
+        "theta": start_value("theta0", theta0, "rad"),
+        "omega": start_value("omega0", omega0, "rad/s"),
+    }
     references = [slave.model.value_reference(n) for n in start]
     try:
         if slave.fmi_version == 3:
@@ -225,14 +256,14 @@ def run_schedule(slave: FmuInstance, plan: TorqueSchedule) -> np.ndarray:
 def _stepper(slave, start_names: tuple[str, ...] = ()) -> cs_loop.Stepper:
     """The native loop bound to an instance: the torque in, its model's recorded variables out,
     a restart setting start_names."""
+
     def references(names):
         return np.array([slave.model.value_reference(name) for name in names], np.uint32)
-    return cs_loop.Stepper(slave, references(["torque"]), references(slave.model.recorded),
-                           references(start_names))
+
+    return cs_loop.Stepper(slave, references(["torque"]), references(slave.model.recorded), references(start_names))
 
 
-def _stepped(stepper: cs_loop.Stepper, plan: TorqueSchedule, recorded_names: tuple[str, ...],
-             **restart) -> np.ndarray:
+def _stepped(stepper: cs_loop.Stepper, plan: TorqueSchedule, recorded_names: tuple[str, ...], **restart) -> np.ndarray:
     """The result array of a schedule through the native loop, which records recorded_names;
     restart: Stepper.run's start_values and tolerance."""
     recorded = np.empty((len(plan.time), len(recorded_names)))
@@ -261,10 +292,15 @@ def run_schedule_python(slave: FmuInstance, plan: TorqueSchedule) -> np.ndarray:
     dll, messages, fmi3 = slave.dll, slave.messages, slave.fmi_version == 3
     ramped = bool(np.any(plan.torque_rate))
     if fmi3 and ramped:
-        raise InvalidInput("FMI 3.0 has no input derivatives, so an FMI 3.0 FMU cannot ramp the "
-                         "torque: hold it over each step (no --ramp), or use the FMI 2.0 FMU")
-    names = (("fmi3SetFloat64", "fmi3GetFloat64", None, "fmi3DoStep") if fmi3 else
-             ("fmi2SetReal", "fmi2GetReal", "fmi2SetRealInputDerivatives", "fmi2DoStep"))
+        raise InvalidInput(
+            "FMI 3.0 has no input derivatives, so an FMI 3.0 FMU cannot ramp the "
+            "torque: hold it over each step (no --ramp), or use the FMI 2.0 FMU"
+        )
+    names = (
+        ("fmi3SetFloat64", "fmi3GetFloat64", None, "fmi3DoStep")
+        if fmi3
+        else ("fmi2SetReal", "fmi2GetReal", "fmi2SetRealInputDerivatives", "fmi2DoStep")
+    )
     set_real, get_real, set_rate, do_step = (dll[name] if name else None for name in names)
     component = ctypes.c_void_p(slave.component)
     recorded_names = slave.model.recorded
@@ -280,13 +316,20 @@ def run_schedule_python(slave: FmuInstance, plan: TorqueSchedule) -> np.ndarray:
     # FMI 3.0 getters and setters also take the number of values, and fmi3DoStep reports back.
     torque_arguments = (component, torque_vr, one, torque) + ((one,) if fmi3 else ())
     get_recorded = (component, recorded_vr, recorded_count, recorded) + ((recorded_count,) if fmi3 else ())
-    step_report = ((ctypes.byref(ctypes.c_bool()), ctypes.byref(ctypes.c_bool()),
-                    ctypes.byref(ctypes.c_bool()), ctypes.byref(ctypes.c_double())) if fmi3 else ())
+    step_report = (
+        (
+            ctypes.byref(ctypes.c_bool()),
+            ctypes.byref(ctypes.c_bool()),
+            ctypes.byref(ctypes.c_bool()),
+            ctypes.byref(ctypes.c_double()),
+        )
+        if fmi3
+        else ()
+    )
     step_arguments = (component, time, step, ctypes.c_bool(True) if fmi3 else no_rollback) + step_report
 
     rows = array.array("d")  # 32 bytes a step, not a Python list of floats
-    for t, h, u, r in zip(plan.time.tolist(), plan.step_size.tolist(), plan.torque.tolist(),
-                          plan.torque_rate.tolist()):
+    for t, h, u, r in zip(plan.time.tolist(), plan.step_size.tolist(), plan.torque.tolist(), plan.torque_rate.tolist()):
         torque[0] = u
         status = set_real(*torque_arguments)
         if status > 1:
@@ -313,10 +356,20 @@ def run_schedule_python(slave: FmuInstance, plan: TorqueSchedule) -> np.ndarray:
     return _result(plan, recorded_names, np.frombuffer(rows).reshape(-1, count))
 
 
-def simulate(torque: TorqueSignal = 20.0, *, start_time: float = 0.0, stop_time: float | None = None,
-             step_size: float = 1e-3, ramp: bool = False, parameters: dict | None = None,
-             theta0: float = 0.0, omega0: float = 0.0, tolerance: float | None = None,
-             fmu_path: str | Path | None = None, max_steps: int | None = None) -> np.ndarray:
+def simulate(
+    torque: TorqueSignal = 20.0,
+    *,
+    start_time: float = 0.0,
+    stop_time: float | None = None,
+    step_size: float = 1e-3,
+    ramp: bool = False,
+    parameters: dict | None = None,
+    theta0: float = 0.0,
+    omega0: float = 0.0,
+    tolerance: float | None = None,
+    fmu_path: str | Path | None = None,
+    max_steps: int | None = None,
+) -> np.ndarray:
     """Simulate the pendulum FMU under a torque signal, one communication step at a time.
 
     The whole schedule runs in one call into the native loop (cs_loop.py) when it was compiled
@@ -377,27 +430,35 @@ def simulate(torque: TorqueSignal = 20.0, *, start_time: float = 0.0, stop_time:
     >>> round(float(run["theta"][-1]), 6)
     0.187205
     """
-    plan = schedule(torque, start_time=start_time, stop_time=stop_time, step_size=step_size,
-                    ramp=ramp, max_steps=max_steps)
-    return simulate_plan(plan, parameters=parameters, theta0=theta0, omega0=omega0,
-                         tolerance=tolerance, fmu_path=fmu_path)
+    plan = schedule(
+        torque, start_time=start_time, stop_time=stop_time, step_size=step_size, ramp=ramp, max_steps=max_steps
+    )
+    return simulate_plan(
+        plan, parameters=parameters, theta0=theta0, omega0=omega0, tolerance=tolerance, fmu_path=fmu_path
+    )
 
 
-def simulate_plan(plan: TorqueSchedule, *, parameters: dict | None = None, theta0: float = 0.0,
-                  omega0: float = 0.0, tolerance: float | None = None,
-                  fmu_path: str | Path | None = None) -> np.ndarray:
+def simulate_plan(
+    plan: TorqueSchedule,
+    *,
+    parameters: dict | None = None,
+    theta0: float = 0.0,
+    omega0: float = 0.0,
+    tolerance: float | None = None,
+    fmu_path: str | Path | None = None,
+) -> np.ndarray:
     """A schedule through this thread's Simulator of the FMU (see simulate)."""
     runner = simulator(fmu_path)
     try:
-        return runner.run(plan, parameters=parameters, theta0=theta0, omega0=omega0,
-                          tolerance=tolerance)
+        return runner.run(plan, parameters=parameters, theta0=theta0, omega0=omega0, tolerance=tolerance)
     except FmuError:
         resolve_parameters(parameters, fmu_path)  # refused with the same words as every other tool
         raise
 
 
-def resolve_parameters(overrides: dict[str, float] | None = None,
-                       fmu_path: str | Path | None = None) -> dict[str, float]:
+def resolve_parameters(
+    overrides: dict[str, float] | None = None, fmu_path: str | Path | None = None
+) -> dict[str, float]:
     """parameters.merged_parameters, and a set the FMU accepts.
 
     The physical checks (mass > 0, an inertia about the pivot > 0, ...) live in one place, the
@@ -441,22 +502,38 @@ class Simulator:
         self.fmu_path, self.version = fmu_path, version
         self.slave = _instantiated(fmu_model(fmu_path), "pendulum")
         self.defaults = default_parameters(self.slave.model)
-        self.stepper = (_stepper(self.slave, (*self.defaults, *self.START_STATES))
-                        if cs_loop.drives(self.slave) else None)
+        self.stepper = (
+            _stepper(self.slave, (*self.defaults, *self.START_STATES)) if cs_loop.drives(self.slave) else None
+        )
 
-    def run(self, plan: TorqueSchedule, *, parameters: dict | None = None, theta0: float = 0.0,
-            omega0: float = 0.0, tolerance: float | None = None) -> np.ndarray:
+    def run(
+        self,
+        plan: TorqueSchedule,
+        *,
+        parameters: dict | None = None,
+        theta0: float = 0.0,
+        omega0: float = 0.0,
+        tolerance: float | None = None,
+    ) -> np.ndarray:
         """The result array of a schedule (see simulate); FmuError when the FMU refuses."""
-        start = [*(merged_with(self.defaults, parameters) if parameters else self.defaults).values(),
-                 start_value("theta0", theta0, "rad"), start_value("omega0", omega0, "rad/s")]
+        start = [
+            *(merged_with(self.defaults, parameters) if parameters else self.defaults).values(),
+            start_value("theta0", theta0, "rad"),
+            start_value("omega0", omega0, "rad/s"),
+        ]
         self.slave.messages.lines.clear()
         if self.stepper is None:
             self.slave.reset()
-            initialize(self.slave, parameters=parameters, theta0=theta0, omega0=omega0,
-                       tolerance=tolerance, start_time=float(plan.time[0]))
+            initialize(
+                self.slave,
+                parameters=parameters,
+                theta0=theta0,
+                omega0=omega0,
+                tolerance=tolerance,
+                start_time=float(plan.time[0]),
+            )
             return run_schedule_python(self.slave, plan)
-        return _stepped(self.stepper, plan, self.slave.model.recorded, start_values=start,
-                        tolerance=tolerance)
+        return _stepped(self.stepper, plan, self.slave.model.recorded, start_values=start, tolerance=tolerance)
 
     def close(self) -> None:
         self.slave.freeInstance()
@@ -508,4 +585,3 @@ def simulator(fmu_path: str | Path | None = None) -> Simulator:
             kept.popitem(last=False)[1].close()
     kept[key] = current
     return current
-

@@ -85,8 +85,7 @@ def signals_deferred():
         yield
         return
     came = []
-    previous = {number: signal.signal(number, lambda number, frame: came.append(number))
-                for number in STOPPING_SIGNALS}
+    previous = {number: signal.signal(number, lambda number, frame: came.append(number)) for number in STOPPING_SIGNALS}
     try:
         yield
     finally:

@@ -43,8 +43,7 @@ import psutil
 
 from .errors import InvalidInput
 
-TorqueSignal = Union[float, int, Callable[[float], float], str, Path, Sequence[float], np.ndarray,
-                     "TorqueTable"]
+TorqueSignal = Union[float, int, Callable[[float], float], str, Path, Sequence[float], np.ndarray, "TorqueTable"]
 
 # Events closer than this to a communication point are that point: a billionth of a step, or 64
 # ulp of the time where times are so large that a grid point's own rounding is bigger.
@@ -73,8 +72,9 @@ def event_tolerance(time, step_size: float):
     """How close an event must be to a communication point to be that point (s)."""
     if isinstance(time, float):  # math.ulp is np.spacing for a scalar, without numpy's overhead
         return max(EVENT_TOLERANCE_STEPS * step_size, EVENT_TOLERANCE_ULPS * math.ulp(abs(time)))
-    return np.maximum(EVENT_TOLERANCE_STEPS * step_size,
-                      EVENT_TOLERANCE_ULPS * np.spacing(np.abs(np.asarray(time, dtype=float))))
+    return np.maximum(
+        EVENT_TOLERANCE_STEPS * step_size, EVENT_TOLERANCE_ULPS * np.spacing(np.abs(np.asarray(time, dtype=float)))
+    )
 
 
 def _nearest(points: np.ndarray, t: np.ndarray) -> np.ndarray:
@@ -150,9 +150,11 @@ def _decode(path: Path, raw: bytes) -> str:
     try:
         return raw.decode("utf-8")
     except UnicodeDecodeError as error:
-        line = raw[:error.start].count(b"\n") + 1
-        raise TorqueFileError(f"{path}:{line}: byte 0x{raw[error.start]:02x} is not UTF-8; save the "
-                              "file as UTF-8 (with or without a byte-order mark)") from None
+        line = raw[: error.start].count(b"\n") + 1
+        raise TorqueFileError(
+            f"{path}:{line}: byte 0x{raw[error.start]:02x} is not UTF-8; save the "
+            "file as UTF-8 (with or without a byte-order mark)"
+        ) from None
 
 
 def _first_bad_row(path: Path, lines: list[str], columns: tuple[int, int]) -> TorqueFileError | None:
@@ -173,8 +175,9 @@ def _first_bad_row(path: Path, lines: list[str], columns: tuple[int, int]) -> To
             if not math.isfinite(value):
                 return TorqueFileError(f"{path}:{number}: {name} is {cell}; values must be finite")
         if len(cells) > header:
-            return TorqueFileError(f"{path}:{number}: {len(cells)} columns, but the header names "
-                                   f"{header}; quote a cell holding a comma")
+            return TorqueFileError(
+                f"{path}:{number}: {len(cells)} columns, but the header names {header}; quote a cell holding a comma"
+            )
     return None
 
 
@@ -202,8 +205,10 @@ def _parse_numbers(raw: bytes, names: list[str], columns: tuple[int, int]) -> tu
         table = pa_csv.read_csv(
             pa.py_buffer(raw),
             read_options=pa_csv.ReadOptions(skip_rows=1, column_names=positional),
-            convert_options=pa_csv.ConvertOptions(include_columns=wanted,
-                                                  column_types={name: pa.float64() for name in wanted}))
+            convert_options=pa_csv.ConvertOptions(
+                include_columns=wanted, column_types={name: pa.float64() for name in wanted}
+            ),
+        )
     except pa.ArrowInvalid:
         return None
     return tuple(table.column(name).to_numpy() for name in wanted)
@@ -220,24 +225,27 @@ def read_torque_csv(path: str | Path) -> TorqueTable:
         raise TorqueFileError(f"{path}: cannot read: {error.strerror}") from None
     raw = raw[3:] if raw.startswith(b"\xef\xbb\xbf") else raw  # spreadsheets write a byte-order mark
     _decode(path, raw)  # only to refuse another encoding here, with its line
-    header_line = raw[:raw.find(b"\n") if b"\n" in raw else len(raw)].decode("utf-8")
+    header_line = raw[: raw.find(b"\n") if b"\n" in raw else len(raw)].decode("utf-8")
     if not header_line.strip():
         if raw.strip():
-            raise TorqueFileError(f"{path}:1: the line is blank; the header, e.g. time,torque, must be "
-                                  "the first line: remove the blank lines before it")
+            raise TorqueFileError(
+                f"{path}:1: the line is blank; the header, e.g. time,torque, must be "
+                "the first line: remove the blank lines before it"
+            )
         raise TorqueFileError(f"{path}: the file is empty; expected a header 'time,torque'")
     header = [name.strip() for name in header_line.split(",")]
     for column in ("time", "torque"):
         if column not in header:
-            raise TorqueFileError(f"{path}:1: missing column {column!r} (header is {','.join(header)}); "
-                                  "the first line must name the columns, e.g. time,torque")
+            raise TorqueFileError(
+                f"{path}:1: missing column {column!r} (header is {','.join(header)}); "
+                "the first line must name the columns, e.g. time,torque"
+            )
     columns = (header.index("time"), header.index("torque"))
     data = _parse_numbers(raw, header, columns)
     if data is None or not all(np.all(np.isfinite(column)) for column in data):
         lines = _decode(path, raw).splitlines()
         error = _first_bad_row(path, lines, columns)
-        raise error or TorqueFileError(f"{path}: rows must have as many columns as the header "
-                                       f"({len(header)})")
+        raise error or TorqueFileError(f"{path}: rows must have as many columns as the header ({len(header)})")
     times, torques = data
     if len(times) == 0:
         raise TorqueFileError(f"{path}: no data rows after the header")
@@ -247,11 +255,15 @@ def read_torque_csv(path: str | Path) -> TorqueTable:
         lines = _decode(path, raw).splitlines()
         if len(backwards) and (not len(triple) or backwards[0] < triple[0] + 1):
             row = backwards[0] + 1
-            raise TorqueFileError(f"{path}:{_line_of_row(lines, row)}: time {times[row]:g} goes backwards "
-                                  f"(previous row: {times[row - 1]:g}); sort the rows by time")
+            raise TorqueFileError(
+                f"{path}:{_line_of_row(lines, row)}: time {times[row]:g} goes backwards "
+                f"(previous row: {times[row - 1]:g}); sort the rows by time"
+            )
         row = triple[0] + 2
-        raise TorqueFileError(f"{path}:{_line_of_row(lines, row)}: time {times[row]:g} appears three "
-                              "times; a jump is two rows with the same time")
+        raise TorqueFileError(
+            f"{path}:{_line_of_row(lines, row)}: time {times[row]:g} appears three "
+            "times; a jump is two rows with the same time"
+        )
     return TorqueTable(np.ascontiguousarray(times), np.ascontiguousarray(torques))
 
 
@@ -263,14 +275,14 @@ def write_torque_csv(path: str | Path, plan: TorqueSchedule) -> Path:
 
     end = plan.torque + plan.torque_rate * plan.step_size
     points = []
-    for t0, t1, u0, u1 in zip(plan.time[:-1].tolist(), plan.time[1:].tolist(), plan.torque.tolist(),
-                              end.tolist()):
+    for t0, t1, u0, u1 in zip(plan.time[:-1].tolist(), plan.time[1:].tolist(), plan.torque.tolist(), end.tolist()):
         if not points or points[-1] != (t0, u0):
             points.append((t0, u0))
         points.append((t1, u1))
     # A point inside a run of constant torque adds nothing.
-    rows = [p for i, p in enumerate(points)
-            if i in (0, len(points) - 1) or not points[i - 1][1] == p[1] == points[i + 1][1]]
+    rows = [
+        p for i, p in enumerate(points) if i in (0, len(points) - 1) or not points[i - 1][1] == p[1] == points[i + 1][1]
+    ]
     with replacing(path, newline="") as file:
         file.write("time,torque\n")
         file.writelines(f"{t!r},{u!r}\n" for t, u in rows)
@@ -294,8 +306,7 @@ def _available_memory() -> int:
     return psutil.virtual_memory().available
 
 
-def step_count(start_time: float, stop_time: float, step_size: float,
-               max_steps: int | None = None) -> int:
+def step_count(start_time: float, stop_time: float, step_size: float, max_steps: int | None = None) -> int:
     """The number of grid steps from start to stop (the last one shorter when stop is off the
     grid). A run over max_steps (default DEFAULT_MAX_STEPS), or one whose arrays would not fit in
     the memory the machine has left, is refused here, before anything is allocated."""
@@ -317,15 +328,19 @@ def step_count(start_time: float, stop_time: float, step_size: float,
         raise InvalidInput(f"max steps {limit!r} must be a whole number of steps, at least 1")
     what = f"{start_time:g} to {stop_time:g} s in steps of {step_size:g} s is {_count(steps)} steps"
     if steps > limit:
-        raise InvalidInput(f"{what}, over the limit of {limit:,}: use a coarser step size or a shorter "
-                         "stop time, or raise the limit (--max-steps) if the run is meant to be that long")
+        raise InvalidInput(
+            f"{what}, over the limit of {limit:,}: use a coarser step size or a shorter "
+            "stop time, or raise the limit (--max-steps) if the run is meant to be that long"
+        )
     needed = steps * BYTES_PER_STEP
     if needed > MEMORY_CHECKED_FROM:
         available = _available_memory()
         if needed > available:
-            raise InvalidInput(f"{what}, which needs {_gib(needed)} and the machine has "
-                               f"{available / 2**30:.1f} GiB free: use a coarser step size or a "
-                               "shorter stop time")
+            raise InvalidInput(
+                f"{what}, which needs {_gib(needed)} and the machine has "
+                f"{available / 2**30:.1f} GiB free: use a coarser step size or a "
+                "shorter stop time"
+            )
     return steps
 
 
@@ -336,7 +351,7 @@ def _count(steps: int) -> str:
     if steps <= 2**53:
         return f"{steps:,}"
     exponent = len(str(steps)) - 1
-    mantissa = round(Fraction(steps, 10**(exponent - 2)))  # three digits, 100 to 1000
+    mantissa = round(Fraction(steps, 10 ** (exponent - 2)))  # three digits, 100 to 1000
     if mantissa == 1000:
         mantissa, exponent = 100, exponent + 1
     return f"about {mantissa / 100:g}e+{exponent}"
@@ -346,8 +361,9 @@ def _gib(size: int) -> str:
     return f"{size / 2**30:.1f} GiB" if size < 2**1000 else f"{_count(size >> 30)} GiB"
 
 
-def communication_points(start_time: float, stop_time: float, step_size: float, *,
-                         max_steps: int | None = None) -> np.ndarray:
+def communication_points(
+    start_time: float, stop_time: float, step_size: float, *, max_steps: int | None = None
+) -> np.ndarray:
     """start, start + h, ... up to stop. A grid point is start + k*h, never a running sum, so no
     rounding accumulates over a long run. max_steps: see step_count."""
     steps = step_count(start_time, stop_time, step_size, max_steps)
@@ -367,15 +383,19 @@ def _with_events(grid: np.ndarray, events: np.ndarray | None, step_size: float) 
     return np.union1d(grid, events)
 
 
-def _array_schedule(values, start_time: float, stop_time: float | None, step_size: float,
-                    ramp: bool, max_steps: int | None) -> TorqueSchedule:
+def _array_schedule(
+    values, start_time: float, stop_time: float | None, step_size: float, ramp: bool, max_steps: int | None
+) -> TorqueSchedule:
     try:
         torque = np.asarray(values, dtype=float)
     except (TypeError, ValueError):
-        raise InvalidInput(f"a torque array needs one value per step, each a number in N.m; got "
-                           f"{_shortened(values)}") from None
+        raise InvalidInput(
+            f"a torque array needs one value per step, each a number in N.m; got {_shortened(values)}"
+        ) from None
     if torque.ndim != 1 or len(torque) == 0:
-        raise InvalidInput(f"a torque array needs one value per step (a flat list of numbers); got shape {torque.shape}")
+        raise InvalidInput(
+            f"a torque array needs one value per step (a flat list of numbers); got shape {torque.shape}"
+        )
     if ramp:
         raise InvalidInput("a per-step torque array is held over each step; ramp needs a CSV or a callable")
     if stop_time is None:
@@ -383,9 +403,11 @@ def _array_schedule(values, start_time: float, stop_time: float | None, step_siz
     time = communication_points(start_time, stop_time, step_size, max_steps=max_steps)
     steps = len(time) - 1
     if steps != len(torque):
-        raise InvalidInput(f"the torque array has {len(torque)} values but {start_time:g} to {stop_time:g} s "
-                         f"in steps of {step_size:g} s is {steps} steps; give one value per step or "
-                         "leave out the stop time")
+        raise InvalidInput(
+            f"the torque array has {len(torque)} values but {start_time:g} to {stop_time:g} s "
+            f"in steps of {step_size:g} s is {steps} steps; give one value per step or "
+            "leave out the stop time"
+        )
     bad = np.flatnonzero(~np.isfinite(torque))
     if len(bad):
         raise InvalidInput(f"the torque array's value {bad[0]} is {torque[bad[0]]}; values must be finite")
@@ -402,8 +424,10 @@ def _takes_time(function: Callable, times: list[float]) -> list[float]:
     try:
         inspect.signature(function).bind(times[0])
     except TypeError as error:
-        raise InvalidInput(f"a torque callable takes the time in s and returns N.m; "
-                           f"{getattr(function, '__name__', 'it')} cannot: {error}") from None
+        raise InvalidInput(
+            f"a torque callable takes the time in s and returns N.m; "
+            f"{getattr(function, '__name__', 'it')} cannot: {error}"
+        ) from None
     except ValueError:  # no signature to read (some builtins): calling it will tell
         pass
     return times
@@ -412,13 +436,21 @@ def _takes_time(function: Callable, times: list[float]) -> list[float]:
 def _sample(function: Callable, t: float) -> float:
     value = function(t)
     if not isinstance(value, numbers.Real):
-        raise InvalidInput(f"the torque callable returned {_shortened(value)} at t = {t}; it must "
-                           "return a number in N.m")
+        raise InvalidInput(
+            f"the torque callable returned {_shortened(value)} at t = {t}; it must return a number in N.m"
+        )
     return float(value)
 
 
-def schedule(torque: TorqueSignal, *, start_time: float = 0.0, stop_time: float | None = None,
-             step_size: float = 1e-3, ramp: bool = False, max_steps: int | None = None) -> TorqueSchedule:
+def schedule(
+    torque: TorqueSignal,
+    *,
+    start_time: float = 0.0,
+    stop_time: float | None = None,
+    step_size: float = 1e-3,
+    ramp: bool = False,
+    max_steps: int | None = None,
+) -> TorqueSchedule:
     """The schedule of a signal: a constant, a callable of time, a per-step array, or a torque
     CSV (path or table); see the module's docstring for what each step applies. stop_time
     defaults to a CSV's last time, an array's last step, or 3 s. max_steps: see step_count."""
@@ -430,24 +462,28 @@ def schedule(torque: TorqueSignal, *, start_time: float = 0.0, stop_time: float 
     if isinstance(torque, TorqueTable):
         stop = float(torque.time[-1]) if stop_time is None else stop_time
         if stop <= start_time and stop_time is None:
-            raise InvalidInput(f"{source} ends at {stop:g} s, not after the start time {start_time:g} s; "
-                             "give a stop time")
+            raise InvalidInput(
+                f"{source} ends at {stop:g} s, not after the start time {start_time:g} s; give a stop time"
+            )
         grid = communication_points(start_time, stop, step_size, max_steps=max_steps)
         table = torque.snapped(grid, step_size)
         time = _with_events(grid, table.time if ramp else table.jumps(), step_size)
         start_values = table.value_after(time[:-1])
         end_values = table.value_before(time[1:])
     else:
-        time = communication_points(start_time, DEFAULT_STOP_TIME if stop_time is None else stop_time,
-                                    step_size, max_steps=max_steps)
+        time = communication_points(
+            start_time, DEFAULT_STOP_TIME if stop_time is None else stop_time, step_size, max_steps=max_steps
+        )
         if callable(torque):
             samples = np.array([_sample(torque, t) for t in _takes_time(torque, time.tolist())])
         else:
             try:
                 samples = np.full(len(time), float(torque))
             except (TypeError, ValueError):
-                raise InvalidInput(f"a torque is a number, a callable of time, a per-step array or a CSV "
-                                 f"path; got {type(torque).__name__}") from None
+                raise InvalidInput(
+                    f"a torque is a number, a callable of time, a per-step array or a CSV "
+                    f"path; got {type(torque).__name__}"
+                ) from None
         if not np.isfinite(samples).all():
             bad = np.flatnonzero(~np.isfinite(samples))[0]
             raise InvalidInput(f"the torque is {samples[bad]} at t = {time[bad]}; it must be finite")
@@ -459,8 +495,10 @@ def schedule(torque: TorqueSignal, *, start_time: float = 0.0, stop_time: float 
     steep = np.flatnonzero(~np.isfinite(rate))
     if len(steep):
         k = steep[0]
-        raise InvalidInput(f"{source if isinstance(torque, TorqueTable) else 'the torque'} ramps from "
-                           f"{start_values[k]:g} to {end_values[k]:g} N.m between t = {time[k]:g} and "
-                           f"{time[k + 1]:g} s, a rate past the largest double: hold the torque "
-                           "(no ramp) or give values that change less steeply")
+        raise InvalidInput(
+            f"{source if isinstance(torque, TorqueTable) else 'the torque'} ramps from "
+            f"{start_values[k]:g} to {end_values[k]:g} N.m between t = {time[k]:g} and "
+            f"{time[k + 1]:g} s, a rate past the largest double: hold the torque "
+            "(no ramp) or give values that change less steeply"
+        )
     return TorqueSchedule(time=time, torque=start_values, torque_rate=rate)

@@ -32,17 +32,34 @@ CACHE = ROOT / ".cache" / "arm64-python"
 # library, the C and C++ runtimes the manylinux wheels link (numpy's OpenBLAS, matplotlib),
 # zlib and expat (the interpreter itself), libffi (ctypes, which loads the FMU and the native
 # loop), OpenSSL (hashlib, which pip uses), bz2, lzma and uuid (standard modules pip imports).
-PACKAGES = ("python3.11-minimal", "libpython3.11-minimal", "libpython3.11-stdlib", "libc6", "libgcc-s1",
-            "libstdc++6", "zlib1g", "libexpat1", "libffi8", "libssl3", "libbz2-1.0", "liblzma5", "libuuid1")
+PACKAGES = (
+    "python3.11-minimal",
+    "libpython3.11-minimal",
+    "libpython3.11-stdlib",
+    "libc6",
+    "libgcc-s1",
+    "libstdc++6",
+    "zlib1g",
+    "libexpat1",
+    "libffi8",
+    "libssl3",
+    "libbz2-1.0",
+    "liblzma5",
+    "libuuid1",
+)
 PYTHON_VERSION = "3.11"
 GLIBC = (2, 36)  # bookworm's: the newest manylinux tag this Python takes
 # Every manylinux tag a glibc 2.36 aarch64 takes; pip before 24 does not expand one into the older.
-PLATFORM_TAGS = ("manylinux2014_aarch64",
-                 *(f"manylinux_2_{minor}_aarch64" for minor in range(17, GLIBC[1] + 1)))
+PLATFORM_TAGS = ("manylinux2014_aarch64", *(f"manylinux_2_{minor}_aarch64" for minor in range(17, GLIBC[1] + 1)))
 # A run here sees neither the machine's pip configuration nor its Python settings.
-CLEAN_ENVIRONMENT = {"PATH": os.defpath, "LC_ALL": "C.UTF-8", "PIP_CONFIG_FILE": os.devnull,
-                     "PIP_DISABLE_PIP_VERSION_CHECK": "1", "PIP_ROOT_USER_ACTION": "ignore",
-                     "PYTHONNOUSERSITE": "1"}
+CLEAN_ENVIRONMENT = {
+    "PATH": os.defpath,
+    "LC_ALL": "C.UTF-8",
+    "PIP_CONFIG_FILE": os.devnull,
+    "PIP_DISABLE_PIP_VERSION_CHECK": "1",
+    "PIP_ROOT_USER_ACTION": "ignore",
+    "PYTHONNOUSERSITE": "1",
+}
 
 
 class Unavailable(RuntimeError):
@@ -51,8 +68,9 @@ class Unavailable(RuntimeError):
 
 def _run(command, what, timeout=900, **options):
     try:
-        result = subprocess.run([str(part) for part in command], capture_output=True, text=True,
-                                timeout=timeout, **options)
+        result = subprocess.run(
+            [str(part) for part in command], capture_output=True, text=True, timeout=timeout, **options
+        )
     except OSError as error:
         raise Unavailable(f"{what}: {command[0]}: {error.strerror}") from None
     if result.returncode != 0:
@@ -84,8 +102,7 @@ def requirements_of(wheel: Path) -> list[str]:
     with zipfile.ZipFile(wheel) as archive:
         [metadata] = [name for name in archive.namelist() if name.endswith(".dist-info/METADATA")]
         headers = HeaderParser().parsestr(archive.read(metadata).decode())
-    return [requirement for requirement in headers.get_all("Requires-Dist", [])
-            if "extra ==" not in requirement]
+    return [requirement for requirement in headers.get_all("Requires-Dist", []) if "extra ==" not in requirement]
 
 
 class Arm64Python:
@@ -108,12 +125,24 @@ class Arm64Python:
             for folder in (state / "lists/partial", work / "cache/archives/partial", debs):
                 folder.mkdir(parents=True)
             (state / "status").touch()
-            options = ["-o", "APT::Architecture=arm64", "-o", "APT::Architectures=arm64",
-                       "-o", f"Dir::State={state}", "-o", f"Dir::State::status={state / 'status'}",
-                       "-o", f"Dir::Cache={work / 'cache'}"]
+            options = [
+                "-o",
+                "APT::Architecture=arm64",
+                "-o",
+                "APT::Architectures=arm64",
+                "-o",
+                f"Dir::State={state}",
+                "-o",
+                f"Dir::State::status={state / 'status'}",
+                "-o",
+                f"Dir::Cache={work / 'cache'}",
+            ]
             _run(["apt-get", *options, "update"], "apt-get update for arm64")
-            _run(["apt-get", *options, "download", *(f"{name}:arm64" for name in PACKAGES)],
-                 "apt-get download of Debian's arm64 python3.11", cwd=debs)
+            _run(
+                ["apt-get", *options, "download", *(f"{name}:arm64" for name in PACKAGES)],
+                "apt-get download of Debian's arm64 python3.11",
+                cwd=debs,
+            )
             for deb in sorted(debs.glob("*.deb")):
                 _run(["dpkg-deb", "-x", deb, sysroot], f"dpkg-deb -x {deb.name}")
         finally:
@@ -128,9 +157,25 @@ class Arm64Python:
         if not set(wanted) <= have:
             self.wheels.mkdir(parents=True, exist_ok=True)
             platforms = [option for tag in PLATFORM_TAGS for option in ("--platform", tag)]
-            _run([sys.executable, "-m", "pip", "download", "--quiet", "--only-binary=:all:",
-                  "--implementation", "cp", "--python-version", PYTHON_VERSION, *platforms,
-                  "--dest", self.wheels, *wanted], "pip download of the aarch64 wheels")
+            _run(
+                [
+                    sys.executable,
+                    "-m",
+                    "pip",
+                    "download",
+                    "--quiet",
+                    "--only-binary=:all:",
+                    "--implementation",
+                    "cp",
+                    "--python-version",
+                    PYTHON_VERSION,
+                    *platforms,
+                    "--dest",
+                    self.wheels,
+                    *wanted,
+                ],
+                "pip download of the aarch64 wheels",
+            )
             marker.write_text("\n".join(sorted(have | set(wanted))) + "\n")
         return self.wheels
 
@@ -140,19 +185,39 @@ class Arm64Python:
     def run(self, arguments, *, cwd: Path, site: Path | None = None, timeout: float = 600):
         """Run this Python with arguments in cwd, site on its path; CompletedProcess (text)."""
         environment = {**CLEAN_ENVIRONMENT, **({"PYTHONPATH": str(site)} if site else {})}
-        return subprocess.run(self.command(arguments), cwd=cwd, env=environment, capture_output=True,
-                              text=True, timeout=timeout)
+        return subprocess.run(
+            self.command(arguments), cwd=cwd, env=environment, capture_output=True, text=True, timeout=timeout
+        )
 
     def install(self, wanted: list, site: Path) -> Path:
         """pip, run under qemu, installs wanted (wheel files and requirement strings) and what they
         need into site (--target), from the cached aarch64 wheels only: the arm64 interpreter
         itself judges each wheel's tag."""
-        self.download([requirement for item in wanted for requirement in
-                       (requirements_of(item) if isinstance(item, Path) else [item])])
+        self.download(
+            [
+                requirement
+                for item in wanted
+                for requirement in (requirements_of(item) if isinstance(item, Path) else [item])
+            ]
+        )
         pip = max(self.wheels.glob("pip-*.whl"))
-        result = self.run([f"{pip}/pip", "install", "--no-index", "--find-links", self.wheels,
-                           "--no-compile", "--no-cache-dir", "--target", site, *wanted], cwd=self.cache)
+        result = self.run(
+            [
+                f"{pip}/pip",
+                "install",
+                "--no-index",
+                "--find-links",
+                self.wheels,
+                "--no-compile",
+                "--no-cache-dir",
+                "--target",
+                site,
+                *wanted,
+            ],
+            cwd=self.cache,
+        )
         if result.returncode != 0:
-            raise AssertionError(f"pip under qemu-aarch64 exited {result.returncode}:\n{result.stdout}\n"
-                                 f"{result.stderr}")
+            raise AssertionError(
+                f"pip under qemu-aarch64 exited {result.returncode}:\n{result.stdout}\n{result.stderr}"
+            )
         return site

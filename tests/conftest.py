@@ -31,9 +31,14 @@ def generated_by_script(tmp_path):
 
     def generate(script: str) -> str:
         out = tmp_path / "generated.md"
-        done = subprocess.run([sys.executable, str(Path(__file__).parent / script), str(out)], cwd=tmp_path,
-                              env={**os.environ, "PYTHONPATH": str(decoy.parent)}, capture_output=True,
-                              text=True, timeout=600)
+        done = subprocess.run(
+            [sys.executable, str(Path(__file__).parent / script), str(out)],
+            cwd=tmp_path,
+            env={**os.environ, "PYTHONPATH": str(decoy.parent)},
+            capture_output=True,
+            text=True,
+            timeout=600,
+        )
         assert done.returncode == 0, done.stderr
         return out.read_text()
 

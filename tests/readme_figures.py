@@ -45,8 +45,10 @@ END = "<!-- end -->"
 # The sections (#, ## or ### headings) where figures stand only in blocks.
 CHECKED = ("Set up, install and build wheels", "Sweeps at scale", "Robustness")
 # A figure: a number with a unit or a count of things, or in scientific notation.
-FIGURE = re.compile(r"\b\d[\d,.]*(?:e-?\d+)?\s?(?:%|µs|ms|s|min|kB|MB|GB|KiB|MiB|bytes|cases|steps|"
-                    r"instances|threads|cycles|calls|workers|tests)(?![\w-])|\b\d(?:\.\d+)?e-\d+\b")
+FIGURE = re.compile(
+    r"\b\d[\d,.]*(?:e-?\d+)?\s?(?:%|µs|ms|s|min|kB|MB|GB|KiB|MiB|bytes|cases|steps|"
+    r"instances|threads|cycles|calls|workers|tests)(?![\w-])|\b\d(?:\.\d+)?e-\d+\b"
+)
 
 
 @dataclass(frozen=True)
@@ -80,6 +82,7 @@ def _wrapped(text: str) -> str:
 
 # --- the generated blocks ------------------------------------------------------------------
 
+
 def sweeps() -> str:
     """The sweep's limits and the figure's kinds, from the package."""
     from pendulum_fmu.plot import QUANTILE_BANDS
@@ -87,11 +90,13 @@ def sweeps() -> str:
     from pendulum_fmu.sweep.figure import LINES_UP_TO
 
     bands = " and ".join(f"{low * 100:g}-{high * 100:g} %" for low, high in QUANTILE_BANDS)
-    return _wrapped(f"A study of more than {DEFAULT_MAX_CASES:,} cases is refused unless "
-                    f"`--max-cases` allows it. `sweep.png` draws every case when there are up to "
-                    f"{LINES_UP_TO}, else the median and the {bands} bands of the largest and the "
-                    "final theta per swept value (where each value has one case, the cases alone), "
-                    "its axes in the FMU's units.")
+    return _wrapped(
+        f"A study of more than {DEFAULT_MAX_CASES:,} cases is refused unless "
+        f"`--max-cases` allows it. `sweep.png` draws every case when there are up to "
+        f"{LINES_UP_TO}, else the median and the {bands} bands of the largest and the "
+        "final theta per swept value (where each value has one case, the cases alone), "
+        "its axes in the FMU's units."
+    )
 
 
 def robustness() -> str:
@@ -101,33 +106,55 @@ def robustness() -> str:
     from bad_calls import CASES, CASES_FMI3
 
     rows = [
-        ("bad calls through ctypes on the FMI 2.0 binary (docs/robustness.md: each with its "
-         "answer)", f"{len(CASES)}", "tests/test_robustness.py"),
+        (
+            "bad calls through ctypes on the FMI 2.0 binary (docs/robustness.md: each with its answer)",
+            f"{len(CASES)}",
+            "tests/test_robustness.py",
+        ),
         ("bad calls through ctypes on the FMI 3.0 binary", f"{len(CASES_FMI3)}", "tests/test_robustness.py"),
-        ("live instances in one process, under AddressSanitizer + UBSan", f"{c.INSTANCES:,}",
-         "tests/test_sanitizers.py"),
-        ("threads, each driving its own instance, bit-identical to one thread", f"{c.THREADS}",
-         "tests/test_sanitizers.py"),
-        ("instantiate/step/free cycles under AddressSanitizer + UBSan, no leak",
-         f"{c.SANITIZED_CYCLES:,}", "tests/test_sanitizers.py"),
-        ("natively: 1 ms steps from 1 rad with no torque and no damping", f"{c.ENERGY_STEPS:,}",
-         "tests/test_sanitizers.py"),
-        ("... over which the energy drifts by less than (relative)", f"{c.ENERGY_DRIFT_BOUND:.0e}".replace("e-0", "e-"),
-         "tests/test_sanitizers.py"),
+        (
+            "live instances in one process, under AddressSanitizer + UBSan",
+            f"{c.INSTANCES:,}",
+            "tests/test_sanitizers.py",
+        ),
+        (
+            "threads, each driving its own instance, bit-identical to one thread",
+            f"{c.THREADS}",
+            "tests/test_sanitizers.py",
+        ),
+        (
+            "instantiate/step/free cycles under AddressSanitizer + UBSan, no leak",
+            f"{c.SANITIZED_CYCLES:,}",
+            "tests/test_sanitizers.py",
+        ),
+        (
+            "natively: 1 ms steps from 1 rad with no torque and no damping",
+            f"{c.ENERGY_STEPS:,}",
+            "tests/test_sanitizers.py",
+        ),
+        (
+            "... over which the energy drifts by less than (relative)",
+            f"{c.ENERGY_DRIFT_BOUND:.0e}".replace("e-0", "e-"),
+            "tests/test_sanitizers.py",
+        ),
         ("natively: instantiate/step/free cycles", f"{c.CYCLES:,}", "tests/test_sanitizers.py"),
-        ("... over which resident memory grows by at most", f"{c.GROWTH_BOUND_KIB} KiB",
-         "tests/test_sanitizers.py"),
-        ("libFuzzer per harness in CI (FUZZ_SECONDS sets it)", f"{test_fuzz.DEFAULT_SECONDS} s",
-         "tests/test_fuzz.py"),
+        ("... over which resident memory grows by at most", f"{c.GROWTH_BOUND_KIB} KiB", "tests/test_sanitizers.py"),
+        ("libFuzzer per harness in CI (FUZZ_SECONDS sets it)", f"{test_fuzz.DEFAULT_SECONDS} s", "tests/test_fuzz.py"),
     ]
-    return "\n".join(["| what the tests try | how much | where |", "|---|---|---|",
-                      *(f"| {what} | {much} | `{where}` |" for what, much, where in rows)])
+    return "\n".join(
+        [
+            "| what the tests try | how much | where |",
+            "|---|---|---|",
+            *(f"| {what} | {much} | `{where}` |" for what, much, where in rows),
+        ]
+    )
 
 
 GENERATED = {"sweeps": sweeps, "robustness": robustness}
 
 
 # --- running the commands, checking, updating ----------------------------------------------
+
 
 def run(command: str) -> str:
     """What a block's command prints, run with this interpreter for .venv/bin/python."""
@@ -198,8 +225,9 @@ def problems(text: str) -> list[str]:
         if block.kind == "generated":
             printed = run(block.command)
             if printed != block.text:
-                found.append(f"`{block.command}` prints another block than the document's (run "
-                             "tests/readme_figures.py --update)")
+                found.append(
+                    f"`{block.command}` prints another block than the document's (run tests/readme_figures.py --update)"
+                )
         elif not template_pattern(block.command).fullmatch(" ".join(block.text.split())):
             found.append(f"the document's block of `{block.command}` is not what it prints: run it again")
     return found + [f"a figure outside a block: {where}" for where in loose_figures(lines)]
@@ -213,19 +241,21 @@ def update(measure: bool) -> None:
         lines = text.splitlines()
         for block in reversed(blocks(lines)):
             if block.kind == "generated" or measure:
-                lines[block.first:block.last] = run(block.command).splitlines()
+                lines[block.first : block.last] = run(block.command).splitlines()
         if "\n".join(lines) + "\n" != text:
             with replacing(document, encoding="utf-8") as file:
                 file.write("\n".join(lines) + "\n")
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(
+        description=__doc__.split("\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("name", nargs="?", choices=sorted(GENERATED), help="print this generated block")
     parser.add_argument("--update", action="store_true", help="rewrite the documents' generated blocks")
-    parser.add_argument("--measure", action="store_true",
-                        help="with --update, run the measured blocks' benchmarks too (minutes)")
+    parser.add_argument(
+        "--measure", action="store_true", help="with --update, run the measured blocks' benchmarks too (minutes)"
+    )
     args = parser.parse_args(argv)
     if args.name:
         print(GENERATED[args.name]())

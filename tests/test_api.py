@@ -74,8 +74,7 @@ def test_a_name_the_api_has_not_is_an_attribute_error():
         pendulum_fmu.simulat  # noqa: B018
 
 
-@pytest.mark.parametrize("name", [name for name in pendulum_fmu.__all__
-                                  if callable(getattr(pendulum_fmu, name))])
+@pytest.mark.parametrize("name", [name for name in pendulum_fmu.__all__ if callable(getattr(pendulum_fmu, name))])
 def test_every_api_docstring_has_numpydoc_sections_and_its_examples_give_what_they_show(name):
     import doctest
     import inspect

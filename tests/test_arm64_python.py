@@ -53,8 +53,19 @@ def test_the_checkout_package_simulates_on_arm64_as_on_x86_64(arm64, fmu, tmp_pa
     (package / "data").mkdir()
     shutil.copy(fmu, package / "data/Pendulum.fmu")
 
-    ran = arm64.run(["-c", "import sys; sys.argv[0] = 'pendulum-fmu'; from pendulum_fmu.entry import run; run()",
-                     "simulate", "--torque", "20", "--output", "arm64.csv"], site=site, cwd=tmp_path)
+    ran = arm64.run(
+        [
+            "-c",
+            "import sys; sys.argv[0] = 'pendulum-fmu'; from pendulum_fmu.entry import run; run()",
+            "simulate",
+            "--torque",
+            "20",
+            "--output",
+            "arm64.csv",
+        ],
+        site=site,
+        cwd=tmp_path,
+    )
     assert ran.returncode == 0, ran.stderr
     monkeypatch.chdir(tmp_path)
     assert main(["simulate", "--torque", "20", "--fmu", str(fmu), "--output", "x86_64.csv"]) == 0

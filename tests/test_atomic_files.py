@@ -52,16 +52,20 @@ def test_a_failed_write_to_a_url_leaves_neither_file_nor_temporary():
     assert filesystem.find("/writes") == ["/writes/kept.bin"]
     assert filesystem.cat("/writes/kept.bin") == b"whole"
 
+
 # A folder that exists and in which nothing can be created, whoever runs the tests (root too).
 UNWRITABLE = "/proc/self"
 needs_proc = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="needs Linux's /proc")
 
 
 @needs_proc
-@pytest.mark.parametrize("target, reason", [
-    (f"{UNWRITABLE}/out.csv", f"no file can be created in {UNWRITABLE}"),
-    (f"{UNWRITABLE}/study/out.csv", f"the folder {UNWRITABLE}/study cannot be created"),
-])
+@pytest.mark.parametrize(
+    "target, reason",
+    [
+        (f"{UNWRITABLE}/out.csv", f"no file can be created in {UNWRITABLE}"),
+        (f"{UNWRITABLE}/study/out.csv", f"the folder {UNWRITABLE}/study cannot be created"),
+    ],
+)
 def test_an_unwritable_target_is_refused_with_the_users_path(target, reason):
     for attempt in (lambda: check_writable(target), lambda: replacing(target).__enter__()):
         with pytest.raises(CannotWrite) as refused:

@@ -31,8 +31,11 @@ def _launcher(folder: Path, refuse_lto: bool) -> Path:
     """A compiler launcher like ccache: logs each command, then runs it; or, like a gcc without
     its LTO plug-in, fails any command with -flto (or -flto=...)."""
     script = folder / "launcher"
-    refusal = ('for a in "$@"; do case "$a" in -flto*) echo "lto-wrapper: not found" >&2; exit 1;; esac; done\n'
-               if refuse_lto else "")
+    refusal = (
+        'for a in "$@"; do case "$a" in -flto*) echo "lto-wrapper: not found" >&2; exit 1;; esac; done\n'
+        if refuse_lto
+        else ""
+    )
     script.write_text(f'#!/bin/sh\necho "$@" >> "{folder}/commands.log"\n{refusal}exec "$@"\n')
     script.chmod(script.stat().st_mode | stat.S_IXUSR)
     return script
@@ -40,8 +43,7 @@ def _launcher(folder: Path, refuse_lto: bool) -> Path:
 
 def _logged_commands(folder: Path, output: str) -> list[list[str]]:
     """The logged commands that wrote output (CMake's checks of the compiler wrote others)."""
-    return [line.split() for line in (folder / "commands.log").read_text().splitlines()
-            if f"-o {output}" in line]
+    return [line.split() for line in (folder / "commands.log").read_text().splitlines() if f"-o {output}" in line]
 
 
 def _theta_error(fmu: Path) -> float:
@@ -65,9 +67,17 @@ def test_cc_and_cflags_with_arguments_and_lto_only_where_it_links(tmp_path, monk
 
 def test_eight_builds_into_one_path_at_once_all_succeed(tmp_path):
     target = tmp_path / "Pendulum.fmu"
-    builds = [subprocess.Popen([sys.executable, "build_fmu.py", "--output", str(target), "--platforms", "linux64"],
-                               cwd=ROOT, env=ENVIRONMENT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-              for _ in range(8)]
+    builds = [
+        subprocess.Popen(
+            [sys.executable, "build_fmu.py", "--output", str(target), "--platforms", "linux64"],
+            cwd=ROOT,
+            env=ENVIRONMENT,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        for _ in range(8)
+    ]
     for build in builds:
         out, err = build.communicate(timeout=300)
         assert build.returncode == 0, err
@@ -85,8 +95,11 @@ def test_checkout_fmu_is_rebuilt_when_a_source_is_newer(tmp_path):
     ask = [sys.executable, "-c", "import pendulum_fmu; print(pendulum_fmu.default_fmu())"]
 
     def default_fmu_mtime():
-        path = Path(subprocess.run(ask, cwd=tmp_path, env=ENVIRONMENT, capture_output=True, text=True,
-                                   check=True).stdout.strip())
+        path = Path(
+            subprocess.run(
+                ask, cwd=tmp_path, env=ENVIRONMENT, capture_output=True, text=True, check=True
+            ).stdout.strip()
+        )
         assert path == tmp_path / "dist" / "Pendulum.fmu"
         return path.stat().st_mtime_ns
 
@@ -119,11 +132,12 @@ def heavier_pendulum(tmp_path_factory):
 def test_a_passed_fmu_brings_its_own_parameters(heavier_pendulum, tmp_path):
     assert default_parameters(heavier_pendulum)["mass"] == 50.0
     expected = reference(20.0, parameters={**default_parameters(), "mass": 50.0})
-    for run in (simulate(20.0, fmu_path=heavier_pendulum),
-                reference(20.0, fmu_path=heavier_pendulum)):
+    for run in (simulate(20.0, fmu_path=heavier_pendulum), reference(20.0, fmu_path=heavier_pendulum)):
         assert np.max(np.abs(run["theta"] - expected["theta"])) < 1e-9
-    assert main(["simulate", "--torque", "20", "--fmu", str(heavier_pendulum),
-                 "--output", str(tmp_path / "heavier.csv")]) == 0
+    assert (
+        main(["simulate", "--torque", "20", "--fmu", str(heavier_pendulum), "--output", str(tmp_path / "heavier.csv")])
+        == 0
+    )
     theta = np.genfromtxt(tmp_path / "heavier.csv", delimiter=",", names=True)["theta"]
     assert np.max(np.abs(theta - expected["theta"])) < 1e-9
     # And 50 kg is not 40 kg: the check above can tell the builds apart.

@@ -225,8 +225,9 @@ def test_a_master_one_step_late_at_10_ms_passes_the_tube_while_the_judge_names_i
     intended.write_text("time,torque\n0,0\n5,0\n5,20\n10,20\n")
     late = np.array([(0, 0), (5.01, 0), (5.01, 20), (10, 20)], dtype=[("time", float), ("torque", float)])
     calls = []
-    simulate_fmu(str(fmu), stop_time=10.0, step_size=0.01, output_interval=0.01, input=late,
-                 fmi_call_logger=calls.append)
+    simulate_fmu(
+        str(fmu), stop_time=10.0, step_size=0.01, output_interval=0.01, input=late, fmi_call_logger=calls.append
+    )
     log = tmp_path / "fmpy_calls.log"
     log.write_text("\n".join(calls) + "\n")
     result = reading(log, IntendedRun(intended))
@@ -255,13 +256,21 @@ def test_the_record_file_a_parameter_names_is_read_by_the_judge(request, fixture
     record = tmp_path / "calls.log"
     late = np.array([(0, 0), (0.006, 0), (0.006, 20), (0.01, 20)], dtype=[("time", float), ("torque", float)])
     calls = []
-    simulate_fmu(str(fmu), stop_time=N_STEPS * STEP, step_size=STEP, output_interval=STEP, input=late,
-                 start_values={"callRecordFile": str(record)}, fmi_call_logger=calls.append)
+    simulate_fmu(
+        str(fmu),
+        stop_time=N_STEPS * STEP,
+        step_size=STEP,
+        output_interval=STEP,
+        input=late,
+        start_values={"callRecordFile": str(record)},
+        fmi_call_logger=calls.append,
+    )
     # fmpy's own call log holds the fmi*SetString call too; the judge reads past it.
     call_log = tmp_path / "fmpy_calls.log"
     call_log.write_text("\n".join(calls) + "\n")
     assert [line.split(" (t")[0] for line in reading(call_log, IntendedRun(jump_csv))["differences"]] == [
-        "input applied 1 step late from step 5"]
+        "input applied 1 step late from step 5"
+    ]
     lines = record.read_text().splitlines()
     prefix = "fmi2" if fixture == "fmu" else "fmi3"
     assert lines[0].startswith(f'[pendulum-calls] instance="Pendulum" {prefix}SetString(file="{record}") ')
@@ -273,11 +282,18 @@ def test_the_record_file_a_parameter_names_is_read_by_the_judge(request, fixture
 
 def test_a_record_file_that_cannot_be_opened_is_one_warning_and_the_run_completes(fmu, tmp_path, capsys):
     missing = tmp_path / "no such folder" / "calls.log"
-    result = simulate_fmu(str(fmu), stop_time=N_STEPS * STEP, step_size=STEP, output_interval=STEP,
-                          start_values={"callRecordFile": str(missing), "torque": 20.0})
+    result = simulate_fmu(
+        str(fmu),
+        stop_time=N_STEPS * STEP,
+        step_size=STEP,
+        output_interval=STEP,
+        start_values={"callRecordFile": str(missing), "torque": 20.0},
+    )
     warnings = [line for line in capsys.readouterr().out.splitlines() if "callRecordFile" in line]
-    assert warnings == [f"[WARNING] fmi2SetString: callRecordFile {missing} cannot be opened for appending "
-                        "(No such file or directory): the FMU writes no record file"]
+    assert warnings == [
+        f"[WARNING] fmi2SetString: callRecordFile {missing} cannot be opened for appending "
+        "(No such file or directory): the FMU writes no record file"
+    ]
     assert not missing.parent.exists()
     assert result["time"].tolist() == pytest.approx([k * STEP for k in range(N_STEPS + 1)], abs=1e-15)
 

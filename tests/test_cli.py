@@ -17,8 +17,18 @@ I_TOTAL = 30.0
 def test_every_command_has_help():
     parser = build_parser()
     commands = parser._subparsers._group_actions[0].choices
-    assert set(commands) == {"build", "export", "cross-check", "simulate", "compare", "sweep", "demo", "judge",
-                             "scenarios", "export-ssp"}
+    assert set(commands) == {
+        "build",
+        "export",
+        "cross-check",
+        "simulate",
+        "compare",
+        "sweep",
+        "demo",
+        "judge",
+        "scenarios",
+        "export-ssp",
+    }
     for name, command in commands.items():
         assert command.description, name
         for action in command._actions:
@@ -33,8 +43,24 @@ def test_build(tmp_path, capsys):
 
 def test_simulate_writes_csv_and_plot(tmp_path, capsys):
     out, png = tmp_path / "out.csv", tmp_path / "out.png"
-    assert main(["simulate", "--torque", "20", "--set", "gravity=0", "--theta0", "0.1",
-                 "--output", str(out), "--plot", str(png)]) == 0
+    assert (
+        main(
+            [
+                "simulate",
+                "--torque",
+                "20",
+                "--set",
+                "gravity=0",
+                "--theta0",
+                "0.1",
+                "--output",
+                str(out),
+                "--plot",
+                str(png),
+            ]
+        )
+        == 0
+    )
     data = np.genfromtxt(out, delimiter=",", names=True)
     assert data.dtype.names == ("time", "torque", "theta", "omega", "alpha")
     assert np.max(np.abs(data["theta"] - (0.1 + 10 / I_TOTAL * data["time"] ** 2))) < 1e-12
@@ -71,15 +97,15 @@ def test_a_users_error_is_one_line_and_anything_else_an_internal_error(monkeypat
 
 
 def test_argument_errors_exit_2_without_traceback():
-    result = subprocess.run([sys.executable, "-m", "pendulum_fmu", "simulate", "--torque", "abc"],
-                            capture_output=True, text=True)
+    result = subprocess.run(
+        [sys.executable, "-m", "pendulum_fmu", "simulate", "--torque", "abc"], capture_output=True, text=True
+    )
     assert result.returncode == 2
     assert "'abc' is not a number" in result.stderr and "Traceback" not in result.stderr
 
 
 def test_compare_passes_and_fails_on_tolerance(tmp_path, capsys):
-    args = ["compare", "--torque", "20", "--tools", "fmu,reference", "--stop-time", "1",
-            "--output-dir", str(tmp_path)]
+    args = ["compare", "--torque", "20", "--tools", "fmu,reference", "--stop-time", "1", "--output-dir", str(tmp_path)]
     assert main(args) == 0
     table = np.genfromtxt(tmp_path / "differences.csv", delimiter=",", names=True, dtype=None, encoding=None)
     assert float(table["theta_max"]) < 1e-10 and str(table["against"]) == "reference"
@@ -91,8 +117,27 @@ def test_compare_passes_and_fails_on_tolerance(tmp_path, capsys):
 
 
 def test_sweep_command(tmp_path, capsys):
-    assert main(["sweep", "--torque", "5", "20", "--gravity", "0", "--set", "damping=0,2",
-                 "--stop-time", "0.2", "--workers", "1", "--output-dir", str(tmp_path)]) == 0
+    assert (
+        main(
+            [
+                "sweep",
+                "--torque",
+                "5",
+                "20",
+                "--gravity",
+                "0",
+                "--set",
+                "damping=0,2",
+                "--stop-time",
+                "0.2",
+                "--workers",
+                "1",
+                "--output-dir",
+                str(tmp_path),
+            ]
+        )
+        == 0
+    )
     assert "4 cases" in capsys.readouterr().out
     cases = pq.read_table(tmp_path / "cases").sort_by("case").to_pydict()
     assert cases["case"] == [0, 1, 2, 3]
@@ -107,8 +152,24 @@ def test_sweep_command(tmp_path, capsys):
 def test_sweep_with_a_refused_case_runs_the_rest_and_exits_1(tmp_path, capsys):
     import pyarrow.parquet as pq
 
-    assert main(["sweep", "--torque", "5", "--set", "mass=0,40", "--stop-time", "0.1", "--workers", "1",
-                 "--output-dir", str(tmp_path)]) == 1
+    assert (
+        main(
+            [
+                "sweep",
+                "--torque",
+                "5",
+                "--set",
+                "mass=0,40",
+                "--stop-time",
+                "0.1",
+                "--workers",
+                "1",
+                "--output-dir",
+                str(tmp_path),
+            ]
+        )
+        == 1
+    )
     assert "1 of 2 cases failed" in capsys.readouterr().err
     cases = pq.read_table(tmp_path / "cases").to_pydict()
     assert sorted(zip(cases["mass"], cases["status"])) == [(0.0, "failed"), (40.0, "ok")]
@@ -117,10 +178,12 @@ def test_sweep_with_a_refused_case_runs_the_rest_and_exits_1(tmp_path, capsys):
 def test_an_output_nothing_can_be_written_to_is_refused_before_the_run(tmp_path, capsys):
     """/proc/self: a folder in which nothing can be created. The error names the user's path, not
     the temporary beside it, and comes before the run (no summary line)."""
-    for argv in (["simulate", "--torque", "1", "--output", "/proc/self/out.csv"],
-                 ["simulate", "--torque", "1", "--output", str(tmp_path / "fine.csv"), "--plot", "/proc/self/out.png"],
-                 ["compare", "--torque", "1", "--tools", "fmu,reference", "--output-dir", "/proc/self/out"],
-                 ["build", "--output", "/proc/self/Pendulum.fmu", "--platforms", "linux64"]):
+    for argv in (
+        ["simulate", "--torque", "1", "--output", "/proc/self/out.csv"],
+        ["simulate", "--torque", "1", "--output", str(tmp_path / "fine.csv"), "--plot", "/proc/self/out.png"],
+        ["compare", "--torque", "1", "--tools", "fmu,reference", "--output-dir", "/proc/self/out"],
+        ["build", "--output", "/proc/self/Pendulum.fmu", "--platforms", "linux64"],
+    ):
         assert main(argv) == 2, argv
         out, err = capsys.readouterr()
         assert out == "" and err.count("\n") == 1 and "/proc/self/" in err and "partial" not in err, (argv, err)
@@ -128,9 +191,25 @@ def test_an_output_nothing_can_be_written_to_is_refused_before_the_run(tmp_path,
 
 
 def _simulate_printing_to(stdout, folder):
-    process = subprocess.Popen([sys.executable, "-m", "pendulum_fmu", "simulate", "--torque", "3",
-                                "--set", "gravity=0", "--stop-time", "0.01", "--output", "out.csv"],
-                               cwd=folder, stdout=stdout, stderr=subprocess.PIPE)
+    process = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "pendulum_fmu",
+            "simulate",
+            "--torque",
+            "3",
+            "--set",
+            "gravity=0",
+            "--stop-time",
+            "0.01",
+            "--output",
+            "out.csv",
+        ],
+        cwd=folder,
+        stdout=stdout,
+        stderr=subprocess.PIPE,
+    )
     if stdout is subprocess.PIPE:
         process.stdout.close()  # the reader is gone before the command prints (`| head -0`)
     error = process.stderr.read()

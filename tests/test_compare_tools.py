@@ -19,8 +19,17 @@ from pendulum_fmu.mapped_fmu import MapError, Mapped, MappedFmu, parse_map
 from pendulum_fmu.reference import reference_schedule
 from pendulum_fmu.torque_schedule import schedule
 
-RENAMES = {"torque": "u", "theta": "phi", "omega": "w", "alpha": "a", "mass": "m", "length": "L",
-           "inertia": "J", "gravity": "g", "damping": "d"}
+RENAMES = {
+    "torque": "u",
+    "theta": "phi",
+    "omega": "w",
+    "alpha": "a",
+    "mass": "m",
+    "length": "L",
+    "inertia": "J",
+    "gravity": "g",
+    "damping": "d",
+}
 FULL_MAP = ",".join(f"{ours}={theirs}" for ours, theirs in RENAMES.items())
 PLAN = schedule(lambda t: 50.0 if t < 0.25 else -80.0, stop_time=0.5, step_size=1e-3)
 
@@ -54,15 +63,18 @@ def test_tools_parse_in_order_with_modes():
     assert [tool.label for tool in parsed] == ["fmu", "reference", "drake:default", "mujoco"]
 
 
-@pytest.mark.parametrize("spec, message", [
-    ("fmu,matlab,simulink", "unknown tool(s) matlab, simulink"),
-    ("reference,fmu,reference", "--tools names reference twice"),
-    ("drake:fast", "drake has modes accurate, default, not 'fast'"),
-    ("fmu:default", "fmu has mode accurate, not 'default'"),
-    (" , ", "--tools is empty"),
-    ("fmu=x.fmu", "the label must be a name"),
-    ("theirs=missing.fmu", "theirs: no FMU at missing.fmu"),
-])
+@pytest.mark.parametrize(
+    "spec, message",
+    [
+        ("fmu,matlab,simulink", "unknown tool(s) matlab, simulink"),
+        ("reference,fmu,reference", "--tools names reference twice"),
+        ("drake:fast", "drake has modes accurate, default, not 'fast'"),
+        ("fmu:default", "fmu has mode accurate, not 'default'"),
+        (" , ", "--tools is empty"),
+        ("fmu=x.fmu", "the label must be a name"),
+        ("theirs=missing.fmu", "theirs: no FMU at missing.fmu"),
+    ],
+)
 def test_bad_tool_lists_are_refused_in_one_line(spec, message):
     with pytest.raises(ValueError) as raised:
         compare_tools.parse_tools(spec)
@@ -71,8 +83,11 @@ def test_bad_tool_lists_are_refused_in_one_line(spec, message):
 
 def test_a_missing_extra_names_the_pip_command(monkeypatch):
     monkeypatch.setattr(compare_tools, "installed", lambda name: name != "pybullet")
-    with pytest.raises(compare_tools.ToolSpecError, match=r'pybullet is not installed; install it with: '
-                                                   r'pip install "\.\[pybullet\]" in a clone'):
+    with pytest.raises(
+        compare_tools.ToolSpecError,
+        match=r"pybullet is not installed; install it with: "
+        r'pip install "\.\[pybullet\]" in a clone',
+    ):
         compare_tools.parse_tools("fmu,pybullet")
 
 
@@ -84,9 +99,16 @@ def test_cli_refuses_a_duplicate_tool_in_one_line(tmp_path, capsys):
 
 def test_map_parsing():
     assert parse_map("torque=u, theta=phi*0.0174532925,alpha=der(w)") == {
-        "torque": Mapped("u"), "theta": Mapped("phi", 0.0174532925), "alpha": Mapped("der(w)")}
-    for text, message in [("speed=w", "unknown quantity 'speed'"), ("theta", "not QUANTITY=VARIABLE"),
-                          ("theta=a,theta=b", "theta is mapped twice"), ("theta=phi*0", "finite and nonzero")]:
+        "torque": Mapped("u"),
+        "theta": Mapped("phi", 0.0174532925),
+        "alpha": Mapped("der(w)"),
+    }
+    for text, message in [
+        ("speed=w", "unknown quantity 'speed'"),
+        ("theta", "not QUANTITY=VARIABLE"),
+        ("theta=a,theta=b", "theta is mapped twice"),
+        ("theta=phi*0", "finite and nonzero"),
+    ]:
         with pytest.raises(MapError, match=message):
             parse_map(text)
     with pytest.raises(compare_tools.ToolSpecError, match="--map applies to FMUs"):
@@ -98,7 +120,8 @@ def test_another_fmu_under_other_names_matches_the_reference(renamed_fmu, interf
     parameters = {"damping": 3.0, "length": 0.7}
     expected = reference_schedule(PLAN, parameters=parameters, theta0=0.2, omega0=-1.0)
     run = MappedFmu(renamed_fmu, FULL_MAP, interface=interface).run(
-        PLAN, parameters=parameters, theta0=0.2, omega0=-1.0)
+        PLAN, parameters=parameters, theta0=0.2, omega0=-1.0
+    )
     assert max_error(run, expected) < 1e-9
     assert max_error(run, expected, "alpha") < 1e-7
 
@@ -127,17 +150,20 @@ def test_an_unmapped_quantity(renamed_fmu):
 
 
 def test_compare_runs_another_fmu_beside_ours(renamed_fmu):
-    runs = run_tools(PLAN, ["fmu", "reference", f"theirs={renamed_fmu}"], mapping=FULL_MAP,
-                     parameters={"gravity": 3.0}, theta0=0.4)
+    runs = run_tools(
+        PLAN, ["fmu", "reference", f"theirs={renamed_fmu}"], mapping=FULL_MAP, parameters={"gravity": 3.0}, theta0=0.4
+    )
     assert list(runs) == ["fmu", "reference", "theirs"]
     assert max_error(runs["theirs"], runs["fmu"]) < 1e-12
     assert max_error(runs["theirs"], runs["reference"]) < 1e-9
 
 
 DEGREE = 0.017453292519943295
-DEGREES_MAP = (f"torque=tau,theta=phi*{DEGREE!r},omega=w*{DEGREE!r},alpha=a*{DEGREE!r},"
-               f"theta0=phi_start*{DEGREE!r},omega0=w_start*{DEGREE!r},"
-               "mass=m,length=L,inertia=J,gravity=g,damping=c")
+DEGREES_MAP = (
+    f"torque=tau,theta=phi*{DEGREE!r},omega=w*{DEGREE!r},alpha=a*{DEGREE!r},"
+    f"theta0=phi_start*{DEGREE!r},omega0=w_start*{DEGREE!r},"
+    "mass=m,length=L,inertia=J,gravity=g,damping=c"
+)
 
 
 @pytest.fixture(scope="module")
@@ -145,8 +171,9 @@ def degrees_fmu(tmp_path_factory):
     """tests/fmus/degrees_pendulum.py built by pythonfmu3: FMI 3.0, CS and ME, angles in degrees,
     the start values as parameters of their own."""
     builder = pytest.importorskip("pythonfmu3.builder")
-    return builder.FmuBuilder.build_FMU(SOURCE_DIR.parent / "tests" / "fmus" / "degrees_pendulum.py",
-                                        dest=tmp_path_factory.mktemp("degrees"))
+    return builder.FmuBuilder.build_FMU(
+        SOURCE_DIR.parent / "tests" / "fmus" / "degrees_pendulum.py", dest=tmp_path_factory.mktemp("degrees")
+    )
 
 
 @pytest.mark.parametrize("interface", ["CoSimulation", "ModelExchange"])
@@ -183,15 +210,20 @@ def test_every_tool_takes_its_defaults_from_the_fmu_compared(tmp_path):
 def test_compare_on_a_plain_install_runs_the_tools_installed_and_says_which_it_skipped(tmp_path):
     # A fresh interpreter in which OpenSim and the engines cannot be imported, as on an install
     # without the extras: a None in sys.modules is what Python's import reads as "not there".
-    script = ("import sys\n"
-              "sys.modules.update(dict.fromkeys(['opensim', 'mujoco', 'pydrake', 'pybullet']))\n"
-              "from pendulum_fmu.cli import main\n"
-              f"sys.exit(main(['compare', '--torque', '20', '--output-dir', {str(tmp_path)!r}]))\n")
-    done = subprocess.run([sys.executable, "-c", script], cwd=Path(__file__).resolve().parents[1],
-                          capture_output=True, text=True)
+    script = (
+        "import sys\n"
+        "sys.modules.update(dict.fromkeys(['opensim', 'mujoco', 'pydrake', 'pybullet']))\n"
+        "from pendulum_fmu.cli import main\n"
+        f"sys.exit(main(['compare', '--torque', '20', '--output-dir', {str(tmp_path)!r}]))\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", script], cwd=Path(__file__).resolve().parents[1], capture_output=True, text=True
+    )
     assert done.returncode == 0, done.stderr
-    assert done.stderr == ('pendulum-fmu compare: skipped opensim (opensim is not installed: pip install '
-                           '".[opensim]" in a clone of pendulum-fmu (or "WHEEL.whl[opensim]" for its wheel))\n')
+    assert done.stderr == (
+        "pendulum-fmu compare: skipped opensim (opensim is not installed: pip install "
+        '".[opensim]" in a clone of pendulum-fmu (or "WHEEL.whl[opensim]" for its wheel))\n'
+    )
     with open(tmp_path / "differences.csv", newline="") as file:
         rows = list(csv.DictReader(file))
     # The FMU ran, and against the scipy reference it agrees to the default tolerance.

@@ -43,10 +43,17 @@ def test_reference_results_agree_with_fmpy_and_scipy_and_pass_fmpys_validator(re
     assert len(set(inputs["torque"])) >= 3  # step-wise, not constant
 
     # fmpy, a master that shares no code with ours, from the files alone.
-    by_fmpy = fmpy.simulate_fmu(str(folder / "Pendulum.fmu"), input=inputs, start_time=options["StartTime"],
-                                stop_time=options["StopTime"], step_size=options["StepSize"],
-                                output_interval=options["StepSize"], relative_tolerance=options["RelTol"],
-                                output=["theta", "omega"], record_events=False)
+    by_fmpy = fmpy.simulate_fmu(
+        str(folder / "Pendulum.fmu"),
+        input=inputs,
+        start_time=options["StartTime"],
+        stop_time=options["StopTime"],
+        step_size=options["StepSize"],
+        output_interval=options["StepSize"],
+        relative_tolerance=options["RelTol"],
+        output=["theta", "omega"],
+        record_events=False,
+    )
     assert np.allclose(by_fmpy["time"], expected["time"], rtol=0, atol=1e-12)
     for name in ("theta", "omega"):
         assert np.array_equal(by_fmpy[name], expected[name])  # the same binary, the same steps

@@ -86,8 +86,7 @@ def test_a_chunk_in_one_call_matches_case_by_case_and_the_physics_bit_for_bit(fm
     refuses in the middle gets its own message and a NaN row, and the cases after it are still
     right (each restart begins with fmi2Reset)."""
     names = ("mass", "damping", "theta", "torque")
-    cases = np.array([[30.0, 2.0, 0.4, 12.0], [-1.0, 0.0, 0.0, 0.0], [55.0, 0.5, -0.2, 7.0],
-                      [1.0, 0.0, 0.1, -3.0]])
+    cases = np.array([[30.0, 2.0, 0.4, 12.0], [-1.0, 0.0, 0.0, 0.0], [55.0, 0.5, -0.2, 7.0], [1.0, 0.0, 0.1, -3.0]])
     references = np.array([value_reference(n, fmu) for n in names], np.uint32)
     outputs = np.array([value_reference(n, fmu) for n in OUTPUTS], np.uint32)
     points = schedule(0.0, stop_time=0.2, step_size=1e-3).time

@@ -29,8 +29,12 @@ def test_demo_runs_the_tutorial_end_to_end(tmp_path, capsys, monkeypatch):
     assert out.count("tools agree") == 2
     assert "theta(3 s) = 3.0000000000 rad" in out  # gravity off: tau t^2 / (2 I) = 3 rad at 3 s
     assert "theta(3 s) = 0.0814310965 rad" in out
-    for figure in ("no_gravity/comparison.png", "gravity/comparison.png", "gravity_effect.png",
-                   "parameter_study/sweep.png"):
+    for figure in (
+        "no_gravity/comparison.png",
+        "gravity/comparison.png",
+        "gravity_effect.png",
+        "parameter_study/sweep.png",
+    ):
         assert (tmp_path / figure).read_bytes()[:4] == b"\x89PNG"
     study = pq.read_table(tmp_path / "parameter_study/cases")
     assert sorted(study["torque"].to_pylist()) == [5.0, 10.0, 20.0, 40.0]
@@ -48,6 +52,7 @@ def test_a_second_demo_into_the_same_folder_is_refused(tmp_path, capsys):
     assert captured.err.splitlines() == [
         f"pendulum-fmu demo: error: {tmp_path} already holds a demo's outputs (gravity_effect.png, "
         "parameter_study): choose another output directory, or add --overwrite to run the demo again in "
-        "their place"]
+        "their place"
+    ]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["gravity_effect.png", "parameter_study"]
     assert (tmp_path / "gravity_effect.png").read_text() == "old"

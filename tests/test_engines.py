@@ -19,8 +19,9 @@ THETA0, OMEGA0 = 0.3, -0.5
 def random_steps(stop_time, *, seed=1, hold=0.1, amplitude=300.0, step_size=1e-3):
     """A torque that jumps to a new uniform random level every `hold` seconds."""
     levels = np.random.default_rng(seed).uniform(-amplitude, amplitude, int(round(stop_time / hold)))
-    return schedule(lambda t: levels[min(int(t / hold + 1e-9), len(levels) - 1)],
-                    stop_time=stop_time, step_size=step_size)
+    return schedule(
+        lambda t: levels[min(int(t / hold + 1e-9), len(levels) - 1)], stop_time=stop_time, step_size=step_size
+    )
 
 
 FOUR_SECONDS = random_steps(4.0)
@@ -46,6 +47,7 @@ def reference_1s():
 def engine(name):
     pytest.importorskip({"drake": "pydrake"}.get(name, name))
     import importlib
+
     return importlib.import_module(f"pendulum_fmu.engines.{name}")
 
 
@@ -58,8 +60,10 @@ ACCURATE_BOUND = {"mujoco": 1e-9, "drake": 1e-9, "pybullet": 3e-5}
 @pytest.mark.parametrize("name", ["mujoco", "drake"])
 def test_accurate_meets_its_bound_over_four_seconds(name, reference_4s):
     run = engine(name).run(FOUR_SECONDS, theta0=THETA0, omega0=OMEGA0)
-    print(f"\n{name} accurate, 4 s random steps: max |dtheta| {error(run, reference_4s):.2e} rad, "
-          f"|domega| {error(run, reference_4s, 'omega'):.2e}, |dalpha| {error(run, reference_4s, 'alpha'):.2e}")
+    print(
+        f"\n{name} accurate, 4 s random steps: max |dtheta| {error(run, reference_4s):.2e} rad, "
+        f"|domega| {error(run, reference_4s, 'omega'):.2e}, |dalpha| {error(run, reference_4s, 'alpha'):.2e}"
+    )
     assert error(run, reference_4s) <= ACCURATE_BOUND[name]
     assert error(run, reference_4s, "omega") <= 10 * ACCURATE_BOUND[name]
     assert error(run, reference_4s, "alpha") <= 100 * ACCURATE_BOUND[name]
@@ -78,8 +82,10 @@ def test_default_mode_runs_and_reports_its_error(name, reference_1s):
     module = engine(name)
     default = module.run(ONE_SECOND, theta0=THETA0, omega0=OMEGA0, mode="default")
     accurate = module.run(ONE_SECOND, theta0=THETA0, omega0=OMEGA0)
-    print(f"\n{name} default, 1 s random steps: max |dtheta| {error(default, reference_1s):.2e} rad, "
-          f"|domega| {error(default, reference_1s, 'omega'):.2e}")
+    print(
+        f"\n{name} default, 1 s random steps: max |dtheta| {error(default, reference_1s):.2e} rad, "
+        f"|domega| {error(default, reference_1s, 'omega'):.2e}"
+    )
     assert np.all(np.isfinite(default["theta"]))
     assert error(default, reference_1s) > error(accurate, reference_1s)
 
@@ -97,8 +103,15 @@ def test_an_unknown_mode_is_refused():
 
 
 # Each change must move the reference far more than the engine's own error.
-CHANGES = [("mass", 20.0), ("length", 0.8), ("inertia", 5.0), ("gravity", 3.7), ("damping", 20.0),
-           ("theta0", 1.2), ("omega0", 2.0)]
+CHANGES = [
+    ("mass", 20.0),
+    ("length", 0.8),
+    ("inertia", 5.0),
+    ("gravity", 3.7),
+    ("damping", 20.0),
+    ("theta0", 1.2),
+    ("omega0", 2.0),
+]
 
 
 @pytest.mark.parametrize("name", ["mujoco", "drake", "pybullet"])
@@ -126,27 +139,64 @@ def _pybullet_without(flag):
 # error at least) on ONE_SECOND; docs/engines.md states the measured figures.
 TRAPS = [
     ("mujoco", "MuJoCo's own 2 ms timestep", lambda m: m.DEFAULT, lambda m: m.Setup("Euler", None), "theta", 0.3),
-    ("mujoco", "ctrlrange -100..100", lambda m: m.ACCURATE,
-     lambda m: m.Setup("RK4", 1e-3, ctrlrange=(-100, 100)), "theta", 0.1),
-    ("mujoco", "sensors read after mj_step", lambda m: m.ACCURATE,
-     lambda m: m.Setup("RK4", 1e-3, read_sensors=True), "theta", 1e-3),
-    ("drake", "sampled output ports", lambda m: m.SETUPS["default"],
-     lambda m: m.Setup(True, sampled_outputs=True), "alpha", 5.0),
-    ("drake", "actuation port left unfixed", lambda m: m.SETUPS["accurate"],
-     lambda m: m.Setup(False, fix_input=False), "theta", 0.3),
+    (
+        "mujoco",
+        "ctrlrange -100..100",
+        lambda m: m.ACCURATE,
+        lambda m: m.Setup("RK4", 1e-3, ctrlrange=(-100, 100)),
+        "theta",
+        0.1,
+    ),
+    (
+        "mujoco",
+        "sensors read after mj_step",
+        lambda m: m.ACCURATE,
+        lambda m: m.Setup("RK4", 1e-3, read_sensors=True),
+        "theta",
+        1e-3,
+    ),
+    (
+        "drake",
+        "sampled output ports",
+        lambda m: m.SETUPS["default"],
+        lambda m: m.Setup(True, sampled_outputs=True),
+        "alpha",
+        5.0,
+    ),
+    (
+        "drake",
+        "actuation port left unfixed",
+        lambda m: m.SETUPS["accurate"],
+        lambda m: m.Setup(False, fix_input=False),
+        "theta",
+        0.3,
+    ),
     ("pybullet", "no setGravity", lambda m: m.DEFAULT, _pybullet_without("set_gravity"), "theta", 0.1),
     ("pybullet", "inertia from the shapes", lambda m: m.DEFAULT, _pybullet_without("inertia_from_file"), "theta", 0.1),
     ("pybullet", "hidden link damping", lambda m: m.DEFAULT, _pybullet_without("remove_hidden_damping"), "theta", 1e-2),
-    ("pybullet", "default velocity motor", lambda m: m.DEFAULT, _pybullet_without("disable_velocity_motor"), "theta", 0.3),
-    ("pybullet", "torque applied only when it changes", lambda m: m.DEFAULT,
-     _pybullet_without("reapply_torque"), "theta", 0.3),
+    (
+        "pybullet",
+        "default velocity motor",
+        lambda m: m.DEFAULT,
+        _pybullet_without("disable_velocity_motor"),
+        "theta",
+        0.3,
+    ),
+    (
+        "pybullet",
+        "torque applied only when it changes",
+        lambda m: m.DEFAULT,
+        _pybullet_without("reapply_torque"),
+        "theta",
+        0.3,
+    ),
 ]
 
 
-@pytest.mark.parametrize("name, trap, correct, trapped, field, at_least", TRAPS,
-                         ids=[f"{case[0]}: {case[1]}" for case in TRAPS])
-def test_each_trap_turned_back_on_grows_the_error(name, trap, correct, trapped, field, at_least,
-                                                  reference_1s):
+@pytest.mark.parametrize(
+    "name, trap, correct, trapped, field, at_least", TRAPS, ids=[f"{case[0]}: {case[1]}" for case in TRAPS]
+)
+def test_each_trap_turned_back_on_grows_the_error(name, trap, correct, trapped, field, at_least, reference_1s):
     module = engine(name)
     parameters = resolve_parameters({})
     right = error(module.simulate(ONE_SECOND, parameters, THETA0, OMEGA0, correct(module)), reference_1s, field)
@@ -163,8 +213,9 @@ def test_pybullet_velocity_limit_is_raised():
     coasting = schedule(0.0, stop_time=0.1, step_size=1e-3)
     expected = 150.0 * coasting.time
     run = pybullet.simulate(coasting, parameters, 0.0, 150.0, pybullet.DEFAULT)
-    clamped = pybullet.simulate(coasting, parameters, 0.0, 150.0,
-                                pybullet.Setup(pybullet.DEFAULT.largest_step, raise_velocity_limit=False))
+    clamped = pybullet.simulate(
+        coasting, parameters, 0.0, 150.0, pybullet.Setup(pybullet.DEFAULT.largest_step, raise_velocity_limit=False)
+    )
     assert np.max(np.abs(run["theta"] - expected)) < 1e-12
     assert np.max(np.abs(clamped["theta"] - expected)) > 4.0
 

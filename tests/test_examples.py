@@ -58,7 +58,10 @@ def test_compare_with_opensim(tmp_path):
     comparison = load("compare_with_opensim").run(stop_time=1.0, output_dir=tmp_path)
     assert comparison.agree and comparison.worst < 1e-9
     assert {(row["tool"], row["against"]) for row in comparison.differences} == {
-        ("fmu", "reference"), ("opensim", "reference"), ("fmu", "opensim")}
+        ("fmu", "reference"),
+        ("opensim", "reference"),
+        ("fmu", "opensim"),
+    }
 
 
 def test_fmpy_command_line(tmp_path):

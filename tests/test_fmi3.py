@@ -36,13 +36,21 @@ def test_description_is_the_fmi2_one_in_fmi3_terms(fmu, fmu3):
     fmi2, fmi3 = read_model_description(str(fmu)), read_model_description(str(fmu3))
     assert fmi3.fmiVersion == "3.0" and fmi3.instantiationToken == fmi2.guid
     variables = {v.name: v for v in fmi3.modelVariables}
-    assert (variables["time"].causality, variables["time"].valueReference, variables["time"].unit) == \
-        ("independent", TIME, "s")
+    assert (variables["time"].causality, variables["time"].valueReference, variables["time"].unit) == (
+        "independent",
+        TIME,
+        "s",
+    )
     for old in fmi2.modelVariables:
         new = variables[old.name]
-        assert (new.type, new.valueReference, new.causality, new.variability, new.unit, new.start) == \
-            ({"Real": "Float64"}.get(old.type, old.type), old.valueReference, old.causality, old.variability,
-             old.unit, old.start)
+        assert (new.type, new.valueReference, new.causality, new.variability, new.unit, new.start) == (
+            {"Real": "Float64"}.get(old.type, old.type),
+            old.valueReference,
+            old.causality,
+            old.variability,
+            old.unit,
+            old.start,
+        )
     assert variables["omega"].derivative is variables["theta"]
     assert variables["alpha"].derivative is variables["omega"]
     assert [u.variable.name for u in fmi3.outputs] == ["theta", "omega", "alpha"]
@@ -52,17 +60,25 @@ def test_description_is_the_fmi2_one_in_fmi3_terms(fmu, fmu3):
     root = ET.fromstring(zipfile.ZipFile(fmu3).read("modelDescription.xml"))
     for interface in ("CoSimulation", "ModelExchange"):
         flags = root.find(interface).attrib
-        for flag in ("canGetAndSetFMUState", "canSerializeFMUState", "providesDirectionalDerivatives",
-                     "providesAdjointDerivatives"):
+        for flag in (
+            "canGetAndSetFMUState",
+            "canSerializeFMUState",
+            "providesDirectionalDerivatives",
+            "providesAdjointDerivatives",
+        ):
             assert flags[flag] == "true", (interface, flag)
     flags = root.find("CoSimulation").attrib
-    assert (flags["maxOutputDerivativeOrder"], flags["canHandleVariableCommunicationStepSize"],
-            flags["hasEventMode"]) == ("2", "true", "false")
+    assert (
+        flags["maxOutputDerivativeOrder"],
+        flags["canHandleVariableCommunicationStepSize"],
+        flags["hasEventMode"],
+    ) == ("2", "true", "false")
 
 
 def _exported(binary):
-    symbols = subprocess.run(["nm", "-D", "--defined-only", str(binary)], capture_output=True, text=True,
-                             check=True).stdout.split()
+    symbols = subprocess.run(
+        ["nm", "-D", "--defined-only", str(binary)], capture_output=True, text=True, check=True
+    ).stdout.split()
     return {s for s in symbols if s.startswith("fmi")}, symbols
 
 
@@ -84,8 +100,13 @@ def test_archive_holds_fmi3_binary_and_build_description(fmu3, tmp_path):
 def test_build_command_writes_the_fmi3_fmu(tmp_path, capsys):
     assert main(["build", "--fmi-version", "3", "--output", str(tmp_path / "P3.fmu")]) == 0
     assert read_model_description(str(tmp_path / "P3.fmu")).fmiVersion == "3.0"
-    assert subprocess.run([sys.executable, "build_fmu.py", "--fmi-version", "3", "--output",
-                           str(tmp_path / "B3.fmu")], cwd=MODEL_DESCRIPTION.parent).returncode == 0
+    assert (
+        subprocess.run(
+            [sys.executable, "build_fmu.py", "--fmi-version", "3", "--output", str(tmp_path / "B3.fmu")],
+            cwd=MODEL_DESCRIPTION.parent,
+        ).returncode
+        == 0
+    )
     assert read_model_description(str(tmp_path / "B3.fmu")).fmiVersion == "3.0"
 
 
@@ -96,7 +117,10 @@ def test_co_simulation_gives_exactly_the_fmi2_numbers(fmu, fmu3, gravity):
         ours = simulate(torque, stop_time=3.0, parameters={"gravity": gravity}, fmu_path=fmu3)
         theirs = simulate(torque, stop_time=3.0, parameters={"gravity": gravity}, fmu_path=fmu)
         assert np.array_equal(ours, theirs)
-    assert np.max(np.abs(ours["theta"] - reference(torque, stop_time=3.0, parameters={"gravity": gravity})["theta"])) < 1e-10
+    assert (
+        np.max(np.abs(ours["theta"] - reference(torque, stop_time=3.0, parameters={"gravity": gravity})["theta"]))
+        < 1e-10
+    )
 
 
 def test_variable_steps_match_fmi2_and_scipy(fmu, fmu3):
@@ -165,8 +189,12 @@ def test_output_derivatives_follow_the_equation(fmu3):
 def _model(fmu_path, version, tmp_path):
     description = read_model_description(str(fmu_path))
     kind = FMU3Model if version == 3 else FMU2Model
-    model = kind(guid=description.guid, unzipDirectory=extract(str(fmu_path), unzipdir=tmp_path),
-                 modelIdentifier="Pendulum", instanceName="jacobian")
+    model = kind(
+        guid=description.guid,
+        unzipDirectory=extract(str(fmu_path), unzipdir=tmp_path),
+        modelIdentifier="Pendulum",
+        instanceName="jacobian",
+    )
     model.instantiate()
     if version == 3:
         model.enterInitializationMode()
@@ -200,15 +228,15 @@ def test_directional_derivatives_match_finite_differences(fmu, fmu3, tmp_path, v
         return np.array(derivatives)
 
     h = 1e-6
-    finite = np.array([(f({**point, k: point[k] + h}) - f({**point, k: point[k] - h})) / (2 * h)
-                       for k in knowns]).T
+    finite = np.array([(f({**point, k: point[k] + h}) - f({**point, k: point[k] - h})) / (2 * h) for k in knowns]).T
     f(point)
     analytic = np.array([model.getDirectionalDerivative(unknowns, knowns, list(seed)) for seed in np.eye(3)]).T
     assert np.allclose(analytic, finite, rtol=1e-8, atol=1e-9)
     # A seed that mixes all knowns gives J @ seed.
     seed = np.array([0.3, -1.2, 2.5])
-    assert np.allclose(model.getDirectionalDerivative(unknowns, knowns, list(seed)), analytic @ seed,
-                       rtol=1e-15, atol=1e-15)
+    assert np.allclose(
+        model.getDirectionalDerivative(unknowns, knowns, list(seed)), analytic @ seed, rtol=1e-15, atol=1e-15
+    )
     if version == 3:
         for weights in np.eye(2):
             adjoint = model.getAdjointDerivative(unknowns, knowns, list(weights), nSensitivity=3)
@@ -220,8 +248,15 @@ def test_directional_derivatives_match_finite_differences(fmu, fmu3, tmp_path, v
 @pytest.mark.parametrize("gravity", [0.0, 9.81])
 def test_model_exchange_cvode_at_default_tolerance_within_1e6_of_scipy(fmu3, gravity):
     torque = np.array([(0.0, 20.0), (3.0, 20.0)], dtype=[("time", "f8"), ("torque", "f8")])
-    result = simulate_fmu(str(fmu3), fmi_type="ModelExchange", stop_time=3.0, output_interval=1e-3,
-                          start_values={"gravity": gravity}, input=torque, output=["theta"])
+    result = simulate_fmu(
+        str(fmu3),
+        fmi_type="ModelExchange",
+        stop_time=3.0,
+        output_interval=1e-3,
+        start_values={"gravity": gravity},
+        input=torque,
+        output=["theta"],
+    )
     expected = reference(20.0, stop_time=3.0, parameters={"gravity": gravity})
     assert np.allclose(result["time"], expected["time"], rtol=0, atol=1e-12)
     assert np.max(np.abs(result["theta"] - expected["theta"])) < 1e-6
@@ -229,8 +264,7 @@ def test_model_exchange_cvode_at_default_tolerance_within_1e6_of_scipy(fmu3, gra
 
 def test_fmpy_validate_on_the_command_line(fmu3):
     """fmpy simulate on the command line: tests/test_fmu.py runs it on both FMUs."""
-    validated = subprocess.run([sys.executable, "-m", "fmpy", "validate", str(fmu3)],
-                               capture_output=True, text=True)
+    validated = subprocess.run([sys.executable, "-m", "fmpy", "validate", str(fmu3)], capture_output=True, text=True)
     assert validated.returncode == 0, validated.stdout + validated.stderr
     assert "No problems found" in validated.stdout, validated.stdout
 
@@ -246,7 +280,12 @@ def test_compare_and_sweep_take_the_fmi3_fmu(fmu, fmu3, tmp_path):
     assert np.array_equal(runs["fmu"], run_tools(plan, ("fmu",), fmu_path=fmu)["fmu"])
     assert np.max(np.abs(runs["fmu"]["theta"] - runs["reference"]["theta"])) < 1e-10
     cases = [{"torque": 10.0, "gravity": 0.0}, {"torque": 40.0, "gravity": 9.81}]
-    tables = [pq.read_table(run_sweep(Study(cases, stop_time=1.0, fmu_path=path), output_dir=tmp_path / name,
-                                      workers=1, progress=False).trajectories).sort_by("case")
-              for name, path in (("fmi3", fmu3), ("fmi2", fmu))]
+    tables = [
+        pq.read_table(
+            run_sweep(
+                Study(cases, stop_time=1.0, fmu_path=path), output_dir=tmp_path / name, workers=1, progress=False
+            ).trajectories
+        ).sort_by("case")
+        for name, path in (("fmi3", fmu3), ("fmi2", fmu))
+    ]
     assert tables[0].equals(tables[1]) and tables[0].num_rows == 2 * 1001

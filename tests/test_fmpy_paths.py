@@ -21,8 +21,22 @@ def write(path, rows):
 
 
 def fmpy_command_line(fmu, csv, out, *extra):
-    subprocess.run([sys.executable, "-m", "fmpy", "simulate", str(fmu), "--input-file", str(csv),
-                    "--output-file", str(out), *extra], check=True, capture_output=True)
+    subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "fmpy",
+            "simulate",
+            str(fmu),
+            "--input-file",
+            str(csv),
+            "--output-file",
+            str(out),
+            *extra,
+        ],
+        check=True,
+        capture_output=True,
+    )
     result = np.genfromtxt(out, delimiter=",", names=True)
     # fmpy records both sides of an input event at the same time: keep the first of each time.
     return result[np.unique(result["time"], return_index=True)[1]]
@@ -38,8 +52,9 @@ def test_both_command_lines_agree_on_decimal_jumps_at_awkward_steps(request, fix
     # fmpy snaps input events to the grid (math.isclose), so 3 * 0.009 meets the jump at 0.027;
     # the FMI 2.0 and 3.0 FMUs alike (fmpy passes the description's default tolerance, 1e-8).
     csv = write(tmp_path / "j.csv", [(0, 10), (0.027, 10), (0.027, -20), (0.5, -20), (0.5, 15), (2, 15)])
-    fmpy_run = fmpy_command_line(request.getfixturevalue(fixture), csv, tmp_path / "fmpy.csv",
-                                 "--output-interval", "0.009", "--stop-time", "2")
+    fmpy_run = fmpy_command_line(
+        request.getfixturevalue(fixture), csv, tmp_path / "fmpy.csv", "--output-interval", "0.009", "--stop-time", "2"
+    )
     assert error_against_oracle(fmpy_run, csv, step_size=0.009, stop_time=2) < 1e-9
     ours = simulate(csv, step_size=0.009, fmu_path=fmu)
     assert error_against_oracle(ours, csv, step_size=0.009) < 1e-9
@@ -49,8 +64,7 @@ def test_fmpy_misreads_a_first_row_jump(fmu, tmp_path):
     # fmpy holds the first row's value when t equals the first time, so a jump in the first two
     # rows is applied one step late; pendulum-fmu applies the value after the jump.
     csv = write(tmp_path / "j.csv", [(0, 0), (0, 20), (1, 20)])
-    fmpy_run = fmpy_command_line(fmu, csv, tmp_path / "fmpy.csv", "--output-interval", "0.001",
-                                 "--stop-time", "1")
+    fmpy_run = fmpy_command_line(fmu, csv, tmp_path / "fmpy.csv", "--output-interval", "0.001", "--stop-time", "1")
     assert error_against_oracle(fmpy_run, csv, step_size=1e-3, stop_time=1) > 1e-4
     ours = simulate(csv, step_size=1e-3, fmu_path=fmu)
     assert error_against_oracle(ours, csv, step_size=1e-3) < 1e-9
@@ -65,10 +79,8 @@ def test_default_stop_time_differs(fmu, tmp_path):
 
 
 def test_simulate_fmu_holds_each_steps_start_value(fmu, tmp_path):
-    signals = np.array([(0.0, 10.0), (0.3, 10.0), (0.3, -5.0), (1.0, -5.0)],
-                       dtype=[("time", float), ("torque", float)])
-    result = simulate_fmu(str(fmu), input=signals, output_interval=1e-3, stop_time=1.0,
-                          output=["theta"])
+    signals = np.array([(0.0, 10.0), (0.3, 10.0), (0.3, -5.0), (1.0, -5.0)], dtype=[("time", float), ("torque", float)])
+    result = simulate_fmu(str(fmu), input=signals, output_interval=1e-3, stop_time=1.0, output=["theta"])
     result = result[np.unique(result["time"], return_index=True)[1]]
     csv = write(tmp_path / "s.csv", signals.tolist())
     assert error_against_oracle(result, csv, step_size=1e-3, stop_time=1.0) < 1e-9
@@ -80,5 +92,4 @@ def test_simulate_fmu_cannot_set_input_derivatives_on_a_one_input_fmu(fmu):
     # The bug is fmpy's, not our model description's; `pendulum-fmu simulate --ramp` ramps.
     signals = np.array([(0.0, 0.0), (1.0, 10.0)], dtype=[("time", float), ("torque", float)])
     with pytest.raises(ValueError, match="Can only assign sequence of same size"):
-        simulate_fmu(str(fmu), input=signals, output_interval=1e-2, stop_time=1.0,
-                     set_input_derivatives=True)
+        simulate_fmu(str(fmu), input=signals, output_interval=1e-2, stop_time=1.0, set_input_derivatives=True)

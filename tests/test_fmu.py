@@ -30,7 +30,16 @@ def test_every_variable_has_unit_and_description(fmu):
         assert variable.unit or variable.type == "String", variable.name
     experiment = description.defaultExperiment
     assert (float(experiment.startTime), float(experiment.stopTime), float(experiment.stepSize)) == (0, 3, 1e-3)
-    assert {u.name for u in description.unitDefinitions} >= {"rad", "rad/s", "rad/s2", "N.m", "kg", "m", "kg.m2", "m/s2"}
+    assert {u.name for u in description.unitDefinitions} >= {
+        "rad",
+        "rad/s",
+        "rad/s2",
+        "N.m",
+        "kg",
+        "m",
+        "kg.m2",
+        "m/s2",
+    }
 
 
 def test_archive_holds_binary_sources_and_documentation(fmu, tmp_path):
@@ -41,8 +50,12 @@ def test_archive_holds_binary_sources_and_documentation(fmu, tmp_path):
         archive.extract("binaries/linux64/Pendulum.so", tmp_path)
     assert "documentation/index.html" in names
     assert {f"sources/{name}" for name in listed} <= names
-    symbols = subprocess.run(["nm", "-D", "--defined-only", str(tmp_path / "binaries/linux64/Pendulum.so")],
-                             capture_output=True, text=True, check=True).stdout.split()
+    symbols = subprocess.run(
+        ["nm", "-D", "--defined-only", str(tmp_path / "binaries/linux64/Pendulum.so")],
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout.split()
     exported = [s for s in symbols if s.startswith(("fmi", "_")) or s.isidentifier() and len(s) > 1]
     names_exported = {s for s in exported if not set(s) <= set("0123456789abcdef")}
     assert names_exported and all(name.startswith("fmi2") for name in names_exported), names_exported
@@ -87,8 +100,7 @@ def test_torque_held_per_step_from_a_callable(fmu):
 
 def test_ramped_torque_is_the_exact_cubic(fmu):
     # Gravity off, torque ramping u(t) = 5 + 10 t: theta = (5 t^2 / 2 + 10 t^3 / 6) / I_total.
-    result = simulate(lambda t: 5 + 10 * t, step_size=0.05, ramp=True, parameters={"gravity": 0},
-                      fmu_path=fmu)
+    result = simulate(lambda t: 5 + 10 * t, step_size=0.05, ramp=True, parameters={"gravity": 0}, fmu_path=fmu)
     t = result["time"]
     assert np.max(np.abs(result["theta"] - (2.5 * t**2 + 10 * t**3 / 6) / I_TOTAL)) < 1e-12
     assert np.max(np.abs(result["torque"] - (5 + 10 * t))) < 1e-12
@@ -161,6 +173,7 @@ def _stepper(fmu, **kwargs):
             slave.doStep(t0 + k * h, h)
             out.append(slave.getReal([THETA, OMEGA, ALPHA]))
         return np.array(out)
+
     return slave, run
 
 
@@ -198,8 +211,12 @@ def test_two_instances_are_independent(fmu):
         interleaved_b.append(run_b(k * 1e-3, 1, torque=-50.0)[0])
     _, alone_a = _stepper(fmu, instance_name="a alone")
     _, alone_b = _stepper(fmu, instance_name="b alone", parameters={"damping": 3.0})
-    assert np.array_equal(np.array(interleaved_a), np.array([alone_a(k * 1e-3, 1, torque=20.0)[0] for k in range(3000)]))
-    assert np.array_equal(np.array(interleaved_b), np.array([alone_b(k * 1e-3, 1, torque=-50.0)[0] for k in range(3000)]))
+    assert np.array_equal(
+        np.array(interleaved_a), np.array([alone_a(k * 1e-3, 1, torque=20.0)[0] for k in range(3000)])
+    )
+    assert np.array_equal(
+        np.array(interleaved_b), np.array([alone_b(k * 1e-3, 1, torque=-50.0)[0] for k in range(3000)])
+    )
     assert not np.array_equal(np.array(interleaved_a), np.array(interleaved_b))
 
 

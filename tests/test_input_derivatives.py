@@ -54,27 +54,38 @@ def test_orders_above_two_are_ignored_with_one_message(fmu):
         slave = open_fmu(fmu)
         for k in range(20):
             status = slave.fmi2SetRealInputDerivatives(
-                slave.component, *_arrays([TORQUE] * len(orders), orders, [3.0, 1.0, 50.0, -7.0][:len(orders)]))
+                slave.component, *_arrays([TORQUE] * len(orders), orders, [3.0, 1.0, 50.0, -7.0][: len(orders)])
+            )
             assert status == (WARNING if k == 0 and len(orders) > 2 else 0)
             slave.doStep(k * 1e-2, 1e-2)
         runs.append(slave.getReal([THETA, OMEGA]))
         ignored = [line for line in slave.messages.lines if "ignored" in line]
         _finish(slave)
     assert runs[0] == runs[1], "orders 3 and 4 must not change the result"
-    assert ignored == ["[WARNING] fmi2SetRealInputDerivatives: order 3 for torque ignored: inputs follow "
-                       "their first and second derivatives only (logged once per instance)"]
+    assert ignored == [
+        "[WARNING] fmi2SetRealInputDerivatives: order 3 for torque ignored: inputs follow "
+        "their first and second derivatives only (logged once per instance)"
+    ]
 
 
 def _arrays(references, orders, values):
     n = len(references)
-    return ((ctypes.c_uint * n)(*references), ctypes.c_size_t(n), (ctypes.c_int * n)(*orders),
-            (ctypes.c_double * n)(*values))
+    return (
+        (ctypes.c_uint * n)(*references),
+        ctypes.c_size_t(n),
+        (ctypes.c_int * n)(*orders),
+        (ctypes.c_double * n)(*values),
+    )
 
 
 def _controller(path):
     folder, description = _unzipped(path)
-    slave = FMU2Slave(guid=description.guid, unzipDirectory=folder, instanceName="controller",
-                      modelIdentifier=description.coSimulation.modelIdentifier)
+    slave = FMU2Slave(
+        guid=description.guid,
+        unzipDirectory=folder,
+        instanceName="controller",
+        modelIdentifier=description.coSimulation.modelIdentifier,
+    )
     slave.messages = MessageLog()
     slave.instantiate(callbacks=slave.messages.callbacks)
     slave.setupExperiment(startTime=0.0)
@@ -117,8 +128,11 @@ def _loop_with_exact_integral(stop_time, h):
     theta = [0.0]
     for _ in range(int(round(stop_time / h))):
         torque = gains["kp"] * (gains["setpoint"] - state[0]) + gains["ki"] * state[2] - gains["kd"] * state[1]
-        rhs = lambda t, y, u=torque: (y[1], (u - gravity_moment * np.sin(y[0])) * inverse_inertia,  # noqa: E731
-                                      gains["setpoint"] - y[0])
+        rhs = lambda t, y, u=torque: (
+            y[1],
+            (u - gravity_moment * np.sin(y[0])) * inverse_inertia,  # noqa: E731
+            gains["setpoint"] - y[0],
+        )
         state = solve_ivp(rhs, (0.0, h), state, method="DOP853", rtol=1e-12, atol=1e-12).y[:, -1]
         theta.append(state[0])
     return np.array(theta)

@@ -15,8 +15,13 @@ STEPS = 1_000_000  # several seconds even on a fast machine: writing 1e6 rows ta
 
 
 def start(arguments, folder):
-    return subprocess.Popen([sys.executable, "-m", "pendulum_fmu", *arguments], cwd=folder,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    return subprocess.Popen(
+        [sys.executable, "-m", "pendulum_fmu", *arguments],
+        cwd=folder,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
 
 
 def check_target(target, complete_rows):
@@ -28,16 +33,19 @@ def check_target(target, complete_rows):
     assert sorted(p.name for p in target.parent.iterdir()) == [target.name]
 
 
-@pytest.mark.parametrize("signal_number, exit_code, word", [
-    (signal.SIGINT, 130, "interrupted"), (signal.SIGTERM, 143, "terminated")])
+@pytest.mark.parametrize(
+    "signal_number, exit_code, word", [(signal.SIGINT, 130, "interrupted"), (signal.SIGTERM, 143, "terminated")]
+)
 @pytest.mark.parametrize("delay", [1.5, 3.0, 6.0])
 def test_simulate_output_survives_a_signal(tmp_path, signal_number, exit_code, word, delay):
     out = tmp_path / "out"
     out.mkdir()
     target = out / "result.csv"
     target.write_text(OLD)
-    process = start(["simulate", "--torque", "1", "--step-size", str(1 / STEPS), "--stop-time", "1",
-                     "--output", str(target)], tmp_path)
+    process = start(
+        ["simulate", "--torque", "1", "--step-size", str(1 / STEPS), "--stop-time", "1", "--output", str(target)],
+        tmp_path,
+    )
     time.sleep(delay)
     process.send_signal(signal_number)
     _, stderr = process.communicate(timeout=120)
@@ -52,8 +60,22 @@ def test_simulate_output_survives_a_signal(tmp_path, signal_number, exit_code, w
 
 def test_compare_outputs_survive_ctrl_c(tmp_path):
     out = tmp_path / "out"
-    process = start(["compare", "--torque", "20", "--tools", "fmu,reference", "--step-size", "1e-5",
-                     "--stop-time", "2", "--output-dir", str(out)], tmp_path)
+    process = start(
+        [
+            "compare",
+            "--torque",
+            "20",
+            "--tools",
+            "fmu,reference",
+            "--step-size",
+            "1e-5",
+            "--stop-time",
+            "2",
+            "--output-dir",
+            str(out),
+        ],
+        tmp_path,
+    )
     time.sleep(4.0)
     os.kill(process.pid, signal.SIGINT)
     _, stderr = process.communicate(timeout=120)
@@ -68,9 +90,12 @@ def test_ctrl_c_while_the_program_starts_is_one_line_too(tmp_path, delay):
     # The installed program sets its handlers before it imports numpy, fmpy or dask. Before its
     # first line only Python's own start-up runs (tens of milliseconds, out of our reach).
     program = os.path.join(os.path.dirname(sys.executable), "pendulum-fmu")
-    process = subprocess.Popen([program, "simulate", "--torque", "1", "--stop-time", "0.5",
-                                "--output", str(tmp_path / "out.csv")],
-                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    process = subprocess.Popen(
+        [program, "simulate", "--torque", "1", "--stop-time", "0.5", "--output", str(tmp_path / "out.csv")],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     time.sleep(delay)
     process.send_signal(signal.SIGINT)
     _, stderr = process.communicate(timeout=120)
@@ -107,6 +132,5 @@ restore_signals(previous)
 def test_a_signal_whose_handler_runs_in_a_gc_callback_still_stops_the_command():
     # Python prints an exception raised in a garbage collector's callback as "Exception ignored"
     # and goes on: a Ctrl-C that came there must still stop the command, with nothing printed.
-    run = subprocess.run([sys.executable, "-c", HANDLER_IN_A_GC_CALLBACK], capture_output=True,
-                         text=True, timeout=60)
+    run = subprocess.run([sys.executable, "-c", HANDLER_IN_A_GC_CALLBACK], capture_output=True, text=True, timeout=60)
     assert (run.stdout, run.stderr) == (f"stopped by {int(signal.SIGINT)}\n", "")

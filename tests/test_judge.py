@@ -10,9 +10,22 @@ import pytest
 
 from benchmarks.masters import WRONG_MASTERS, run
 from pendulum_fmu.cli import main
-from pendulum_fmu.judge import (AGREES, DRIFT, EARLY, EXPLAINS, HELD, INTEGRATION,
-                                INTEGRATION_SMALL, INTERPOLATED, LATE, NOT_RESTORED, UNEXPLAINED,
-                                ResultFileError, judge, read_result)
+from pendulum_fmu.judge import (
+    AGREES,
+    DRIFT,
+    EARLY,
+    EXPLAINS,
+    HELD,
+    INTEGRATION,
+    INTEGRATION_SMALL,
+    INTERPOLATED,
+    LATE,
+    NOT_RESTORED,
+    UNEXPLAINED,
+    ResultFileError,
+    judge,
+    read_result,
+)
 from pendulum_fmu.parameters import total_inertia
 from pendulum_fmu.plot import _log_difference
 from pendulum_fmu.scenarios import KIT_FMU, read_settings, write_scenarios
@@ -30,8 +43,7 @@ def _judged(kit, name, **changes):
     return judge(kit / settings.pop("output"), **settings)
 
 
-@pytest.mark.parametrize(("name", "mistake", "expected"), WRONG_MASTERS,
-                         ids=[f"{n}-{m}" for n, m, _ in WRONG_MASTERS])
+@pytest.mark.parametrize(("name", "mistake", "expected"), WRONG_MASTERS, ids=[f"{n}-{m}" for n, m, _ in WRONG_MASTERS])
 def test_a_wrong_master_is_diagnosed_as_made(kit, name, mistake, expected):
     run(kit, name, mistake)
     judgement = _judged(kit, name)
@@ -64,10 +76,16 @@ def test_the_diagnosed_variant_holds_at_fewer_points_than_steps(kit):
 def test_the_analytic_parabola_passes_under_other_names_and_units(tmp_path):
     """Gravity off: theta = tau t^2 / (2 I); written in ms and degrees, read through --map."""
     t = np.linspace(0, 3, 301)
-    theta = 20.0 / (2 * total_inertia({"mass": 40.0, "length": 0.5, "inertia": 20.0})) * t ** 2
+    theta = 20.0 / (2 * total_inertia({"mass": 40.0, "length": 0.5, "inertia": 20.0})) * t**2
     result = tmp_path / "theirs.csv"
-    np.savetxt(result, np.column_stack([t * 1000, np.degrees(theta)]), delimiter=",",
-               header="t_ms,phi_deg", comments="", fmt="%.17g")
+    np.savetxt(
+        result,
+        np.column_stack([t * 1000, np.degrees(theta)]),
+        delimiter=",",
+        header="t_ms,phi_deg",
+        comments="",
+        fmt="%.17g",
+    )
     mapping = "time=t_ms*0.001,theta=phi_deg*0.017453292519943295"
     judgement = judge(result, 20.0, step_size=0.01, parameters={"gravity": 0.0}, mapping=mapping)
     assert judgement.passed and judgement.diagnosis == AGREES and judgement.max_abs_dtheta < 1e-12
@@ -81,9 +99,18 @@ def test_the_analytic_parabola_passes_under_other_names_and_units(tmp_path):
 
 def test_the_command_exits_0_on_pass_and_1_on_fail_and_writes_json_and_plot(kit, tmp_path, capsys):
     run(kit, "decimal_steps", "late")
-    arguments = ["judge", str(kit / "decimal_steps_out.csv"),
-                 "--torque-file", str(kit / "decimal_steps_in.csv"),
-                 "--step-size", "0.009", "--json", str(tmp_path / "j.json"), "--plot", str(tmp_path / "j.png")]
+    arguments = [
+        "judge",
+        str(kit / "decimal_steps_out.csv"),
+        "--torque-file",
+        str(kit / "decimal_steps_in.csv"),
+        "--step-size",
+        "0.009",
+        "--json",
+        str(tmp_path / "j.json"),
+        "--plot",
+        str(tmp_path / "j.png"),
+    ]
     assert main(arguments) == 1
     out = capsys.readouterr().out
     assert out.startswith(f"{kit / 'decimal_steps_out.csv'}: fail: {LATE} (residual ")
@@ -134,12 +161,18 @@ def test_bad_result_files_get_one_line(tmp_path):
         judge(tmp_path / "bad.csv", 1.0)
 
 
-@pytest.mark.parametrize(("rows", "options", "message"), [
-    ("0,0\n", {}, "the result ends at 0 s, before the run's stop time 3 s, so it covers only part of the run"),
-    ("0,0\n0.001,0\n", {"start_time": -1.0, "stop_time": 0.001},
-     "the result starts at 0 s, not at the run's start time -1 s"),
-    ("0.001,0\n0.002,0\n", {"stop_time": 0.002}, "the result starts at 0.001 s, not at the run's start time 0 s"),
-])
+@pytest.mark.parametrize(
+    ("rows", "options", "message"),
+    [
+        ("0,0\n", {}, "the result ends at 0 s, before the run's stop time 3 s, so it covers only part of the run"),
+        (
+            "0,0\n0.001,0\n",
+            {"start_time": -1.0, "stop_time": 0.001},
+            "the result starts at 0 s, not at the run's start time -1 s",
+        ),
+        ("0.001,0\n0.002,0\n", {"stop_time": 0.002}, "the result starts at 0.001 s, not at the run's start time 0 s"),
+    ],
+)
 def test_a_result_of_part_of_the_run_is_refused(tmp_path, rows, options, message):
     """Wherever it has rows such a result agrees with the reference (theta 0 at t = 0 from rest):
     judged, it would pass a run that never happened."""
@@ -175,8 +208,14 @@ def test_fmpy_applying_a_jump_in_the_first_two_rows_late_is_diagnosed(fmu, tmp_p
     signal = np.array([(0.0, 0.0), (0.0, 20.0), (1.0, 20.0)], dtype=[("time", "f8"), ("torque", "f8")])
     fmpy_run = simulate_fmu(str(fmu), stop_time=1.0, output_interval=1e-3, input=signal, output=["theta"])
     result = tmp_path / "fmpy.csv"
-    np.savetxt(result, np.column_stack([fmpy_run["time"], fmpy_run["theta"]]), delimiter=",", header="time,theta",
-               comments="", fmt="%.17g")
+    np.savetxt(
+        result,
+        np.column_stack([fmpy_run["time"], fmpy_run["theta"]]),
+        delimiter=",",
+        header="time,theta",
+        comments="",
+        fmt="%.17g",
+    )
     (tmp_path / "jump.csv").write_text("time,torque\n0,0\n0,20\n1,20\n")
     judgement = judge(result, tmp_path / "jump.csv", fmu_path=fmu)
     assert judgement.diagnosis == LATE and judgement.residual < 1e-10 < 1e-4 < judgement.max_abs_dtheta
@@ -190,10 +229,24 @@ def test_fmpy_model_exchange_solvers_are_integration_errors(kit, solver):
     from fmpy import simulate_fmu
 
     signal = np.genfromtxt(kit / "constant_torque_in.csv", delimiter=",", names=True)
-    fmpy_run = simulate_fmu(str(kit / KIT_FMU), fmi_type="ModelExchange", solver=solver, step_size=1e-3,
-                        output_interval=1e-3, stop_time=3.0, input=signal, output=["theta"])
-    np.savetxt(kit / "constant_torque_out.csv", np.column_stack([fmpy_run["time"], fmpy_run["theta"]]),
-               delimiter=",", header="time,theta", comments="", fmt="%.17g")
+    fmpy_run = simulate_fmu(
+        str(kit / KIT_FMU),
+        fmi_type="ModelExchange",
+        solver=solver,
+        step_size=1e-3,
+        output_interval=1e-3,
+        stop_time=3.0,
+        input=signal,
+        output=["theta"],
+    )
+    np.savetxt(
+        kit / "constant_torque_out.csv",
+        np.column_stack([fmpy_run["time"], fmpy_run["theta"]]),
+        delimiter=",",
+        header="time,theta",
+        comments="",
+        fmt="%.17g",
+    )
     judgement = _judged(kit, "constant_torque")
     assert judgement.verdict == "fail" and judgement.diagnosis == INTEGRATION
     if solver == "Euler":

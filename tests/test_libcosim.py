@@ -51,19 +51,24 @@ def test_override_manipulator_and_observer_match_the_reference(fmu):
 def test_two_slaves_close_the_loop_through_connections(fmu, tmp_path):
     controller_fmu = build_pid_controller(tmp_path / "PIDController.fmu")
     execution = CosimExecution.from_step_size(step_size=STEP_NS)
-    slaves = {"pendulum": execution.add_local_slave(CosimLocalSlave(fmu_path=str(fmu), instance_name="pendulum")),
-              "controller": execution.add_local_slave(CosimLocalSlave(fmu_path=str(controller_fmu),
-                                                                      instance_name="controller"))}
+    slaves = {
+        "pendulum": execution.add_local_slave(CosimLocalSlave(fmu_path=str(fmu), instance_name="pendulum")),
+        "controller": execution.add_local_slave(
+            CosimLocalSlave(fmu_path=str(controller_fmu), instance_name="controller")
+        ),
+    }
     vr = {"pendulum": _references(fmu), "controller": _references(controller_fmu)}
     for source, output, target, into in WIRES:
         execution.connect_real_variables(slaves[source], vr[source][output], slaves[target], vr[target][into])
     series = CosimObserver.create_time_series()
     execution.add_observer(series)
-    series.start_time_series(slaves["pendulum"], value_reference=vr["pendulum"]["theta"],
-                             variable_type=CosimVariableType.REAL)
+    series.start_time_series(
+        slaves["pendulum"], value_reference=vr["pendulum"]["theta"], variable_type=CosimVariableType.REAL
+    )
     assert execution.simulate_until(target_time=4 * 10**9)
-    times, _, theta = series.time_series_real_samples(slaves["pendulum"], vr["pendulum"]["theta"],
-                                                      from_step=0, sample_count=4001)
+    times, _, theta = series.time_series_real_samples(
+        slaves["pendulum"], vr["pendulum"]["theta"], from_step=0, sample_count=4001
+    )
     # libcosim hands the controller's torque over one step after the theta it came from.
     expected = sampled_loop_reference(stop_time=4.0, coupling="jacobi")
     index = np.rint(np.array(times) / STEP_NS).astype(int)

@@ -20,9 +20,17 @@ def _states(*values):
 @pytest.mark.parametrize("gravity", [0.0, 9.81])
 def test_cvode_agrees_with_co_simulation(fmu, gravity):
     torque = np.array([(0.0, 20.0), (3.0, 20.0)], dtype=[("time", "f8"), ("torque", "f8")])
-    me = simulate_fmu(str(fmu), fmi_type="ModelExchange", solver="CVode", relative_tolerance=1e-10,
-                      stop_time=3.0, output_interval=1e-3, start_values={"gravity": gravity},
-                      input=torque, output=["theta", "omega"])
+    me = simulate_fmu(
+        str(fmu),
+        fmi_type="ModelExchange",
+        solver="CVode",
+        relative_tolerance=1e-10,
+        stop_time=3.0,
+        output_interval=1e-3,
+        start_values={"gravity": gravity},
+        input=torque,
+        output=["theta", "omega"],
+    )
     cs = simulate(20.0, parameters={"gravity": gravity}, fmu_path=fmu)
     assert np.allclose(me["time"], cs["time"], rtol=0, atol=1e-12)
     assert np.max(np.abs(me["theta"] - cs["theta"])) < 1e-8
@@ -31,8 +39,12 @@ def test_cvode_agrees_with_co_simulation(fmu, gravity):
 @pytest.fixture
 def model(fmu, tmp_path):
     description = read_model_description(str(fmu))
-    model = FMU2Model(guid=description.guid, unzipDirectory=extract(str(fmu), unzipdir=tmp_path),
-                      modelIdentifier="Pendulum", instanceName="me")
+    model = FMU2Model(
+        guid=description.guid,
+        unzipDirectory=extract(str(fmu), unzipdir=tmp_path),
+        modelIdentifier="Pendulum",
+        instanceName="me",
+    )
     model.instantiate()
     model.setupExperiment(startTime=0.0)
     model.enterInitializationMode()

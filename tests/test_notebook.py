@@ -32,12 +32,17 @@ def test_engines_notebook_runs_with_the_tools_installed(tmp_path):
     settings.source = settings.source.replace("STOP_TIME = 3.0", "STOP_TIME = 0.3")
     # OpenSim, the slowest and tested elsewhere, is hidden as if it were not installed, so the
     # skip note is checked too.
-    notebook.cells.insert(1, nbformat.v4.new_code_cell(
-        "import pendulum_fmu.compare_tools\n"
-        "_installed = pendulum_fmu.compare_tools.installed\n"
-        "pendulum_fmu.compare_tools.installed = lambda name: name != 'opensim' and _installed(name)"))
-    nbclient.NotebookClient(notebook, timeout=600, kernel_name="python3",
-                            resources={"metadata": {"path": str(tmp_path)}}).execute()
+    notebook.cells.insert(
+        1,
+        nbformat.v4.new_code_cell(
+            "import pendulum_fmu.compare_tools\n"
+            "_installed = pendulum_fmu.compare_tools.installed\n"
+            "pendulum_fmu.compare_tools.installed = lambda name: name != 'opensim' and _installed(name)"
+        ),
+    )
+    nbclient.NotebookClient(
+        notebook, timeout=600, kernel_name="python3", resources={"metadata": {"path": str(tmp_path)}}
+    ).execute()
     text = outputs_text(notebook)
     assert float(re.search(r"reference vs the parabola: (\S+) rad", text)[1]) < 1e-12
     for name in KINDS:
@@ -47,5 +52,4 @@ def test_engines_notebook_runs_with_the_tools_installed(tmp_path):
             assert re.search(rf"^\| {name} \| \S+ \| \S+ \|$", text, re.MULTILINE), name
         else:
             assert f"{name} is not installed here, so it is skipped" in text
-    assert any("image/png" in output.get("data", {})
-               for cell in notebook.cells for output in cell.get("outputs", []))
+    assert any("image/png" in output.get("data", {}) for cell in notebook.cells for output in cell.get("outputs", []))

@@ -17,8 +17,9 @@ except ImportError as error:
 
 @pytest.mark.parametrize("gravity", [0.0, 9.81])
 def test_tutorial_case_three_tools_agree(fmu, tmp_path, gravity):
-    comparison = compare(20.0, ("fmu", "reference", "opensim"), output_dir=tmp_path,
-                         parameters={"gravity": gravity}, fmu_path=fmu)
+    comparison = compare(
+        20.0, ("fmu", "reference", "opensim"), output_dir=tmp_path, parameters={"gravity": gravity}, fmu_path=fmu
+    )
     assert comparison.worst < 1e-9
     if gravity == 0.0:
         t = comparison.runs["opensim"]["time"]
@@ -28,8 +29,16 @@ def test_tutorial_case_three_tools_agree(fmu, tmp_path, gravity):
 def test_stepwise_signal_with_damping_and_start_values(fmu, tmp_path):
     csv = tmp_path / "t.csv"
     csv.write_text("time,torque\n0,20\n0.4,20\n0.4,-15\n1.2345,-15\n1.2345,40\n2,40\n2,0\n3,0\n")
-    comparison = compare(csv, ("fmu", "reference", "opensim"), output_dir=tmp_path, step_size=2.5e-3,
-                         parameters={"damping": 2.0}, theta0=0.5, omega0=-1.0, fmu_path=fmu)
+    comparison = compare(
+        csv,
+        ("fmu", "reference", "opensim"),
+        output_dir=tmp_path,
+        step_size=2.5e-3,
+        parameters={"damping": 2.0},
+        theta0=0.5,
+        omega0=-1.0,
+        fmu_path=fmu,
+    )
     assert comparison.worst < 1e-9
 
 

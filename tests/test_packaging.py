@@ -37,11 +37,13 @@ ENVIRONMENT = {name: value for name, value in os.environ.items() if name != "PYT
 
 
 def _run(command, cwd=None, check=True):
-    result = subprocess.run([str(part) for part in command], cwd=cwd, env=ENVIRONMENT,
-                            capture_output=True, text=True, timeout=600)
+    result = subprocess.run(
+        [str(part) for part in command], cwd=cwd, env=ENVIRONMENT, capture_output=True, text=True, timeout=600
+    )
     if check and result.returncode != 0:
-        raise AssertionError(f"{' '.join(map(str, command))} exited {result.returncode}:\n"
-                             f"{result.stdout}\n{result.stderr}")
+        raise AssertionError(
+            f"{' '.join(map(str, command))} exited {result.returncode}:\n{result.stdout}\n{result.stderr}"
+        )
     return result
 
 
@@ -64,13 +66,22 @@ def installed(request, artefacts, tmp_path_factory):
     venv = tmp_path_factory.mktemp(f"venv_{request.param}")
     _run([sys.executable, "-m", "venv", venv])
     [site_packages] = venv.glob("lib/python*/site-packages")
-    (site_packages / "dependencies_from_the_test_environment.pth").write_text(
-        sysconfig.get_paths()["purelib"] + "\n")
+    (site_packages / "dependencies_from_the_test_environment.pth").write_text(sysconfig.get_paths()["purelib"] + "\n")
     # The sdist builds its wheel (and the FMU in it) here, in pip's isolated build environment.
     # --ignore-installed: the test environment on the .pth path may hold this package itself
     # (a non-editable install), which pip would otherwise take as already satisfied.
-    _run([venv / "bin/python", "-m", "pip", "install", "--no-deps", "--ignore-installed", "--no-cache-dir",
-          artefacts[request.param]])
+    _run(
+        [
+            venv / "bin/python",
+            "-m",
+            "pip",
+            "install",
+            "--no-deps",
+            "--ignore-installed",
+            "--no-cache-dir",
+            artefacts[request.param],
+        ]
+    )
     _run([venv / "bin/python", "-m", "pip", "check"])
     return venv, site_packages
 
@@ -93,19 +104,30 @@ def test_wheel_carries_the_fmu_for_every_platform_built(artefacts, tmp_path):
         # The MIT text pyproject names travels with the wheel (license-files) and the sdist.
         licence = next(name for name in names if name.endswith(".dist-info/licenses/LICENSE"))
         assert wheel.read(licence) == (ROOT / "LICENSE").read_bytes()
-        fmus = {version: zipfile.ZipFile(io.BytesIO(wheel.read(f"pendulum_fmu/data/{name}")))
-                for version, name in FMU_FILES.items()}
+        fmus = {
+            version: zipfile.ZipFile(io.BytesIO(wheel.read(f"pendulum_fmu/data/{name}")))
+            for version, name in FMU_FILES.items()
+        }
     with tarfile.open(artefacts["sdist"]) as sdist:
         [top] = {name.split("/")[0] for name in sdist.getnames()}
         assert sdist.extractfile(f"{top}/LICENSE").read() == (ROOT / "LICENSE").read_bytes()
     # Every platform the docs promise, from this source build (zig, a build requirement, makes macOS's).
     assert {name for name in fmus[2].namelist() if name.startswith("binaries/")} == {
-        "binaries/linux64/Pendulum.so", "binaries/win64/Pendulum.dll", "binaries/aarch64-linux/Pendulum.so",
-        "binaries/darwin64/Pendulum.dylib"}
+        "binaries/linux64/Pendulum.so",
+        "binaries/win64/Pendulum.dll",
+        "binaries/aarch64-linux/Pendulum.so",
+        "binaries/darwin64/Pendulum.dylib",
+    }
     assert {name for name in fmus[3].namelist() if name.startswith("binaries/")} == {
-        f"binaries/{folder}/Pendulum.{suffix}" for folder, suffix in (
-            ("x86_64-linux", "so"), ("x86_64-windows", "dll"), ("aarch64-linux", "so"),
-            ("x86_64-darwin", "dylib"), ("aarch64-darwin", "dylib"))}
+        f"binaries/{folder}/Pendulum.{suffix}"
+        for folder, suffix in (
+            ("x86_64-linux", "so"),
+            ("x86_64-windows", "dll"),
+            ("aarch64-linux", "so"),
+            ("x86_64-darwin", "dylib"),
+            ("aarch64-darwin", "dylib"),
+        )
+    }
     # darwin64 is one universal binary of both Mac slices, as LLVM reads it.
     universal = tmp_path / "Pendulum.dylib"
     universal.write_bytes(fmus[2].read("binaries/darwin64/Pendulum.dylib"))
@@ -120,8 +142,9 @@ def test_installed_package_runs_from_an_empty_folder(installed, tmp_path):
     python, cli = venv / "bin/python", venv / "bin/pendulum-fmu"
 
     assert _run([cli, "--version"], cwd=tmp_path).stdout.strip() == f"pendulum-fmu {__version__}"
-    fmu = Path(_run([python, "-c", "import pendulum_fmu; print(pendulum_fmu.default_fmu())"],
-                    cwd=tmp_path).stdout.strip())
+    fmu = Path(
+        _run([python, "-c", "import pendulum_fmu; print(pendulum_fmu.default_fmu())"], cwd=tmp_path).stdout.strip()
+    )
     assert fmu == package / "data" / "Pendulum.fmu"
     assert read_model_description(str(fmu)).generationTool == f"pendulum_fmu {__version__}"
     _run([python, "-c", "from pendulum_fmu import cs_loop; assert cs_loop.available()"], cwd=tmp_path)
@@ -131,15 +154,36 @@ def test_installed_package_runs_from_an_empty_folder(installed, tmp_path):
     simulated = _csv_columns(tmp_path / "simulated.csv")
     assert np.max(np.abs(simulated["theta"] - expected["theta"])) < 1e-9
 
-    _run([python, "-m", "fmpy", "simulate", fmu, "--start-values", "torque", "20", "--stop-time", "3",
-          "--step-size", "1e-3", "--output-interval", "1e-3", "--output-file", "fmpy.csv"], cwd=tmp_path)
+    _run(
+        [
+            python,
+            "-m",
+            "fmpy",
+            "simulate",
+            fmu,
+            "--start-values",
+            "torque",
+            "20",
+            "--stop-time",
+            "3",
+            "--step-size",
+            "1e-3",
+            "--output-interval",
+            "1e-3",
+            "--output-file",
+            "fmpy.csv",
+        ],
+        cwd=tmp_path,
+    )
     by_fmpy = _csv_columns(tmp_path / "fmpy.csv")
     assert np.allclose(by_fmpy["time"], expected["time"], rtol=0, atol=1e-12)
     assert np.max(np.abs(by_fmpy["theta"] - expected["theta"])) < 1e-9
 
     _run([cli, "compare", "--torque", "20", "--tools", "fmu,reference", "--output-dir", "compared"], cwd=tmp_path)
-    _run([cli, "sweep", "--torque", "5", "10", "--stop-time", "0.5", "--workers", "1",
-          "--output-dir", "swept"], cwd=tmp_path)
+    _run(
+        [cli, "sweep", "--torque", "5", "10", "--stop-time", "0.5", "--workers", "1", "--output-dir", "swept"],
+        cwd=tmp_path,
+    )
     assert (tmp_path / "swept/sweep.png").is_file() and (tmp_path / "compared/differences.csv").is_file()
     assert any((tmp_path / "swept/cases").glob("*.parquet"))
 
@@ -149,7 +193,8 @@ def test_installed_package_runs_from_an_empty_folder(installed, tmp_path):
     assert exported == "wrote Pendulum.fmu (binaries for aarch64-linux, darwin64, linux64, win64)\n"
     assert _run([cli, "export", "--fmi-version", "3"], cwd=tmp_path).stdout == (
         "wrote Pendulum-fmi3.fmu (binaries for aarch64-darwin, aarch64-linux, x86_64-darwin, x86_64-linux, "
-        "x86_64-windows)\n")
+        "x86_64-windows)\n"
+    )
     refused = _run([cli, "export"], cwd=tmp_path, check=False)
     assert refused.returncode == 2 and refused.stderr.startswith("pendulum-fmu export: error: Pendulum.fmu exists")
     # Building is the repository's (python build_fmu.py): an installed package has no build command.
@@ -176,15 +221,15 @@ def _dependency_closure(name: str, extras=("",), found=None) -> dict:
         found[key] = distribution = importlib.metadata.distribution(name)
         for text in distribution.requires or []:
             requirement = Requirement(text)
-            if requirement.marker is None or any(requirement.marker.evaluate({"extra": extra})
-                                                 for extra in extras):
+            if requirement.marker is None or any(requirement.marker.evaluate({"extra": extra}) for extra in extras):
                 _dependency_closure(requirement.name, ("", *requirement.extras), found)
     return found
 
 
 def _installed_bytes(distribution) -> int:
-    return sum(path.stat().st_size for path in map(distribution.locate_file, distribution.files or [])
-               if path.is_file())
+    return sum(
+        path.stat().st_size for path in map(distribution.locate_file, distribution.files or []) if path.is_file()
+    )
 
 
 def test_the_documented_sizes_are_this_build_s(artefacts, installed):
@@ -203,6 +248,9 @@ def test_the_documented_sizes_are_this_build_s(artefacts, installed):
         "package_kb": package / 1e3,
         "environment_mb": (_bytes_under(venv) + sum(map(_installed_bytes, dependencies.values()))) / 1e6,
     }
-    drifted = {name: f"stated {stated[name]}, measured {value:.0f}" for name, value in measured.items()
-               if abs(value - float(stated[name])) > SIZE_TOLERANCE * value}
+    drifted = {
+        name: f"stated {stated[name]}, measured {value:.0f}"
+        for name, value in measured.items()
+        if abs(value - float(stated[name])) > SIZE_TOLERANCE * value
+    }
     assert not drifted, f"docs/install.md's sizes drifted (rerun `{INSTALL_BENCHMARK}`): {drifted}"

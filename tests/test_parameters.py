@@ -34,10 +34,11 @@ TOOLS = [name for name, kind in KINDS.items() if kind.package is None or importl
 def test_every_path_refuses_with_the_fmus_words(fmu, parameters, reason):
     expected = f"the FMU refuses the parameters: {reason}"
     messages = set()
-    for run in (lambda: simulate(20.0, stop_time=0.01, parameters=parameters, fmu_path=fmu),
-                lambda: reference(20.0, stop_time=0.01, parameters=parameters, fmu_path=fmu),
-                *(lambda tool=tool: tool.run(PLAN, parameters=parameters)
-                  for tool in parse_tools(TOOLS, fmu_path=fmu))):
+    for run in (
+        lambda: simulate(20.0, stop_time=0.01, parameters=parameters, fmu_path=fmu),
+        lambda: reference(20.0, stop_time=0.01, parameters=parameters, fmu_path=fmu),
+        *(lambda tool=tool: tool.run(PLAN, parameters=parameters) for tool in parse_tools(TOOLS, fmu_path=fmu)),
+    ):
         with pytest.raises(ValueError) as refused:
             run()
         messages.add(str(refused.value))
@@ -76,10 +77,12 @@ def not_runnable(fmu, tmp_path_factory):
 @pytest.mark.parametrize("name, reason", NOT_RUNNABLE, ids=[name for name, _ in NOT_RUNNABLE])
 def test_a_file_that_is_no_pendulum_fmu_is_refused_by_every_entry_point(not_runnable, tmp_path, name, reason):
     path = not_runnable / name
-    for run in (lambda: default_parameters(path),
-                lambda: simulate(20.0, stop_time=0.01, fmu_path=path),
-                lambda: reference(20.0, stop_time=0.01, fmu_path=path),
-                lambda: write_cross_check(tmp_path / "cross_check", path)):
+    for run in (
+        lambda: default_parameters(path),
+        lambda: simulate(20.0, stop_time=0.01, fmu_path=path),
+        lambda: reference(20.0, stop_time=0.01, fmu_path=path),
+        lambda: write_cross_check(tmp_path / "cross_check", path),
+    ):
         with pytest.raises(FmuFileError, match=f"^{re.escape(str(path))}.*{re.escape(reason)}"):
             run()
     assert not (tmp_path / "cross_check").exists()

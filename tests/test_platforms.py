@@ -24,8 +24,7 @@ from fmpy import read_model_description
 import fmu_build
 from benchmarks.builds import build_bare_master, build_step_master
 from build_wheels import MANYLINUX_GLIBC
-from fmu_build import (FMI_VERSIONS, PLATFORMS, BuildError, PlatformSkipped, available_platforms,
-                                build_fmu, find_zig)
+from fmu_build import FMI_VERSIONS, PLATFORMS, BuildError, PlatformSkipped, available_platforms, build_fmu, find_zig
 from pendulum_fmu.cli import main
 from pendulum_fmu.reference import reference
 
@@ -33,10 +32,17 @@ STEPS, STEP_SIZE = 3000, 1e-3  # the tutorial case: 20 N.m, gravity on, 3 s
 POW_INPUTS = 1_000_000
 # How each platform's master runs here: natively, under wine, under qemu with the cross libc.
 RUNNERS = {"linux64": [], "win64": ["wine"], "aarch64-linux": ["qemu-aarch64", "-L", "/usr/aarch64-linux-gnu"]}
-CROSS = [pytest.param(platform, marks=pytest.mark.skipif(
-    shutil.which(PLATFORMS[platform].targets[0].cross_compiler) is None or shutil.which(RUNNERS[platform][0]) is None,
-    reason=f"needs {PLATFORMS[platform].targets[0].package} and {RUNNERS[platform][0]} (.ci/run installs them)"))
-    for platform in ("win64", "aarch64-linux")]
+CROSS = [
+    pytest.param(
+        platform,
+        marks=pytest.mark.skipif(
+            shutil.which(PLATFORMS[platform].targets[0].cross_compiler) is None
+            or shutil.which(RUNNERS[platform][0]) is None,
+            reason=f"needs {PLATFORMS[platform].targets[0].package} and {RUNNERS[platform][0]} (.ci/run installs them)",
+        ),
+    )
+    for platform in ("win64", "aarch64-linux")
+]
 POW_VERSIONS = Path(__file__).parent / "c/pow_versions.c"
 EACH_FMI_VERSION = pytest.mark.parametrize("fmi_version", FMI_VERSIONS, ids=lambda version: f"fmi{version}")
 # The value references benchmarks/bare_master.h hard-codes (VR_TORQUE, VR_THETA).
@@ -67,8 +73,9 @@ def _unzipped_build(fmu, work):
         archive.extractall(work / "unzipped")
     description = read_model_description(str(fmu))
     fmi_version = int(description.fmiVersion[0])
-    return UnzippedBuild(fmi_version, work, description.guid,
-                         {v.name: v.valueReference for v in description.modelVariables})
+    return UnzippedBuild(
+        fmi_version, work, description.guid, {v.name: v.valueReference for v in description.modelVariables}
+    )
 
 
 @pytest.fixture(scope="module")
@@ -83,15 +90,17 @@ def every_platform(tmp_path_factory):
 
 
 def _exports_of_dll(dll):
-    table = subprocess.run(["x86_64-w64-mingw32-objdump", "-p", str(dll)], capture_output=True,
-                           text=True, check=True).stdout
+    table = subprocess.run(
+        ["x86_64-w64-mingw32-objdump", "-p", str(dll)], capture_output=True, text=True, check=True
+    ).stdout
     names = table.split("[Ordinal/Name Pointer] Table", 1)[1].split("\n\n", 1)[0]
     return set(re.findall(r"\]\s+(\w+)", names))
 
 
 def _exports_of_so(library, nm="nm"):
-    symbols = subprocess.run([nm, "-D", "--defined-only", str(library)], capture_output=True,
-                             text=True, check=True).stdout
+    symbols = subprocess.run(
+        [nm, "-D", "--defined-only", str(library)], capture_output=True, text=True, check=True
+    ).stdout
     return {line.split()[-1] for line in symbols.splitlines()}
 
 
@@ -109,9 +118,22 @@ def _theta_by_step_master(build, platform, master=None):
     trajectory = build.work / f"theta_{platform}.txt"
     # One wine prefix for both FMI versions: making one takes wine seconds.
     environment = {**os.environ, "WINEPREFIX": str(build.work.parent / "wineprefix"), "WINEDEBUG": "-all"}
-    subprocess.run([*RUNNERS[platform], str(master), str(build.library(platform)), build.token, str(STEPS),
-                    repr(STEP_SIZE), "0", str(trajectory)], check=True, capture_output=True,
-                   env=environment, timeout=300)
+    subprocess.run(
+        [
+            *RUNNERS[platform],
+            str(master),
+            str(build.library(platform)),
+            build.token,
+            str(STEPS),
+            repr(STEP_SIZE),
+            "0",
+            str(trajectory),
+        ],
+        check=True,
+        capture_output=True,
+        env=environment,
+        timeout=300,
+    )
     return np.loadtxt(trajectory)
 
 
@@ -144,14 +166,14 @@ MACOS_SLICES = {"x86_64": ("x86_64-darwin", "10.13"), "arm64": ("aarch64-darwin"
 LLVM_TOOLS = ("llvm-objdump-14", "llvm-lipo-14")
 READS_MACH_O = pytest.mark.skipif(
     find_zig() is None or not all(map(shutil.which, LLVM_TOOLS)),
-    reason="needs zig (pip install ziglang) and llvm-objdump-14, llvm-lipo-14 (apt-get install llvm-14)")
+    reason="needs zig (pip install ziglang) and llvm-objdump-14, llvm-lipo-14 (apt-get install llvm-14)",
+)
 CS_ADHOC, CS_HASHTYPE_SHA256 = 0x2, 2
 ZIG_HEADER_SYMBOLS = {"__mh_dylib_header", "___dso_handle"}
 
 
 def _llvm(tool, *arguments):
-    return subprocess.run([f"llvm-{tool}-14", *map(str, arguments)], capture_output=True, text=True,
-                          check=True).stdout
+    return subprocess.run([f"llvm-{tool}-14", *map(str, arguments)], capture_output=True, text=True, check=True).stdout
 
 
 def _macho_slices(build, work):
@@ -185,20 +207,22 @@ def _check_ad_hoc_signature(slice_, signature):
     what macOS checks, page by page, before it runs code on Apple Silicon."""
     data = slice_.read_bytes()
     offset = int(signature["dataoff"])
-    blob = data[offset:offset + int(signature["datasize"])]
+    blob = data[offset : offset + int(signature["datasize"])]
     magic, _, count = struct.unpack_from(">III", blob)
     assert magic == 0xFADE0CC0  # an embedded signature's super blob
-    [directory] = [blob[at:] for kind, at in (struct.unpack_from(">II", blob, 12 + 8 * i) for i in range(count))
-                   if kind == 0]
-    (magic, _, _, flags, hash_offset, _, _, code_slots, code_limit, hash_size, hash_type, _,
-     page_shift) = struct.unpack_from(">9I4B", directory)
+    [directory] = [
+        blob[at:] for kind, at in (struct.unpack_from(">II", blob, 12 + 8 * i) for i in range(count)) if kind == 0
+    ]
+    (magic, _, _, flags, hash_offset, _, _, code_slots, code_limit, hash_size, hash_type, _, page_shift) = (
+        struct.unpack_from(">9I4B", directory)
+    )
     assert magic == 0xFADE0C02 and flags & CS_ADHOC and hash_type == CS_HASHTYPE_SHA256
     assert code_limit == offset  # it covers every byte before it
     page = 1 << page_shift
     assert code_slots == -(-code_limit // page)
     for index in range(code_slots):
-        expected = directory[hash_offset + index * hash_size:hash_offset + (index + 1) * hash_size]
-        assert hashlib.sha256(data[index * page:min((index + 1) * page, code_limit)]).digest() == expected
+        expected = directory[hash_offset + index * hash_size : hash_offset + (index + 1) * hash_size]
+        assert hashlib.sha256(data[index * page : min((index + 1) * page, code_limit)]).digest() == expected
 
 
 @READS_MACH_O
@@ -209,8 +233,11 @@ def test_every_macos_slice_exports_the_fmi_functions_and_loads_only_libsystem(ev
     linux_exports = _exports_of_so(build.library("linux64"))
     for architecture, slice_ in _macho_slices(build, tmp_path).items():
         assert _llvm("lipo", "-archs", slice_).split() == [architecture]
-        exports = {line.split()[-1] for line in _llvm("objdump", "--macho", "--exports-trie", slice_).splitlines()
-                   if line.startswith("0x")}
+        exports = {
+            line.split()[-1]
+            for line in _llvm("objdump", "--macho", "--exports-trie", slice_).splitlines()
+            if line.startswith("0x")
+        }
         # C names take a _ on Mach-O. zig's Mach-O linker also exports the two symbols it makes
         # for the image's header (Apple's ld64 and LLVM's keep them private): nothing else may leak.
         assert exports == {f"_{name}" for name in linux_exports} | ZIG_HEADER_SYMBOLS, architecture
@@ -223,20 +250,28 @@ def test_every_macos_slice_exports_the_fmi_functions_and_loads_only_libsystem(ev
         assert [load["name"].split(" (")[0] for load in by_kind["LC_LOAD_DYLIB"]] == ["/usr/lib/libSystem.B.dylib"]
         assert not {"LC_LOAD_WEAK_DYLIB", "LC_REEXPORT_DYLIB", "LC_RPATH"} & by_kind.keys()
         # macOS 10.13 binaries say their minimum in LC_VERSION_MIN_MACOSX, 11.0 ones in LC_BUILD_VERSION.
-        [minimum] = ([build_version["minos"] for build_version in by_kind.get("LC_BUILD_VERSION", [])]
-                     or [old["version"] for old in by_kind["LC_VERSION_MIN_MACOSX"]])
+        [minimum] = [build_version["minos"] for build_version in by_kind.get("LC_BUILD_VERSION", [])] or [
+            old["version"] for old in by_kind["LC_VERSION_MIN_MACOSX"]
+        ]
         assert minimum == MACOS_SLICES[architecture][1], architecture
         if architecture == "arm64":
             [signature] = by_kind["LC_CODE_SIGNATURE"]
             _check_ad_hoc_signature(slice_, signature)
 
 
-RUNS_ZIG = [pytest.param(platform, marks=pytest.mark.skipif(
-    find_zig() is None or shutil.which(RUNNERS[platform][0] if RUNNERS[platform] else "true") is None
-    or shutil.which(PLATFORMS[platform].targets[0].compiler()[0]) is None,
-    reason=f"needs zig (pip install ziglang) and {PLATFORMS[platform].targets[0].compiler()[0]}, "
-           f"{(RUNNERS[platform] or ['nothing'])[0]} to build and run the master"))
-    for platform in ("linux64", "aarch64-linux")]
+RUNS_ZIG = [
+    pytest.param(
+        platform,
+        marks=pytest.mark.skipif(
+            find_zig() is None
+            or shutil.which(RUNNERS[platform][0] if RUNNERS[platform] else "true") is None
+            or shutil.which(PLATFORMS[platform].targets[0].compiler()[0]) is None,
+            reason=f"needs zig (pip install ziglang) and {PLATFORMS[platform].targets[0].compiler()[0]}, "
+            f"{(RUNNERS[platform] or ['nothing'])[0]} to build and run the master",
+        ),
+    )
+    for platform in ("linux64", "aarch64-linux")
+]
 
 
 def _readelf(library, *options):
@@ -246,14 +281,17 @@ def _readelf(library, *options):
 def _glibc_versions(library):
     """{symbol: (major, minor[, patch])}: the glibc symbol version each function the ELF library
     imports is bound to."""
-    return {name: tuple(map(int, version.split("."))) for name, version in
-            re.findall(r" UND (\w+)@GLIBC_([\d.]+)", _readelf(library, "--dyn-syms", "--wide"))}
+    return {
+        name: tuple(map(int, version.split(".")))
+        for name, version in re.findall(r" UND (\w+)@GLIBC_([\d.]+)", _readelf(library, "--dyn-syms", "--wide"))
+    }
 
 
 @pytest.mark.parametrize("platform", RUNS_ZIG)
 @EACH_FMI_VERSION
-def test_zig_builds_for_the_wheels_glibc_give_the_gcc_builds_theta_bit_for_bit(every_platform, tmp_path,
-                                                                               fmi_version, platform):
+def test_zig_builds_for_the_wheels_glibc_give_the_gcc_builds_theta_bit_for_bit(
+    every_platform, tmp_path, fmi_version, platform
+):
     """The wheels' Linux binaries come from zig's C compiler for glibc 2.17 (build_wheels.py), the
     macOS ones from the same zig, and nothing here can run those: the same build, through the same
     CMake description (cmake/linux.cmake, cmake/zig.cmake), whose binaries the bare C masters run
@@ -266,8 +304,12 @@ def test_zig_builds_for_the_wheels_glibc_give_the_gcc_builds_theta_bit_for_bit(e
     checks on a million inputs here. What this cannot show is another libm: an old glibc's own
     (its sin, cos and pow predate glibc 2.28's rewrite) or a Mac's."""
     master = build_step_master(tmp_path, platform, fmi_version)  # by gcc
-    build = _unzipped_build(build_fmu(tmp_path / "Pendulum.fmu", platforms=(platform,), fmi_version=fmi_version,
-                                      linux_glibc=MANYLINUX_GLIBC), tmp_path)
+    build = _unzipped_build(
+        build_fmu(
+            tmp_path / "Pendulum.fmu", platforms=(platform,), fmi_version=fmi_version, linux_glibc=MANYLINUX_GLIBC
+        ),
+        tmp_path,
+    )
     library = build.library(platform)
     comment = _readelf(library, "-p", ".comment")
     assert "clang" in comment and "GCC" not in comment, comment  # zig's clang built it, not gcc
@@ -275,8 +317,13 @@ def test_zig_builds_for_the_wheels_glibc_give_the_gcc_builds_theta_bit_for_bit(e
     assert "pow" in versions and max(versions.values()) <= tuple(map(int, MANYLINUX_GLIBC.split("."))), versions
     # This machine's libm: the pow zig's build binds gives pow@GLIBC_2.29's bits.
     pow_version = "GLIBC_" + ".".join(map(str, versions["pow"]))
-    compared = subprocess.run([*RUNNERS[platform], build_bare_master(tmp_path, POW_VERSIONS, platform), pow_version,
-                               str(POW_INPUTS)], capture_output=True, text=True, check=True, timeout=300).stdout
+    compared = subprocess.run(
+        [*RUNNERS[platform], build_bare_master(tmp_path, POW_VERSIONS, platform), pow_version, str(POW_INPUTS)],
+        capture_output=True,
+        text=True,
+        check=True,
+        timeout=300,
+    ).stdout
     assert compared.splitlines()[-1] == f"0 of {POW_INPUTS} differ", compared
     run = _theta_by_step_master(build, platform, master)
     assert len(run) == STEPS + 1
@@ -296,25 +343,40 @@ def test_build_command_builds_for_any_glibc_floor_and_refuses_a_malformed_one_in
     capsys.readouterr()
     assert main(["build", "--linux-glibc", "17", "--output", str(tmp_path / "Other.fmu")]) == 2
     assert capsys.readouterr().err.splitlines() == [
-        "pendulum-fmu build: error: glibc floor '17': give a glibc version such as 2.17"]
+        "pendulum-fmu build: error: glibc floor '17': give a glibc version such as 2.17"
+    ]
     assert not (tmp_path / "Other.fmu").exists()
 
 
 def _without_compiler(monkeypatch, platform):
     """Neither the platform's cross gcc nor zig, which stands in for a missing one."""
-    targets = tuple(dataclasses.replace(target, cross_compiler="no-such-cross-gcc")
-                    for target in PLATFORMS[platform].targets if target.cross_compiler != fmu_build.ZIG)
+    targets = tuple(
+        dataclasses.replace(target, cross_compiler="no-such-cross-gcc")
+        for target in PLATFORMS[platform].targets
+        if target.cross_compiler != fmu_build.ZIG
+    )
     if targets:
         monkeypatch.setitem(fmu_build.PLATFORMS, platform, dataclasses.replace(PLATFORMS[platform], targets=targets))
     monkeypatch.setattr(fmu_build, "find_zig", lambda: None)
-    monkeypatch.setenv("PATH", os.pathsep.join(folder for folder in os.environ["PATH"].split(os.pathsep)
-                                               if not Path(folder, fmu_build.ZIG).exists()))
+    monkeypatch.setenv(
+        "PATH",
+        os.pathsep.join(
+            folder for folder in os.environ["PATH"].split(os.pathsep) if not Path(folder, fmu_build.ZIG).exists()
+        ),
+    )
 
 
-@pytest.mark.parametrize("platform, missing", [
-    ("win64", "no-such-cross-gcc not found (apt-get install gcc-mingw-w64-x86-64, or pip install ziglang)"),
-    ("aarch64-linux", "no-such-cross-gcc not found (apt-get install gcc-aarch64-linux-gnu, or pip install ziglang)"),
-    ("darwin64", "zig cc not found (pip install ziglang)")])
+@pytest.mark.parametrize(
+    "platform, missing",
+    [
+        ("win64", "no-such-cross-gcc not found (apt-get install gcc-mingw-w64-x86-64, or pip install ziglang)"),
+        (
+            "aarch64-linux",
+            "no-such-cross-gcc not found (apt-get install gcc-aarch64-linux-gnu, or pip install ziglang)",
+        ),
+        ("darwin64", "zig cc not found (pip install ziglang)"),
+    ],
+)
 def test_default_build_skips_a_platform_without_its_compiler_in_one_line(tmp_path, monkeypatch, platform, missing):
     _without_compiler(monkeypatch, platform)
     with pytest.warns(PlatformSkipped) as skipped:
@@ -340,7 +402,8 @@ def test_build_command_says_what_it_skipped_in_one_line(tmp_path, monkeypatch, c
     assert capsys.readouterr().err.splitlines() == [
         "pendulum-fmu build: aarch64-linux: C compiler no-such-cross-gcc not found "
         "(apt-get install gcc-aarch64-linux-gnu, or pip install ziglang); skipped",
-        "pendulum-fmu build: darwin64: C compiler zig cc not found (pip install ziglang); skipped"]
+        "pendulum-fmu build: darwin64: C compiler zig cc not found (pip install ziglang); skipped",
+    ]
 
 
 CROSS_GCC_PREFIXES = ("x86_64-w64-mingw32-", "aarch64-linux-gnu-")
@@ -363,13 +426,17 @@ def _imported_dlls(dll):
     return re.findall(r"DLL Name: (\S+)", _llvm("objdump", "-p", dll))
 
 
-@pytest.mark.skipif(find_zig() is None or not all(shutil.which(RUNNERS[platform][0]) for platform in RUNNERS if
-                                                     RUNNERS[platform]) or shutil.which("llvm-objdump-14") is None,
-                    reason="needs zig (pip install ziglang), wine, qemu-aarch64 and llvm-objdump-14")
+@pytest.mark.skipif(
+    find_zig() is None
+    or not all(shutil.which(RUNNERS[platform][0]) for platform in RUNNERS if RUNNERS[platform])
+    or shutil.which("llvm-objdump-14") is None,
+    reason="needs zig (pip install ziglang), wine, qemu-aarch64 and llvm-objdump-14",
+)
 @pytest.mark.parametrize("platform", CROSS)
 @EACH_FMI_VERSION
-def test_zig_stands_in_for_a_missing_cross_gcc_with_the_gcc_builds_theta(every_platform, tmp_path, monkeypatch,
-                                                                       fmi_version, platform):
+def test_zig_stands_in_for_a_missing_cross_gcc_with_the_gcc_builds_theta(
+    every_platform, tmp_path, monkeypatch, fmi_version, platform
+):
     """A source build on a machine without Debian's cross gccs (pip wheel ., an sdist, an editable
     install) has zig, a build requirement, build win64 (x86_64-windows-gnu) and aarch64-linux
     (aarch64-linux-gnu.2.17): the FMU holds every platform's binary, which the bare C master (built
@@ -383,8 +450,11 @@ def test_zig_stands_in_for_a_missing_cross_gcc_with_the_gcc_builds_theta(every_p
         fmu = build_fmu(tmp_path / "Pendulum.fmu", fmi_version=fmi_version)
     monkeypatch.undo()
     build = _unzipped_build(fmu, tmp_path)
-    expected = {folder for platform_ in PLATFORMS.values()
-                for folder in ((platform_.fmi2_folder,) if fmi_version == 2 else platform_.fmi3_folders)}
+    expected = {
+        folder
+        for platform_ in PLATFORMS.values()
+        for folder in ((platform_.fmi2_folder,) if fmi_version == 2 else platform_.fmi3_folders)
+    }
     assert {path.name for path in (tmp_path / "unzipped/binaries").iterdir()} == expected
     library = build.library(platform)
     if platform == "win64":

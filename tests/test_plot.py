@@ -30,8 +30,7 @@ def test_band_quantiles_are_numpys_per_value():
     levels, values = plot._quantiles(x, y, [0.05, 0.5, 0.75])
     assert levels.tolist() == sorted(set(x.tolist()))
     for i, level in enumerate(levels):
-        assert np.allclose([v[i] for v in values], np.quantile(y[x == level], [0.05, 0.5, 0.75]),
-                           rtol=0, atol=1e-12)
+        assert np.allclose([v[i] for v in values], np.quantile(y[x == level], [0.05, 0.5, 0.75]), rtol=0, atol=1e-12)
     many = rng.uniform(0.0, 1.0, 5000)  # more distinct values than levels: pooled into bins
     levels, (median,) = plot._quantiles(many, many, [0.5])
     assert len(levels) == plot.BAND_LEVELS and np.max(np.abs(median - levels)) < 0.5 / plot.BAND_LEVELS
@@ -59,8 +58,9 @@ def test_several_cases_per_value_draw_the_median_and_two_bands(drawn, tmp_path):
     rng = np.random.default_rng(3)
     gravity = np.repeat([0.0, 9.81], 20)
     y = rng.normal(size=40)
-    plot.plot_case_bands({"gravity": gravity}, {"final theta in rad": y}, tmp_path / "bands.png", "t",
-                         units={"gravity": "m/s2"})
+    plot.plot_case_bands(
+        {"gravity": gravity}, {"final theta in rad": y}, tmp_path / "bands.png", "t", units={"gravity": "m/s2"}
+    )
     (_, (ax,), _) = drawn[0]
     assert len(ax.collections) == 2
     (median,) = ax.get_lines()
@@ -103,13 +103,28 @@ def test_a_difference_zero_everywhere_is_written_not_drawn(drawn, tmp_path):
 def test_titles_name_the_torque_and_the_parameters_with_their_units(tmp_path):
     assert plot.case_title(20.0) == "Torque-driven pendulum: torque 20 N.m, gravity 9.81 m/s2"
     assert plot.case_title(tmp_path / "steps.csv", {"gravity": 0.0, "damping": 2.0}, theta0=0.1) == (
-        "Torque-driven pendulum: torque from steps.csv, gravity 0 m/s2, damping 2 N.m.s/rad, theta0 0.1 rad")
+        "Torque-driven pendulum: torque from steps.csv, gravity 0 m/s2, damping 2 N.m.s/rad, theta0 0.1 rad"
+    )
     assert plot.case_title(lambda t: t).startswith("Torque-driven pendulum: a torque signal, gravity 9.81 m/s2")
 
 
 def test_simulate_plot_says_torque_and_gravity_and_draws_the_run(drawn, tmp_path):
-    assert main(["simulate", "--torque", "20", "--set", "gravity=0", "--stop-time", "1",
-                 "--plot", str(tmp_path / "run.png")]) == 0
+    assert (
+        main(
+            [
+                "simulate",
+                "--torque",
+                "20",
+                "--set",
+                "gravity=0",
+                "--stop-time",
+                "1",
+                "--plot",
+                str(tmp_path / "run.png"),
+            ]
+        )
+        == 0
+    )
     _, axes, title = drawn[0]
     assert title == "Torque-driven pendulum: torque 20 N.m, gravity 0 m/s2"
     (theta,) = axes[0].get_lines()
@@ -120,8 +135,12 @@ def test_simulate_plot_says_torque_and_gravity_and_draws_the_run(drawn, tmp_path
 def test_a_sweep_of_one_case_per_torque_draws_the_cases_with_units(drawn, tmp_path):
     from pendulum_fmu.sweep import Study, run_sweep, sweep_grid
 
-    run_sweep(Study(sweep_grid([5.0, 10.0, 20.0, 40.0], [0.0]), stop_time=0.1, outputs=[]),
-              output_dir=tmp_path, workers=1, progress=False)
+    run_sweep(
+        Study(sweep_grid([5.0, 10.0, 20.0, 40.0], [0.0]), stop_time=0.1, outputs=[]),
+        output_dir=tmp_path,
+        workers=1,
+        progress=False,
+    )
     _, axes, _ = drawn[-1]
     for ax in axes:
         assert len(ax.collections) == 0
@@ -150,8 +169,22 @@ def test_values_too_large_to_draw_are_left_out_and_said(drawn, tmp_path):
 
 @pytest.mark.filterwarnings("error")
 def test_a_run_started_past_drawable_angles_is_written_with_a_note(drawn, tmp_path, capsys):
-    assert main(["simulate", "--torque", "1", "--stop-time", "0.05", "--theta0", "1e308",
-                 "--plot", str(tmp_path / "run.png")]) == 0
+    assert (
+        main(
+            [
+                "simulate",
+                "--torque",
+                "1",
+                "--stop-time",
+                "0.05",
+                "--theta0",
+                "1e308",
+                "--plot",
+                str(tmp_path / "run.png"),
+            ]
+        )
+        == 0
+    )
     _, axes, _ = drawn[0]
     assert [text.get_text() for text in axes[0].texts] == ["FMU reaches 1e+308: too large to draw"]
     assert len(axes[1].get_lines()) == 1  # omega stays small: drawn
@@ -162,9 +195,14 @@ def test_a_run_started_past_drawable_angles_is_written_with_a_note(drawn, tmp_pa
 def test_a_sweep_started_past_drawable_angles_still_writes_its_figure(drawn, tmp_path):
     from pendulum_fmu.sweep import Study, run_sweep, sweep_grid
 
-    done = run_sweep(Study(sweep_grid([1.0], extra={"theta0": [1e308]}), stop_time=0.01, format="csv"),
-                     output_dir=tmp_path, workers=1, progress=False)
+    done = run_sweep(
+        Study(sweep_grid([1.0], extra={"theta0": [1e308]}), stop_time=0.01, format="csv"),
+        output_dir=tmp_path,
+        workers=1,
+        progress=False,
+    )
     _, axes, _ = drawn[-1]
     assert [text.get_text() for text in axes[0].texts] == [
-        "torque = 1 N.m, gravity = 9.81 m/s2, theta0 = 1e+308 rad reaches 1e+308: too large to draw"]
+        "torque = 1 N.m, gravity = 9.81 m/s2, theta0 = 1e+308 rad reaches 1e+308: too large to draw"
+    ]
     assert Path(done.figure).is_file()

@@ -30,9 +30,25 @@ import pytest
 ROOT = Path(__file__).resolve().parent.parent
 READMES = ("README.md", "examples/README.md")
 # The docs pages with commands, in the order the README held them.
-DOCS_PAGES = tuple(f"docs/{name}.md" for name in (
-    "install", "fmu", "fmi3", "torque_signals", "python_api", "command_line", "comparing", "judging",
-    "scenario_kit", "masters", "sweeps", "robustness_overview", "benchmarks", "layout"))
+DOCS_PAGES = tuple(
+    f"docs/{name}.md"
+    for name in (
+        "install",
+        "fmu",
+        "fmi3",
+        "torque_signals",
+        "python_api",
+        "command_line",
+        "comparing",
+        "judging",
+        "scenario_kit",
+        "masters",
+        "sweeps",
+        "robustness_overview",
+        "benchmarks",
+        "layout",
+    )
+)
 DOCUMENTS = READMES + DOCS_PAGES
 # The heading of the .gitignore section that lists what the documents' commands write.
 OUTPUTS_SECTION = "# What the README's commands write when run in a clone"
@@ -47,11 +63,10 @@ EXCLUDED = {
     r"^\.venv/bin/pip install ": "changes the environment this test suite runs in",
     r"^ssh ": "runs on other machines (head, node1, ...)",
     r"^\.venv/bin/python build_wheels\.py$": "builds every OS's wheel, longer than a README command "
-                                              "may take; tests/test_wheels.py runs the same build",
+    "may take; tests/test_wheels.py runs the same build",
     r"^(helm|kubectl) ": "needs a Kubernetes cluster",
     r"--scheduler tcp://(head|localhost):8786": "needs the cluster's dask scheduler started above",
-    r"jupyter notebook": "starts a server that runs until stopped; tests/test_notebook.py runs "
-                         "the notebook",
+    r"jupyter notebook": "starts a server that runs until stopped; tests/test_notebook.py runs the notebook",
 }
 
 # A command that needs longer than this is a README bug: the README's commands are what a
@@ -89,8 +104,7 @@ def commands_in(text: str) -> list[str]:
                 span = re.search(r"`([^`]+)`", cells[table_column])
                 if span:
                     found.append(span.group(1))
-        indented = fence is None and language is None and line.startswith("    ") and \
-            (indented or previous_blank)
+        indented = fence is None and language is None and line.startswith("    ") and (indented or previous_blank)
         if not line.startswith("|"):
             table_column = None
         previous_blank = not line.strip()
@@ -128,18 +142,38 @@ COMMANDS = list(readme_commands())
 
 
 def test_extraction_reads_every_kind_of_block():
-    text = "\n".join([
-        "Prose with `inline code` that is not a command.", "",
-        "    first --flag \\", "        --continued", "    second", "",
-        "```python", "print('not a command')", "```",
-        "```text", "    not a command either", "```",
-        "```console", "$ third", "output line", "```",
-        "```sh", "fourth", "```",
-        "| example | command |", "|---|---|", "| a | `fifth arg` (after `x`) |", "| b | none |", "",
-        "Text.", "", "    sixth",
-    ])
-    assert commands_in(text) == ["first --flag --continued", "second", "third", "fourth", "fifth arg",
-                                 "sixth"]
+    text = "\n".join(
+        [
+            "Prose with `inline code` that is not a command.",
+            "",
+            "    first --flag \\",
+            "        --continued",
+            "    second",
+            "",
+            "```python",
+            "print('not a command')",
+            "```",
+            "```text",
+            "    not a command either",
+            "```",
+            "```console",
+            "$ third",
+            "output line",
+            "```",
+            "```sh",
+            "fourth",
+            "```",
+            "| example | command |",
+            "|---|---|",
+            "| a | `fifth arg` (after `x`) |",
+            "| b | none |",
+            "",
+            "Text.",
+            "",
+            "    sixth",
+        ]
+    )
+    assert commands_in(text) == ["first --flag --continued", "second", "third", "fourth", "fifth arg", "sixth"]
 
 
 def test_every_exclusion_matches_a_command():
@@ -151,8 +185,8 @@ def test_every_exclusion_matches_a_command():
 def command_outputs(gitignore: str) -> set[str]:
     """The top-level names .gitignore's OUTPUTS_SECTION lists (`/demo/` -> `demo`)."""
     lines = gitignore.splitlines()
-    section = lines[lines.index(OUTPUTS_SECTION) + 1:]
-    listed = section[:next((n for n, line in enumerate(section) if not line.startswith("/")), len(section))]
+    section = lines[lines.index(OUTPUTS_SECTION) + 1 :]
+    listed = section[: next((n for n, line in enumerate(section) if not line.startswith("/")), len(section))]
     return {line.strip("/").split("/")[0] for line in listed}
 
 
@@ -166,9 +200,9 @@ def copy_of_the_clone(root: Path, target: Path) -> Path:
 
     def ignored(folder, names):
         at_top = Path(folder) == root
-        return shutil.ignore_patterns(".venv", ".git", "dist", "build", "out", "__pycache__", "*.egg-info",
-                                      ".pytest_cache")(folder, names) | \
-            {name for name in names if at_top and name in left_out}
+        return shutil.ignore_patterns(
+            ".venv", ".git", "dist", "build", "out", "__pycache__", "*.egg-info", ".pytest_cache"
+        )(folder, names) | {name for name in names if at_top and name in left_out}
 
     shutil.copytree(root, target, symlinks=True, ignore=ignored)
     (target / ".venv").symlink_to(sys.prefix, target_is_directory=True)
@@ -185,6 +219,7 @@ def copies(tmp_path_factory):
         if key not in made:
             made[key] = copy_of_the_clone(ROOT, tmp_path_factory.mktemp("readme") / "pendulum-fmu")
         return made[key]
+
     return copy_for
 
 
@@ -206,10 +241,12 @@ def test_the_copy_leaves_out_what_the_main_job_wrote(tmp_path):
 def fresh_shell_environment():
     """The caller's environment less any trace of a virtual environment, as a new terminal has."""
     venv_bin = {str(Path(sys.prefix) / "bin"), os.environ.get("VIRTUAL_ENV", "") + "/bin"}
-    environment = {name: value for name, value in os.environ.items()
-                   if name not in ("VIRTUAL_ENV", "PYTHONPATH", "PYTHONHOME")}
+    environment = {
+        name: value for name, value in os.environ.items() if name not in ("VIRTUAL_ENV", "PYTHONPATH", "PYTHONHOME")
+    }
     environment["PATH"] = os.pathsep.join(
-        part for part in environment.get("PATH", "").split(os.pathsep) if part not in venv_bin)
+        part for part in environment.get("PATH", "").split(os.pathsep) if part not in venv_bin
+    )
     return environment
 
 
@@ -219,20 +256,28 @@ def test_readme_command_runs_as_written(readme, command, copies):
     if command is None:
         pytest.skip(f"not run here: {reason}")
     started = time.monotonic()
-    result = subprocess.run(["bash", "-c", command], cwd=copies(readme), env=fresh_shell_environment(),
-                            capture_output=True, text=True, timeout=COMMAND_TIMEOUT)
+    result = subprocess.run(
+        ["bash", "-c", command],
+        cwd=copies(readme),
+        env=fresh_shell_environment(),
+        capture_output=True,
+        text=True,
+        timeout=COMMAND_TIMEOUT,
+    )
     elapsed = time.monotonic() - started
     assert result.returncode == 0, (
         f"{readme}: `{command}` exited {result.returncode} after {elapsed:.0f} s\n"
-        f"--- stdout (end)\n{result.stdout[-3000:]}\n--- stderr (end)\n{result.stderr[-3000:]}")
+        f"--- stdout (end)\n{result.stdout[-3000:]}\n--- stderr (end)\n{result.stderr[-3000:]}"
+    )
 
 
 def test_ci_runs_the_readme_test_command_after_the_readme_system_packages():
     readme = commands_in((ROOT / "README.md").read_text(encoding="utf-8"))
     ci = (ROOT / ".ci" / "run").read_text(encoding="utf-8")
     test_command = [command for command in readme if command.endswith("&& .venv/bin/pytest")]
-    assert len(test_command) == 1 and test_command[0] in ci.splitlines(), \
+    assert len(test_command) == 1 and test_command[0] in ci.splitlines(), (
         f"the README's test command {test_command} is not a line of .ci/run"
+    )
     readme_packages = [command.split()[3:] for command in readme if command.startswith("sudo apt-get install ")]
     ci_packages = re.search(r"apt-get install -y -qq ([^>]+)>", ci.replace("\\\n", " ")).group(1).split()
     assert len(readme_packages) == 1 and sorted(readme_packages[0]) == sorted(ci_packages)

@@ -21,9 +21,24 @@ pytestmark = pytest.mark.skipif(shutil.which("gcc") is None, reason="needs gcc")
 
 
 def _compile(sources, out, flags):
-    command = ["gcc", "-std=c99", "-D_DEFAULT_SOURCE", "-g", "-Wall", "-Wextra", "-Werror", *flags,
-               f"-I{sources}", f"-I{FMI_HEADERS}", *map(str, sorted(sources.glob("*.c"))), str(DRIVER),
-               "-lm", "-lpthread", "-o", str(out)]
+    command = [
+        "gcc",
+        "-std=c99",
+        "-D_DEFAULT_SOURCE",
+        "-g",
+        "-Wall",
+        "-Wextra",
+        "-Werror",
+        *flags,
+        f"-I{sources}",
+        f"-I{FMI_HEADERS}",
+        *map(str, sorted(sources.glob("*.c"))),
+        str(DRIVER),
+        "-lm",
+        "-lpthread",
+        "-o",
+        str(out),
+    ]
     subprocess.run(command, check=True, capture_output=True, text=True)
     return out
 
@@ -33,10 +48,14 @@ def drivers(tmp_path_factory):
     work = tmp_path_factory.mktemp("driver")
     sources = assemble_sources(work / "sources")
     shutil.copy2(PLUMBING_DIR / "fmi3_functions.c", sources)  # both adapters over one core
-    return {"asan": _compile(sources, work / "driver_asan",
-                             ["-O1", "-fno-omit-frame-pointer", "-fsanitize=address,undefined",
-                              "-fno-sanitize-recover=all"]),
-            "plain": _compile(sources, work / "driver", ["-O2"])}
+    return {
+        "asan": _compile(
+            sources,
+            work / "driver_asan",
+            ["-O1", "-fno-omit-frame-pointer", "-fsanitize=address,undefined", "-fno-sanitize-recover=all"],
+        ),
+        "plain": _compile(sources, work / "driver", ["-O2"]),
+    }
 
 
 def _run(command, **kwargs):
@@ -45,23 +64,54 @@ def _run(command, **kwargs):
     return result.stdout
 
 
-@pytest.mark.parametrize("case", [["bad-calls"], ["bad-calls-fmi3"], ["foreign-states"],
-                                  ["instances", str(INSTANCES)], ["threads", str(THREADS)],
-                                  ["energy", "100000"], ["churn", str(SANITIZED_CYCLES)],
-                                  ["churn-fmi3", str(SANITIZED_CYCLES)]])
+@pytest.mark.parametrize(
+    "case",
+    [
+        ["bad-calls"],
+        ["bad-calls-fmi3"],
+        ["foreign-states"],
+        ["instances", str(INSTANCES)],
+        ["threads", str(THREADS)],
+        ["energy", "100000"],
+        ["churn", str(SANITIZED_CYCLES)],
+        ["churn-fmi3", str(SANITIZED_CYCLES)],
+    ],
+)
 def test_under_address_and_undefined_behavior_sanitizers(drivers, case):
-    environment = {**os.environ, "ASAN_OPTIONS": "detect_leaks=1:abort_on_error=0",
-                   "UBSAN_OPTIONS": "print_stacktrace=1"}
+    environment = {
+        **os.environ,
+        "ASAN_OPTIONS": "detect_leaks=1:abort_on_error=0",
+        "UBSAN_OPTIONS": "print_stacktrace=1",
+    }
     out = _run([str(drivers["asan"]), *case], env=environment)
     assert out.startswith(case[0])
 
 
 @pytest.mark.skipif(shutil.which("valgrind") is None, reason="needs valgrind")
-@pytest.mark.parametrize("case", [["bad-calls"], ["bad-calls-fmi3"], ["foreign-states"], ["instances", "100"],
-                                  ["threads", "8"], ["churn", "2000"], ["churn-fmi3", "2000"]])
+@pytest.mark.parametrize(
+    "case",
+    [
+        ["bad-calls"],
+        ["bad-calls-fmi3"],
+        ["foreign-states"],
+        ["instances", "100"],
+        ["threads", "8"],
+        ["churn", "2000"],
+        ["churn-fmi3", "2000"],
+    ],
+)
 def test_under_valgrind_memcheck(drivers, case):
-    _run(["valgrind", "-q", "--leak-check=full", "--errors-for-leak-kinds=all", "--error-exitcode=1",
-          str(drivers["plain"]), *case])
+    _run(
+        [
+            "valgrind",
+            "-q",
+            "--leak-check=full",
+            "--errors-for-leak-kinds=all",
+            "--error-exitcode=1",
+            str(drivers["plain"]),
+            *case,
+        ]
+    )
 
 
 def test_energy_is_conserved_over_ten_million_steps(drivers):

@@ -20,16 +20,26 @@ from pendulum_fmu.cli import main
 from pendulum_fmu.judge import AGREES, judge, judge_kit
 from pendulum_fmu.parameters import default_parameters, total_inertia
 from pendulum_fmu.errors import InvalidInput
-from pendulum_fmu.scenarios import (KIT_FMU, LS_REF_FOLDER, LS_REF_VERSION, SCENARIOS, KitExists, kit_files,
-                                    read_settings, write_scenarios)
+from pendulum_fmu.scenarios import (
+    KIT_FMU,
+    LS_REF_FOLDER,
+    LS_REF_VERSION,
+    SCENARIOS,
+    KitExists,
+    kit_files,
+    read_settings,
+    write_scenarios,
+)
 from pendulum_fmu.simulate import open_fmu, run_schedule
 from pendulum_fmu.torque_schedule import TorqueSchedule, schedule
 
 NAMES = [s.name for s in SCENARIOS]
 # The role values of the FMI-LS-REF 1.0.0-beta.1 schema (fmi3LayeredStandardReferenceManifest.xsd).
-ROLE = re.compile(r"(document|requirement|specification|model|parameter|system|testcase|"
-                  r"experiment(/(smoke-test|validation|uncertainty-analysis))?|result|method|rationale|"
-                  r"report|request|delivery|configuration|signature|serialized-state(/.*)?|meta-data|other)")
+ROLE = re.compile(
+    r"(document|requirement|specification|model|parameter|system|testcase|"
+    r"experiment(/(smoke-test|validation|uncertainty-analysis))?|result|method|rationale|"
+    r"report|request|delivery|configuration|signature|serialized-state(/.*)?|meta-data|other)"
+)
 LS = "{http://fmi-standard.org/fmi-ls-manifest}"
 SSV = "{http://ssp-standard.org/SSP1/SystemStructureParameterValues}"
 
@@ -72,7 +82,7 @@ def test_steps_on_grid_reference_is_the_analytic_solution(kit):
     alphas = [float(rows[0][1]) / inertia] + [u / inertia for _, u in jumps]
     reference = np.genfromtxt(kit / "steps_on_grid_ref.csv", delimiter=",", names=True)
     for t, theta in zip(reference["time"][::97], reference["theta"][::97]):
-        exact = settings["theta0"] + settings["omega0"] * t + alphas[0] * t ** 2 / 2
+        exact = settings["theta0"] + settings["omega0"] * t + alphas[0] * t**2 / 2
         for (when, _), before, after in zip(jumps, alphas, alphas[1:]):
             if float(when) <= t:  # from a jump on, the change of alpha adds its own parabola
                 exact += (after - before) * (t - float(when)) ** 2 / 2
@@ -121,13 +131,25 @@ def test_an_fmpy_master_passes_every_scenario(kit, name):
 def test_fmpy_simulate_fmu_passes_the_held_scenarios(kit, name):
     settings = json.loads((kit / f"{name}.json").read_text())
     signal = np.genfromtxt(kit / settings["input"], delimiter=",", names=True)
-    run = simulate_fmu(str(kit / KIT_FMU), start_time=settings["start_time"], stop_time=settings["stop_time"],
-                       step_size=settings["step_size"], output_interval=settings["step_size"],
-                       relative_tolerance=settings["relative_tolerance"], input=signal,
-                       start_values={**settings["parameters"], "theta": settings["theta0"],
-                                     "omega": settings["omega0"]}, output=["theta", "omega"])
-    np.savetxt(kit / settings["output"], np.column_stack([run["time"], run["theta"], run["omega"]]),
-               delimiter=",", header="time,theta,omega", comments="", fmt="%.17g")
+    run = simulate_fmu(
+        str(kit / KIT_FMU),
+        start_time=settings["start_time"],
+        stop_time=settings["stop_time"],
+        step_size=settings["step_size"],
+        output_interval=settings["step_size"],
+        relative_tolerance=settings["relative_tolerance"],
+        input=signal,
+        start_values={**settings["parameters"], "theta": settings["theta0"], "omega": settings["omega0"]},
+        output=["theta", "omega"],
+    )
+    np.savetxt(
+        kit / settings["output"],
+        np.column_stack([run["time"], run["theta"], run["omega"]]),
+        delimiter=",",
+        header="time,theta,omega",
+        comments="",
+        fmt="%.17g",
+    )
     judgement = _judged(kit, name)
     assert judgement.passed and judgement.max_abs_dtheta < 1e-10
 
@@ -136,8 +158,9 @@ def _native(kit, name):
     """The scenario through this package's schedule and native loop; resume through a serialized
     FMU state restored into a new instance."""
     s = read_settings(kit / f"{name}.json")
-    plan = schedule(s["torque"], start_time=s["start_time"], stop_time=s["stop_time"],
-                    step_size=s["step_size"], ramp=s["ramp"])
+    plan = schedule(
+        s["torque"], start_time=s["start_time"], stop_time=s["stop_time"], step_size=s["step_size"], ramp=s["ramp"]
+    )
     resume = json.loads((kit / f"{name}.json").read_text())["resume_time"]
     cut = len(plan.time) - 1 if resume is None else int(np.argmin(np.abs(plan.time - resume)))
     start = dict(parameters=s["parameters"], theta0=s["theta0"], omega0=s["omega0"], fmu_path=kit / KIT_FMU)
@@ -155,13 +178,20 @@ def _native(kit, name):
     slave.freeInstance()
     result = np.concatenate(parts)
     columns = [result["time"], result["theta"], result["omega"], result["alpha"]]
-    np.savetxt(kit / f"{name}_out.csv", np.column_stack(columns),
-               delimiter=",", header="time,theta,omega,alpha", comments="", fmt="%.17g")
+    np.savetxt(
+        kit / f"{name}_out.csv",
+        np.column_stack(columns),
+        delimiter=",",
+        header="time,theta,omega,alpha",
+        comments="",
+        fmt="%.17g",
+    )
 
 
 def _part(plan, first, last):
-    return TorqueSchedule(time=plan.time[first:last + 1], torque=plan.torque[first:last],
-                      torque_rate=plan.torque_rate[first:last])
+    return TorqueSchedule(
+        time=plan.time[first : last + 1], torque=plan.torque[first:last], torque_rate=plan.torque_rate[first:last]
+    )
 
 
 def test_the_native_loop_passes_every_scenario_and_judge_says_so_per_line(kit, capsys, tmp_path):
@@ -175,7 +205,7 @@ def test_the_native_loop_passes_every_scenario_and_judge_says_so_per_line(kit, c
     assert all(j.passed and j.max_abs_dtheta < 1e-10 for j in verdicts.values())
     assert main(["judge", str(own), "--json", str(tmp_path / "kit.json")]) == 0
     lines = capsys.readouterr().out.splitlines()
-    assert [line.split()[:3] for line in lines[:len(NAMES)]] == [[n, "pass", AGREES] for n in sorted(NAMES)]
+    assert [line.split()[:3] for line in lines[: len(NAMES)]] == [[n, "pass", AGREES] for n in sorted(NAMES)]
     assert lines[len(NAMES)] == f"{len(NAMES)} of {len(NAMES)} results pass"
     assert json.loads((tmp_path / "kit.json").read_text())["scenarios"]["resume"]["verdict"] == "pass"
 
@@ -189,10 +219,12 @@ def test_a_kit_is_replaced_only_when_asked_and_the_results_stay(tmp_path, capsys
     (folder / "random_steps_in.csv").write_text("time,torque\n0,1\n4,1\n")
     assert main(["scenarios", "--output-dir", str(folder)]) == 2
     err = capsys.readouterr().err.splitlines()
-    assert err == [f"pendulum-fmu scenarios: error: {folder} already holds a scenario kit (Pendulum.fmu, "
-                   "ReadMe.md, constant_torque_in.csv and 17 more): choose another output directory, or add "
-                   "--overwrite to write the kit again in its place (the results NAME_out.csv beside it "
-                   "are kept)"]
+    assert err == [
+        f"pendulum-fmu scenarios: error: {folder} already holds a scenario kit (Pendulum.fmu, "
+        "ReadMe.md, constant_torque_in.csv and 17 more): choose another output directory, or add "
+        "--overwrite to write the kit again in its place (the results NAME_out.csv beside it "
+        "are kept)"
+    ]
     assert (folder / "ReadMe.md").read_text() == "my notes\n"
     assert (folder / "random_steps_in.csv").read_text() == "time,torque\n0,1\n4,1\n"
     assert main(["scenarios", "--output-dir", str(folder), "--overwrite"]) == 0
@@ -254,16 +286,20 @@ def test_hand_edited_settings_are_refused_naming_the_file_and_field(kit, tmp_pat
     with pytest.raises(InvalidInput) as refused:
         read_settings(path)
     assert str(refused.value).startswith(f"{path}: {message}")
-    assert str(refused.value).endswith("write the kit again with pendulum-fmu scenarios --output-dir "
-                                       "FOLDER --overwrite")
+    assert str(refused.value).endswith(
+        "write the kit again with pendulum-fmu scenarios --output-dir FOLDER --overwrite"
+    )
 
 
-@pytest.mark.parametrize(("text", "message"), [
-    ("[]", "not a scenario's settings: it holds a JSON array, not an object"),
-    ("null", "not a scenario's settings: it holds a JSON null, not an object"),
-    ('{"input": "a_in.csv"}', "not a scenario's settings: no 'output', 'start_time'"),
-    ("{", "not a scenario's settings: Expecting property name"),
-])
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("[]", "not a scenario's settings: it holds a JSON array, not an object"),
+        ("null", "not a scenario's settings: it holds a JSON null, not an object"),
+        ('{"input": "a_in.csv"}', "not a scenario's settings: no 'output', 'start_time'"),
+        ("{", "not a scenario's settings: Expecting property name"),
+    ],
+)
 def test_settings_that_are_no_settings_are_refused(tmp_path, text, message):
     (tmp_path / "s.json").write_text(text)
     with pytest.raises(InvalidInput, match=f"^{tmp_path / 's.json'}: {message}"):

@@ -15,20 +15,28 @@ from pendulum_fmu.torque_schedule import TorqueTable, schedule
 from pendulum_fmu.simulate import RECORDED, open_fmu, run_schedule_python, simulate, simulate_plan, simulator
 
 # Runs one after the other through the same cached instance: each must come out as a fresh one.
-RUNS = [dict(parameters={"damping": 2.0, "mass": 25.0}, theta0=0.3, omega0=-1.0, tolerance=None),
-        dict(parameters=None, theta0=0.0, omega0=0.0, tolerance=None),
-        dict(parameters={"inertia": 5.0}, theta0=1.0, omega0=0.5, tolerance=1e-6),
-        dict(parameters=None, theta0=0.0, omega0=0.0, tolerance=None)]
+RUNS = [
+    dict(parameters={"damping": 2.0, "mass": 25.0}, theta0=0.3, omega0=-1.0, tolerance=None),
+    dict(parameters=None, theta0=0.0, omega0=0.0, tolerance=None),
+    dict(parameters={"inertia": 5.0}, theta0=1.0, omega0=0.5, tolerance=1e-6),
+    dict(parameters=None, theta0=0.0, omega0=0.0, tolerance=None),
+]
 
 
 def _fresh_fmpy_run(fmu, plan, parameters, theta0, omega0, tolerance, tmp_path):
     """The schedule through a new fmpy FMU2Slave, driven call by call as a master would."""
     description = read_model_description(str(fmu))
     refs = {v.name: v.valueReference for v in description.modelVariables}
-    start = {v.name: float(v.start) for v in description.modelVariables if v.causality == "parameter" and v.type == "Real"}
+    start = {
+        v.name: float(v.start) for v in description.modelVariables if v.causality == "parameter" and v.type == "Real"
+    }
     start.update(parameters or {}, theta=theta0, omega=omega0)
-    slave = FMU2Slave(guid=description.guid, unzipDirectory=extract(str(fmu), str(tmp_path / "fresh")),
-                      modelIdentifier=description.coSimulation.modelIdentifier, instanceName="fresh")
+    slave = FMU2Slave(
+        guid=description.guid,
+        unzipDirectory=extract(str(fmu), str(tmp_path / "fresh")),
+        modelIdentifier=description.coSimulation.modelIdentifier,
+        instanceName="fresh",
+    )
     slave.instantiate()
     slave.setupExperiment(tolerance=tolerance, startTime=float(plan.time[0]))
     slave.enterInitializationMode()
@@ -67,8 +75,9 @@ def test_an_fmi3_fmu_restarted_matches_a_fresh_instance_bit_for_bit(fmu3):
     plan = schedule(20.0, stop_time=0.05)
     for run in RUNS:
         cached = simulate_plan(plan, fmu_path=fmu3, **run)
-        fresh = open_fmu(fmu3, parameters=run["parameters"], theta0=run["theta0"], omega0=run["omega0"],
-                         tolerance=run["tolerance"])
+        fresh = open_fmu(
+            fmu3, parameters=run["parameters"], theta0=run["theta0"], omega0=run["omega0"], tolerance=run["tolerance"]
+        )
         try:
             assert np.array_equal(cached, run_schedule_python(fresh, plan)), run
         finally:
@@ -113,8 +122,7 @@ def test_an_fmu_file_rebuilt_on_disk_is_noticed(fmu, tmp_path):
     text = MODEL_DESCRIPTION.read_text()
     xml.write_text(re.sub(r'(name="mass".*?start=")40"', r'\g<1>10"', text, count=1, flags=re.S))
     assert xml.read_text() != text
-    rebuilt = build_fmu(tmp_path / "rebuilt" / "Pendulum.fmu", model_description_file=xml,
-                        platforms=("linux64",))
+    rebuilt = build_fmu(tmp_path / "rebuilt" / "Pendulum.fmu", model_description_file=xml, platforms=("linux64",))
     rebuilt.replace(path)
     after = simulate(20.0, stop_time=0.5, fmu_path=path)
     assert simulator(path) is not first

@@ -44,8 +44,11 @@ POINTS = 501
 def _table(path, format="parquet", filesystem=None) -> dict[str, np.ndarray]:
     """A study's table as numpy columns, sorted by case (and time)."""
     if format == "csv":
-        format = ds.CsvFileFormat(convert_options=pyarrow.csv.ConvertOptions(
-            column_types={"message": pyarrow.string()}, strings_can_be_null=False))
+        format = ds.CsvFileFormat(
+            convert_options=pyarrow.csv.ConvertOptions(
+                column_types={"message": pyarrow.string()}, strings_can_be_null=False
+            )
+        )
     table = ds.dataset(str(path), format=format, filesystem=filesystem).to_table()
     keys = [("case", "ascending")] + ([("time", "ascending")] if "time" in table.column_names else [])
     table = table.sort_by(keys)
@@ -55,8 +58,14 @@ def _table(path, format="parquet", filesystem=None) -> dict[str, np.ndarray]:
 def _exact(case: dict, stride: int = 1) -> np.ndarray:
     """The case through simulate(), the readable path, at the points a study keeps."""
     parameters = {k: v for k, v in case.items() if k not in ("torque", "theta0", "omega0")}
-    run = simulate.simulate(case["torque"], parameters=parameters, theta0=case.get("theta0", 0.0),
-                            omega0=case.get("omega0", 0.0), stop_time=STOP_TIME, step_size=STEP_SIZE)
+    run = simulate.simulate(
+        case["torque"],
+        parameters=parameters,
+        theta0=case.get("theta0", 0.0),
+        omega0=case.get("omega0", 0.0),
+        stop_time=STOP_TIME,
+        step_size=STEP_SIZE,
+    )
     keep = np.unique(np.append(np.arange(0, len(run), stride), len(run) - 1))
     return run[keep]
 
@@ -69,19 +78,19 @@ def _built_fmu(fmu, monkeypatch):
 
 # --- studies on a local cluster -------------------------------------------------------------
 
+
 @pytest.fixture(scope="module")
 def threads_scheduler():
     """Workers as threads of this process: quick to start, and they share its memory:// file system."""
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=":0",
-                      silence_logs=logging.WARNING) as cluster:
+    with LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=False, dashboard_address=":0", silence_logs=logging.WARNING
+    ) as cluster:
         yield cluster.scheduler_address
-
 
 
 def test_grid_on_a_local_cluster_matches_simulate_bit_for_bit(tmp_path, capsys):
     cases = sweep_grid([5.0, 20.0], [0.0, 9.81])
-    result = run_sweep(Study(cases, stop_time=STOP_TIME, step_size=STEP_SIZE), output_dir=tmp_path,
-                        workers=2)
+    result = run_sweep(Study(cases, stop_time=STOP_TIME, step_size=STEP_SIZE), output_dir=tmp_path, workers=2)
     assert "4/4 cases, 0 failed" in capsys.readouterr().err
     assert (result.cases, result.failed, result.chunks_run) == (4, 0, result.chunks)
     trajectories, table = _table(result.trajectories), _table(result.cases_table)
@@ -105,8 +114,9 @@ def test_grid_on_a_local_cluster_matches_simulate_bit_for_bit(tmp_path, capsys):
 
 def test_csv_with_chosen_outputs_and_interval(tmp_path, threads_scheduler):
     cases = [{"torque": 10.0, "damping": 0.0, "theta0": 0.3}, {"torque": 10.0, "damping": 4.0, "theta0": 0.3}]
-    study = Study(cases, stop_time=STOP_TIME, step_size=STEP_SIZE, outputs=["theta"],
-                  output_interval=0.007, format="csv")
+    study = Study(
+        cases, stop_time=STOP_TIME, step_size=STEP_SIZE, outputs=["theta"], output_interval=0.007, format="csv"
+    )
     result = run_sweep(study, output_dir=tmp_path, scheduler=threads_scheduler, progress=False)
     trajectories = _table(result.trajectories, "csv")
     assert set(trajectories) == {"case", "time", "theta"}
@@ -117,16 +127,21 @@ def test_csv_with_chosen_outputs_and_interval(tmp_path, threads_scheduler):
         # The CSV's shortest round-trip digits read back as the same doubles.
         assert np.array_equal(trajectories["time"][rows], expected["time"])
         assert np.array_equal(trajectories["theta"][rows], expected["theta"])
-        oracle = reference(10.0, stop_time=STOP_TIME, step_size=STEP_SIZE, theta0=0.3,
-                           parameters={"damping": case["damping"]})
+        oracle = reference(
+            10.0, stop_time=STOP_TIME, step_size=STEP_SIZE, theta0=0.3, parameters={"damping": case["damping"]}
+        )
         assert abs(expected["theta"][-1] - oracle["theta"][-1]) < 1e-10
     assert _table(result.cases_table, "csv")["damping"].tolist() == [0.0, 4.0]
 
 
 def test_a_case_the_fmu_refuses_is_recorded_and_the_rest_go_on(tmp_path, threads_scheduler):
     cases = sweep_grid([1.0, 2.0], [9.81], {"mass": [0.0, 1.0], "length": [0.0, 0.5], "inertia": [0.0]})
-    result = run_sweep(Study(cases, stop_time=0.05, step_size=STEP_SIZE), output_dir=tmp_path,
-                        scheduler=threads_scheduler, progress=False)
+    result = run_sweep(
+        Study(cases, stop_time=0.05, step_size=STEP_SIZE),
+        output_dir=tmp_path,
+        scheduler=threads_scheduler,
+        progress=False,
+    )
     table, trajectories = _table(result.cases_table), _table(result.trajectories)
     refused = {"mass must be > 0", "inertia about the pivot) must be > 0"}
     for number, case in enumerate(cases):
@@ -145,8 +160,7 @@ def test_a_case_the_fmu_refuses_is_recorded_and_the_rest_go_on(tmp_path, threads
 
 def test_resume_runs_only_the_chunks_not_written(tmp_path, threads_scheduler):
     cases = sweep_grid(list(np.linspace(1.0, 40.0, 70)), [9.81])  # 2 cases per chunk, 35 chunks
-    first = run_sweep(Study(cases, stop_time=0.05), output_dir=tmp_path, scheduler=threads_scheduler,
-                      progress=False)
+    first = run_sweep(Study(cases, stop_time=0.05), output_dir=tmp_path, scheduler=threads_scheduler, progress=False)
     parts = sorted(tmp_path.glob("cases/part-*.parquet"))
     assert first.chunks == len(parts) == 35
     # As if interrupted: three chunks never finished (one wrote its trajectories only).
@@ -154,8 +168,9 @@ def test_resume_runs_only_the_chunks_not_written(tmp_path, threads_scheduler):
         parts[index].unlink()
     (tmp_path / "trajectories" / "part-000005.parquet").unlink()  # its cases part still says done
     kept = {p.name: p.stat().st_mtime_ns for p in tmp_path.glob("cases/part-*.parquet")}
-    again = run_sweep(Study(cases, stop_time=0.05), output_dir=tmp_path, resume=True,
-                      scheduler=threads_scheduler, progress=False)
+    again = run_sweep(
+        Study(cases, stop_time=0.05), output_dir=tmp_path, resume=True, scheduler=threads_scheduler, progress=False
+    )
     assert again.chunks_run == 3 and again.cases == 70
     assert {p.name: p.stat().st_mtime_ns for p in tmp_path.glob("cases/part-*.parquet") if p.name in kept} == kept
     table = _table(again.cases_table)
@@ -166,8 +181,13 @@ def test_resume_runs_only_the_chunks_not_written(tmp_path, threads_scheduler):
     with pytest.raises(StudyExists, match="holds another study \\(stop_time differ; 35 of 35 chunks"):
         run_sweep(Study(cases, stop_time=0.06), output_dir=tmp_path, resume=True, progress=False)
     # Asked to, a new study replaces the old one.
-    fresh = run_sweep(Study(cases[:3], stop_time=0.05), output_dir=tmp_path, overwrite=True,
-                      scheduler=threads_scheduler, progress=False)
+    fresh = run_sweep(
+        Study(cases[:3], stop_time=0.05),
+        output_dir=tmp_path,
+        overwrite=True,
+        scheduler=threads_scheduler,
+        progress=False,
+    )
     assert fresh.chunks_run == fresh.chunks and len(_table(fresh.cases_table)["case"]) == 3
     assert not list(tmp_path.glob("**/.*"))
 
@@ -176,9 +196,15 @@ def _stale_task(output_dir) -> Task:
     """The task a worker of the run that last wrote output_dir holds: its store and run token."""
     manifest = json.loads((output_dir / "study.json").read_text())
     study = manifest["study"]
-    return Task(fmu=str(default_fmu()), store=Store(LocalFileSystem(), str(output_dir), "parquet"),
-                stop_time=study["stop_time"], step_size=study["step_size"],
-                outputs=tuple(study["outputs"]), stride=study["stride"], run=manifest["run"])
+    return Task(
+        fmu=str(default_fmu()),
+        store=Store(LocalFileSystem(), str(output_dir), "parquet"),
+        stop_time=study["stop_time"],
+        step_size=study["step_size"],
+        outputs=tuple(study["outputs"]),
+        stride=study["stride"],
+        run=manifest["run"],
+    )
 
 
 def test_a_stale_workers_part_never_enters_the_study_that_replaced_its_own(tmp_path, threads_scheduler):
@@ -186,11 +212,15 @@ def test_a_stale_workers_part_never_enters_the_study_that_replaced_its_own(tmp_p
     # another (--overwrite, another grid) in the same folder.
     old_cases = sweep_grid([10.0, 20.0], [9.81], {"damping": [0.0, 0.5]})
     new_cases = sweep_grid([10.0, 20.0], [9.81], {"damping": [0.0, 0.25]})
-    run_sweep(Study(old_cases, stop_time=STOP_TIME), output_dir=tmp_path, scheduler=threads_scheduler,
-              progress=False)
+    run_sweep(Study(old_cases, stop_time=STOP_TIME), output_dir=tmp_path, scheduler=threads_scheduler, progress=False)
     stale = _stale_task(tmp_path)
-    new = run_sweep(Study(new_cases, stop_time=STOP_TIME), output_dir=tmp_path, overwrite=True,
-                    scheduler=threads_scheduler, progress=False)
+    new = run_sweep(
+        Study(new_cases, stop_time=STOP_TIME),
+        output_dir=tmp_path,
+        overwrite=True,
+        scheduler=threads_scheduler,
+        progress=False,
+    )
     assert new.chunks == 4 and _stale_task(tmp_path).run != stale.run
     parts = {p: p.read_bytes() for p in tmp_path.glob("*/part-*")}
     cases, trajectories = _table(tmp_path / "cases"), _table(tmp_path / "trajectories")
@@ -205,10 +235,19 @@ def test_a_stale_workers_part_never_enters_the_study_that_replaced_its_own(tmp_p
     expected = _exact({"torque": 10.0, "damping": 0.25})
     assert cases["damping"][1] == 0.25 and cases["final_theta"][1] == expected["theta"][-1]
     assert np.array_equal(trajectories["theta"][trajectories["case"] == 1], expected["theta"])
-    assert Store(LocalFileSystem(), str(tmp_path), "parquet").read_cases(["torque", "gravity", "damping"])[
-        "final_theta"].to_pylist() == cases["final_theta"].tolist()
-    resumed = run_sweep(Study(new_cases, stop_time=STOP_TIME), output_dir=tmp_path, resume=True,
-                        scheduler=threads_scheduler, progress=False)
+    assert (
+        Store(LocalFileSystem(), str(tmp_path), "parquet")
+        .read_cases(["torque", "gravity", "damping"])["final_theta"]
+        .to_pylist()
+        == cases["final_theta"].tolist()
+    )
+    resumed = run_sweep(
+        Study(new_cases, stop_time=STOP_TIME),
+        output_dir=tmp_path,
+        resume=True,
+        scheduler=threads_scheduler,
+        progress=False,
+    )
     assert resumed.chunks_run == 0 and {p: p.read_bytes() for p in tmp_path.glob("*/part-*")} == parts
     assert not list(tmp_path.glob("*/_part-*"))  # and the stale parts are gone
 
@@ -224,8 +263,9 @@ def test_a_run_commits_only_the_parts_staged_under_its_own_token(tmp_path):
 
 
 def test_output_to_a_file_url(tmp_path):
-    result = run_sweep(Study(sweep_grid([3.0, 6.0]), stop_time=0.1), output_dir=tmp_path.as_uri(),
-                        workers=1, progress=False)
+    result = run_sweep(
+        Study(sweep_grid([3.0, 6.0]), stop_time=0.1), output_dir=tmp_path.as_uri(), workers=1, progress=False
+    )
     assert result.figure == tmp_path / "sweep.png" and result.figure.exists()
     table = _table(tmp_path / "cases")
     run = simulate.simulate(6.0, stop_time=0.1)
@@ -235,8 +275,12 @@ def test_output_to_a_file_url(tmp_path):
 def test_output_to_fsspec_memory(threads_scheduler):
     import fsspec
 
-    result = run_sweep(Study(sweep_grid([3.0, 6.0], [0.0]), stop_time=0.1), output_dir="memory://study",
-                        scheduler=threads_scheduler, progress=False)
+    result = run_sweep(
+        Study(sweep_grid([3.0, 6.0], [0.0]), stop_time=0.1),
+        output_dir="memory://study",
+        scheduler=threads_scheduler,
+        progress=False,
+    )
     assert result.figure == "memory://study/sweep.png"
     filesystem = fsspec.filesystem("memory")
     assert filesystem.cat("/study/sweep.png")[:4] == b"\x89PNG"
@@ -248,8 +292,9 @@ def test_output_to_fsspec_memory(threads_scheduler):
 
 def test_many_cases_draw_quantile_bands(tmp_path, threads_scheduler):
     cases = sweep_grid(list(np.linspace(0.0, 40.0, 8)), [0.0, 9.81], {"damping": [0.0, 1.0]})
-    result = run_sweep(Study(cases, stop_time=0.05, outputs=[]), output_dir=tmp_path,
-                        scheduler=threads_scheduler, progress=False)
+    result = run_sweep(
+        Study(cases, stop_time=0.05, outputs=[]), output_dir=tmp_path, scheduler=threads_scheduler, progress=False
+    )
     assert not (tmp_path / "trajectories").exists()  # no outputs: the cases table alone
     assert result.figure.read_bytes()[:4] == b"\x89PNG"
 
@@ -270,8 +315,25 @@ def test_the_command_names_only_what_it_wrote_and_one_duration(tmp_path, capsys,
             return True
 
     monkeypatch.setattr(sys, "stderr", Terminal())
-    assert main(["sweep", "--torque", "2", "4", "--stop-time", "0.1", "--outputs", "none",
-                 "--workers", "1", "--output-dir", str(tmp_path)]) == 0
+    assert (
+        main(
+            [
+                "sweep",
+                "--torque",
+                "2",
+                "4",
+                "--stop-time",
+                "0.1",
+                "--outputs",
+                "none",
+                "--workers",
+                "1",
+                "--output-dir",
+                str(tmp_path),
+            ]
+        )
+        == 0
+    )
     out = capsys.readouterr().out.splitlines()
     assert re.fullmatch(r"2 cases in \d+\.\d s", out[0]), out
     assert out[1:] == [f"wrote {tmp_path / 'cases'}", f"wrote {tmp_path / 'sweep.png'}"]
@@ -281,6 +343,7 @@ def test_the_command_names_only_what_it_wrote_and_one_duration(tmp_path, capsys,
 
 
 # --- a folder that holds a study: refused, resumed, or replaced once the new one is whole ----
+
 
 def _snapshot(folder) -> dict:
     """Every file under folder (hidden ones too) and its bytes."""
@@ -318,8 +381,13 @@ def test_a_finished_study_is_never_replaced_unasked(tmp_path, monkeypatch, capsy
     assert table["final_theta"][0] == simulate.simulate(1.0)["theta"][-1]
     assert len(_table(tmp_path / "study" / "trajectories")["case"]) == 3001
     assert (tmp_path / "study" / "notes.txt").read_text() == "mine"
-    assert sorted(p.name for p in (tmp_path / "study").iterdir()) == \
-        ["cases", "notes.txt", "study.json", "sweep.png", "trajectories"]
+    assert sorted(p.name for p in (tmp_path / "study").iterdir()) == [
+        "cases",
+        "notes.txt",
+        "study.json",
+        "sweep.png",
+        "trajectories",
+    ]
 
 
 def test_an_unfinished_study_is_refused_too(tmp_path, threads_scheduler):
@@ -327,20 +395,24 @@ def test_an_unfinished_study_is_refused_too(tmp_path, threads_scheduler):
     run_sweep(Study(cases, stop_time=0.05), output_dir=tmp_path, scheduler=threads_scheduler, progress=False)
     for part in list(tmp_path.glob("cases/part-00000[12].parquet")):  # as if interrupted
         part.unlink()
-    with pytest.raises(StudyExists, match="already holds this study, unfinished \\(2 of 4 chunks written\\): add --resume"):
+    with pytest.raises(
+        StudyExists, match="already holds this study, unfinished \\(2 of 4 chunks written\\): add --resume"
+    ):
         run_sweep(Study(cases, stop_time=0.05), output_dir=tmp_path, progress=False)
     with pytest.raises(StudyExists, match="holds another study \\(stop_time differ; 2 of 4 chunks written\\)"):
         run_sweep(Study(cases, stop_time=0.06), output_dir=tmp_path, progress=False)
     # A folder with a study's entries that no sweep's study.json describes is someone else's.
     (tmp_path / "study.json").write_text("my notes")
-    with pytest.raises(StudyExists, match="holds study.json, trajectories, cases, sweep.png but no "
-                                          "study.json of a sweep"):
+    with pytest.raises(
+        StudyExists, match="holds study.json, trajectories, cases, sweep.png but no study.json of a sweep"
+    ):
         run_sweep(Study(cases, stop_time=0.05), output_dir=tmp_path, resume=True, progress=False)
 
 
 def test_a_study_that_fails_to_replace_another_leaves_it_whole(tmp_path, threads_scheduler, monkeypatch):
-    run_sweep(Study(sweep_grid([1.0, 2.0]), stop_time=0.05), output_dir=tmp_path,
-              scheduler=threads_scheduler, progress=False)
+    run_sweep(
+        Study(sweep_grid([1.0, 2.0]), stop_time=0.05), output_dir=tmp_path, scheduler=threads_scheduler, progress=False
+    )
     before = _snapshot(tmp_path)
 
     def fail(*arguments):
@@ -348,8 +420,13 @@ def test_a_study_that_fails_to_replace_another_leaves_it_whole(tmp_path, threads
 
     monkeypatch.setattr("pendulum_fmu.sweep.run.draw", fail)  # the very last step before the move
     with pytest.raises(OSError, match="the disk is full"):
-        run_sweep(Study(sweep_grid([3.0]), stop_time=0.05), output_dir=tmp_path, overwrite=True,
-                  scheduler=threads_scheduler, progress=False)
+        run_sweep(
+            Study(sweep_grid([3.0]), stop_time=0.05),
+            output_dir=tmp_path,
+            overwrite=True,
+            scheduler=threads_scheduler,
+            progress=False,
+        )
     assert _snapshot(tmp_path) == before and not list(tmp_path.glob(".*"))
 
 
@@ -357,30 +434,55 @@ def test_overwrite_on_an_fsspec_url(threads_scheduler):
     import fsspec
 
     for torques in ([3.0, 6.0], [9.0]):
-        result = run_sweep(Study(sweep_grid(torques, [0.0]), stop_time=0.1),
-                           output_dir="memory://replaced", overwrite=True,
-                           scheduler=threads_scheduler, progress=False)
+        result = run_sweep(
+            Study(sweep_grid(torques, [0.0]), stop_time=0.1),
+            output_dir="memory://replaced",
+            overwrite=True,
+            scheduler=threads_scheduler,
+            progress=False,
+        )
     filesystem = fsspec.filesystem("memory")
     table = _table("/replaced/cases", filesystem=filesystem)
     assert result.cases == 1 and table["torque"].tolist() == [9.0]
     assert table["final_theta"][0] == pytest.approx(0.5 * 9.0 / I_TOTAL * 0.1**2, abs=1e-14)
     assert sorted(filesystem.ls("/replaced", detail=False)) == [
-        f"/replaced/{name}" for name in ("cases", "study.json", "sweep.png", "trajectories")]
+        f"/replaced/{name}" for name in ("cases", "study.json", "sweep.png", "trajectories")
+    ]
 
 
 def test_ctrl_c_during_overwrite_leaves_the_old_study_whole(tmp_path):
     old = tmp_path / "study"
-    assert subprocess.run(_sweep_command(old, "--torque", "1", "2", "--stop-time", "0.1", "--workers", "1"),
-                          capture_output=True).returncode == 0
+    assert (
+        subprocess.run(
+            _sweep_command(old, "--torque", "1", "2", "--stop-time", "0.1", "--workers", "1"), capture_output=True
+        ).returncode
+        == 0
+    )
     before = _snapshot(old)
     # 594 cases of 600 s on one worker: still running after 4 s on any machine (with 60-s cases
     # one CI run had finished them all in 2.9 s and printed its progress line before the signal).
     for delay in (2.0, 4.0):  # while the cluster starts, while the chunks run
-        process = subprocess.Popen(_sweep_command(old, "--overwrite", "--torque", *map(str, range(3, 300)),
-                                                  "--gravity", "0", "9.81", "--stop-time", "600",
-                                                  "--outputs", "none", "--workers", "1"),
-                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                                   start_new_session=True)
+        process = subprocess.Popen(
+            _sweep_command(
+                old,
+                "--overwrite",
+                "--torque",
+                *map(str, range(3, 300)),
+                "--gravity",
+                "0",
+                "9.81",
+                "--stop-time",
+                "600",
+                "--outputs",
+                "none",
+                "--workers",
+                "1",
+            ),
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            start_new_session=True,
+        )
         time.sleep(delay)
         assert process.poll() is None, process.communicate()
         os.killpg(process.pid, signal.SIGINT)
@@ -392,6 +494,7 @@ def test_ctrl_c_during_overwrite_leaves_the_old_study_whole(tmp_path):
 
 # --- a cluster of separate processes, as on a real cluster ---------------------------------
 
+
 @pytest.fixture
 def dask_processes():
     """`dask scheduler` and two `dask worker`s on localhost, each its own process."""
@@ -400,28 +503,60 @@ def dask_processes():
 
 
 def test_a_study_on_a_scheduler_and_workers_started_as_processes(tmp_path, dask_processes, fmu, capsys):
-    assert main(["sweep", "--torque", "2", "4", "8", "16", "--gravity", "0", "9.81",
-                 "--stop-time", "0.2", "--scheduler", dask_processes,
-                 "--output-dir", str(tmp_path)]) == 0
+    assert (
+        main(
+            [
+                "sweep",
+                "--torque",
+                "2",
+                "4",
+                "8",
+                "16",
+                "--gravity",
+                "0",
+                "9.81",
+                "--stop-time",
+                "0.2",
+                "--scheduler",
+                dask_processes,
+                "--output-dir",
+                str(tmp_path),
+            ]
+        )
+        == 0
+    )
     assert "8 cases" in capsys.readouterr().out
     table = _table(tmp_path / "cases")
     for number, (torque, gravity) in enumerate([(t, g) for t in (2, 4, 8, 16) for g in (0.0, 9.81)]):
-        expected = (0.5 * torque / I_TOTAL * 0.2**2 if gravity == 0.0 else
-                    reference(float(torque), stop_time=0.2, step_size=STEP_SIZE)["theta"][-1])
+        expected = (
+            0.5 * torque / I_TOTAL * 0.2**2
+            if gravity == 0.0
+            else reference(float(torque), stop_time=0.2, step_size=STEP_SIZE)["theta"][-1]
+        )
         assert abs(table["final_theta"][number] - expected) < 1e-10
     with Client(dask_processes) as client:
         # Both workers ran chunks, each unzipping the FMU once (into its one model object).
-        assert list(client.run(lambda: sum(
-            1 for held in __import__("gc").get_objects()
-            if type(held).__name__ == "FmuModel" and "_unzipped" in vars(held))).values()) == [1, 1]
+        assert list(
+            client.run(
+                lambda: sum(
+                    1
+                    for held in __import__("gc").get_objects()
+                    if type(held).__name__ == "FmuModel" and "_unzipped" in vars(held)
+                )
+            ).values()
+        ) == [1, 1]
 
 
 def test_a_chunk_whose_worker_dies_is_run_again(tmp_path, dask_processes):
     cases = sweep_grid(list(np.linspace(1.0, 40.0, 256)), [9.81])  # 64 chunks of 4 cases
     results = []
-    study = threading.Thread(target=lambda: results.append(run_sweep(
-        Study(cases, stop_time=10.0, outputs=[]), output_dir=tmp_path, scheduler=dask_processes,
-        progress=False)))
+    study = threading.Thread(
+        target=lambda: results.append(
+            run_sweep(
+                Study(cases, stop_time=10.0, outputs=[]), output_dir=tmp_path, scheduler=dask_processes, progress=False
+            )
+        )
+    )
     study.start()
     deadline = time.monotonic() + 120
     while not list(tmp_path.glob("cases/part-*")):
@@ -446,11 +581,14 @@ def test_a_scheduler_killed_mid_study_is_one_line_and_resume_on_a_new_one_finish
     # Issue 32, fault 2: the cluster's failure, not ours: exit 2 (as for an unreachable
     # scheduler), one line naming --resume, none of dask's log.
     torques = list(map(str, np.linspace(1.0, 40.0, 128)))  # 64 chunks of 2 cases
-    arguments = ("--torque", *torques, "--stop-time", "300", "--outputs", "theta",
-                 "--output-interval", "1")
+    arguments = ("--torque", *torques, "--stop-time", "300", "--outputs", "theta", "--output-interval", "1")
     with benchmarks.scale.dask_process_handles(1) as (address, processes):
-        sweep = subprocess.Popen(_sweep_command(tmp_path, *arguments, "--scheduler", address),
-                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        sweep = subprocess.Popen(
+            _sweep_command(tmp_path, *arguments, "--scheduler", address),
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
         deadline = time.monotonic() + 120
         while not list(tmp_path.glob("cases/part-*")):
             assert sweep.poll() is None and time.monotonic() < deadline, sweep.communicate()
@@ -459,15 +597,21 @@ def test_a_scheduler_killed_mid_study_is_one_line_and_resume_on_a_new_one_finish
         out, err = sweep.communicate(timeout=120)
     assert sweep.returncode == 2 and out == "", (out, err)
     lines = [line for line in err.splitlines() if not line.startswith("sweep: ")]  # progress
-    assert lines == [f"pendulum-fmu sweep: error: the dask scheduler at {address} was lost "
-                     "mid-study (scheduler-connection-lost); the chunks that finished are kept in "
-                     f"{tmp_path}: start a scheduler and run the same command with --resume to "
-                     "run the rest"], err
+    assert lines == [
+        f"pendulum-fmu sweep: error: the dask scheduler at {address} was lost "
+        "mid-study (scheduler-connection-lost); the chunks that finished are kept in "
+        f"{tmp_path}: start a scheduler and run the same command with --resume to "
+        "run the rest"
+    ], err
     written = len(list(tmp_path.glob("cases/part-*")))
     assert 0 < written < 64
     with benchmarks.scale.dask_processes(1) as address:
-        resumed = subprocess.run(_sweep_command(tmp_path, *arguments, "--scheduler", address,
-                                                "--resume"), capture_output=True, text=True, timeout=300)
+        resumed = subprocess.run(
+            _sweep_command(tmp_path, *arguments, "--scheduler", address, "--resume"),
+            capture_output=True,
+            text=True,
+            timeout=300,
+        )
     assert resumed.returncode == 0, resumed.stderr
     assert f"({64 - written} of 64 chunks run;" in resumed.stdout
     table, trajectories = _table(tmp_path / "cases"), _table(tmp_path / "trajectories")
@@ -491,8 +635,9 @@ def test_a_worker_stopped_mid_study_and_continued_after_an_overwrite_changes_not
     with benchmarks.scale.dask_process_handles(2, nanny=False) as (address, processes):
         stopped = psutil.Process(processes[1].pid)
         results = []
-        first = threading.Thread(target=lambda: results.append(run_sweep(
-            old, output_dir=tmp_path, scheduler=address, progress=False)))
+        first = threading.Thread(
+            target=lambda: results.append(run_sweep(old, output_dir=tmp_path, scheduler=address, progress=False))
+        )
         first.start()
         deadline = time.monotonic() + 120
         while not (list(tmp_path.glob("cases/part-*")) and stopped.cpu_percent(0.1) > 30):
@@ -516,8 +661,7 @@ def test_a_worker_stopped_mid_study_and_continued_after_an_overwrite_changes_not
     # unchanged above; a sample of the damping-0.25 cases against simulate() here).
     for number in range(1, 256, 16):
         expected = simulate.simulate(torques[number // 2], parameters={"damping": 0.25}, stop_time=600.0)
-        assert np.array_equal(trajectories["theta"][trajectories["case"] == number],
-                              expected["theta"][::1000]), number
+        assert np.array_equal(trajectories["theta"][trajectories["case"] == number], expected["theta"][::1000]), number
     again = run_sweep(new, output_dir=tmp_path, resume=True, workers=1, progress=False)
     assert again.chunks_run == 0 and {p: p.read_bytes() for p in tmp_path.glob("*/part-*")} == parts
     assert not list(tmp_path.glob("*/_part-*"))
@@ -546,8 +690,24 @@ def test_an_unreachable_silent_or_wrong_scheduler_is_one_line_within_the_timeout
         for server in (None, silent, impostor):
             address = f"tcp://127.0.0.1:{server.getsockname()[1]}" if server else closed
             started = time.perf_counter()
-            assert main(["sweep", "--torque", "1", "--stop-time", "0.01", "--scheduler", address,
-                         "--connect-timeout", "2", "--output-dir", str(tmp_path)]) == 2
+            assert (
+                main(
+                    [
+                        "sweep",
+                        "--torque",
+                        "1",
+                        "--stop-time",
+                        "0.01",
+                        "--scheduler",
+                        address,
+                        "--connect-timeout",
+                        "2",
+                        "--output-dir",
+                        str(tmp_path),
+                    ]
+                )
+                == 2
+            )
             assert time.perf_counter() - started < 2 + 3  # the timeout, and a margin for a loaded machine
             err = capsys.readouterr().err
             assert err.count("\n") == 1 and f"no dask scheduler answered at {address} within 2 s" in err
@@ -558,16 +718,17 @@ def test_an_unreachable_silent_or_wrong_scheduler_is_one_line_within_the_timeout
 
 # --- signals and concurrent runs, with real processes --------------------------------------
 
+
 def _sweep_command(output_dir, *arguments):
     default_fmu()  # built (when stale) here once, not by every process at once
     return [sys.executable, "-m", "pendulum_fmu", "sweep", "--output-dir", str(output_dir), *arguments]
 
 
-@pytest.mark.parametrize("signal_number, code, word", [(signal.SIGINT, 130, "interrupted"),
-                                                       (signal.SIGTERM, 143, "terminated")])
+@pytest.mark.parametrize(
+    "signal_number, code, word", [(signal.SIGINT, 130, "interrupted"), (signal.SIGTERM, 143, "terminated")]
+)
 def test_a_signal_stops_a_sweep_cleanly(tmp_path, signal_number, code, word):
-    command = _sweep_command(tmp_path, "--torque", *map(str, range(1, 300)), "--gravity", "0", "9.81",
-                             "--workers", "2")
+    command = _sweep_command(tmp_path, "--torque", *map(str, range(1, 300)), "--gravity", "0", "9.81", "--workers", "2")
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 120
     while not glob.glob(str(tmp_path / "cases" / "part-*")):
@@ -595,18 +756,36 @@ def test_ctrl_c_to_the_process_group_is_one_line_whenever_it_comes(tmp_path, del
     # 400 cases of 600 s (only the cases table kept): still running after 4 s on any machine
     # (2 workers ran 400 cases of 60 s in 1.8 s here, after the Taylor integrator).
     study = tmp_path / "study"
-    process = subprocess.Popen(_sweep_command(study, "--torque", *map(str, range(1, 201)),
-                                              "--gravity", "0", "9.81", "--stop-time", "600",
-                                              "--outputs", "none"),
-                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                               start_new_session=True)
+    process = subprocess.Popen(
+        _sweep_command(
+            study,
+            "--torque",
+            *map(str, range(1, 201)),
+            "--gravity",
+            "0",
+            "9.81",
+            "--stop-time",
+            "600",
+            "--outputs",
+            "none",
+        ),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
     time.sleep(delay)
     assert process.poll() is None, process.communicate()
     os.killpg(process.pid, signal.SIGINT)
     _, err = process.communicate(timeout=120)
     assert process.returncode == 130 and err.count("\n") == 1, err
-    assert err.startswith(("pendulum-fmu: interrupted while starting", "pendulum-fmu sweep: interrupted;",
-                           "pendulum-fmu sweep: interrupted before anything was written"))
+    assert err.startswith(
+        (
+            "pendulum-fmu: interrupted while starting",
+            "pendulum-fmu sweep: interrupted;",
+            "pendulum-fmu sweep: interrupted before anything was written",
+        )
+    )
     if "before anything was written" in err:
         assert not any(study.glob("*")), "nothing of the study is there"
     deadline = time.monotonic() + 30
@@ -623,10 +802,17 @@ def _in_group(pid: int, group: int) -> bool:
 
 
 def test_eight_sweeps_into_eight_directories_at_once(tmp_path):
-    processes = [subprocess.Popen(_sweep_command(tmp_path / f"study{i}", "--torque", str(i + 1.0),
-                                                 str(i + 2.0), "--stop-time", "0.05", "--workers", "1"),
-                                  stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-                 for i in range(8)]
+    processes = [
+        subprocess.Popen(
+            _sweep_command(
+                tmp_path / f"study{i}", "--torque", str(i + 1.0), str(i + 2.0), "--stop-time", "0.05", "--workers", "1"
+            ),
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        for i in range(8)
+    ]
     for i, process in enumerate(processes):
         out, err = process.communicate(timeout=300)
         assert process.returncode == 0, err
@@ -637,15 +823,22 @@ def test_eight_sweeps_into_eight_directories_at_once(tmp_path):
 
 
 def test_a_second_run_into_a_folder_in_use_is_refused_and_the_first_is_whole(tmp_path, capsys):
-    first = subprocess.Popen(_sweep_command(tmp_path, "--torque", *map(str, range(1, 201)),
-                                            "--stop-time", "0.5", "--workers", "1"),
-                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    first = subprocess.Popen(
+        _sweep_command(tmp_path, "--torque", *map(str, range(1, 201)), "--stop-time", "0.5", "--workers", "1"),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     deadline = time.monotonic() + 120
     while not (tmp_path / "study.json").exists() and first.poll() is None and time.monotonic() < deadline:
         time.sleep(0.1)
     # A different study into the same folder would replace the first one's parts as it runs.
-    assert main(["sweep", "--torque", "1001", "1002", "--stop-time", "0.5", "--workers", "1",
-                 "--output-dir", str(tmp_path)]) == 2
+    assert (
+        main(
+            ["sweep", "--torque", "1001", "1002", "--stop-time", "0.5", "--workers", "1", "--output-dir", str(tmp_path)]
+        )
+        == 2
+    )
     refusal = capsys.readouterr().err.strip().splitlines()
     assert len(refusal) == 1 and "is in use by another run" in refusal[0], refusal
     out, err = first.communicate(timeout=300)
@@ -660,31 +853,41 @@ def test_a_second_run_into_a_folder_in_use_is_refused_and_the_first_is_whole(tmp
 STUDY_FIELDS = ("stop_time", "step_size", "outputs", "output_interval", "format")
 
 
-@pytest.mark.parametrize("cases, options, message", [
-    ([], {}, "no cases to run"),
-    ([{"gravity": 1.0}], {}, "every case needs a 'torque'"),
-    ([{"torque": 1.0}, {"torque": 1.0, "mass": 2.0}], {}, "case 1 has keys"),
-    ([{"torque": 1.0, "colour": 2.0}], {}, "cannot sweep 'colour'"),
-    ([{"torque": float("nan")}], {}, "case 0: torque = nan must be a finite number"),
-    ([{"torque": "5"}], {}, "case 0: torque = '5' must be a finite number"),
-    ([{"torque": 1.0}, {"torque": 2.0}, {"torque": 1.0}], {}, "case 2 repeats case 0"),
-    ([{"torque": 1.0}], {"step_size": 0.0}, "step size 0.0 must be positive"),
-    ([{"torque": 1.0}], {"stop_time": float("inf")}, "stop time inf must be a finite number"),
-    ([{"torque": 1.0}], {"workers": 0}, "workers must be a positive integer"),
-    ([{"torque": 1.0}], {"workers": 2, "scheduler": "tcp://127.0.0.1:1"}, "workers sizes the local cluster"),
-    ([{"torque": 1.0}], {"outputs": ["theta", "torque"]}, "choose each at most once among theta, omega, alpha"),
-    ([{"torque": 1.0}], {"outputs": ["theta", "theta"]}, "choose each at most once"),
-    ([{"torque": 1.0}], {"output_interval": 0.0015}, "output interval 0.0015 s must be a whole number of steps"),
-    ([{"torque": 1.0}], {"output_interval": 0.0}, "output interval 0.0 s must be"),
-    ([{"torque": 1.0}], {"format": "xlsx"}, "format 'xlsx': choose parquet or csv"),
-    ([{"torque": 1.0}], {"connect_timeout": 0}, "connect timeout 0 must be a positive number"),
-    ([{"torque": 1.0}], {"connect_timeout": float("inf")}, "connect timeout inf must be a positive"),
-    ([{"torque": 1.0}, {"torque": 2.0}, {"torque": 3.0}], {"max_cases": 2}, "3 cases is over the limit of 2"),
-    ([{"torque": 1.0}], {"resume": True, "overwrite": True}, "resume continues .* and overwrite replaces it: choose one"),
-])
+@pytest.mark.parametrize(
+    "cases, options, message",
+    [
+        ([], {}, "no cases to run"),
+        ([{"gravity": 1.0}], {}, "every case needs a 'torque'"),
+        ([{"torque": 1.0}, {"torque": 1.0, "mass": 2.0}], {}, "case 1 has keys"),
+        ([{"torque": 1.0, "colour": 2.0}], {}, "cannot sweep 'colour'"),
+        ([{"torque": float("nan")}], {}, "case 0: torque = nan must be a finite number"),
+        ([{"torque": "5"}], {}, "case 0: torque = '5' must be a finite number"),
+        ([{"torque": 1.0}, {"torque": 2.0}, {"torque": 1.0}], {}, "case 2 repeats case 0"),
+        ([{"torque": 1.0}], {"step_size": 0.0}, "step size 0.0 must be positive"),
+        ([{"torque": 1.0}], {"stop_time": float("inf")}, "stop time inf must be a finite number"),
+        ([{"torque": 1.0}], {"workers": 0}, "workers must be a positive integer"),
+        ([{"torque": 1.0}], {"workers": 2, "scheduler": "tcp://127.0.0.1:1"}, "workers sizes the local cluster"),
+        ([{"torque": 1.0}], {"outputs": ["theta", "torque"]}, "choose each at most once among theta, omega, alpha"),
+        ([{"torque": 1.0}], {"outputs": ["theta", "theta"]}, "choose each at most once"),
+        ([{"torque": 1.0}], {"output_interval": 0.0015}, "output interval 0.0015 s must be a whole number of steps"),
+        ([{"torque": 1.0}], {"output_interval": 0.0}, "output interval 0.0 s must be"),
+        ([{"torque": 1.0}], {"format": "xlsx"}, "format 'xlsx': choose parquet or csv"),
+        ([{"torque": 1.0}], {"connect_timeout": 0}, "connect timeout 0 must be a positive number"),
+        ([{"torque": 1.0}], {"connect_timeout": float("inf")}, "connect timeout inf must be a positive"),
+        ([{"torque": 1.0}, {"torque": 2.0}, {"torque": 3.0}], {"max_cases": 2}, "3 cases is over the limit of 2"),
+        (
+            [{"torque": 1.0}],
+            {"resume": True, "overwrite": True},
+            "resume continues .* and overwrite replaces it: choose one",
+        ),
+    ],
+)
 def test_bad_runs_are_refused_before_any_cluster_starts(tmp_path, cases, options, message):
     study_options = {k: v for k, v in options.items() if k in STUDY_FIELDS}
     with pytest.raises(InvalidInput, match=message):
-        run_sweep(Study(cases, **study_options), output_dir=tmp_path,
-                  **{k: v for k, v in options.items() if k not in study_options})
+        run_sweep(
+            Study(cases, **study_options),
+            output_dir=tmp_path,
+            **{k: v for k, v in options.items() if k not in study_options},
+        )
     assert list(tmp_path.iterdir()) == []

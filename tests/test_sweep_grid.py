@@ -5,17 +5,20 @@ import pytest
 from pendulum_fmu.sweep import sweep_grid
 
 
-@pytest.mark.parametrize("arguments, message", [
-    (([1.0], [9.81], {"colour": [1.0]}), "cannot sweep 'colour': extra takes mass, length, inertia, damping"),
-    (([1.0], [9.81], {"gravity": [1.0]}), "give gravity values as the gravities argument"),
-    (([], [9.81]), "no values given for torque"),
-    (([1.0], [9.81], {"mass": []}), "no values given for mass"),
-    (([1.0], [float("nan")]), "gravity values must be finite"),
-    (([float("inf")],), "torque values must be finite"),
-    ((["heavy"],), "torque values must be numbers"),
-    (([[1.0, 2.0]],), "torque values must be a flat list"),
-    (([1.0, 2.0, 1.0],), "torque values repeat"),
-])
+@pytest.mark.parametrize(
+    "arguments, message",
+    [
+        (([1.0], [9.81], {"colour": [1.0]}), "cannot sweep 'colour': extra takes mass, length, inertia, damping"),
+        (([1.0], [9.81], {"gravity": [1.0]}), "give gravity values as the gravities argument"),
+        (([], [9.81]), "no values given for torque"),
+        (([1.0], [9.81], {"mass": []}), "no values given for mass"),
+        (([1.0], [float("nan")]), "gravity values must be finite"),
+        (([float("inf")],), "torque values must be finite"),
+        ((["heavy"],), "torque values must be numbers"),
+        (([[1.0, 2.0]],), "torque values must be a flat list"),
+        (([1.0, 2.0, 1.0],), "torque values repeat"),
+    ],
+)
 def test_bad_grids(arguments, message):
     with pytest.raises(ValueError, match=message):
         sweep_grid(*arguments)

@@ -6,8 +6,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pendulum_fmu.torque_schedule import (BYTES_PER_STEP, TorqueFileError, read_torque_csv, schedule,
-                                          step_count, write_torque_csv)
+from pendulum_fmu.torque_schedule import (
+    BYTES_PER_STEP,
+    TorqueFileError,
+    read_torque_csv,
+    schedule,
+    step_count,
+    write_torque_csv,
+)
 
 
 def test_csv_jumps_become_communication_points(tmp_path):
@@ -37,23 +43,26 @@ def test_written_schedule_reads_back(tmp_path):
     assert np.allclose(again.time, plan.time) and np.array_equal(again.torque, plan.torque)
 
 
-@pytest.mark.parametrize("content, message", [
-    ("", "the file is empty"),
-    ("t,torque\n0,1\n", "t.csv:1: missing column 'time'"),
-    ("time,force\n0,1\n", "t.csv:1: missing column 'torque'"),
-    ("time,torque\n0,1\n1,abc\n", "t.csv:3: torque 'abc' is not a number"),
-    ("time,torque\n0,1\n1\n", "t.csv:3: torque '' is not a number"),
-    ("time,torque\n0,1\n2,1\n1,1\n", "t.csv:4: time 1 goes backwards"),
-    ("time,torque\n0,1\n1,nan\n", "t.csv:3: torque is nan"),
-    ("time,torque\n0,1\ninf,1\n", "t.csv:3: time is inf"),
-    ("time,torque\n0,1\n1,1\n1,2\n1,3\n", "t.csv:5: time 1 appears three times"),
-    ("time,torque\n", "no data rows"),
-    ("time,torque\n0,1\n1,1_0\n", "t.csv:3: torque '1_0' is not a number"),  # Python's float takes it
-    ("time,torque\n0,1\n1,\uff11\n", "t.csv:3: torque '\uff11' is not a number"),  # a fullwidth 1
-    ("time,torque\n0,1\n1,2,3\n", "t.csv:3: 3 columns, but the header names 2"),
-    ("\n\ntime,torque\n0,1\n", "t.csv:1: the line is blank; the header, e.g. time,torque, must be the first line"),
-    ('time,torque\n"0","1,5"\n', "t.csv:2: torque '1,5' is not a number"),
-])
+@pytest.mark.parametrize(
+    "content, message",
+    [
+        ("", "the file is empty"),
+        ("t,torque\n0,1\n", "t.csv:1: missing column 'time'"),
+        ("time,force\n0,1\n", "t.csv:1: missing column 'torque'"),
+        ("time,torque\n0,1\n1,abc\n", "t.csv:3: torque 'abc' is not a number"),
+        ("time,torque\n0,1\n1\n", "t.csv:3: torque '' is not a number"),
+        ("time,torque\n0,1\n2,1\n1,1\n", "t.csv:4: time 1 goes backwards"),
+        ("time,torque\n0,1\n1,nan\n", "t.csv:3: torque is nan"),
+        ("time,torque\n0,1\ninf,1\n", "t.csv:3: time is inf"),
+        ("time,torque\n0,1\n1,1\n1,2\n1,3\n", "t.csv:5: time 1 appears three times"),
+        ("time,torque\n", "no data rows"),
+        ("time,torque\n0,1\n1,1_0\n", "t.csv:3: torque '1_0' is not a number"),  # Python's float takes it
+        ("time,torque\n0,1\n1,\uff11\n", "t.csv:3: torque '\uff11' is not a number"),  # a fullwidth 1
+        ("time,torque\n0,1\n1,2,3\n", "t.csv:3: 3 columns, but the header names 2"),
+        ("\n\ntime,torque\n0,1\n", "t.csv:1: the line is blank; the header, e.g. time,torque, must be the first line"),
+        ('time,torque\n"0","1,5"\n', "t.csv:2: torque '1,5' is not a number"),
+    ],
+)
 def test_bad_files_name_file_row_and_problem(tmp_path, content, message):
     csv = tmp_path / "t.csv"
     csv.write_text(content, encoding="utf-8")
@@ -109,8 +118,11 @@ def test_errors_after_blank_lines_name_the_file_line(tmp_path):
 @pytest.mark.skipif(not Path("/proc/meminfo").is_file(), reason="needs Linux's /proc/meminfo as the reference")
 def test_a_run_larger_than_the_free_memory_is_refused():
     # The kernel's own figure, read without psutil, which the package now asks on every OS.
-    free_kib = next(int(line.split()[1]) for line in Path("/proc/meminfo").read_text().splitlines()
-                    if line.startswith("MemAvailable:"))
+    free_kib = next(
+        int(line.split()[1])
+        for line in Path("/proc/meminfo").read_text().splitlines()
+        if line.startswith("MemAvailable:")
+    )
     steps = 2 * free_kib * 1024 // BYTES_PER_STEP
     with pytest.raises(ValueError, match=r"needs [\d.]+ GiB and the machine has ([\d.]+) GiB free") as refused:
         step_count(0.0, float(steps), 1.0, max_steps=steps)
@@ -118,13 +130,16 @@ def test_a_run_larger_than_the_free_memory_is_refused():
     assert said == pytest.approx(free_kib / 2**20, rel=0.1)  # other jobs allocate in between
 
 
-@pytest.mark.parametrize("start, stop, step, count", [
-    (0.0, 1e308, 1e-3, "about 1e+311"),
-    (-1e308, 1e308, 1.0, "about 2e+308"),  # the span itself is past the largest double
-    (0.0, 0.01, 1e-320, "about 1e+318"),
-    (0.0, 1e20, 1e-3, "about 1e+23"),  # past 2**53 the trailing digits would be a float's rounding
-    (0.0, 9e12, 1e-3, "9,000,000,000,000,000"),
-])
+@pytest.mark.parametrize(
+    "start, stop, step, count",
+    [
+        (0.0, 1e308, 1e-3, "about 1e+311"),
+        (-1e308, 1e308, 1.0, "about 2e+308"),  # the span itself is past the largest double
+        (0.0, 0.01, 1e-320, "about 1e+318"),
+        (0.0, 1e20, 1e-3, "about 1e+23"),  # past 2**53 the trailing digits would be a float's rounding
+        (0.0, 9e12, 1e-3, "9,000,000,000,000,000"),
+    ],
+)
 def test_a_count_past_the_largest_double_is_refused_like_any_long_run(start, stop, step, count):
     with pytest.raises(ValueError, match=re.escape(f"is {count} steps, over the limit of 10,000,000")):
         step_count(start, stop, step)
@@ -142,8 +157,12 @@ def test_rows_near_the_largest_double_interpolate_without_overflow(tmp_path):
     csv.write_text("time,torque\n0,1e308\n0.01,-1e308\n")
     plan = schedule(csv, step_size=0.0025)
     assert plan.torque.tolist() == pytest.approx([1e308, 0.5e308, 0.0, -0.5e308], rel=1e-15, abs=1e293)
-    with pytest.raises(ValueError, match=re.escape(f"{csv} ramps from 1e+308 to 5e+307 N.m between t = 0 "
-                                                   "and 0.0025 s, a rate past the largest double")):
+    with pytest.raises(
+        ValueError,
+        match=re.escape(
+            f"{csv} ramps from 1e+308 to 5e+307 N.m between t = 0 and 0.0025 s, a rate past the largest double"
+        ),
+    ):
         schedule(csv, step_size=0.0025, ramp=True)
 
 

@@ -147,12 +147,10 @@ def test_compare_catches_a_schedule_that_does_not_carry_the_signal(tmp_path, mon
 
 def test_compare_agrees_on_the_awkward_cases(fmu, tmp_path):
     csv = write_rows(tmp_path / "j.csv", [(0, 10), (0.027, 10), (0.027, -20), (0.5, -20)])
-    comparison = compare(csv, ["fmu", "reference"], output_dir=tmp_path / "held", step_size=0.009,
-                         fmu_path=fmu)
+    comparison = compare(csv, ["fmu", "reference"], output_dir=tmp_path / "held", step_size=0.009, fmu_path=fmu)
     assert comparison.agree and comparison.torque_worst < 1e-12
     kinks = write_rows(tmp_path / "k.csv", [(0, 0), (0.3915, 20), (1, -5)])
-    ramped = compare(kinks, ["fmu", "reference"], output_dir=tmp_path / "ramp", step_size=0.1,
-                     ramp=True, fmu_path=fmu)
+    ramped = compare(kinks, ["fmu", "reference"], output_dir=tmp_path / "ramp", step_size=0.1, ramp=True, fmu_path=fmu)
     assert ramped.agree and ramped.worst < BOUND
 
 

@@ -77,18 +77,25 @@ def _glibc_needed(elf: bytes, tmp_path: Path) -> tuple[int, int]:
     path = tmp_path / "elf"
     path.write_bytes(elf)
     with open(path, "rb") as file:
-        versions = [tuple(map(int, re.match(r"GLIBC_(\d+)\.(\d+)", auxiliary.name).groups()))
-                    for section in ELFFile(file).iter_sections() if isinstance(section, GNUVerNeedSection)
-                    for _, auxiliaries in section.iter_versions() for auxiliary in auxiliaries
-                    if auxiliary.name.startswith("GLIBC_")]
+        versions = [
+            tuple(map(int, re.match(r"GLIBC_(\d+)\.(\d+)", auxiliary.name).groups()))
+            for section in ELFFile(file).iter_sections()
+            if isinstance(section, GNUVerNeedSection)
+            for _, auxiliaries in section.iter_versions()
+            for auxiliary in auxiliaries
+            if auxiliary.name.startswith("GLIBC_")
+        ]
     return max(versions, default=(0, 0))
 
 
 def _manylinux_policies(machine: str) -> list[tuple[int, int]]:
     """The glibc (x, y) of every manylinux_x_y policy auditwheel has for machine: its own table."""
     policies = json.loads((resources.files("auditwheel.policy") / "manylinux-policy.json").read_text())
-    return [tuple(map(int, re.fullmatch(r"manylinux_(\d+)_(\d+)", policy["name"]).groups()))
-            for policy in policies if machine in policy["symbol_versions"]]
+    return [
+        tuple(map(int, re.fullmatch(r"manylinux_(\d+)_(\d+)", policy["name"]).groups()))
+        for policy in policies
+        if machine in policy["symbol_versions"]
+    ]
 
 
 @needs_build
@@ -97,12 +104,18 @@ def test_every_wheel_has_the_same_fmus_and_its_own_native_loop(wheelhouse, tmp_p
     contents = {}
     for platform, wheel in wheelhouse.items():
         # wheel unpack checks every file against the RECORD's hash and size.
-        subprocess.run([sys.executable, "-m", "wheel", "unpack", "--dest", tmp_path / platform, wheel],
-                       check=True, capture_output=True)
+        subprocess.run(
+            [sys.executable, "-m", "wheel", "unpack", "--dest", tmp_path / platform, wheel],
+            check=True,
+            capture_output=True,
+        )
         with zipfile.ZipFile(wheel) as archive:
             names = set(archive.namelist())
-            contents[platform] = {name: archive.read(name) for name in names
-                                  if name.startswith("pendulum_fmu/") and "_cs_loop" not in name}
+            contents[platform] = {
+                name: archive.read(name)
+                for name in names
+                if name.startswith("pendulum_fmu/") and "_cs_loop" not in name
+            }
         native_loop, _ = _native_loop(wheel)
         assert native_loop == f"pendulum_fmu/_cs_loop{'.pyd' if platform == 'win64' else '.so'}"
         assert not any(name.startswith(("fmu_src/", "tests/", "dist/")) for name in names)
@@ -110,11 +123,16 @@ def test_every_wheel_has_the_same_fmus_and_its_own_native_loop(wheelhouse, tmp_p
     assert all(files == first for files in contents.values())  # one build of the FMUs and modules
     for fmi_version, name in FMU_FILES.items():
         description = read_model_description(str(_extracted(wheelhouse["linux64"], name, tmp_path)))
-        assert description.generationTool == f"pendulum_fmu {__version__}" and description.fmiVersion == f"{fmi_version}.0"
+        assert (
+            description.generationTool == f"pendulum_fmu {__version__}" and description.fmiVersion == f"{fmi_version}.0"
+        )
         with zipfile.ZipFile(_extracted(wheelhouse["linux64"], name, tmp_path)) as fmu:
             folders = {entry.split("/")[1] for entry in fmu.namelist() if entry.startswith("binaries/")}
-        assert folders == {folder for platform in PLATFORMS.values()
-                           for folder in ((platform.fmi2_folder,) if fmi_version == 2 else platform.fmi3_folders)}
+        assert folders == {
+            folder
+            for platform in PLATFORMS.values()
+            for folder in ((platform.fmi2_folder,) if fmi_version == 2 else platform.fmi3_folders)
+        }
 
 
 def _extracted(wheel: Path, fmu_name: str, tmp_path: Path) -> Path:
@@ -132,12 +150,12 @@ def test_each_native_loop_is_built_for_its_wheels_machine(wheelhouse):
         assert elf[:4] == b"\x7fELF" and int.from_bytes(elf[18:20], "little") == ELF_MACHINES[machine]
     _, pe = _native_loop(wheelhouse["win64"])
     header = int.from_bytes(pe[0x3C:0x40], "little")
-    assert pe[:2] == b"MZ" and pe[header:header + 4] == b"PE\0\0"
-    assert int.from_bytes(pe[header + 4:header + 6], "little") == PE_MACHINE_AMD64
+    assert pe[:2] == b"MZ" and pe[header : header + 4] == b"PE\0\0"
+    assert int.from_bytes(pe[header + 4 : header + 6], "little") == PE_MACHINE_AMD64
     _, macho = _native_loop(wheelhouse["darwin64"])
     assert macho[:4] == bytes.fromhex("cafebabe")  # universal, big-endian header
     count = int.from_bytes(macho[4:8], "big")
-    cpu_types = {int.from_bytes(macho[8 + 20 * i:12 + 20 * i], "big") for i in range(count)}
+    cpu_types = {int.from_bytes(macho[8 + 20 * i : 12 + 20 * i], "big") for i in range(count)}
     assert {MACHO_CPU_TYPES.get(cpu) for cpu in cpu_types} == {"x86_64", "arm64"}
 
 
@@ -177,27 +195,38 @@ def test_each_tag_is_the_lowest_that_holds_for_every_binary_of_the_wheel(wheelho
         assert {(tag.interpreter, tag.abi) for tag in wheel_tags} == {("py3", "none")}
         platforms = {tag.platform for tag in wheel_tags}
         if target.system == "linux":
-            shown = " ".join(subprocess.run([sys.executable, "-m", "auditwheel", "show", str(wheel)],
-                                            capture_output=True, text=True, check=True).stdout.split())
+            shown = " ".join(
+                subprocess.run(
+                    [sys.executable, "-m", "auditwheel", "show", str(wheel)], capture_output=True, text=True, check=True
+                ).stdout.split()
+            )
             policy = tuple(map(int, re.search(r'platform tag: "manylinux_(\d+)_(\d+)_', shown).groups()))
-            fmu_binaries = [_fmu_binary(wheel, FMU_FILES[2], target.platform),
-                            *(_fmu_binary(wheel, FMU_FILES[3], folder)
-                              for folder in PLATFORMS[target.platform].fmi3_folders)]
+            fmu_binaries = [
+                _fmu_binary(wheel, FMU_FILES[2], target.platform),
+                *(_fmu_binary(wheel, FMU_FILES[3], folder) for folder in PLATFORMS[target.platform].fmi3_folders),
+            ]
             needed = max(policy, *(_glibc_needed(binary, tmp_path) for binary in fmu_binaries))
             # The lowest policy that admits every binary: the native loop's, the FMUs' for the machine.
             glibc = min(version for version in _manylinux_policies(target.machine) if version >= needed)
             legacy = LEGACY_MANYLINUX.get(glibc)
-            assert platforms == {f"manylinux_{glibc[0]}_{glibc[1]}_{target.machine}",
-                                 *([f"{legacy}_{target.machine}"] if legacy else [])}, (policy, needed)
+            assert platforms == {
+                f"manylinux_{glibc[0]}_{glibc[1]}_{target.machine}",
+                *([f"{legacy}_{target.machine}"] if legacy else []),
+            }, (policy, needed)
             # Built by zig for the wheels' glibc floor, the wheel installs on that glibc.
             assert glibc <= tuple(map(int, MANYLINUX_GLIBC.split("."))), glibc
         elif target.system == "macos":
             [platform] = platforms
             # The native loop and every FMU binary for a Mac, x86_64 slices and arm64 ones.
-            macho = [_native_loop(wheel)[1], _fmu_binary(wheel, FMU_FILES[2], target.platform),
-                     *(_fmu_binary(wheel, FMU_FILES[3], folder) for folder in PLATFORMS[target.platform].fmi3_folders)]
-            headers = "".join(_llvm("llvm-objdump", binary, tmp_path, "--macho", "--private-headers", "--arch=all")
-                              for binary in macho)
+            macho = [
+                _native_loop(wheel)[1],
+                _fmu_binary(wheel, FMU_FILES[2], target.platform),
+                *(_fmu_binary(wheel, FMU_FILES[3], folder) for folder in PLATFORMS[target.platform].fmi3_folders),
+            ]
+            headers = "".join(
+                _llvm("llvm-objdump", binary, tmp_path, "--macho", "--private-headers", "--arch=all")
+                for binary in macho
+            )
             x86_64 = re.findall(r"cmd LC_VERSION_MIN_MACOSX\n\s+cmdsize \d+\n\s+version (\d+)\.(\d+)", headers)
             arm64 = re.findall(r"cmd LC_BUILD_VERSION\n(?:.*\n){3}\s+minos (\S+)", headers)
             assert len(x86_64) == len(arm64) == 3 and set(arm64) == {"11.0"}, headers
@@ -236,14 +265,37 @@ def test_x86_64_wheel_installs_and_simulates_in_a_venv(wheelhouse, x86_64_csv, t
     [site_packages] = venv.glob("lib/python*/site-packages")
     (site_packages / "dependencies_from_the_test_environment.pth").write_text(sysconfig.get_paths()["purelib"] + "\n")
     # pip checks the manylinux tag against this machine's glibc.
-    subprocess.run([venv / "bin/python", "-m", "pip", "install", "--no-deps", "--ignore-installed",
-                    "--no-cache-dir", wheelhouse["linux64"]], check=True, capture_output=True, env=ENVIRONMENT)
-    loaded = subprocess.run([venv / "bin/python", "-c", "from pendulum_fmu import cs_loop; "
-                             "print(cs_loop.__file__, cs_loop.available())"],
-                            check=True, cwd=tmp_path, capture_output=True, text=True, env=ENVIRONMENT)
+    subprocess.run(
+        [
+            venv / "bin/python",
+            "-m",
+            "pip",
+            "install",
+            "--no-deps",
+            "--ignore-installed",
+            "--no-cache-dir",
+            wheelhouse["linux64"],
+        ],
+        check=True,
+        capture_output=True,
+        env=ENVIRONMENT,
+    )
+    loaded = subprocess.run(
+        [venv / "bin/python", "-c", "from pendulum_fmu import cs_loop; print(cs_loop.__file__, cs_loop.available())"],
+        check=True,
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        env=ENVIRONMENT,
+    )
     assert loaded.stdout.split() == [str(site_packages / "pendulum_fmu/cs_loop.py"), "True"]
-    subprocess.run([venv / "bin/pendulum-fmu", "simulate", "--torque", "20", "--output", "out.csv"],
-                   check=True, cwd=tmp_path, capture_output=True, env=ENVIRONMENT)
+    subprocess.run(
+        [venv / "bin/pendulum-fmu", "simulate", "--torque", "20", "--output", "out.csv"],
+        check=True,
+        cwd=tmp_path,
+        capture_output=True,
+        env=ENVIRONMENT,
+    )
     _check_simulated(tmp_path / "out.csv", x86_64_csv)
 
 
@@ -256,8 +308,9 @@ def test_aarch64_wheel_installs_and_simulates_on_arm64_python_under_qemu(wheelho
     site = arm64.install([wheelhouse["aarch64-linux"]], tmp_path / "site")  # pip there judges the tag
     loaded = arm64.run(["-c", "from pendulum_fmu import cs_loop; print(cs_loop.available())"], site=site, cwd=tmp_path)
     assert loaded.stdout.split()[-1:] == ["True"], loaded.stderr
-    ran = arm64.run([site / "bin/pendulum-fmu", "simulate", "--torque", "20", "--output", "out.csv"],
-                    site=site, cwd=tmp_path)
+    ran = arm64.run(
+        [site / "bin/pendulum-fmu", "simulate", "--torque", "20", "--output", "out.csv"], site=site, cwd=tmp_path
+    )
     assert ran.returncode == 0, ran.stderr
     _check_simulated(tmp_path / "out.csv", x86_64_csv)
 
@@ -273,9 +326,23 @@ def _theta_by_harness(platform: str, wheel: Path, folder: Path) -> np.ndarray:
     guid = read_model_description(str(_extracted(wheel, FMU_FILES[2], folder))).guid
     harness = build_bare_master(folder, HARNESS, platform)
     environment = {**os.environ, "WINEPREFIX": str(folder / "wineprefix"), "WINEDEBUG": "-all"}
-    subprocess.run([*(["wine"] if platform == "win64" else []), harness, folder / Path(name).name, library, guid,
-                    str(STEPS), repr(STEP_SIZE), "0", folder / "theta.txt"],
-                   check=True, capture_output=True, env=environment, timeout=300)
+    subprocess.run(
+        [
+            *(["wine"] if platform == "win64" else []),
+            harness,
+            folder / Path(name).name,
+            library,
+            guid,
+            str(STEPS),
+            repr(STEP_SIZE),
+            "0",
+            folder / "theta.txt",
+        ],
+        check=True,
+        capture_output=True,
+        env=environment,
+        timeout=300,
+    )
     return np.loadtxt(folder / "theta.txt")
 
 
@@ -296,5 +363,6 @@ def test_a_missing_tool_stops_the_wheelhouse_in_one_line_naming_its_package(monk
     assert main(["--output-dir", str(tmp_path / "wheelhouse")]) == 2
     assert capsys.readouterr().err.splitlines() == [
         "build_wheels.py: building the wheels needs the no_such_packaging_tool package "
-        "(pip install no-such-packaging-tool)"]
+        "(pip install no-such-packaging-tool)"
+    ]
     assert not (tmp_path / "wheelhouse").exists()

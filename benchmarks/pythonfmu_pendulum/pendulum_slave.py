@@ -20,18 +20,23 @@ class PythonPendulum(Fmi2Slave):
         for name in ("theta", "omega", "alpha"):
             self.register_variable(Real(name, causality=Fmi2Causality.output))
         for name in ("mass", "length", "inertia", "gravity", "damping", "tolerance"):
-            self.register_variable(Real(name, causality=Fmi2Causality.parameter,
-                                        variability=Fmi2Variability.tunable))
+            self.register_variable(Real(name, causality=Fmi2Causality.parameter, variability=Fmi2Variability.tunable))
 
     def _acceleration(self, theta, omega):
-        inertia_total = self.inertia + self.mass * self.length ** 2
-        return (self.torque - self.mass * self.gravity * self.length * np.sin(theta)
-                - self.damping * omega) / inertia_total
+        inertia_total = self.inertia + self.mass * self.length**2
+        return (
+            self.torque - self.mass * self.gravity * self.length * np.sin(theta) - self.damping * omega
+        ) / inertia_total
 
     def do_step(self, current_time, step_size):
-        solution = solve_ivp(lambda t, y: (y[1], self._acceleration(y[0], y[1])),
-                             (current_time, current_time + step_size), (self.theta, self.omega),
-                             method="DOP853", rtol=self.tolerance, atol=self.tolerance)
+        solution = solve_ivp(
+            lambda t, y: (y[1], self._acceleration(y[0], y[1])),
+            (current_time, current_time + step_size),
+            (self.theta, self.omega),
+            method="DOP853",
+            rtol=self.tolerance,
+            atol=self.tolerance,
+        )
         self.theta, self.omega = solution.y[:, -1]
         self.alpha = self._acceleration(self.theta, self.omega)
         return True

@@ -35,8 +35,10 @@ class ToolCannotRamp(InvalidInput):
 def check_held(plan: TorqueSchedule, tool: str) -> None:
     """Refuse a schedule whose torque ramps within a step: the tool can only hold it."""
     if np.any(plan.torque_rate):
-        raise ToolCannotRamp(f"{tool} holds the torque over each step and cannot ramp it: compare "
-                             f"held torques only (no --ramp), or leave {tool} out of --tools")
+        raise ToolCannotRamp(
+            f"{tool} holds the torque over each step and cannot ramp it: compare "
+            f"held torques only (no --ramp), or leave {tool} out of --tools"
+        )
 
 
 def check_mode(mode: str, tool: str) -> None:
@@ -63,9 +65,15 @@ def runner(tool: str, simulate: Callable[..., np.ndarray], setups: dict) -> Call
     """The uniform run() of an engine module from its simulate(plan, parameters, theta0, omega0,
     setup) and its setup per mode."""
 
-    def run(plan: TorqueSchedule, *, parameters: dict | None = None, theta0: float = 0.0,
-            omega0: float = 0.0, mode: str = "accurate",
-            fmu_path: str | Path | FmuModel | None = None) -> np.ndarray:
+    def run(
+        plan: TorqueSchedule,
+        *,
+        parameters: dict | None = None,
+        theta0: float = 0.0,
+        omega0: float = 0.0,
+        mode: str = "accurate",
+        fmu_path: str | Path | FmuModel | None = None,
+    ) -> np.ndarray:
         check_held(plan, tool)
         check_mode(mode, tool)
         return simulate(plan, resolve_parameters(parameters, fmu_path), theta0, omega0, setups[mode])

@@ -61,28 +61,28 @@ def build(parameters: dict, time_step: float, sampled_outputs: bool):
     if time_step > 0:
         plant.SetUseSampledOutputPorts(sampled_outputs)
     mass, inertia = p["mass"], p["inertia"]
-    head = plant.AddRigidBody("head", SpatialInertia(
-        mass, np.zeros(3), UnitInertia(*(inertia / mass,) * 3)))
-    pin_on_head = plant.AddFrame(FixedOffsetFrame(
-        "pin_on_head", head.body_frame(), RigidTransform([0.0, 0.0, p["length"]])))
-    joint = plant.AddJoint(RevoluteJoint("pin", plant.world_frame(), pin_on_head, [0.0, 1.0, 0.0],
-                                         p["damping"]))
+    head = plant.AddRigidBody("head", SpatialInertia(mass, np.zeros(3), UnitInertia(*(inertia / mass,) * 3)))
+    pin_on_head = plant.AddFrame(
+        FixedOffsetFrame("pin_on_head", head.body_frame(), RigidTransform([0.0, 0.0, p["length"]]))
+    )
+    joint = plant.AddJoint(RevoluteJoint("pin", plant.world_frame(), pin_on_head, [0.0, 1.0, 0.0], p["damping"]))
     plant.AddJointActuator("torque", joint)
     plant.mutable_gravity_field().set_gravity_vector([0.0, 0.0, -p["gravity"]])
     plant.Finalize()
     return builder.Build(), plant
 
 
-def simulate(plan: TorqueSchedule, parameters: dict, theta0: float, omega0: float,
-             setup: Setup) -> np.ndarray:
+def simulate(plan: TorqueSchedule, parameters: dict, theta0: float, omega0: float, setup: Setup) -> np.ndarray:
     """The schedule through Drake as setup says; the result array of results.py."""
     time_step = 0.0
     if setup.discrete:
         time_step = float(plan.step_size[0])
         if not np.allclose(plan.step_size, time_step, rtol=1e-9, atol=0):
-            raise UnequalSteps("drake:default steps a discrete plant at one period, but the "
-                               "communication steps differ (a torque jump off the step grid, or a "
-                               "short last step): use drake (accurate) or a grid-aligned signal")
+            raise UnequalSteps(
+                "drake:default steps a discrete plant at one period, but the "
+                "communication steps differ (a torque jump off the step grid, or a "
+                "short last step): use drake (accurate) or a grid-aligned signal"
+            )
     diagram, plant = build(parameters, time_step, setup.sampled_outputs)
     simulator = Simulator(diagram)
     context = simulator.get_mutable_context()

@@ -50,17 +50,20 @@ SETUPS = {"accurate": ACCURATE, "default": DEFAULT}
 
 def model_xml(parameters: dict, setup: Setup) -> str:
     p = parameters
-    limits = ('ctrllimited="false"' if setup.ctrlrange is None else
-              f'ctrllimited="true" ctrlrange="{setup.ctrlrange[0]!r} {setup.ctrlrange[1]!r}"')
+    limits = (
+        'ctrllimited="false"'
+        if setup.ctrlrange is None
+        else f'ctrllimited="true" ctrlrange="{setup.ctrlrange[0]!r} {setup.ctrlrange[1]!r}"'
+    )
     # MuJoCo refuses a zero inertia; the hinge only feels the y component, so a tiny one
     # elsewhere changes nothing.
     inertia = max(p["inertia"], 1e-12)
     return f"""<mujoco model="pendulum">
-  <option gravity="0 0 {-p['gravity']!r}" integrator="{setup.integrator}"/>
+  <option gravity="0 0 {-p["gravity"]!r}" integrator="{setup.integrator}"/>
   <worldbody>
     <body name="head">
-      <joint name="pin" type="hinge" axis="0 1 0" damping="{p['damping']!r}"/>
-      <inertial pos="0 0 {-p['length']!r}" mass="{p['mass']!r}" diaginertia="{inertia!r} {inertia!r} {inertia!r}"/>
+      <joint name="pin" type="hinge" axis="0 1 0" damping="{p["damping"]!r}"/>
+      <inertial pos="0 0 {-p["length"]!r}" mass="{p["mass"]!r}" diaginertia="{inertia!r} {inertia!r} {inertia!r}"/>
     </body>
   </worldbody>
   <actuator><motor name="torque" joint="pin" gear="1" {limits}/></actuator>
@@ -68,15 +71,17 @@ def model_xml(parameters: dict, setup: Setup) -> str:
 </mujoco>"""
 
 
-def simulate(plan: TorqueSchedule, parameters: dict, theta0: float, omega0: float,
-             setup: Setup) -> np.ndarray:
+def simulate(plan: TorqueSchedule, parameters: dict, theta0: float, omega0: float, setup: Setup) -> np.ndarray:
     """The schedule through MuJoCo as setup says; the result array of results.py."""
     model = mujoco.MjModel.from_xml_string(model_xml(parameters, setup))
     data = mujoco.MjData(model)
     data.qpos[0], data.qvel[0] = theta0, omega0
     out = held_results(plan)
-    counts = (np.ones(len(plan.step_size), dtype=int) if setup.largest_step is None
-              else substeps(plan.step_size, setup.largest_step))
+    counts = (
+        np.ones(len(plan.step_size), dtype=int)
+        if setup.largest_step is None
+        else substeps(plan.step_size, setup.largest_step)
+    )
 
     def record(k, fresh):
         if fresh:

@@ -28,8 +28,7 @@ def _import_opensim():
         import opensim
     except ImportError as error:
         raise MissingDependency(
-            "opensim_simulate needs the OpenSim Python package; "
-            "install the extra: pip install '.[opensim]'"
+            "opensim_simulate needs the OpenSim Python package; install the extra: pip install '.[opensim]'"
         ) from error
     return opensim
 
@@ -42,19 +41,29 @@ def _build_pendulum_model(osim, mass, length, inertia, gravity, damping):
 
     base = osim.Body("pendulum_base", 1.0, osim.Vec3(0), osim.Inertia(0, 0, 0))
     model.addBody(base)
-    model.addJoint(osim.WeldJoint(
-        "base_to_ground",
-        model.getGround(), osim.Vec3(0, 1.2 * length, 0), osim.Vec3(0),
-        base, osim.Vec3(0), osim.Vec3(0),
-    ))
+    model.addJoint(
+        osim.WeldJoint(
+            "base_to_ground",
+            model.getGround(),
+            osim.Vec3(0, 1.2 * length, 0),
+            osim.Vec3(0),
+            base,
+            osim.Vec3(0),
+            osim.Vec3(0),
+        )
+    )
 
     # Inertia is about the head's centre of mass; the pin sits `length` above it.
     head = osim.Body("pendulum_head", mass, osim.Vec3(0), osim.Inertia(0, 0, inertia))
     model.addBody(head)
     pin = osim.PinJoint(
         "head_to_base",
-        base, osim.Vec3(0), osim.Vec3(0),
-        head, osim.Vec3(0, length, 0), osim.Vec3(0),
+        base,
+        osim.Vec3(0),
+        osim.Vec3(0),
+        head,
+        osim.Vec3(0, length, 0),
+        osim.Vec3(0),
     )
     model.addJoint(pin)
 
@@ -83,8 +92,19 @@ def _build_pendulum_model(osim, mass, length, inertia, gravity, damping):
     return model, coordinate, actuator
 
 
-def opensim_simulate(time, torque, *, mass=40.0, length=0.5, inertia=20.0, gravity=9.81,
-                     damping=0.0, theta0=0.0, omega0=0.0, accuracy=1e-12):
+def opensim_simulate(
+    time,
+    torque,
+    *,
+    mass=40.0,
+    length=0.5,
+    inertia=20.0,
+    gravity=9.81,
+    damping=0.0,
+    theta0=0.0,
+    omega0=0.0,
+    accuracy=1e-12,
+):
     """Simulate the pendulum in OpenSim with a torque held constant per step.
 
     Parameters
@@ -125,8 +145,7 @@ def opensim_simulate(time, torque, *, mass=40.0, length=0.5, inertia=20.0, gravi
     if np.any(np.diff(time) <= 0):
         raise InvalidInput("time must be strictly increasing")
 
-    model, coordinate, actuator = _build_pendulum_model(
-        osim, mass, length, inertia, gravity, damping)
+    model, coordinate, actuator = _build_pendulum_model(osim, mass, length, inertia, gravity, damping)
     coordinate.setDefaultValue(theta0)
     coordinate.setDefaultSpeedValue(omega0)
     state = model.initSystem()
@@ -178,11 +197,11 @@ def opensim_simulate(time, torque, *, mass=40.0, length=0.5, inertia=20.0, gravi
     }
 
 
-def simulate(plan: TorqueSchedule, parameters: dict[str, float], theta0: float, omega0: float,
-             accuracy: float | None) -> np.ndarray:
+def simulate(
+    plan: TorqueSchedule, parameters: dict[str, float], theta0: float, omega0: float, accuracy: float | None
+) -> np.ndarray:
     """The schedule through OpenSim at the Manager's accuracy (None: its own), as a results array."""
-    run = opensim_simulate(plan.time, plan.torque, theta0=theta0, omega0=omega0, accuracy=accuracy,
-                           **parameters)
+    run = opensim_simulate(plan.time, plan.torque, theta0=theta0, omega0=omega0, accuracy=accuracy, **parameters)
     out = results.empty(len(plan.time))  # an output OpenSim does not compute stays NaN
     for name, values in run.items():
         out[name] = values

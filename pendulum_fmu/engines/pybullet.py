@@ -81,15 +81,14 @@ def urdf(parameters: dict) -> str:
     return f"""<robot name="pendulum">
   <link name="base"><inertial><mass value="0"/><inertia ixx="0" iyy="0" izz="0" ixy="0" ixz="0" iyz="0"/></inertial></link>
   <link name="head">
-    <inertial><origin xyz="0 0 {-p['length']!r}"/><mass value="{p['mass']!r}"/>
+    <inertial><origin xyz="0 0 {-p["length"]!r}"/><mass value="{p["mass"]!r}"/>
       <inertia ixx="{inertia}" iyy="{inertia}" izz="{inertia}" ixy="0" ixz="0" iyz="0"/></inertial>
   </link>
   <joint name="pin" type="continuous"><parent link="base"/><child link="head"/><axis xyz="0 1 0"/></joint>
 </robot>"""
 
 
-def simulate(plan: TorqueSchedule, parameters: dict, theta0: float, omega0: float,
-             setup: Setup) -> np.ndarray:
+def simulate(plan: TorqueSchedule, parameters: dict, theta0: float, omega0: float, setup: Setup) -> np.ndarray:
     """The schedule through PyBullet as setup says; the result array of results.py."""
     client = pybullet.connect(pybullet.DIRECT)
     try:
@@ -115,13 +114,11 @@ def _step_through(plan, parameters, theta0, omega0, setup, client, body):
         dynamics.update(linearDamping=0.0, angularDamping=0.0)
     pybullet.changeDynamics(body, joint, physicsClientId=client, **dynamics)
     if setup.disable_velocity_motor:
-        pybullet.setJointMotorControl2(body, joint, pybullet.VELOCITY_CONTROL, force=0,
-                                       physicsClientId=client)
+        pybullet.setJointMotorControl2(body, joint, pybullet.VELOCITY_CONTROL, force=0, physicsClientId=client)
     pybullet.resetJointState(body, joint, theta0, omega0, physicsClientId=client)
 
     def apply(u):
-        pybullet.setJointMotorControl2(body, joint, pybullet.TORQUE_CONTROL, force=u,
-                                       physicsClientId=client)
+        pybullet.setJointMotorControl2(body, joint, pybullet.TORQUE_CONTROL, force=u, physicsClientId=client)
 
     def state():
         theta, omega, _, _ = pybullet.getJointState(body, joint, physicsClientId=client)

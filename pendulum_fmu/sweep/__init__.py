@@ -42,5 +42,4 @@ from .grid import Grid, sweep_grid
 from .run import DEFAULT_MAX_CASES, run_sweep
 from .study import FORMATS, OUTPUTS, Study, SweepResult
 
-__all__ = ["DEFAULT_MAX_CASES", "FORMATS", "OUTPUTS", "Grid", "Study", "SweepResult", "run_sweep",
-           "sweep_grid"]
+__all__ = ["DEFAULT_MAX_CASES", "FORMATS", "OUTPUTS", "Grid", "Study", "SweepResult", "run_sweep", "sweep_grid"]

@@ -39,9 +39,15 @@ def dask_client(scheduler: str | None, workers: int | None, connect_timeout: flo
         with contextlib.ExitStack() as stack:
             with _ctrl_c_held():
                 # Port 0 for the scheduler's HTTP server: another cluster may hold dask's usual 8787.
-                cluster = stack.enter_context(LocalCluster(
-                    n_workers=workers or 2, threads_per_worker=1, processes=True,
-                    dashboard_address=":0", silence_logs=logging.CRITICAL))
+                cluster = stack.enter_context(
+                    LocalCluster(
+                        n_workers=workers or 2,
+                        threads_per_worker=1,
+                        processes=True,
+                        dashboard_address=":0",
+                        silence_logs=logging.CRITICAL,
+                    )
+                )
             # A Ctrl-C held while the cluster started is raised here, and the stack closes it.
             yield stack.enter_context(Client(cluster))
         return
@@ -55,7 +61,8 @@ def dask_client(scheduler: str | None, workers: int | None, connect_timeout: flo
         raise SchedulerUnreachable(
             f"no dask scheduler answered at {scheduler} within {connect_timeout:g} s"
             f"{f' ({reason})' if reason else ''}; check the address (start one with `dask "
-            "scheduler`), raise --connect-timeout, or leave out --scheduler for a local cluster")
+            "scheduler`), raise --connect-timeout, or leave out --scheduler for a local cluster"
+        )
     with _quiet(logging.getLogger("distributed.client")), client:
         yield client
 
@@ -176,12 +183,29 @@ def progress_bar(total: int, done: int, enabled: bool):
     # miniters=1: every update counts and only the interval thins them out, so tqdm's monitor
     # thread never redraws a bar on its own.
     if sys.stderr.isatty():
-        return tqdm(total=total, initial=done, disable=not enabled, file=sys.stderr, miniters=1,
-                    mininterval=0.2, ascii=" #", postfix="0 failed",
-                    bar_format="sweep [{bar:30}] " + counts)
-    return tqdm(total=total, initial=done, disable=not enabled, file=_Lines(sys.stderr), miniters=1,
-                mininterval=5.0, delay=5.0, leave=False, postfix="0 failed",
-                bar_format="sweep: " + counts)
+        return tqdm(
+            total=total,
+            initial=done,
+            disable=not enabled,
+            file=sys.stderr,
+            miniters=1,
+            mininterval=0.2,
+            ascii=" #",
+            postfix="0 failed",
+            bar_format="sweep [{bar:30}] " + counts,
+        )
+    return tqdm(
+        total=total,
+        initial=done,
+        disable=not enabled,
+        file=_Lines(sys.stderr),
+        miniters=1,
+        mininterval=5.0,
+        delay=5.0,
+        leave=False,
+        postfix="0 failed",
+        bar_format="sweep: " + counts,
+    )
 
 
 @dataclass
@@ -199,8 +223,7 @@ def run_chunks(client, task: Task, chunks: Iterable[tuple[int, int, dict]], bar)
     committing its parts (only those of this run: task.run) and advancing the bar as each
     finishes."""
     totals = Totals()
-    futures = [client.submit(run_chunk, index, first, values, task, pure=False)
-               for index, first, values in chunks]
+    futures = [client.submit(run_chunk, index, first, values, task, pure=False) for index, first, values in chunks]
     # Done callbacks rather than as_completed: on Ctrl-C no waiting coroutine is left to fail,
     # with a traceback, when the cluster closes.
     finished = queue.SimpleQueue()

@@ -14,8 +14,7 @@ from .store import Store
 LINES_UP_TO = 20
 
 
-def draw(store: Store, cases_table, names: list[str], outputs: tuple[str, ...], fmu: str,
-         target: str) -> None:
+def draw(store: Store, cases_table, names: list[str], outputs: tuple[str, ...], fmu: str, target: str) -> None:
     """Write target (on the store's file system) from the cases table and, for few cases with
     theta and omega kept, their trajectories; the axes and labels carry the units fmu declares."""
     import pyarrow.dataset as ds
@@ -27,8 +26,9 @@ def draw(store: Store, cases_table, names: list[str], outputs: tuple[str, ...], 
     with tempfile.TemporaryDirectory(prefix="pendulum_fmu_sweep_") as scratch:
         figure = Path(scratch) / "sweep.png"
         if cases_table.num_rows <= LINES_UP_TO and {"theta", "omega"} <= set(outputs):
-            trajectories = ds.dataset(f"{store.root}/trajectories", format=store.format,
-                                      filesystem=store.filesystem).to_table()
+            trajectories = ds.dataset(
+                f"{store.root}/trajectories", format=store.format, filesystem=store.filesystem
+            ).to_table()
             case_column = trajectories["case"].to_numpy()
             runs = {}
             for row in cases_table.to_pylist():
@@ -38,9 +38,15 @@ def draw(store: Store, cases_table, names: list[str], outputs: tuple[str, ...], 
                     runs[label] = {k: trajectories[k].to_numpy()[rows] for k in ("time", "theta", "omega")}
             plot_cases(runs, figure, title)
         else:
-            plot_case_bands({name: cases_table[name].to_numpy() for name in names},
-                            {"max |theta| in rad": cases_table["max_abs_theta"].to_numpy(),
-                             "final theta in rad": cases_table["final_theta"].to_numpy()},
-                            figure, title, units)
+            plot_case_bands(
+                {name: cases_table[name].to_numpy() for name in names},
+                {
+                    "max |theta| in rad": cases_table["max_abs_theta"].to_numpy(),
+                    "final theta in rad": cases_table["final_theta"].to_numpy(),
+                },
+                figure,
+                title,
+                units,
+            )
         with replacing_on(store.filesystem, target) as file:
             file.write(figure.read_bytes())

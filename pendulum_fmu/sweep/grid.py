@@ -98,8 +98,9 @@ def sweep_grid(torques, gravities=(9.81,), extra: dict | None = None) -> Grid:
     (8, {'torque': 5.0, 'gravity': 0.0, 'damping': 0.0})
     """
     if not isinstance(extra, Mapping | None):
-        raise WrongType(f"extra is a dict {{name: [values, ...]}}, e.g. {{'damping': [0, 0.5]}}; got "
-                        f"a {type(extra).__name__}")
+        raise WrongType(
+            f"extra is a dict {{name: [values, ...]}}, e.g. {{'damping': [0, 0.5]}}; got a {type(extra).__name__}"
+        )
     extra = dict(extra or {})
     extra_names = _extra_names()
     for name in extra:
@@ -121,12 +122,10 @@ def check_cases(cases, fmu_path=None) -> list[str]:
     if not cases:
         raise InvalidInput("no cases to run")
     if isinstance(cases, str | Mapping) or not isinstance(cases, Sequence):
-        raise WrongType(f"cases are sweep_grid(...) or a list of dicts {{'torque': ..}}; got a "
-                        f"{type(cases).__name__}")
+        raise WrongType(f"cases are sweep_grid(...) or a list of dicts {{'torque': ..}}; got a {type(cases).__name__}")
     for number, case in enumerate(cases):
         if not isinstance(case, Mapping):
-            raise WrongType(f"case {number} is {case!r}, not a dict {{'torque': .., <parameter or "
-                            "start value>: ..}")
+            raise WrongType(f"case {number} is {case!r}, not a dict {{'torque': .., <parameter or start value>: ..}}")
     names = list(cases[0])
     if "torque" not in names:
         raise InvalidInput("every case needs a 'torque'")

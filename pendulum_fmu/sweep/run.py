@@ -23,11 +23,18 @@ from .study import Study, SweepResult
 from .worker import Task
 
 
-
-def run_sweep(study: Study, *, output_dir: str | os.PathLike, resume: bool = False,
-              overwrite: bool = False, scheduler: str | None = None, workers: int | None = None,
-              connect_timeout: float = 10.0, progress: bool = True,
-              max_cases: int = DEFAULT_MAX_CASES) -> SweepResult:
+def run_sweep(
+    study: Study,
+    *,
+    output_dir: str | os.PathLike,
+    resume: bool = False,
+    overwrite: bool = False,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    connect_timeout: float = 10.0,
+    progress: bool = True,
+    max_cases: int = DEFAULT_MAX_CASES,
+) -> SweepResult:
     """Run every case of a study on dask; the workers write it into output_dir.
 
     output_dir receives study.json, trajectories/ and cases/ (a Parquet or CSV file per chunk of
@@ -114,9 +121,15 @@ def run_sweep(study: Study, *, output_dir: str | os.PathLike, resume: bool = Fal
         # A study that replaces another is written apart and moved into place once whole.
         store = target.staging() if overwrite else target
         # This run's token: only parts staged under it are committed (see store.py).
-        task = Task(fmu=fmu, store=store, stop_time=float(study.stop_time),
-                    step_size=float(study.step_size), outputs=study.outputs, stride=study.stride,
-                    run=uuid.uuid4().hex)
+        task = Task(
+            fmu=fmu,
+            store=store,
+            stop_time=float(study.stop_time),
+            step_size=float(study.step_size),
+            outputs=study.outputs,
+            stride=study.stride,
+            run=uuid.uuid4().hex,
+        )
         try:
             try:
                 with dask_client(scheduler, workers, connect_timeout) as client:
@@ -127,11 +140,24 @@ def run_sweep(study: Study, *, output_dir: str | os.PathLike, resume: bool = Fal
                     finished = sum(min(chunk_cases, len(cases) - i * chunk_cases) for i in done)
                     with progress_bar(len(cases), finished, progress) as bar:
                         try:
-                            totals = run_chunks(client, task, (
-                                (index, index * chunk_cases,
-                                 columns(cases, study.names, index * chunk_cases,
-                                         min(len(cases), (index + 1) * chunk_cases)))
-                                for index in pending), bar)
+                            totals = run_chunks(
+                                client,
+                                task,
+                                (
+                                    (
+                                        index,
+                                        index * chunk_cases,
+                                        columns(
+                                            cases,
+                                            study.names,
+                                            index * chunk_cases,
+                                            min(len(cases), (index + 1) * chunk_cases),
+                                        ),
+                                    )
+                                    for index in pending
+                                ),
+                                bar,
+                            )
                         except CancelledError as error:  # this run cancels none: the cluster did
                             raise _lost(scheduler, error, url, overwrite) from None
             finally:
@@ -149,17 +175,24 @@ def run_sweep(study: Study, *, output_dir: str | os.PathLike, resume: bool = Fal
                 store.discard()
             raise
     # Paths on the local file system, URLs elsewhere.
-    where = (Path(target.root).joinpath if isinstance(target.filesystem, LocalFileSystem)
-             else f"{url.rstrip('/')}/".__add__)
+    where = (
+        Path(target.root).joinpath if isinstance(target.filesystem, LocalFileSystem) else f"{url.rstrip('/')}/".__add__
+    )
     return SweepResult(
-        output_dir=where(""), trajectories=where("trajectories") if study.outputs else None,
+        output_dir=where(""),
+        trajectories=where("trajectories") if study.outputs else None,
         cases_table=where("cases"),
-        figure=where("sweep.png"), cases=len(cases),
+        figure=where("sweep.png"),
+        cases=len(cases),
         failed=int(np.sum(table["status"].to_numpy(zero_copy_only=False) == "failed")),
-        chunks=len(chunks), chunks_run=len(pending), bytes=totals.bytes,
-        seconds=time.perf_counter() - started, figure_seconds=drawn - drawing,
+        chunks=len(chunks),
+        chunks_run=len(pending),
+        bytes=totals.bytes,
+        seconds=time.perf_counter() - started,
+        figure_seconds=drawn - drawing,
         worker_cpu_seconds=totals.worker_cpu_seconds,
-        worker_stepping_seconds=totals.worker_stepping_seconds)
+        worker_stepping_seconds=totals.worker_stepping_seconds,
+    )
 
 
 def _lost(scheduler: str | None, error: CancelledError, url: str, overwrite: bool) -> SchedulerLost:
@@ -167,16 +200,19 @@ def _lost(scheduler: str | None, error: CancelledError, url: str, overwrite: boo
     which = f"the dask scheduler at {scheduler}" if scheduler else "the local dask cluster's scheduler"
     reason = getattr(error, "reason", None) or "its work was cancelled"
     if overwrite:
-        kept = (f"{url} holds what it held before (the new study was not finished and is not "
-                "kept): start a scheduler and run the same command again")
+        kept = (
+            f"{url} holds what it held before (the new study was not finished and is not "
+            "kept): start a scheduler and run the same command again"
+        )
     else:
-        kept = (f"the chunks that finished are kept in {url}: start a scheduler and run the same "
-                "command with --resume to run the rest")
+        kept = (
+            f"the chunks that finished are kept in {url}: start a scheduler and run the same "
+            "command with --resume to run the rest"
+        )
     return SchedulerLost(f"{which} was lost mid-study ({reason}); {kept}")
 
 
-def _chunk_cases(held: Held, definition: dict, study: Study, resume: bool, overwrite: bool,
-                 output_dir: str) -> int:
+def _chunk_cases(held: Held, definition: dict, study: Study, resume: bool, overwrite: bool, output_dir: str) -> int:
     """The cases per chunk of this run: the study's own, or on resume those of the run it
     continues. StudyExists where the run would replace a study without being asked to."""
     if overwrite or not held.entries:
@@ -185,7 +221,8 @@ def _chunk_cases(held: Held, definition: dict, study: Study, resume: bool, overw
         raise StudyExists(
             f"{output_dir} holds {', '.join(held.entries)} but no study.json of a sweep: choose "
             "another output directory, or add --overwrite to replace them (--resume continues "
-            "only a study a sweep wrote)")
+            "only a study a sweep wrote)"
+        )
     previous = held.manifest["study"]
     differences = [key for key in definition if previous.get(key) != definition[key]]
     progress = f"{held.done_chunks} of {held.chunks()} chunks written"
@@ -193,26 +230,38 @@ def _chunk_cases(held: Held, definition: dict, study: Study, resume: bool, overw
         raise StudyExists(
             f"{output_dir} holds another study ({', '.join(differences)} differ; {progress}): "
             "choose another output directory, or add --overwrite to replace it once the new one "
-            "is whole (--resume continues only the same study)")
+            "is whole (--resume continues only the same study)"
+        )
     if not resume and held.done_chunks == held.chunks():
         raise StudyExists(
             f"{output_dir} already holds this study, finished ({progress}): nothing to run; add "
             "--overwrite to run it again and replace it once the new one is whole (--resume only "
-            "draws its figure again)")
+            "draws its figure again)"
+        )
     if not resume:
         raise StudyExists(
             f"{output_dir} already holds this study, unfinished ({progress}): add --resume to run "
             "only the chunks not written, or --overwrite to run it all again and replace it once "
-            "the new one is whole")
+            "the new one is whole"
+        )
     return held.manifest["chunk_cases"]
 
 
-def _check_options(count: int, max_cases: int, scheduler: str | None, workers: int | None,
-                   connect_timeout: float, resume: bool, overwrite: bool) -> None:
+def _check_options(
+    count: int,
+    max_cases: int,
+    scheduler: str | None,
+    workers: int | None,
+    connect_timeout: float,
+    resume: bool,
+    overwrite: bool,
+) -> None:
     if count > max_cases:
-        raise InvalidInput(f"{count:,} cases is over the limit of {max_cases:,}: give fewer "
-                           "values, or raise the limit (--max-cases) if the study is meant to be "
-                           "that large")
+        raise InvalidInput(
+            f"{count:,} cases is over the limit of {max_cases:,}: give fewer "
+            "values, or raise the limit (--max-cases) if the study is meant to be "
+            "that large"
+        )
     if scheduler is not None and workers is not None:
         raise InvalidInput("workers sizes the local cluster; with a scheduler the cluster has its own")
     if workers is not None and (not isinstance(workers, numbers.Integral) or workers < 1):
@@ -220,8 +269,9 @@ def _check_options(count: int, max_cases: int, scheduler: str | None, workers: i
     if not (isinstance(connect_timeout, numbers.Real) and 0 < connect_timeout < math.inf):
         raise InvalidInput(f"connect timeout {connect_timeout} must be a positive number of seconds")
     if resume and overwrite:
-        raise InvalidInput("resume continues the study the output directory holds and overwrite "
-                           "replaces it: choose one")
+        raise InvalidInput(
+            "resume continues the study the output directory holds and overwrite replaces it: choose one"
+        )
 
 
 def _file_system(url: str) -> tuple[object, str]:

@@ -88,8 +88,10 @@ class Store:
 
         arrays = {column: pa.array(values) for column, values in columns.items()}
         # Not nullable (no value is ever missing): the writer then has no definition levels to write.
-        table = pa.table(list(arrays.values()), schema=pa.schema(
-            [pa.field(column, array.type, nullable=False) for column, array in arrays.items()]))
+        table = pa.table(
+            list(arrays.values()),
+            schema=pa.schema([pa.field(column, array.type, nullable=False) for column, array in arrays.items()]),
+        )
         with replacing_on(self.filesystem, self.staged(name, index, run)) as file:
             if self.format == "parquet":
                 import pyarrow.parquet as pq
@@ -98,9 +100,13 @@ class Store:
                 # LZ4 after byte-stream-split is within 2 % of zstd's size (57 kB for a 3-s case)
                 # for about two thirds of its CPU, and 23 % smaller than LZ4 alone; dictionaries
                 # only where values repeat within a column (case numbers, status).
-                pq.write_table(table, file, compression="lz4",
-                               use_dictionary=[c for c in table.column_names if c not in split],
-                               column_encoding={c: "BYTE_STREAM_SPLIT" for c in split})
+                pq.write_table(
+                    table,
+                    file,
+                    compression="lz4",
+                    use_dictionary=[c for c in table.column_names if c not in split],
+                    column_encoding={c: "BYTE_STREAM_SPLIT" for c in split},
+                )
             else:
                 import pyarrow.csv
 
@@ -131,8 +137,16 @@ class Store:
         """What interrupted chunks leave: the temporaries of writes cut short (a killed worker, see
         atomic_files.py), the staged parts no client committed (of this run or any other), and
         trajectory parts whose chunk did not get to commit its cases part."""
-        self.remove((TEMPORARY_GLOB, *(f"{table}/{pattern}" for table in ("trajectories", "cases")
-                                       for pattern in (TEMPORARY_GLOB, STAGED_GLOB))))
+        self.remove(
+            (
+                TEMPORARY_GLOB,
+                *(
+                    f"{table}/{pattern}"
+                    for table in ("trajectories", "cases")
+                    for pattern in (TEMPORARY_GLOB, STAGED_GLOB)
+                ),
+            )
+        )
         done = self.done_chunks()
         for index, path in self.parts("trajectories").items():
             if index not in done:
@@ -145,8 +159,11 @@ class Store:
         with contextlib.suppress(OSError, ValueError):
             with fs.open(f"{self.root}/study.json", "r") as file:
                 content = json.load(file)
-            if isinstance(content, dict) and isinstance(content.get("study"), dict) and \
-                    isinstance(content.get("chunk_cases"), int):
+            if (
+                isinstance(content, dict)
+                and isinstance(content.get("study"), dict)
+                and isinstance(content.get("chunk_cases"), int)
+            ):
                 manifest = content
         entries = tuple(name for name in ENTRIES if fs.exists(f"{self.root}/{name}"))
         return Held(manifest, entries, len(self.done_chunks()) if entries else 0)
@@ -155,8 +172,7 @@ class Store:
         """Write study.json: what the study is, its cases per chunk, and the token of the run
         now writing it."""
         with replacing_on(self.filesystem, f"{self.root}/study.json") as file:
-            file.write(json.dumps({"study": definition, "chunk_cases": chunk_cases, "run": run},
-                                  indent=1).encode())
+            file.write(json.dumps({"study": definition, "chunk_cases": chunk_cases, "run": run}, indent=1).encode())
 
     def staging(self) -> Store:
         """A new hidden folder inside this one, where a study that replaces this one is written."""
@@ -205,11 +221,14 @@ class Store:
         try:
             lock.acquire()
         except Timeout:
-            raise InUse(f"output directory {output_dir} is in use by another run (it holds {path}); "
-                        "wait for that run to end, or choose another output") from None
+            raise InUse(
+                f"output directory {output_dir} is in use by another run (it holds {path}); "
+                "wait for that run to end, or choose another output"
+            ) from None
         except OSError as error:
-            raise CannotWrite(f"cannot write {output_dir}: {error.strerror or error}; choose "
-                              "another output directory") from None
+            raise CannotWrite(
+                f"cannot write {output_dir}: {error.strerror or error}; choose another output directory"
+            ) from None
         try:
             yield
         finally:
@@ -224,14 +243,19 @@ class Store:
         import pyarrow as pa
         import pyarrow.dataset as ds
 
-        types = {"case": pa.int64(), **{n: pa.float64() for n in (*names, *SUMMARIES)},
-                 "status": pa.string(), "message": pa.string()}
+        types = {
+            "case": pa.int64(),
+            **{n: pa.float64() for n in (*names, *SUMMARIES)},
+            "status": pa.string(),
+            "message": pa.string(),
+        }
         if self.format == "csv":
             import pyarrow.csv
 
             file_format = ds.CsvFileFormat(convert_options=pyarrow.csv.ConvertOptions(column_types=types))
         else:
             file_format = "parquet"
-        dataset = ds.dataset(f"{self.root}/cases", format=file_format, schema=pa.schema(types),
-                             filesystem=self.filesystem)
+        dataset = ds.dataset(
+            f"{self.root}/cases", format=file_format, schema=pa.schema(types), filesystem=self.filesystem
+        )
         return dataset.to_table(columns=["case", *names, "max_abs_theta", "final_theta", "status"])

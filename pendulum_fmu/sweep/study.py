@@ -92,8 +92,7 @@ class Study:
         derived["outputs"] = outputs = tuple(self.outputs)
         for name in outputs:
             if name not in OUTPUTS or outputs.count(name) > 1:
-                raise InvalidInput(f"outputs {', '.join(outputs)}: choose each at most once among "
-                                   f"{', '.join(OUTPUTS)}")
+                raise InvalidInput(f"outputs {', '.join(outputs)}: choose each at most once among {', '.join(OUTPUTS)}")
         derived["stride"] = _stride(self.output_interval, self.step_size)
         if self.format not in FORMATS:
             raise InvalidInput(f"format {self.format!r}: choose {' or '.join(FORMATS)}")
@@ -114,10 +113,17 @@ class Study:
             values = hashlib.sha256(np.stack(list(table.values())).tobytes()).hexdigest()
         with open(fmu, "rb") as file:
             fmu_sha256 = hashlib.file_digest(file, "sha256").hexdigest()
-        return {"names": self.names, "cases": len(self.cases), "values": values,
-                "stop_time": float(self.stop_time), "step_size": float(self.step_size),
-                "outputs": list(self.outputs), "stride": self.stride, "format": self.format,
-                "fmu_sha256": fmu_sha256}
+        return {
+            "names": self.names,
+            "cases": len(self.cases),
+            "values": values,
+            "stop_time": float(self.stop_time),
+            "step_size": float(self.step_size),
+            "outputs": list(self.outputs),
+            "stride": self.stride,
+            "format": self.format,
+            "fmu_sha256": fmu_sha256,
+        }
 
 
 def _stride(output_interval: float | None, step_size: float) -> int:
@@ -127,8 +133,7 @@ def _stride(output_interval: float | None, step_size: float) -> int:
         raise InvalidInput(f"output interval {output_interval!r} must be a number of seconds")
     stride = round(output_interval / step_size) if math.isfinite(output_interval) else 0
     if stride < 1 or abs(stride * step_size - output_interval) > 1e-9 * output_interval:
-        raise InvalidInput(f"output interval {output_interval} s must be a whole number of steps "
-                           f"of {step_size} s")
+        raise InvalidInput(f"output interval {output_interval} s must be a whole number of steps of {step_size} s")
     return stride
 
 

@@ -53,15 +53,18 @@ class Runner:
         self.defaults = {**fmu_simulator.defaults, "theta": 0.0, "omega": 0.0, "torque": 0.0}
         start_references = np.array([value_reference(n, fmu) for n in self.defaults], np.uint32)
         outputs = np.array([value_reference(name, fmu) for name in OUTPUTS], np.uint32)
-        self.stepper = (cs_loop.Stepper(fmu_simulator.slave, np.empty(0, np.uint32), outputs,
-                                        start_references)
-                        if fmu_simulator.stepper is not None else None)
+        self.stepper = (
+            cs_loop.Stepper(fmu_simulator.slave, np.empty(0, np.uint32), outputs, start_references)
+            if fmu_simulator.stepper is not None
+            else None
+        )
 
     def start_values(self, values: dict[str, np.ndarray], count: int) -> np.ndarray:
         """(count, start values) of the cases given as {name: column}, the defaults elsewhere."""
         given = {START_VALUES.get(name, name): column for name, column in values.items()}
-        return np.column_stack([np.broadcast_to(given.get(name, default), count)
-                                for name, default in self.defaults.items()]).astype(float)
+        return np.column_stack(
+            [np.broadcast_to(given.get(name, default), count) for name, default in self.defaults.items()]
+        ).astype(float)
 
     def run_cases(self, start_values: np.ndarray, points: np.ndarray, outputs: np.ndarray) -> list[str]:
         """theta, omega and alpha of each case (a row of start_values) at every communication
@@ -86,8 +89,9 @@ class Runner:
         slave = self.simulator.slave
         slave.reset()
         initialize(slave, parameters=start, theta0=theta0, omega0=omega0, start_time=float(points[0]))
-        plan = TorqueSchedule(time=points, torque=np.full(len(points) - 1, torque),
-                              torque_rate=np.zeros(len(points) - 1))
+        plan = TorqueSchedule(
+            time=points, torque=np.full(len(points) - 1, torque), torque_rate=np.zeros(len(points) - 1)
+        )
         run = run_schedule_python(slave, plan)
         outputs[:] = [run[name] for name in OUTPUTS]
 
@@ -134,18 +138,33 @@ def run_chunk(index: int, first: int, values: dict[str, np.ndarray], task: Task)
         if len(keep) < len(points):
             kept = kept[:, :, keep]
         # Each output's series of the chunk is contiguous: pyarrow takes its buffer as it is.
-        written += task.store.write_table("trajectories", index, {
-            "case": np.repeat(numbers[ok], len(keep)),
-            "time": _tiled(points[keep], int(ok.sum())),
-            **{name: kept[OUTPUTS.index(name)].reshape(-1) for name in task.outputs}},
-            task.run, split=("time", *task.outputs))
+        written += task.store.write_table(
+            "trajectories",
+            index,
+            {
+                "case": np.repeat(numbers[ok], len(keep)),
+                "time": _tiled(points[keep], int(ok.sum())),
+                **{name: kept[OUTPUTS.index(name)].reshape(-1) for name in task.outputs},
+            },
+            task.run,
+            split=("time", *task.outputs),
+        )
     theta = recorded[OUTPUTS.index("theta")]
     # max |theta| as |max(max, -min)|: two passes and no temporary the size of the chunk (the
     # outer abs only for theta all -0.0, where abs first gives 0.0).
     summaries = [*recorded[:, :, -1], np.abs(np.maximum(theta.max(axis=1), -theta.min(axis=1)))]
-    written += task.store.write_table("cases", index, {
-        "case": numbers, **values, **dict(zip(SUMMARIES, summaries)),
-        "status": np.where(ok, "ok", "failed").tolist(), "message": messages}, task.run)
+    written += task.store.write_table(
+        "cases",
+        index,
+        {
+            "case": numbers,
+            **values,
+            **dict(zip(SUMMARIES, summaries)),
+            "status": np.where(ok, "ok", "failed").tolist(),
+            "message": messages,
+        },
+        task.run,
+    )
     return index, count, count - int(ok.sum()), written, time.thread_time() - cpu, stepping
 
 
@@ -156,7 +175,7 @@ def _tiled(times: np.ndarray, cases: int) -> np.ndarray:
     """The time column of a chunk of cases: times once per case. Kept per thread for the last
     shape asked, as a study's chunks all have one (but its last), so it is built once per study."""
     last = getattr(_tiled_times, "column", None)
-    if last is None or len(last) != len(times) * cases or not np.array_equal(last[:len(times)], times):
+    if last is None or len(last) != len(times) * cases or not np.array_equal(last[: len(times)], times):
         last = _tiled_times.column = np.tile(times, cases)
         last.flags.writeable = False
     return last
