@@ -1,5 +1,6 @@
 """Build dist/Pendulum.fmu from fmu_src/ and modelDescription.xml: `pendulum-fmu build` from a
-checkout, for every platform whose compiler is installed (see --help)."""
+checkout, for every platform whose compiler is installed (see --help).
+"""
 
 import sys
 

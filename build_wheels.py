@@ -35,8 +35,8 @@ import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 
-from pendulum_fmu import FMU_FILES
 from fmu_build import PLATFORMS, BuildError, check_toolchain, compile_native_loop
+from pendulum_fmu import FMU_FILES
 from pendulum_fmu.atomic_files import replacing_path
 
 ROOT = Path(__file__).resolve().parent
@@ -53,7 +53,8 @@ TOOLS = {"build": "pip install build", "wheel": "pip install wheel", "auditwheel
 @dataclass(frozen=True)
 class WheelPlatform:
     """A wheel: the platform (a key of fmu_build.PLATFORMS) whose native loop and FMU
-    binaries it loads."""
+    binaries it loads.
+    """
 
     platform: str
     system: str  # linux, macos or windows
@@ -101,7 +102,8 @@ def check_tools() -> None:
 
 def _zig_on_path() -> dict:
     """The environment with the ziglang package's zig on PATH, so that the isolated build
-    environment of `python -m build` compiles the macOS binaries of the FMUs too."""
+    environment of `python -m build` compiles the macOS binaries of the FMUs too.
+    """
     spec = importlib.util.find_spec("ziglang")
     if spec is None or spec.origin is None:
         return dict(os.environ)
@@ -110,7 +112,8 @@ def _zig_on_path() -> dict:
 
 def _extract_fmu_binaries(wheel: Path, out_dir: Path) -> None:
     """The binaries of the wheel's FMUs into out_dir/<FMU file>/binaries/<folder>/; WheelhouseError
-    unless they are there for every platform of fmu_build.PLATFORMS."""
+    unless they are there for every platform of fmu_build.PLATFORMS.
+    """
     with zipfile.ZipFile(wheel) as archive:
         for fmi_version, name in FMU_FILES.items():
             with zipfile.ZipFile(archive.open(f"pendulum_fmu/data/{name}")) as fmu:
@@ -156,7 +159,8 @@ def manylinux_tag(wheel: Path, machine: str, binaries: list[Path]) -> str:
     """The lowest manylinux policy auditwheel finds the wheel's own libraries and the FMU binaries
     for its machine consistent with, with its legacy alias where it has one. auditwheel reads
     every library a wheel's RECORD lists but none inside an .fmu: it is shown the wheel packed
-    again with those binaries added."""
+    again with those binaries added.
+    """
     with tempfile.TemporaryDirectory(prefix="pendulum_fmu_auditwheel_") as tmp:
         _run([sys.executable, "-m", "wheel", "unpack", "--dest", Path(tmp, "unpacked"), wheel], "wheel unpack")
         [tree] = Path(tmp, "unpacked").iterdir()
@@ -178,7 +182,8 @@ def manylinux_tag(wheel: Path, machine: str, binaries: list[Path]) -> str:
 
 def macos_tag(binaries: list[Path]) -> str:
     """macosx_<the oldest macOS every x86_64 slice loads on>_universal2. An arm64 slice may ask
-    no more than 11.0, the first macOS on Apple Silicon, which the tag then says nothing about."""
+    no more than 11.0, the first macOS on Apple Silicon, which the tag then says nothing about.
+    """
     x86_64 = []
     for binary in binaries:
         for architecture, minimum in macos_minimums(binary).items():
@@ -213,7 +218,7 @@ def _build_base_wheel(out_dir: Path) -> Path:
 
 
 def _retagged(wheel: Path, platform_tag: str) -> Path:
-    """wheel tags: the wheel under another platform tag (the old file removed)."""
+    """Wheel tags: the wheel under another platform tag (the old file removed)."""
     printed = _run(
         [sys.executable, "-m", "wheel", "tags", "--platform-tag", platform_tag, "--remove", wheel], "wheel tags"
     )

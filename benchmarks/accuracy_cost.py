@@ -1,5 +1,6 @@
 """Part 3: what accuracy costs. For each tolerance and communication step: the largest theta
-error of the tutorial case against the scipy oracle, and instructions per step."""
+error of the tutorial case against the scipy oracle, and instructions per step.
+"""
 
 from __future__ import annotations
 
@@ -37,7 +38,8 @@ def step_label(step_size: float) -> str:
 
 def oracle_error(step_size: float = 1e-3) -> float:
     """How far the oracle is from another method's (Radau, implicit) on the same terms: errors
-    below it are not resolved."""
+    below it are not resolved.
+    """
     return float(np.max(np.abs(oracle_theta(step_size) - oracle_theta(step_size, "Radau"))))
 
 

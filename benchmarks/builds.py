@@ -12,7 +12,7 @@ from pathlib import Path
 
 from fmpy import extract, read_model_description
 
-from fmu_build import FMI_HEADERS, PLATFORMS, build_fmu, cmake_build, check_toolchain, run_tool
+from fmu_build import FMI_HEADERS, PLATFORMS, build_fmu, check_toolchain, cmake_build, run_tool
 
 HERE = Path(__file__).resolve().parent
 NULL_FMU_SOURCES = HERE / "null_fmu"
@@ -48,7 +48,8 @@ def build_pendulum_fmu(out_dir: Path) -> BuiltFmu:
 
 def build_null_fmu(out_dir: Path) -> BuiltFmu:
     """Build null_fmu/ with the pendulum's compiler flags (its CMakeLists.txt includes
-    cmake/flags.cmake) and zip it as NullFmu.fmu."""
+    cmake/flags.cmake) and zip it as NullFmu.fmu.
+    """
     work = out_dir / "null_fmu_build"
     work.mkdir(parents=True, exist_ok=True)
     [native] = PLATFORMS["linux64"].targets
@@ -64,13 +65,15 @@ def build_null_fmu(out_dir: Path) -> BuiltFmu:
 def build_step_master(out_dir: Path, platform: str = "linux64", fmi_version: int = 2) -> Path:
     """Compile the bare C master of an FMI version (step_master.c, fmi3_step_master.c) for a
     platform of fmu_build.PLATFORMS with that platform's compiler (the tests run the win64
-    one under wine, the aarch64-linux one under qemu-aarch64)."""
+    one under wine, the aarch64-linux one under qemu-aarch64).
+    """
     return build_bare_master(out_dir, STEP_MASTER_SOURCES[fmi_version], platform)
 
 
 def build_bare_master(out_dir: Path, source: Path, platform: str = "linux64") -> Path:
     """Compile a C program, one file (a step master over bare_master.h, a program of tests/c/),
-    for a platform of fmu_build.PLATFORMS with that platform's compiler."""
+    for a platform of fmu_build.PLATFORMS with that platform's compiler.
+    """
     chosen = PLATFORMS[platform]
     check_toolchain(chosen)
     [target] = chosen.targets  # the masters run here, where no universal binary is needed

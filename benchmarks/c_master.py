@@ -37,7 +37,7 @@ def run(command: list[str]) -> None:
 
 
 def theta_trajectory(master: Path, fmu: BuiltFmu, steps: int, step_size: float, tolerance: float | None) -> np.ndarray:
-    """theta at t = 0, h, ..., steps*h, as the master saw it."""
+    """Theta at t = 0, h, ..., steps*h, as the master saw it."""
     with tempfile.TemporaryDirectory() as scratch:
         path = Path(scratch) / "theta.txt"
         run(master_command(master, fmu, steps, step_size, tolerance, path))

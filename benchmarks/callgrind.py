@@ -32,7 +32,8 @@ def count_instructions(
     master: Path, fmu: BuiltFmu, steps: int, step_size: float, tolerance: float | None, only_in: tuple[str, ...]
 ) -> int:
     """Instructions of one master run; with only_in, just those inside those functions and what
-    they call (callgrind's --toggle-collect)."""
+    they call (callgrind's --toggle-collect).
+    """
     with tempfile.TemporaryDirectory() as scratch:
         profile = Path(scratch) / "callgrind.out"
         command = [

@@ -42,7 +42,8 @@ def _values() -> dict[str, np.ndarray]:
 
 def chunk_cpu(outputs: tuple[str, ...]) -> tuple[float, float, float]:
     """(CPU, of which stepping, bytes written) per case of run_chunk, over CHUNKS chunks: the
-    round of least CPU."""
+    round of least CPU.
+    """
     rounds = []
     with tempfile.TemporaryDirectory(prefix="pendulum-chunk-cost-") as folder:
         task = Task(
@@ -81,7 +82,8 @@ def native_loop_cpu() -> float:
 def encodings() -> list[tuple[str, bool, float, float]]:
     """(compression, byte-stream-split, bytes per case, write CPU per case) of a chunk's
     trajectories table (case, time, theta, omega, alpha), written as sweep/store.py writes it
-    but for these two choices."""
+    but for these two choices.
+    """
     runner = _runner(str(default_fmu()))
     points = communication_points(0.0, STOP_TIME, STEP_SIZE)
     recorded = np.empty((len(OUTPUTS), CASES, len(points)))

@@ -7,9 +7,9 @@ from __future__ import annotations
 
 from .builds import BuiltFmu
 from .fmpy_loop import timed_tutorial_loop
-from .tutorial import STEPS
 from .report import Row, microseconds, ratio
 from .timing import interleaved, median
+from .tutorial import STEPS
 
 PART = "1 floor"
 TARGET_RATIO = 1.10

@@ -36,7 +36,8 @@ def tutorial_loop(slave: FMU2Slave, fmu: BuiltFmu) -> list[float]:
 
 def timed_tutorial_loop(fmu: BuiltFmu) -> tuple[float, np.ndarray]:
     """(seconds of the stepping loop alone, theta at every communication point) of the tutorial
-    case on a fresh instance."""
+    case on a fresh instance.
+    """
     slave = open_slave(fmu)
     try:
         initial = slave.getReal([fmu.value_references["theta"]])

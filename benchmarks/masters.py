@@ -60,7 +60,8 @@ MISTAKES = {
 
 class Signal:
     """A time,torque CSV in fmpy's convention: linear between rows, a jump where a time repeats;
-    a row within a billionth of a step of a time counts as at that time."""
+    a row within a billionth of a step of a time counts as at that time.
+    """
 
     def __init__(self, path: Path, step_size: float):
         with open(path, newline="") as file:
@@ -139,7 +140,8 @@ def _slave(kit: Kit, start_time: float, name: str) -> FMU2Slave:
 
 def co_simulation(kit: Kit, mistake: str | None = None) -> Path:
     """A Co-Simulation master: set the torque (and its slope), read the outputs, step; with a
-    resume_time, keep the FMU state there and go on in a new instance."""
+    resume_time, keep the FMU state there and go on in a new instance.
+    """
     times = kit.times
     if mistake == "drift":
         # Time summed in single precision, as a master with a float clock does.
@@ -190,7 +192,8 @@ def co_simulation(kit: Kit, mistake: str | None = None) -> Path:
 
 def model_exchange(kit: Kit, method: str) -> Path:
     """A master that integrates the Model Exchange interface itself, one solver step per
-    communication step, holding each step's torque: explicit Euler, or Heun (second order)."""
+    communication step, holding each step's torque: explicit Euler, or Heun (second order).
+    """
     model = FMU2Model(
         guid=kit.description.guid,
         unzipDirectory=kit.unzipped,
@@ -234,7 +237,8 @@ def model_exchange(kit: Kit, method: str) -> Path:
 
 def run(folder: Path, name: str, mistake: str | None = None) -> Path:
     """Run scenario `name` of the kit in `folder`, making `mistake` (None: none); returns the
-    NAME_out.csv written."""
+    NAME_out.csv written.
+    """
     kit = Kit(folder, name)
     if mistake in ("euler", "heun"):
         return model_exchange(kit, mistake)

@@ -24,7 +24,8 @@ OPENSIM_TARGET, PYTHONFMU_TARGET = 30.0, 20.0
 
 def opensim_rows(fmu: BuiltFmu, repetitions: int) -> list[Row]:
     """OpenSim's tutorial pendulum against simulate(), each end to end (building or opening the
-    model included, as a user pays it), and the theta error of each against the scipy oracle."""
+    model included, as a user pays it), and the theta error of each against the scipy oracle.
+    """
     part = "peer OpenSim"
     # engines.opensim imports opensim only when called, so ask for the package itself.
     if importlib.util.find_spec("opensim") is None:
@@ -73,7 +74,8 @@ def pythonfmu_rows(pendulum: BuiltFmu, out_dir: Path, repetitions: int) -> list[
     """The PythonFMU pendulum against ours in the same fmpy loop as part 1.
 
     Expects benchmarks/pythonfmu_pendulum/build.py to provide build_pythonfmu_pendulum(out_dir)
-    returning the path of the .fmu it built, with variables named torque and theta."""
+    returning the path of the .fmu it built, with variables named torque and theta.
+    """
     part = "peer PythonFMU"
     try:
         from .pythonfmu_pendulum.build import build_pythonfmu_pendulum

@@ -1,14 +1,14 @@
 """Part 4: our Python master loop (run_schedule_python, simulate()'s reference path) against
 fmpy's FMU2Slave wrappers making the same FMI calls, and the native loop (cs_loop, what
-simulate() runs when it is built) making them from C; same FMU, same results bit for bit."""
+simulate() runs when it is built) making them from C; same FMU, same results bit for bit.
+"""
 
 from __future__ import annotations
 
 import numpy as np
 from fmpy.fmi2 import FMU2Slave
 
-from pendulum_fmu import results
-from pendulum_fmu import cs_loop
+from pendulum_fmu import cs_loop, results
 from pendulum_fmu.parameters import value_reference
 from pendulum_fmu.simulate import open_fmu, run_schedule, run_schedule_python
 from pendulum_fmu.torque_schedule import TorqueSchedule, schedule
@@ -24,7 +24,8 @@ TARGET_RATIO = 0.5
 
 def fmpy_schedule_loop(slave: FMU2Slave, plan: TorqueSchedule) -> np.ndarray:
     """run_schedule's calls for a held torque (setReal torque, getReal theta/omega/alpha, doStep),
-    each through fmpy's wrapper, which builds its ctypes arrays and checks the status anew."""
+    each through fmpy's wrapper, which builds its ctypes arrays and checks the status anew.
+    """
     torque_vr = [value_reference("torque")]
     output_vrs = [value_reference(n) for n in ("theta", "omega", "alpha")]
     out = results.empty(len(plan.time))

@@ -44,7 +44,8 @@ def free_port() -> int:
 @contextlib.contextmanager
 def dask_processes(workers: int):
     """The address of a `dask scheduler` with `workers` single-threaded `dask worker`s, each its
-    own process on localhost, started as a user starts them on a cluster; stopped on exit."""
+    own process on localhost, started as a user starts them on a cluster; stopped on exit.
+    """
     with dask_process_handles(workers) as (address, _):
         yield address
 
@@ -53,7 +54,8 @@ def dask_processes(workers: int):
 def dask_process_handles(workers: int, nanny: bool = True):
     """(address, [the scheduler's process, each worker's]) of a cluster as dask_processes
     starts it; nanny=False: each worker is the process that runs its tasks (no nanny restarts
-    it), for the fault tests to stop or kill."""
+    it), for the fault tests to stop or kill.
+    """
     from dask.distributed import Client
 
     port = free_port()
@@ -155,7 +157,8 @@ def simulate_repeatedly(fmu: str, cases: int) -> None:
 
 def _control_speedup(fmu: BuiltFmu, processes: int, cases: int = 200) -> float:
     """How many times one process's rate N plain processes reach together: what the machine
-    gives at that moment, the ceiling for N workers."""
+    gives at that moment, the ceiling for N workers.
+    """
     import time
 
     code = f"from benchmarks.scale import simulate_repeatedly; simulate_repeatedly({str(fmu.path)!r}, {cases})"
@@ -203,7 +206,8 @@ def _cpu_seconds(process: subprocess.Popen) -> float:
 
 def scale_rows(fmu: BuiltFmu, quick: bool, cases: int | None = None) -> list[Row]:
     """The part's rows; cases: of each 3-s study (default 1024 quick, else 4096), more where the
-    cores are many, so that 16 workers each run more than a few chunks' worth."""
+    cores are many, so that 16 workers each run more than a few chunks' worth.
+    """
     cases = cases or (1024 if quick else 4096)
     rounds = 1 if quick else 3
     worker_counts = [n for n in (1, 2, 4, 8, 16) if n <= (os.cpu_count() or 1)]

@@ -21,7 +21,8 @@ from pendulum_fmu.simulate import simulate
 def random_step_rows(rng: np.random.Generator, stop_time: float = 4.0, running_sum: bool = False) -> list[tuple]:
     """A random step signal: levels held for random decimal durations (ms resolution). With
     running_sum the times are what a tool accumulating durations writes (0.39100000000000029).
-    tests/test_torque_schedule_exactness.py draws its signals here too."""
+    tests/test_torque_schedule_exactness.py draws its signals here too.
+    """
     durations = rng.integers(20, 400, size=60) / 1000
     if running_sum:
         times = np.cumsum(durations)

@@ -18,8 +18,9 @@ ORACLE_MAX_STEP = 1e-3  # s
 
 
 def oracle_theta(step_size: float = STEP, method: str = "DOP853") -> np.ndarray:
-    """theta at t = 0, h, ..., STOP_TIME from scipy's solve_ivp (method) at rtol = atol =
-    ORACLE_TOLERANCE and steps of at most ORACLE_MAX_STEP."""
+    """Theta at t = 0, h, ..., STOP_TIME from scipy's solve_ivp (method) at rtol = atol =
+    ORACLE_TOLERANCE and steps of at most ORACLE_MAX_STEP.
+    """
     return reference(
         TORQUE,
         stop_time=STOP_TIME,

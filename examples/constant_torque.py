@@ -1,5 +1,6 @@
 """The tutorial's constant torque (20 N.m), without and with gravity: the FMU against the
-analytic parabola and the scipy reference, in the tutorial's figures."""
+analytic parabola and the scipy reference, in the tutorial's figures.
+"""
 
 import argparse
 

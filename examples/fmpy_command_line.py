@@ -1,5 +1,6 @@
 """The FMU under fmpy's own command line: write a step-wise torque CSV in fmpy's convention (a
-repeated time marks a step), run `fmpy simulate`, and check the result against scipy."""
+repeated time marks a step), run `fmpy simulate`, and check the result against scipy.
+"""
 
 import argparse
 import subprocess

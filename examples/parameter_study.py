@@ -1,5 +1,6 @@
 """The tutorial's parameter study: several torques with gravity, run as a grid on a local dask
-cluster (pass --scheduler to use a running dask.distributed cluster instead)."""
+cluster (pass --scheduler to use a running dask.distributed cluster instead).
+"""
 
 import argparse
 

@@ -44,7 +44,8 @@ _NAME_IN_TEMPORARY = 64
 
 def _streamed(path: Path) -> bool:
     """Whether path is an existing file that is no regular file or folder (a device, a named
-    pipe, a socket): renaming over it would destroy it, so it is written into as it is."""
+    pipe, a socket): renaming over it would destroy it, so it is written into as it is.
+    """
     try:
         mode = path.stat().st_mode  # through a link, to what it leads to
     except OSError:
@@ -54,13 +55,15 @@ def _streamed(path: Path) -> bool:
 
 def _final(path: Path) -> Path:
     """The file a write to path replaces: the one a symbolic link leads to (so the link stays a
-    link), else path itself."""
+    link), else path itself.
+    """
     return Path(os.path.realpath(path)) if path.is_symlink() else path
 
 
 def _longest_name(folder: Path) -> int:
     """The longest file name folder's file system allows, in bytes (255 where the platform cannot
-    say, as on Windows, whose file systems allow 255 characters)."""
+    say, as on Windows, whose file systems allow 255 characters).
+    """
     try:
         return os.pathconf(folder, "PC_NAME_MAX")
     except (AttributeError, OSError, ValueError):
@@ -70,7 +73,8 @@ def _longest_name(folder: Path) -> int:
 def _temporary_beside(path: Path, suffix: str) -> tuple[int, str]:
     """A new file beside path with the permissions of the file it replaces, or those a plain
     open() would give (mkstemp's are 0600, which would hide an FMU or a table from the other users
-    of a shared folder)."""
+    of a shared folder).
+    """
     for folder in (path.parent, *path.parent.parents):
         if folder.exists() and not folder.is_dir():
             raise CannotWrite(f"cannot write {path}: {folder} is a file, not a folder; choose another output path")
@@ -187,7 +191,8 @@ def replacing(path: str | os.PathLike, mode: str = "w", **open_arguments):
 @contextlib.contextmanager
 def replacing_path(path: str | os.PathLike):
     """A unique temporary path beside path, for writers that want a file name (savefig, zip);
-    renamed to path on success, removed otherwise."""
+    renamed to path on success, removed otherwise.
+    """
     path = Path(path)
     if _streamed(path):
         yield path

@@ -22,8 +22,8 @@ from fmpy.container_fmu.config import Component, Configuration, Connection
 from fmpy.model_description import CoSimulation, DefaultExperiment, ModelDescription, ModelVariable
 from scipy.integrate import solve_ivp
 
-from .atomic_files import replacing
 from ._checkout import ROOT, build_tool
+from .atomic_files import replacing
 from .errors import InvalidInput
 from .parameters import total_inertia
 from .simulate import resolve_parameters
@@ -224,7 +224,7 @@ def sampled_loop_reference(
             y[1],
             (
                 u
-                - gravity_moment * np.sin(y[0])  # noqa: E731
+                - gravity_moment * np.sin(y[0])
                 - p["damping"] * y[1]
             )
             * inverse_inertia,

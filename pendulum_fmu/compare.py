@@ -45,7 +45,8 @@ def run_tools(
 ) -> dict[str, np.ndarray]:
     """{tool label: result array} for the same schedule, parameters and start values; tools as
     --tools gives them (see compare_tools.py), mapping the --map of other FMUs. "reference" here is
-    reference_schedule: the schedule's own torques through scipy."""
+    reference_schedule: the schedule's own torques through scipy.
+    """
     fmu_path = fmu_model(fmu_path)  # read once, passed to every tool
     parsed = parse_tools(tools, mapping=mapping, fmu_path=fmu_path)
     # Every tool gets the whole set, so the defaults are fmu_path's for all of them.
@@ -60,8 +61,9 @@ def check_tolerance(tolerance: float) -> float:
 
 
 def differences(run: np.ndarray, judge: np.ndarray) -> dict[str, float]:
-    """max and RMS |run - judge| of each output (theta, omega, alpha: the fields after time and
-    torque), and max |torque difference|."""
+    """Max and RMS |run - judge| of each output (theta, omega, alpha: the fields after time and
+    torque), and max |torque difference|.
+    """
     row = {}
     # A tool whose numbers run past the largest double (a --map factor of 1e308) differs by inf:
     # that is its verdict, and numpy's overflow warnings on the way say nothing more.
@@ -106,7 +108,8 @@ def format_table(rows: list[dict]) -> str:
 
 def write_trajectories(runs: dict[str, np.ndarray], path: str | Path) -> Path:
     """One CSV: time, then torque, theta, omega, alpha (every field after time) of each tool
-    (torque_fmu, theta_fmu, ...)."""
+    (torque_fmu, theta_fmu, ...).
+    """
     columns = {"time": next(iter(runs.values()))["time"]}
     for tool, run in runs.items():
         for name in run.dtype.names[1:]:

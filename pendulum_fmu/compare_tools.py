@@ -24,10 +24,10 @@ import importlib
 import importlib.util
 import re
 import warnings
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
-from typing import Callable, Sequence
 
 import numpy as np
 
@@ -47,7 +47,8 @@ class ToolSpecError(InvalidInput):
 @dataclass(frozen=True)
 class Tool:
     """A tool as compare runs it: its label in tables and figures, its runner, and the FMU (a
-    path, a model or None for the default) whose outputs it is asked for."""
+    path, a model or None for the default) whose outputs it is asked for.
+    """
 
     label: str
     runner: Callable[..., np.ndarray]
@@ -153,7 +154,8 @@ def installed(name: str) -> bool:
 
 def install_hint(name: str) -> str:
     """The pip command that installs what the tool needs: its extra of this package, which is
-    installed from a clone or a wheel (it is on no package registry)."""
+    installed from a clone or a wheel (it is on no package registry).
+    """
     extra = KINDS[name].extra
     return f'pip install ".[{extra}]" in a clone of pendulum-fmu (or "WHEEL.whl[{extra}]" for its wheel)'
 

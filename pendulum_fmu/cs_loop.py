@@ -13,9 +13,9 @@ from __future__ import annotations
 
 import ctypes
 import importlib.machinery
+from collections.abc import Sequence
 from functools import lru_cache
 from pathlib import Path
-from typing import Sequence
 
 import numpy as np
 
@@ -54,7 +54,8 @@ INTERFACE = 6
 @lru_cache(maxsize=1)
 def _library():
     """The compiled loop's (run, run_cases) functions, or None when it was not built (or is a
-    stale build)."""
+    stale build).
+    """
     # setup.py gives it the platform's plain extension name (_cs_loop.so, _cs_loop.pyd).
     path = Path(__file__).resolve().parent / f"_cs_loop{importlib.machinery.EXTENSION_SUFFIXES[-1]}"
     if not path.is_file():
@@ -252,7 +253,8 @@ class Stepper:
     def _error(self, status: int, time: np.ndarray) -> Exception:
         """The error of a run that failed with status: the slave's MessageLog error with the FMU's
         messages, the failing call and the time of its step, or FmuError("initialization failed:
-        ...") for a restart's call, as simulate.initialize raises."""
+        ...") for a restart's call, as simulate.initialize raises.
+        """
         call = self._failed_call.value
         if call >= _RESTART:
             return self.messages.initialization_error(f"{_CALLS[call]} failed")

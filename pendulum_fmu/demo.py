@@ -28,7 +28,8 @@ ENTRIES = ("no_gravity", "gravity", "gravity_effect.png", "parameter_study")
 
 class DemoExists(PendulumFmuError, FileExistsError):
     """The output folder holds a previous demo's outputs that the run would replace without being
-    asked to; the message names them and --overwrite."""
+    asked to; the message names them and --overwrite.
+    """
 
 
 def run_demo(output_dir: str | Path, workers: int | None = None, overwrite: bool = False) -> bool:

@@ -38,13 +38,14 @@ from pathlib import Path
 import numpy as np
 
 from . import results
-from .regression_tools import format_verdicts, regression_verdicts
 from .atomic_files import replacing
 from .errors import InvalidInput
 from .mapped_fmu import as_map
 from .parameters import variables
 from .reference import equation_of_motion, reference, reference_schedule
-from .scenarios import JUDGE_TOLERANCE as DEFAULT_TOLERANCE, read_settings, settings_files
+from .regression_tools import format_verdicts, regression_verdicts
+from .scenarios import JUDGE_TOLERANCE as DEFAULT_TOLERANCE
+from .scenarios import read_settings, settings_files
 from .simulate import resolve_parameters
 from .torque_schedule import TorqueSchedule, TorqueTable, event_tolerance, read_torque_csv, schedule
 
@@ -81,7 +82,8 @@ OPTIONAL = ("omega", "alpha")
 
 class ResultFileError(InvalidInput):
     """A result file, or a kit's folder, that cannot be judged; the message names the file, the
-    line and the problem."""
+    line and the problem.
+    """
 
 
 @dataclass
@@ -256,7 +258,8 @@ def _check_span(result: np.ndarray, plan: TorqueSchedule, step_size: float, sour
     """Refuse a result that is not a record of this run: times outside it, or a first or last row
     that is not the run's start or stop. A result that stops short (a master that crashed, a file
     cut off, only the t = 0 row) agrees with the reference wherever it has rows, so judged it would
-    pass a run that never happened."""
+    pass a run that never happened.
+    """
     start, stop = float(plan.time[0]), float(plan.time[-1])
     slack = float(event_tolerance(max(abs(start), abs(stop)), step_size))
     first, last = float(result["time"][0]), float(result["time"][-1])
@@ -298,7 +301,8 @@ def _changed(plan: TorqueSchedule, torque: np.ndarray, rate: np.ndarray | None =
 
 def _late(plan: TorqueSchedule, start_torque: float) -> list[TorqueSchedule]:
     """Step k holds what step k-1 should; the first step the signal's first value or the FMU's
-    start value (whatever the master set before it began)."""
+    start value (whatever the master set before it began).
+    """
     variants = []
     for first in dict.fromkeys((float(plan.torque[0]), start_torque)):
         first_rate = plan.torque_rate[0] if first == plan.torque[0] else 0.0
@@ -318,7 +322,8 @@ def _interpolated(plan: TorqueSchedule) -> list[TorqueSchedule]:
 def _signal_values(torque, times: np.ndarray, side: str) -> np.ndarray | None:
     """The signal just after (side "after") or before each time, sampled as a master would,
     without the definition's snapping of events onto communication points; None for a per-step
-    array, which has no value between its steps."""
+    array, which has no value between its steps.
+    """
     if isinstance(torque, (str, Path)):
         torque = read_torque_csv(torque)
     if isinstance(torque, TorqueTable):
@@ -342,7 +347,8 @@ def _drifted(torque, times: np.ndarray, ramp: bool) -> list[TorqueSchedule]:
 
 def _euler(plan: TorqueSchedule, acceleration, theta0: float, omega0: float, semi_implicit: bool) -> np.ndarray:
     """The equation of motion stepped once per communication step, holding each step's start
-    torque: explicit Euler, or semi-implicit (the new omega moves theta)."""
+    torque: explicit Euler, or semi-implicit (the new omega moves theta).
+    """
     out = results.empty(len(plan.time))
     out["time"] = plan.time
     theta, omega = theta0, omega0
@@ -387,7 +393,8 @@ def _not_restored(run: _Run, correct: np.ndarray, first_wrong: int) -> list[np.n
     """Up to a point the reference; from there the run restarts from its initial state, as a
     resumed run that did not restore its saved FMU state. The restart is where the first row that
     disagrees is (it shows the initial state), or the row before it (it shows the old instance's
-    state, the next row the new one's)."""
+    state, the next row the new one's).
+    """
     variants = []
     for restart_row in (first_wrong, first_wrong - 1):
         if restart_row < 1:  # a restart at the very start is no restart
@@ -422,7 +429,8 @@ def _candidates(
     start_torque: float,
 ) -> dict[str, list[np.ndarray]]:
     """{candidate: its variants at the result's times}; an empty list where it does not apply.
-    held: for a ramp run, the same signal held over each step (schedule without ramp)."""
+    held: for a ramp run, the same signal held over each step (schedule without ramp).
+    """
     plan, ramp = run.plan, held is not None
     off_grid = _plan_index(plan, run.times, run.step_size) is None
     wrong = np.flatnonzero(np.abs(result["theta"] - correct["theta"]) > tolerance)

@@ -62,7 +62,8 @@ def quantities() -> tuple[str, ...]:
 
 def parse_map(text: str | None, allowed: tuple[str, ...] | None = None) -> dict[str, Mapped]:
     """{quantity: Mapped} from 'torque=u,theta=phi*0.0174532925,...'; allowed: the quantities
-    that may be mapped (default: every quantity of a compared FMU, quantities())."""
+    that may be mapped (default: every quantity of a compared FMU, quantities()).
+    """
     allowed = quantities() if allowed is None else allowed
     mapping: dict[str, Mapped] = {}
     for item in filter(None, (part.strip() for part in (text or "").split(","))):
@@ -261,8 +262,9 @@ class MappedFmu:
         return {name: recorded[:, i] for i, name in enumerate(outputs)}
 
     def _model_exchange(self, plan, start, tolerance):
-        """fmpy's CVode on the FMU's derivatives, with the torque as a table that jumps where the
-        schedule's torque changes (fmpy stops the integrator at each such time)."""
+        """Fmpy's CVode on the FMU's derivatives, with the torque as a table that jumps where the
+        schedule's torque changes (fmpy stops the integrator at each such time).
+        """
         torque = self.mapping["torque"]
         change = np.flatnonzero(np.diff(plan.torque)) + 1
         # Rows in fmpy's convention: a time given twice is a jump from the first value to the second.

@@ -32,12 +32,14 @@ FMI_VERSIONS = ("2.0", "3.0")
 
 class FmuFileError(InvalidInput):
     """The file given as an FMU is none this package can run: not a zip, no modelDescription.xml,
-    not FMI 2.0 or 3.0, or not a pendulum; the message names the file and what to do."""
+    not FMI 2.0 or 3.0, or not a pendulum; the message names the file and what to do.
+    """
 
 
 def file_version(path: str | os.PathLike) -> tuple[int, int, int, int]:
     """(device, inode, size, modification time in ns) of a file: a file rebuilt, rewritten or
-    replaced has another. MissingFile (with the path) when it is not there."""
+    replaced has another. MissingFile (with the path) when it is not there.
+    """
     try:
         status = os.stat(path)
     except OSError as error:
@@ -47,7 +49,8 @@ def file_version(path: str | os.PathLike) -> tuple[int, int, int, int]:
 
 def fmu_file(fmu_path: str | os.PathLike | FmuModel | None) -> Path:
     """The FMU file a function is about: fmu_path (a model's own path), or
-    pendulum_fmu.default_fmu()."""
+    pendulum_fmu.default_fmu().
+    """
     if isinstance(fmu_path, FmuModel):
         return fmu_path.path
     if fmu_path is None:
@@ -95,7 +98,7 @@ class FmuModel:
 
     @cached_property
     def pendulum_variables(self) -> dict:
-        """variables of a pendulum FMU this machine can run.
+        """Variables of a pendulum FMU this machine can run.
 
         Raises
         ------
@@ -127,7 +130,8 @@ class FmuModel:
     @cached_property
     def default_parameters(self) -> dict[str, float]:
         """{name: start value} of every Real parameter (shared: copy before changing); raises as
-        pendulum_variables. String parameters (callRecordFile) are no physical parameter."""
+        pendulum_variables. String parameters (callRecordFile) are no physical parameter.
+        """
         return {
             name: float(v.start)
             for name, v in self.pendulum_variables.items()
@@ -137,23 +141,27 @@ class FmuModel:
     @cached_property
     def outputs(self) -> tuple[str, ...]:
         """The names of the FMU's output variables, in modelDescription.xml's order: the one place
-        that names what a result records besides time and the inputs."""
+        that names what a result records besides time and the inputs.
+        """
         return tuple(name for name, v in self.variables.items() if v.causality == "output")
 
     @cached_property
     def recorded(self) -> tuple[str, ...]:
         """What a run records at every communication point, read back from the FMU: its inputs
-        (the torque it received), then its outputs, in modelDescription.xml's order."""
+        (the torque it received), then its outputs, in modelDescription.xml's order.
+        """
         return tuple(name for name, v in self.variables.items() if v.causality in ("input", "output"))
 
     def value_reference(self, name: str) -> int:
         """The value reference of a pendulum variable; raises as pendulum_variables, KeyError
-        for a name it does not have."""
+        for a name it does not have.
+        """
         return self.pendulum_variables[name].valueReference
 
     def unit(self, name: str) -> str:
         """The declared unit of a variable, parameter or start value (theta0: theta's), '' where
-        none; raises as value_reference."""
+        none; raises as value_reference.
+        """
         return self.pendulum_variables[START_VALUES.get(name, name)].unit or ""
 
     @cached_property
@@ -169,7 +177,8 @@ class FmuModel:
 @lru_cache(maxsize=32)
 def _read(path: str, version: tuple, shown: str) -> FmuModel:
     """The FmuModel of the file at path (resolved) as it is at version; shown is the path as the
-    user gave it, for the messages."""
+    user gave it, for the messages.
+    """
     try:
         with zipfile.ZipFile(path) as archive:
             names = frozenset(archive.namelist())

@@ -14,13 +14,7 @@ from pathlib import Path
 
 from .errors import InvalidInput, WrongType
 from .model import (
-    FMI_VERSIONS,
-    PENDULUM_VARIABLES,
-    START_VALUES,
-    FmuFileError,
-    FmuModel,  # noqa: F401
-    file_version,
-    fmu_file,
+    FmuModel,
     fmu_model,
 )
 
@@ -33,7 +27,7 @@ def pendulum_variables(fmu_path: Fmu = None) -> dict:
 
 
 def model_description(fmu_path: Fmu = None):
-    """fmpy's ModelDescription of the FMU.
+    """Fmpy's ModelDescription of the FMU.
 
     Raises
     ------
@@ -47,7 +41,8 @@ def model_description(fmu_path: Fmu = None):
 
 def variables(fmu_path: Fmu = None) -> dict:
     """{name: fmpy ModelVariable} of any FMI 2.0 or 3.0 FMU (shared: do not modify); raises as
-    model_description."""
+    model_description.
+    """
     return fmu_model(fmu_path).variables
 
 
@@ -59,7 +54,8 @@ def value_reference(name: str, fmu_path: Fmu = None) -> int:
 def unit(name: str, fmu_path: Fmu = None) -> str:
     """The unit the pendulum FMU declares for a variable, a parameter or a start value (theta0:
     theta's), '' where it declares none; raises as default_parameters, KeyError for a name it
-    does not have."""
+    does not have.
+    """
     return fmu_model(fmu_path).unit(name)
 
 
@@ -79,7 +75,8 @@ def default_parameters(fmu_path: Fmu = None) -> dict[str, float]:
 
 def merged_parameters(overrides: dict[str, float] | None = None, fmu_path: Fmu = None) -> dict[str, float]:
     """The FMU's defaults with overrides applied; unknown names and non-finite values are refused.
-    What the FMU itself refuses is left to it: see simulate.resolve_parameters."""
+    What the FMU itself refuses is left to it: see simulate.resolve_parameters.
+    """
     return merged_with(default_parameters(fmu_path), overrides)
 
 

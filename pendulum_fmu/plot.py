@@ -10,14 +10,14 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")  # files only: works on machines without a display
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.backend_bases import FigureCanvasBase  # noqa: E402
-from matplotlib.lines import Line2D  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.backend_bases import FigureCanvasBase
+from matplotlib.lines import Line2D
 
-from .atomic_files import replacing_path  # noqa: E402
-from .errors import InvalidInput  # noqa: E402
-from .parameters import merged_parameters, unit  # noqa: E402
+from .atomic_files import replacing_path
+from .errors import InvalidInput
+from .parameters import merged_parameters, unit
 
 THETA_LABEL = r"Position $\theta$ in rad"
 OMEGA_LABEL = r"Velocity $\omega$ in rad/s"
@@ -88,7 +88,8 @@ def _too_large(values) -> float | None:
 
 def _leave_out_undrawable(ax) -> None:
     """Take out of the panel every line or band reaching past DRAWABLE and write in its place
-    one line saying what and how large, rather than fail or draw a garbage scale."""
+    one line saying what and how large, rather than fail or draw a garbage scale.
+    """
     notes = []
     for artist in [*ax.lines, *ax.collections]:
         if isinstance(artist, Line2D):
@@ -122,7 +123,8 @@ def _leave_out_undrawable(ax) -> None:
 def _drawing(plot):
     """plot, with numpy's overflow warnings silenced while it draws: values near the largest
     double overflow in differences and in matplotlib's autoscaling, which runs as each panel is
-    drawn, before _finish leaves such values out and resets the limits they set."""
+    drawn, before _finish leaves such values out and resets the limits they set.
+    """
 
     @functools.wraps(plot)
     def quietly(*args, **kwargs):
@@ -152,7 +154,7 @@ def _finish(fig, axes, title: str, path: str | Path) -> Path:
 
 @_drawing
 def plot_overlay(runs: dict[str, np.ndarray], path: str | Path, title: str) -> Path:
-    """theta and omega of each run, overlaid (dashed after the first, so coincident lines show)."""
+    """Theta and omega of each run, overlaid (dashed after the first, so coincident lines show)."""
     fig, axes = plt.subplots(2, 1, figsize=(10, 6), sharex=True)
     for i, (label, run) in enumerate(runs.items()):
         style = dict(linewidth=2 if i == 0 else 1.5, linestyle="-" if i == 0 else "--")
@@ -167,7 +169,8 @@ def plot_overlay(runs: dict[str, np.ndarray], path: str | Path, title: str) -> P
 def _draw_difference(ax, time: np.ndarray, difference: np.ndarray, label: str, index: int) -> None:
     """|difference| on a log axis. Exact zeros have no place there: they are left out and the
     label says how many (a point between two of them is marked, having no line); a difference
-    that is zero everywhere is written into the panel instead of drawn."""
+    that is zero everywhere is written into the panel instead of drawn.
+    """
     ax.set_yscale("log")
     identical = difference == 0
     if identical.all():
@@ -194,7 +197,8 @@ def _draw_difference(ax, time: np.ndarray, difference: np.ndarray, label: str, i
 @_drawing
 def plot_comparison(runs: dict[str, np.ndarray], path: str | Path, title: str) -> Path:
     """Left: theta and omega of every tool overlaid. Right: |difference| of each tool against
-    the first one, on a log scale, where agreement to 1e-10 is visible."""
+    the first one, on a log scale, where agreement to 1e-10 is visible.
+    """
     fig, axes = plt.subplots(2, 2, figsize=(14, 6), sharex=True)
     labels = list(runs)
     base = runs[labels[0]]
@@ -217,7 +221,7 @@ def plot_comparison(runs: dict[str, np.ndarray], path: str | Path, title: str) -
 
 @_drawing
 def plot_cases(runs: dict[str, np.ndarray], path: str | Path, title: str) -> Path:
-    """theta and omega of many cases, coloured along a colormap; labelled when few enough."""
+    """Theta and omega of many cases, coloured along a colormap; labelled when few enough."""
     fig, axes = plt.subplots(2, 1, figsize=(10, 6), sharex=True)
     colors = plt.cm.viridis(np.linspace(0, 0.9, max(len(runs), 1)))
     labelled = len(runs) <= 12
@@ -237,7 +241,8 @@ BAND_LEVELS = 50
 
 def _quantiles(x: np.ndarray, y: np.ndarray, quantiles) -> tuple[np.ndarray, list[np.ndarray]]:
     """The levels of x (bin centres when there are many) and, per level, the quantiles of the y
-    sharing it (numpy's linear method), in one sort rather than a call per level."""
+    sharing it (numpy's linear method), in one sort rather than a call per level.
+    """
     levels = np.unique(x)
     if len(levels) > BAND_LEVELS:
         edges = np.linspace(levels[0], levels[-1], BAND_LEVELS + 1)
@@ -268,7 +273,8 @@ def plot_case_bands(
     the median and the 5-95 % and 25-75 % bands over the cases sharing that value; where each
     value has one case there is nothing to spread, and the cases alone are drawn. One sort per
     panel, so 100,000 cases draw about as fast as 100. NaN summaries (failed cases) are left out.
-    units: {swept name: unit} for the axes."""
+    units: {swept name: unit} for the axes.
+    """
     swept = {name: column for name, column in values.items() if len(np.unique(column)) > 1} or values
     fig, axes = plt.subplots(len(summaries), len(swept), figsize=(4.5 * len(swept) + 1, 6), squeeze=False, sharey="row")
     labelled = set()
@@ -310,7 +316,8 @@ def plot_case_bands(
 
 def _log_difference(ax, time: np.ndarray, difference: np.ndarray, label: str, **style) -> int:
     """|difference| on a log axis, leaving out the points where it is exactly zero (a log axis has
-    no zero, and a floor would draw them as spikes); returns how many were left out."""
+    no zero, and a floor would draw them as spikes); returns how many were left out.
+    """
     magnitude = np.abs(difference)
     zero = magnitude == 0
     if not zero.all():
@@ -323,7 +330,8 @@ def plot_judgement(judgement, path: str | Path, title: str) -> Path:
     """A judged result (judge.Judgement): the torque the run asks for and, when the diagnosis
     names a variant, the torque that variant applies (N.m); theta of the result and of the
     reference (rad); |theta_result - theta_reference| and the variant's own difference from the
-    reference (rad, log), with the tolerance. Exact zeros are said in words, not drawn."""
+    reference (rad, log), with the tolerance. Exact zeros are said in words, not drawn.
+    """
     result, reference, variant = judgement.result, judgement.reference, judgement.explanation
     time = result["time"]
     fig, axes = plt.subplots(3, 1, figsize=(10, 8), sharex=True)

@@ -18,9 +18,9 @@ import bisect
 import csv
 import math
 import numbers
+from collections.abc import Callable
 from fractions import Fraction
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 from scipy.integrate import solve_ivp
@@ -65,7 +65,8 @@ def _tolerance(time: Fraction, step: Fraction) -> Fraction:
 
 class _TorqueFile:
     """A time,torque CSV as exact times and float torques: linear between rows, a jump where a
-    time repeats, held outside."""
+    time repeats, held outside.
+    """
 
     def __init__(self, path: Path):
         with open(path, newline="", encoding="utf-8-sig") as file:
@@ -111,7 +112,7 @@ class _TorqueFile:
 
 
 def _grid(start: Fraction, stop: Fraction, step: Fraction) -> list[Fraction]:
-    """start + k*step up to stop; stop itself ends a shorter last step unless it is on the grid."""
+    """Start + k*step up to stop; stop itself ends a shorter last step unless it is on the grid."""
     # Only checked by the schedule's code, in simulate()'s words (a step that is not positive, a
     # stop not after the start, a run too long to hold): the grid below is the oracle's own.
     step_count(float(start), float(stop), float(step))
@@ -138,7 +139,8 @@ def _with_events(grid: list[Fraction], events: list[Fraction], step: Fraction) -
 
 class _Pieces:
     """The torque as pieces [start, end) on which it is u0 + rate * (t - start), the
-    communication points the signal defines, and the torque just after any time."""
+    communication points the signal defines, and the torque just after any time.
+    """
 
     def __init__(
         self,
@@ -195,7 +197,8 @@ def _signal_pieces(torque, start: Fraction, stop: Fraction | None, step: Fractio
 
 def _holding(points: list[Fraction], values: list[float], step: Fraction) -> Callable[[Fraction], float]:
     """The torque just after t of a signal holding values[k] from points[k]: the step holding t
-    is the one starting at the latest point at or (within the tolerance) just after t."""
+    is the one starting at the latest point at or (within the tolerance) just after t.
+    """
 
     def value_after(t: Fraction) -> float:
         j = max(bisect.bisect_right(points, t + _tolerance(t, step)) - 1, 0)

@@ -85,7 +85,8 @@ class Scenario:
 
 def _random_steps(seed: int, stop_time: float, amplitude: float) -> tuple[tuple[float, float], ...]:
     """Levels in -amplitude..amplitude N.m (to the mN.m), jumping at random times on the ms grid
-    50 to 400 ms apart."""
+    50 to 400 ms apart.
+    """
     rng = np.random.default_rng(seed)
     jumps_ms = np.cumsum(rng.integers(50, 400, size=int(stop_time * 20) + 1))
     jumps = [int(ms) / 1000 for ms in jumps_ms if ms < stop_time * 1000]
@@ -287,7 +288,8 @@ def _json_kind(value) -> str:
 @dataclass(frozen=True)
 class _FieldChecker:
     """The checks of NAME.json's fields: a hand-edited value of the wrong type or out of range is
-    refused naming the file and the field, before it can reach the judge's arithmetic."""
+    refused naming the file and the field, before it can reach the judge's arithmetic.
+    """
 
     path: Path
     settings: dict
@@ -351,7 +353,8 @@ def settings_files(folder: str | Path) -> dict[str, Path]:
 
 def _ssv(scenario: Scenario, parameters: dict) -> bytes:
     """The parameter set and initial state as an SSV file (SSP 1.0); theta and omega are the
-    FMU's own variables, so the set applies as-is."""
+    FMU's own variables, so the set applies as-is.
+    """
     ElementTree.register_namespace("ssv", SSV_NAMESPACE)
     tag = lambda name: f"{{{SSV_NAMESPACE}}}{name}"  # noqa: E731
     root = ElementTree.Element(tag("ParameterSet"), {"version": "1.0", "name": scenario.name})
@@ -525,7 +528,8 @@ def _write(path: Path, text: str) -> None:
 
 class KitExists(PendulumFmuError, FileExistsError):
     """The output folder holds files of a scenario kit that writing the kit would replace without
-    being asked to; the message names them and --overwrite."""
+    being asked to; the message names them and --overwrite.
+    """
 
 
 def kit_files() -> tuple[str, ...]:

@@ -32,12 +32,9 @@ from .parameters import (
     fmu_file,
     merged_parameters,
     merged_with,
-    model_description,
-    pendulum_variables,
     start_value,
-    value_reference,
 )
-from .torque_schedule import TorqueSignal, TorqueSchedule, schedule
+from .torque_schedule import TorqueSchedule, TorqueSignal, schedule
 
 _STATUS = ["OK", "WARNING", "DISCARD", "ERROR", "FATAL", "PENDING"]
 
@@ -77,7 +74,8 @@ class MessageLog:
     """FMI callbacks whose logger keeps what the FMU says, so a failure can say why.
 
     FMI 2.0: `callbacks` for fmi2Instantiate. FMI 3.0: `log_fmi3` is the logMessage callback (it
-    has no instance name), and fmpy's FMI 2.0 proxy is left alone."""
+    has no instance name), and fmpy's FMI 2.0 proxy is left alone.
+    """
 
     def __init__(self, fmi_version: int = 2):
         self.lines: list[str] = []
@@ -113,7 +111,8 @@ class MessageLog:
 
 def instantiate(slave: FMU2Slave | FMU3Slave, messages: MessageLog, fmu_path) -> None:
     """slave.instantiate with messages as its logger; FmuError naming fmu_path and what the FMU
-    logged when it returns no instance."""
+    logged when it returns no instance.
+    """
     try:
         if isinstance(slave, FMU3Slave):
             slave.instantiate(logMessage=messages.log_fmi3)
@@ -220,7 +219,8 @@ def initialize(
     start_time: float = 0.0,
 ) -> None:
     """Set the parameters and start values of an instantiated (or reset) slave from open_fmu and
-    leave it in step mode; FmuError says why the FMU refused."""
+    leave it in step mode; FmuError says why the FMU refused.
+    """
     # The FMU checks the parameters itself, here as everywhere (resolve_parameters).
     start = {
         **merged_with(slave.model.default_parameters, parameters),
@@ -255,7 +255,8 @@ def run_schedule(slave: FmuInstance, plan: TorqueSchedule) -> np.ndarray:
 
 def _stepper(slave, start_names: tuple[str, ...] = ()) -> cs_loop.Stepper:
     """The native loop bound to an instance: the torque in, its model's recorded variables out,
-    a restart setting start_names."""
+    a restart setting start_names.
+    """
 
     def references(names):
         return np.array([slave.model.value_reference(name) for name in names], np.uint32)
@@ -265,7 +266,8 @@ def _stepper(slave, start_names: tuple[str, ...] = ()) -> cs_loop.Stepper:
 
 def _stepped(stepper: cs_loop.Stepper, plan: TorqueSchedule, recorded_names: tuple[str, ...], **restart) -> np.ndarray:
     """The result array of a schedule through the native loop, which records recorded_names;
-    restart: Stepper.run's start_values and tolerance."""
+    restart: Stepper.run's start_values and tolerance.
+    """
     recorded = np.empty((len(plan.time), len(recorded_names)))
     rates = np.ascontiguousarray(plan.torque_rate)[:, None] if np.count_nonzero(plan.torque_rate) else None
     stepper.run(plan.time, np.ascontiguousarray(plan.torque)[:, None], rates, recorded, **restart)

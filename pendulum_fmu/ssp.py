@@ -19,8 +19,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from xml.etree import ElementTree
 
-from .atomic_files import replacing
 from ._checkout import build_tool
+from .atomic_files import replacing
 from .closed_loop import WIRES, controller_defaults
 from .errors import InvalidInput, MissingFile, PendulumFmuError
 from .simulate import resolve_parameters

@@ -18,7 +18,8 @@ STOPPING_SIGNALS = {signal.SIGINT: "interrupted", signal.SIGTERM: "terminated"}
 
 class Stopped(BaseException):
     """SIGINT or SIGTERM, raised where the program is, so that every file being written is
-    cleaned up on the way out (a BaseException, so no `except Exception` swallows it)."""
+    cleaned up on the way out (a BaseException, so no `except Exception` swallows it).
+    """
 
     def __init__(self, signal_number: int):
         super().__init__(signal_number)
@@ -33,7 +34,8 @@ def stop_on_signals() -> dict:
     exceptions Python cannot pass on, a garbage collector's callback (dask's client runs one on
     every collection) or a __del__, it prints Stopped as an ignored exception and goes on, so the
     program would finish as if no signal had come. sys.unraisablehook catches that Stopped,
-    silently, and the signal is sent again, to land once the main thread is back in the command."""
+    silently, and the signal is sent again, to land once the main thread is back in the command.
+    """
 
     def stop(number, frame):
         for name in STOPPING_SIGNALS:
@@ -57,7 +59,8 @@ def stop_on_signals() -> dict:
 
 def restore_signals(previous: dict) -> None:
     """Undo stop_on_signals: the handlers it returned, and Python's own hook for ignored
-    exceptions."""
+    exceptions.
+    """
     for number, handler in previous.items():
         signal.signal(number, handler)
     sys.unraisablehook = getattr(sys.unraisablehook, "replaced", sys.unraisablehook)
@@ -80,7 +83,8 @@ _REDELIVERY_DELAY = 0.05  # s
 def signals_deferred():
     """Hold SIGINT and SIGTERM off until the block ends, then let the handler they had act on the
     first that came. Python runs signal handlers in the main thread only, so elsewhere nothing
-    can cut the block and nothing needs holding."""
+    can cut the block and nothing needs holding.
+    """
     if threading.current_thread() is not threading.main_thread():
         yield
         return

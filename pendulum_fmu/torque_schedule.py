@@ -32,11 +32,12 @@ import csv
 import inspect
 import math
 import numbers
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from fractions import Fraction
 from functools import cached_property
 from pathlib import Path
-from typing import Callable, Sequence, Union
+from typing import Union
 
 import numpy as np
 import psutil
@@ -128,7 +129,7 @@ class TorqueTable:
         """Times where the torque jumps (a repeated time)."""
         return self.time[1:][np.diff(self.time) == 0]
 
-    def snapped(self, points: np.ndarray, step_size: float) -> "TorqueTable":
+    def snapped(self, points: np.ndarray, step_size: float) -> TorqueTable:
         """The same table with every row time within event_tolerance of a point moved onto it."""
         nearest = _nearest(points, self.time)
         close = np.abs(nearest - self.time) <= event_tolerance(self.time, step_size)
@@ -159,7 +160,8 @@ def _decode(path: Path, raw: bytes) -> str:
 
 def _first_bad_row(path: Path, lines: list[str], columns: tuple[int, int]) -> TorqueFileError | None:
     """The one-line error for the first row that is not two finite numbers, or has more
-    columns than the header, or None."""
+    columns than the header, or None.
+    """
     header = len(next(csv.reader([lines[0]])))
     for number, line in enumerate(lines[1:], start=2):
         if not line.strip():
@@ -194,7 +196,8 @@ def _line_of_row(lines: list[str], row: int) -> int:
 
 def _parse_numbers(raw: bytes, names: list[str], columns: tuple[int, int]) -> tuple[np.ndarray, np.ndarray] | None:
     """The time and torque columns as float arrays, parsed by pyarrow's multi-threaded C
-    reader; None when a cell is not a number (the caller then finds the line)."""
+    reader; None when a cell is not a number (the caller then finds the line).
+    """
     import pyarrow as pa
     import pyarrow.csv as pa_csv
 
@@ -217,7 +220,8 @@ def _parse_numbers(raw: bytes, names: list[str], columns: tuple[int, int]) -> tu
 def read_torque_csv(path: str | Path) -> TorqueTable:
     """Read a ``time,torque`` CSV (UTF-8, with or without a byte-order mark; other columns are
     ignored). A bad file raises TorqueFileError naming the file, line and problem. The numbers
-    are parsed in C in one pass, with no Python object per row."""
+    are parsed in C in one pass, with no Python object per row.
+    """
     path = Path(path)
     try:
         raw = path.read_bytes()
@@ -270,7 +274,8 @@ def read_torque_csv(path: str | Path) -> TorqueTable:
 def write_torque_csv(path: str | Path, plan: TorqueSchedule) -> Path:
     """Write a schedule in fmpy's convention: a row where each run of equal steps starts and
     ends, so a held torque reads as steps and a ramp as a line. Times are written with 17
-    significant digits, so they read back as the same doubles."""
+    significant digits, so they read back as the same doubles.
+    """
     from .atomic_files import replacing
 
     end = plan.torque + plan.torque_rate * plan.step_size
@@ -309,7 +314,8 @@ def _available_memory() -> int:
 def step_count(start_time: float, stop_time: float, step_size: float, max_steps: int | None = None) -> int:
     """The number of grid steps from start to stop (the last one shorter when stop is off the
     grid). A run over max_steps (default DEFAULT_MAX_STEPS), or one whose arrays would not fit in
-    the memory the machine has left, is refused here, before anything is allocated."""
+    the memory the machine has left, is refused here, before anything is allocated.
+    """
     _check_times(start_time, stop_time, step_size)
     span = stop_time - start_time
     ratio = span / step_size
@@ -347,7 +353,8 @@ def step_count(start_time: float, stop_time: float, step_size: float, max_steps:
 def _count(steps: int) -> str:
     """A step count as a line can hold it: every digit up to 2**53, then 'about 1.23e+628'. Past
     2**53 the count came from a float quotient, whose trailing digits are rounding, and past 1e308
-    no float holds it, so it is rounded here in integers."""
+    no float holds it, so it is rounded here in integers.
+    """
     if steps <= 2**53:
         return f"{steps:,}"
     exponent = len(str(steps)) - 1
@@ -365,7 +372,8 @@ def communication_points(
     start_time: float, stop_time: float, step_size: float, *, max_steps: int | None = None
 ) -> np.ndarray:
     """start, start + h, ... up to stop. A grid point is start + k*h, never a running sum, so no
-    rounding accumulates over a long run. max_steps: see step_count."""
+    rounding accumulates over a long run. max_steps: see step_count.
+    """
     steps = step_count(start_time, stop_time, step_size, max_steps)
     grid = start_time + step_size * np.arange(steps + 1, dtype=float)
     grid[-1] = stop_time if abs(grid[-1] - stop_time) > event_tolerance(stop_time, step_size) else grid[-1]
@@ -453,7 +461,8 @@ def schedule(
 ) -> TorqueSchedule:
     """The schedule of a signal: a constant, a callable of time, a per-step array, or a torque
     CSV (path or table); see the module's docstring for what each step applies. stop_time
-    defaults to a CSV's last time, an array's last step, or 3 s. max_steps: see step_count."""
+    defaults to a CSV's last time, an array's last step, or 3 s. max_steps: see step_count.
+    """
     source = "the torque table"
     if isinstance(torque, (str, Path)):
         source, torque = str(torque), read_torque_csv(torque)

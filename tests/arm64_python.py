@@ -81,7 +81,8 @@ def _run(command, what, timeout=900, **options):
 
 def _renamed_into_place(target: Path, make) -> Path:
     """make(folder) fills a fresh folder beside target, which is then renamed to target; when
-    another process got there first, its copy stays."""
+    another process got there first, its copy stays.
+    """
     if target.exists():
         return target
     target.parent.mkdir(parents=True, exist_ok=True)
@@ -150,7 +151,8 @@ class Arm64Python:
 
     def download(self, requirements: list[str]) -> Path:
         """The aarch64 CPython 3.11 wheels of requirements and of everything they need, and pip's
-        own, in self.wheels; pip is asked only when the wheels there do not satisfy them."""
+        own, in self.wheels; pip is asked only when the wheels there do not satisfy them.
+        """
         wanted = ["pip", *requirements]
         marker = self.wheels / "requirements.txt"
         have = set(marker.read_text().splitlines()) if marker.is_file() else set()
@@ -192,7 +194,8 @@ class Arm64Python:
     def install(self, wanted: list, site: Path) -> Path:
         """pip, run under qemu, installs wanted (wheel files and requirement strings) and what they
         need into site (--target), from the cached aarch64 wheels only: the arm64 interpreter
-        itself judges each wheel's tag."""
+        itself judges each wheel's tag.
+        """
         self.download(
             [
                 requirement

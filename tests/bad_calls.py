@@ -10,9 +10,9 @@ from __future__ import annotations
 import ctypes
 import struct
 import sys
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
 
 if __name__ == "__main__":  # a script documents the clone it is in, whatever package is installed
     sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
@@ -157,7 +157,8 @@ class Harness3(Harness):
     def __getattr__(self, name):
         """The library's function, with Python numbers passed as ctypes would not guess them: an
         int as a 64-bit word (every integer argument, size_t or bool, takes a full register or
-        stack slot in the x86-64 and AArch64 calling conventions), a float as a double."""
+        stack slot in the x86-64 and AArch64 calling conventions), a float as a double.
+        """
         function = getattr(self.lib, name)
 
         def call(*arguments):
@@ -326,7 +327,8 @@ def _fnv1a(data: bytes) -> int:
 
 def _resealed(offset, replacement):
     """A blob with bytes at offset replaced and its checksum made anew: what a master forging a
-    state would send, which the checksum cannot catch."""
+    state would send, which the checksum cannot catch.
+    """
 
     def mangle(blob):
         blob[offset : offset + len(replacement)] = replacement
@@ -389,7 +391,8 @@ FOREIGN = "is not a state this instance handed out"
 
 def _steps_on_after(bad_call):
     """The bad call on an instance 0.5 s into a swing under 20 N.m; the instance must then step
-    to the theta of an instance that never saw the call, and its own state must still restore."""
+    to the theta of an instance that never saw the call, and its own state must still restore.
+    """
 
     def run(h):
         call = {name: getattr(h, function) for name, function in h.state_calls.items()}

@@ -5,14 +5,15 @@ tests/test_bad_inputs.py, and written as the tables in docs/bad_inputs.md by
 Each case is a `pendulum-fmu` command line, with `{files}` standing for a folder of the input
 files below, the exit code it must give and a part of the one line it must print. Each call is a
 Python expression a user of the API writes (with API_IMPORTS done), the PendulumFmuError subclass
-it must raise and a part of its one-line message."""
+it must raise and a part of its one-line message.
+"""
 
 from __future__ import annotations
 
 import contextlib
 import io
-import re
 import json
+import re
 import sys
 import warnings
 import zipfile
@@ -56,7 +57,8 @@ FMI1 = """<?xml version="1.0" encoding="UTF-8"?>
 
 def _settings(**changes) -> str:
     """A scenario's NAME.json as `pendulum-fmu scenarios` writes it (the fields the judge reads),
-    with fields edited by hand."""
+    with fields edited by hand.
+    """
     settings = {
         "input": "s_in.csv",
         "output": "s_out.csv",
@@ -894,8 +896,9 @@ def write_files(folder: Path) -> None:
 
 @contextlib.contextmanager
 def _no_runtime_warnings():
-    """numpy's RuntimeWarnings (overflow, invalid value) raised as errors: printed, each would be
-    lines beside the one line, and pytest would record them instead, unseen."""
+    """Numpy's RuntimeWarnings (overflow, invalid value) raised as errors: printed, each would be
+    lines beside the one line, and pytest would record them instead, unseen.
+    """
     with warnings.catch_warnings():
         warnings.simplefilter("error", RuntimeWarning)
         yield

@@ -19,7 +19,8 @@ def fmu3(tmp_path_factory):
 def generated_by_script(tmp_path):
     """What a generator script of tests/ writes when run as the README has it, `python
     tests/NAME.py OUT`, where another pendulum_fmu (the main job's non-editable install, say)
-    comes first on the path: a script that imported it instead of the clone's would fail."""
+    comes first on the path: a script that imported it instead of the clone's would fail.
+    """
     import os
     import subprocess
     import sys

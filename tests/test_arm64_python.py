@@ -1,6 +1,7 @@
 """The arm64 Python of tests/arm64_python.py (Debian's python3.11 under qemu-aarch64): it is an
 aarch64 interpreter, and it runs this checkout's package as a wheel lays it out (the Python
-modules, data/Pendulum.fmu; no sources beside it) with the x86-64 numbers."""
+modules, data/Pendulum.fmu; no sources beside it) with the x86-64 numbers.
+"""
 
 import shutil
 import tomllib

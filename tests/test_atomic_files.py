@@ -1,5 +1,6 @@
 """Files that appear whole or not at all, locally and on fsspec file systems; an output path
-nothing can be written to is refused before the work, naming the user's path."""
+nothing can be written to is refused before the work, naming the user's path.
+"""
 
 import os
 import sys

@@ -1,12 +1,13 @@
 """Every bad input of tests/bad_inputs.py gets its exit code and one clear line, no traceback, on
 the command line, and its PendulumFmuError with a one-line message in the Python API;
-docs/bad_inputs.md is what the cases give."""
+docs/bad_inputs.md is what the cases give.
+"""
 
 from pathlib import Path
 
 import pytest
-
 from bad_inputs import CALLS, CASES, markdown, raised, run_call, run_case, write_files
+
 from pendulum_fmu import errors
 
 ROOT = Path(__file__).resolve().parent.parent

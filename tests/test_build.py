@@ -1,7 +1,8 @@
 """Builds that survive a user's toolchain: LTO only where the compiler has it (CMake's
 CheckIPOSupported asks), CC and CFLAGS with arguments, eight builds into one path at once, an FMU
 older than its sources rebuilt; and the FMU's own model description, not the repository's,
-wherever an FMU is passed."""
+wherever an FMU is passed.
+"""
 
 import os
 import shutil
@@ -16,8 +17,8 @@ import numpy as np
 import pytest
 from fmpy import read_model_description
 
-from pendulum_fmu import __version__
 from fmu_build import MODEL_DESCRIPTION, build_fmu
+from pendulum_fmu import __version__
 from pendulum_fmu.cli import main
 from pendulum_fmu.parameters import default_parameters
 from pendulum_fmu.reference import reference
@@ -29,7 +30,8 @@ ENVIRONMENT = {name: value for name, value in os.environ.items() if name != "PYT
 
 def _launcher(folder: Path, refuse_lto: bool) -> Path:
     """A compiler launcher like ccache: logs each command, then runs it; or, like a gcc without
-    its LTO plug-in, fails any command with -flto (or -flto=...)."""
+    its LTO plug-in, fails any command with -flto (or -flto=...).
+    """
     script = folder / "launcher"
     refusal = (
         'for a in "$@"; do case "$a" in -flto*) echo "lto-wrapper: not found" >&2; exit 1;; esac; done\n'

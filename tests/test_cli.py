@@ -177,7 +177,8 @@ def test_sweep_with_a_refused_case_runs_the_rest_and_exits_1(tmp_path, capsys):
 
 def test_an_output_nothing_can_be_written_to_is_refused_before_the_run(tmp_path, capsys):
     """/proc/self: a folder in which nothing can be created. The error names the user's path, not
-    the temporary beside it, and comes before the run (no summary line)."""
+    the temporary beside it, and comes before the run (no summary line).
+    """
     for argv in (
         ["simulate", "--torque", "1", "--output", "/proc/self/out.csv"],
         ["simulate", "--torque", "1", "--output", str(tmp_path / "fine.csv"), "--plot", "/proc/self/out.png"],

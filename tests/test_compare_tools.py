@@ -10,8 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pendulum_fmu import compare_tools
 from fmu_build import MODEL_DESCRIPTION, PENDULUM_DIR, SOURCE_DIR, build_fmu
+from pendulum_fmu import compare_tools
 from pendulum_fmu.cli import main
 from pendulum_fmu.compare import run_tools
 from pendulum_fmu.errors import NotComputed, Skipped
@@ -37,7 +37,8 @@ PLAN = schedule(lambda t: 50.0 if t < 0.25 else -80.0, stop_time=0.5, step_size=
 @pytest.fixture(scope="module")
 def renamed_fmu(tmp_path_factory):
     """The pendulum under other variable names and another model identifier, built over the same
-    plumbing from a copied model.c and modelDescription.xml."""
+    plumbing from a copied model.c and modelDescription.xml.
+    """
     folder = tmp_path_factory.mktemp("renamed")
     model = folder / "model"
     model.mkdir()
@@ -169,7 +170,8 @@ DEGREES_MAP = (
 @pytest.fixture(scope="module")
 def degrees_fmu(tmp_path_factory):
     """tests/fmus/degrees_pendulum.py built by pythonfmu3: FMI 3.0, CS and ME, angles in degrees,
-    the start values as parameters of their own."""
+    the start values as parameters of their own.
+    """
     builder = pytest.importorskip("pythonfmu3.builder")
     return builder.FmuBuilder.build_FMU(
         SOURCE_DIR.parent / "tests" / "fmus" / "degrees_pendulum.py", dest=tmp_path_factory.mktemp("degrees")
@@ -194,7 +196,8 @@ def test_compare_takes_an_fmi3_fmu_by_path(degrees_fmu):
 
 def test_every_tool_takes_its_defaults_from_the_fmu_compared(tmp_path):
     """An FMU whose description gives another default mass: the reference beside it (and the
-    judge) use that mass too, not the packaged FMU's."""
+    judge) use that mass too, not the packaged FMU's.
+    """
     description = tmp_path / "modelDescription.xml"
     xml = MODEL_DESCRIPTION.read_text()
     assert xml.count('<Real unit="kg" start="40" min="0"/>') == 1
@@ -241,7 +244,8 @@ def test_the_default_tools_leave_out_what_is_not_installed_with_a_warning(monkey
 def test_a_tool_asked_for_an_output_it_cannot_compute_says_so(tool, renamed_fmu):
     """An output added to the set a tool is asked for (energy, which no tool computes) comes back
     as a NaN column with a one-line warning naming the tool, never zeros; the outputs it does
-    compute stay the same numbers, checked against scipy's."""
+    compute stay the same numbers, checked against scipy's.
+    """
     if tool == "mujoco":
         pytest.importorskip("mujoco")
     spec = f"theirs={renamed_fmu}" if tool == "theirs" else tool

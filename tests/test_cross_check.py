@@ -1,5 +1,6 @@
 """pendulum-fmu cross-check: the FMI cross-check layout, passed by fmpy's validator, with
-reference results that fmpy reproduces from the input file alone and that agree with scipy."""
+reference results that fmpy reproduces from the input file alone and that agree with scipy.
+"""
 
 import shutil
 

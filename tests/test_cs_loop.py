@@ -1,5 +1,6 @@
 """The native co-simulation loop against the Python loop, bit for bit, and against scipy; its
-failures and its restarts."""
+failures and its restarts.
+"""
 
 from importlib import import_module
 
@@ -56,7 +57,8 @@ def test_native_loop_reports_the_failing_step(fmu):
 
 def test_native_restart_matches_a_fresh_instance_bit_for_bit(fmu):
     """A restart in C (fmi2Reset, initialization with new start values, the torque among them)
-    gives what a new instance initialized in Python and fed the torque every step gives."""
+    gives what a new instance initialized in Python and fed the torque every step gives.
+    """
     plan = schedule(12.0, stop_time=0.2, step_size=1e-3)
     names = ("mass", "damping", "theta", "torque")
     references = np.array([value_reference(n, fmu) for n in names], np.uint32)
@@ -84,7 +86,8 @@ def test_a_chunk_in_one_call_matches_case_by_case_and_the_physics_bit_for_bit(fm
     """run_cases (a chunk's cases in one call, as a sweep worker runs them) gives, for every case,
     what a restart per call and a fresh instance in Python give, bit for bit; a case the FMU
     refuses in the middle gets its own message and a NaN row, and the cases after it are still
-    right (each restart begins with fmi2Reset)."""
+    right (each restart begins with fmi2Reset).
+    """
     names = ("mass", "damping", "theta", "torque")
     cases = np.array([[30.0, 2.0, 0.4, 12.0], [-1.0, 0.0, 0.0, 0.0], [55.0, 0.5, -0.2, 7.0], [1.0, 0.0, 0.1, -3.0]])
     references = np.array([value_reference(n, fmu) for n in names], np.uint32)

@@ -42,7 +42,8 @@ def test_demo_runs_the_tutorial_end_to_end(tmp_path, capsys, monkeypatch):
 
 def test_a_second_demo_into_the_same_folder_is_refused(tmp_path, capsys):
     """Refused before anything runs: the study in parameter_study is what plain sweep refuses to
-    replace, and the figures are the previous run's results."""
+    replace, and the figures are the previous run's results.
+    """
     (tmp_path / "parameter_study").mkdir()
     (tmp_path / "parameter_study/study.json").write_text("{}")
     (tmp_path / "gravity_effect.png").write_text("old")

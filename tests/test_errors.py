@@ -1,5 +1,6 @@
 """Every error type the package defines for its user derives from PendulumFmuError, which the
-command line prints as one line (tests/test_cli.py, tests/test_bad_inputs.py)."""
+command line prints as one line (tests/test_cli.py, tests/test_bad_inputs.py).
+"""
 
 import importlib
 import importlib.util

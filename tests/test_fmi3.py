@@ -1,5 +1,6 @@
 """The FMI 3.0 FMU, built from the same sources as the FMI 2.0 one, driven by fmpy's FMU3Slave and
-FMU3Model: same numbers as FMI 2.0, its own model description, states, Jacobians, Model Exchange."""
+FMU3Model: same numbers as FMI 2.0, its own model description, states, Jacobians, Model Exchange.
+"""
 
 import ctypes
 import subprocess
@@ -263,7 +264,7 @@ def test_model_exchange_cvode_at_default_tolerance_within_1e6_of_scipy(fmu3, gra
 
 
 def test_fmpy_validate_on_the_command_line(fmu3):
-    """fmpy simulate on the command line: tests/test_fmu.py runs it on both FMUs."""
+    """Fmpy simulate on the command line: tests/test_fmu.py runs it on both FMUs."""
     validated = subprocess.run([sys.executable, "-m", "fmpy", "validate", str(fmu3)], capture_output=True, text=True)
     assert validated.returncode == 0, validated.stdout + validated.stderr
     assert "No problems found" in validated.stdout, validated.stdout

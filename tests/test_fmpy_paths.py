@@ -2,7 +2,8 @@
 `pendulum-fmu simulate`, on the same signals, judged by the independent oracle.
 
 These pin where fmpy 0.3.32 agrees with the signal definition (docs/signals.md) and where it
-does not, so the README's table of paths stays true: a change in fmpy shows up here."""
+does not, so the README's table of paths stays true: a change in fmpy shows up here.
+"""
 
 import subprocess
 import sys

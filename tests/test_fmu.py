@@ -56,7 +56,7 @@ def test_archive_holds_binary_sources_and_documentation(fmu, tmp_path):
         text=True,
         check=True,
     ).stdout.split()
-    exported = [s for s in symbols if s.startswith(("fmi", "_")) or s.isidentifier() and len(s) > 1]
+    exported = [s for s in symbols if s.startswith(("fmi", "_")) or (s.isidentifier() and len(s) > 1)]
     names_exported = {s for s in exported if not set(s) <= set("0123456789abcdef")}
     assert names_exported and all(name.startswith("fmi2") for name in names_exported), names_exported
 

@@ -1,6 +1,7 @@
 """libFuzzer on the state deserializer and on random call sequences, for a bounded time.
 
-Run longer with FUZZ_SECONDS=3600 pytest tests/test_fuzz.py (or see the README)."""
+Run longer with FUZZ_SECONDS=3600 pytest tests/test_fuzz.py (or see the README).
+"""
 
 import os
 import re

@@ -1,6 +1,7 @@
 """FMI 2.0 input derivatives of any order, as an extrapolating master sends them: orders 1 and 2
 shape the input over the step (a quadratic torque is integrated as exactly as a linear one),
-higher orders are ignored with one message per instance; the PID controller FMU does the same."""
+higher orders are ignored with one message per instance; the PID controller FMU does the same.
+"""
 
 import ctypes
 
@@ -30,7 +31,8 @@ def _finish(*slaves):
 def test_quadratic_torque_gives_the_exact_quartic(fmu, every_step):
     """Gravity off: alpha = u(t)/I with u = u0 + u1 t + u2 t^2/2, so theta is a quartic that
     Dormand-Prince 5(4) integrates exactly. Set once, the derivatives carry the polynomial on;
-    set every step (as an extrapolating master does), they give the same polynomial."""
+    set every step (as an extrapolating master does), they give the same polynomial.
+    """
     u0, u1, u2 = 5.0, 4.0, -6.0
     slave = open_fmu(fmu, parameters={"gravity": 0.0})
     h, n = 1e-3, 3000
@@ -97,7 +99,8 @@ def _controller(path):
 def _closed_loop(fmu, controller_fmu, stop_time, h, extrapolate):
     """A master that, like the fmpy container, hands theta and omega to the controller before
     reading its torque; with extrapolate it also sends their first and second derivatives, as
-    OMSimulator with --inputExtrapolation does for an FMU with maxOutputDerivativeOrder 2."""
+    OMSimulator with --inputExtrapolation does for an FMU with maxOutputDerivativeOrder 2.
+    """
     pendulum, controller = open_fmu(fmu), _controller(controller_fmu)
     names = {v.name: v.valueReference for v in read_model_description(str(controller_fmu)).modelVariables}
     inputs = [names["theta"], names["omega"]]
@@ -121,7 +124,8 @@ def _closed_loop(fmu, controller_fmu, stop_time, h, extrapolate):
 def _loop_with_exact_integral(stop_time, h):
     """The oracle of the extrapolated loop: torque sampled and held as before, but the
     controller's integral of (setpoint - theta) follows theta within the step, as the
-    extrapolated inputs let it. One scipy integration of (theta, omega, integral) per step."""
+    extrapolated inputs let it. One scipy integration of (theta, omega, integral) per step.
+    """
     gains, p = controller_defaults(), default_parameters()
     gravity_moment, inverse_inertia = p["mass"] * p["gravity"] * p["length"], 1.0 / total_inertia(p)
     state = np.zeros(3)
@@ -130,7 +134,7 @@ def _loop_with_exact_integral(stop_time, h):
         torque = gains["kp"] * (gains["setpoint"] - state[0]) + gains["ki"] * state[2] - gains["kd"] * state[1]
         rhs = lambda t, y, u=torque: (
             y[1],
-            (u - gravity_moment * np.sin(y[0])) * inverse_inertia,  # noqa: E731
+            (u - gravity_moment * np.sin(y[0])) * inverse_inertia,
             gains["setpoint"] - y[0],
         )
         state = solve_ivp(rhs, (0.0, h), state, method="DOP853", rtol=1e-12, atol=1e-12).y[:, -1]

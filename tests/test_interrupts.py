@@ -1,5 +1,6 @@
 """Ctrl-C and SIGTERM at any moment of a real `pendulum-fmu` process leave the old file or the
-whole new one at the target, no temporary beside it, and one line on stderr (exit 130 or 143)."""
+whole new one at the target, no temporary beside it, and one line on stderr (exit 130 or 143).
+"""
 
 import os
 import signal

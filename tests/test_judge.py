@@ -1,6 +1,7 @@
 """The judge: deliberately wrong masters (benchmarks/masters.py) and fmpy's own solvers run the
 kit's scenarios, each mistake must be diagnosed as made; results from the analytic solution under
-other names and units; the command's exit codes, JSON and figure; bad result files."""
+other names and units; the command's exit codes, JSON and figure; bad result files.
+"""
 
 import json
 import re
@@ -175,7 +176,8 @@ def test_bad_result_files_get_one_line(tmp_path):
 )
 def test_a_result_of_part_of_the_run_is_refused(tmp_path, rows, options, message):
     """Wherever it has rows such a result agrees with the reference (theta 0 at t = 0 from rest):
-    judged, it would pass a run that never happened."""
+    judged, it would pass a run that never happened.
+    """
     (tmp_path / "part.csv").write_text("time,theta\n" + rows)
     with pytest.raises(ResultFileError, match="^" + re.escape(f"{tmp_path / 'part.csv'}: {message}")):
         judge(tmp_path / "part.csv", 0.0, **options)
@@ -200,9 +202,10 @@ def test_a_kit_result_cut_short_is_refused_naming_it(kit, tmp_path, capsys):
 
 
 def test_fmpy_applying_a_jump_in_the_first_two_rows_late_is_diagnosed(fmu, tmp_path):
-    """fmpy 0.3.32's simulate_fmu applies a jump at t = 0 one step late (docs/signals.md): the
+    """Fmpy 0.3.32's simulate_fmu applies a jump at t = 0 one step late (docs/signals.md): the
     first step holds the value before it, 0 N.m. From rest at the equilibrium that is also a
-    restart from the initial state after one step; the tie goes to the input mistake."""
+    restart from the initial state after one step; the tie goes to the input mistake.
+    """
     from fmpy import simulate_fmu
 
     signal = np.array([(0.0, 0.0), (0.0, 20.0), (1.0, 20.0)], dtype=[("time", "f8"), ("torque", "f8")])
@@ -224,8 +227,9 @@ def test_fmpy_applying_a_jump_in_the_first_two_rows_late_is_diagnosed(fmu, tmp_p
 
 @pytest.mark.parametrize("solver", ["Euler", "CVode"])
 def test_fmpy_model_exchange_solvers_are_integration_errors(kit, solver):
-    """fmpy's own Model Exchange solvers: its Euler is explicit Euler at the step (the variant to
-    the last bit); CVode at its default tolerance is no variant but small and smooth."""
+    """Fmpy's own Model Exchange solvers: its Euler is explicit Euler at the step (the variant to
+    the last bit); CVode at its default tolerance is no variant but small and smooth.
+    """
     from fmpy import simulate_fmu
 
     signal = np.genfromtxt(kit / "constant_torque_in.csv", delimiter=",", names=True)

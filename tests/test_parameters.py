@@ -1,7 +1,8 @@
 """One validation: every tool refuses a parameter set the FMU refuses, with the FMU's own words.
 
 The physical checks live once, in the FMU's model.c; simulate.resolve_parameters asks the FMU,
-and the scipy reference, OpenSim and the engines all go through it."""
+and the scipy reference, OpenSim and the engines all go through it.
+"""
 
 import importlib.util
 import re
@@ -9,8 +10,8 @@ import zipfile
 
 import numpy as np
 import pytest
-
 from bad_inputs import write_files
+
 from pendulum_fmu.compare_tools import KINDS, parse_tools
 from pendulum_fmu.cross_check import write_cross_check
 from pendulum_fmu.parameters import FmuFileError, default_parameters, model_description
@@ -89,5 +90,5 @@ def test_a_file_that_is_no_pendulum_fmu_is_refused_by_every_entry_point(not_runn
 
 
 def test_an_fmu_of_another_model_is_read_for_compare_s_own_map(not_runnable):
-    """compare --tools LABEL=path runs any FMI 2.0/3.0 model through a map: its description reads."""
+    """Compare --tools LABEL=path runs any FMI 2.0/3.0 model through a map: its description reads."""
     assert model_description(not_runnable / "spring.fmu").modelName == "Spring"

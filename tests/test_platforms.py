@@ -3,7 +3,8 @@ and the aarch64-linux binary (gcc-aarch64-linux-gnu) run under qemu-aarch64, eac
 C master that runs the linux64 binary, with the same numbers; the macOS binaries (zig), which
 nothing here can run, read slice by slice; zig's builds for Linux, which the wheels carry (for
 glibc 2.17), run to show that zig compiles the sources to the same numbers; and a build that
-skips a platform whose compiler is missing."""
+skips a platform whose compiler is missing.
+"""
 
 import dataclasses
 import hashlib
@@ -24,7 +25,7 @@ from fmpy import read_model_description
 import fmu_build
 from benchmarks.builds import build_bare_master, build_step_master
 from build_wheels import MANYLINUX_GLIBC
-from fmu_build import FMI_VERSIONS, PLATFORMS, BuildError, PlatformSkipped, available_platforms, build_fmu, find_zig
+from fmu_build import FMI_VERSIONS, PLATFORMS, BuildError, PlatformSkipped, build_fmu, find_zig
 from pendulum_fmu.cli import main
 from pendulum_fmu.reference import reference
 
@@ -52,7 +53,8 @@ MASTER_VALUE_REFERENCES = {"torque": 0, "theta": 1}
 @dataclass(frozen=True)
 class UnzippedBuild:
     """A default build (every platform whose compiler is here) of one FMI version, unzipped into
-    work/, where its masters and their trajectories go too."""
+    work/, where its masters and their trajectories go too.
+    """
 
     fmi_version: int
     work: Path
@@ -111,8 +113,9 @@ def _exports(platform, library):
 
 
 def _theta_by_step_master(build, platform, master=None):
-    """theta at every communication point, from the C master of build's FMI version built for and
-    run on platform (or master, built before)."""
+    """Theta at every communication point, from the C master of build's FMI version built for and
+    run on platform (or master, built before).
+    """
     assert {name: build.value_references[name] for name in MASTER_VALUE_REFERENCES} == MASTER_VALUE_REFERENCES
     master = master or build_step_master(build.work, platform, build.fmi_version)
     trajectory = build.work / f"theta_{platform}.txt"
@@ -178,7 +181,8 @@ def _llvm(tool, *arguments):
 
 def _macho_slices(build, work):
     """{architecture: the slice as a file of its own}: FMI 2.0's universal darwin64 binary cut
-    into its slices, FMI 3.0's two binaries as they are."""
+    into its slices, FMI 3.0's two binaries as they are.
+    """
     if build.fmi_version == 3:
         return {architecture: build.library("darwin64", folder) for architecture, (folder, _) in MACOS_SLICES.items()}
     universal = build.library("darwin64")
@@ -204,7 +208,8 @@ def _load_commands(slice_):
 
 def _check_ad_hoc_signature(slice_, signature):
     """The code directory of an ad-hoc signature whose page hashes are those of the slice's bytes:
-    what macOS checks, page by page, before it runs code on Apple Silicon."""
+    what macOS checks, page by page, before it runs code on Apple Silicon.
+    """
     data = slice_.read_bytes()
     offset = int(signature["dataoff"])
     blob = data[offset : offset + int(signature["datasize"])]
@@ -280,7 +285,8 @@ def _readelf(library, *options):
 
 def _glibc_versions(library):
     """{symbol: (major, minor[, patch])}: the glibc symbol version each function the ELF library
-    imports is bound to."""
+    imports is bound to.
+    """
     return {
         name: tuple(map(int, version.split(".")))
         for name, version in re.findall(r" UND (\w+)@GLIBC_([\d.]+)", _readelf(library, "--dyn-syms", "--wide"))
@@ -302,7 +308,8 @@ def test_zig_builds_for_the_wheels_glibc_give_the_gcc_builds_theta_bit_for_bit(
     glibc keeps those as a wrapper around the same pow that only reports errors the old way
     (math/w_pow_compat.c), so a finite result is the same bits, which tests/c/pow_versions.c
     checks on a million inputs here. What this cannot show is another libm: an old glibc's own
-    (its sin, cos and pow predate glibc 2.28's rewrite) or a Mac's."""
+    (its sin, cos and pow predate glibc 2.28's rewrite) or a Mac's.
+    """
     master = build_step_master(tmp_path, platform, fmi_version)  # by gcc
     build = _unzipped_build(
         build_fmu(
@@ -441,7 +448,8 @@ def test_zig_stands_in_for_a_missing_cross_gcc_with_the_gcc_builds_theta(
     install) has zig, a build requirement, build win64 (x86_64-windows-gnu) and aarch64-linux
     (aarch64-linux-gnu.2.17): the FMU holds every platform's binary, which the bare C master (built
     by the cross gcc before it is hidden) runs under qemu to the linux64 gcc build's theta at every
-    point, bit for bit, and under wine to within the last bit (Windows' C runtime is not glibc)."""
+    point, bit for bit, and under wine to within the last bit (Windows' C runtime is not glibc).
+    """
     master = build_step_master(tmp_path, platform, fmi_version)
     monkeypatch.setenv("PATH", _path_without_cross_gccs(tmp_path / "bin"))
     assert shutil.which(PLATFORMS[platform].targets[0].cross_compiler) is None

@@ -1,12 +1,13 @@
 """Every bad call of tests/bad_calls.py gets its status and message, and the instance survives:
-the FMI 2.0 cases on the FMI 2.0 binary, the FMI 3.0 cases on the FMI 3.0 binary."""
+the FMI 2.0 cases on the FMI 2.0 binary, the FMI 3.0 cases on the FMI 3.0 binary.
+"""
 
 import zipfile
 
 import pytest
+from bad_calls import CASES, CASES_FMI3, Harness, Harness3, markdown, run_case, status_name
 from fmpy import read_model_description
 
-from bad_calls import CASES, CASES_FMI3, Harness, Harness3, markdown, run_case, status_name
 from fmu_build import ROOT
 
 

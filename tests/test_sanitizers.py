@@ -1,6 +1,7 @@
 """The C driver (tests/c/driver.c) links the FMU's sources and runs the bad calls and the loads
 under AddressSanitizer + UndefinedBehaviorSanitizer, under valgrind memcheck, and natively for
-the figures (10 million steps of energy drift, memory growth over 100,000 instances)."""
+the figures (10 million steps of energy drift, memory growth over 100,000 instances).
+"""
 
 import os
 import re

@@ -1,6 +1,7 @@
 """The scenario kit: its files, its FMI-LS-REF layout, its references against the analytic
 solution, and every scenario run through fmpy (a master on FMU2Slave, benchmarks/masters.py, and
-simulate_fmu) and through this package's own native loop, each judged a pass."""
+simulate_fmu) and through this package's own native loop, each judged a pass.
+"""
 
 import json
 import re
@@ -17,9 +18,9 @@ from fmpy.validation import validate_fmu
 from benchmarks.masters import run
 from pendulum_fmu import cs_loop
 from pendulum_fmu.cli import main
+from pendulum_fmu.errors import InvalidInput
 from pendulum_fmu.judge import AGREES, judge, judge_kit
 from pendulum_fmu.parameters import default_parameters, total_inertia
-from pendulum_fmu.errors import InvalidInput
 from pendulum_fmu.scenarios import (
     KIT_FMU,
     LS_REF_FOLDER,
@@ -156,7 +157,8 @@ def test_fmpy_simulate_fmu_passes_the_held_scenarios(kit, name):
 
 def _native(kit, name):
     """The scenario through this package's schedule and native loop; resume through a serialized
-    FMU state restored into a new instance."""
+    FMU state restored into a new instance.
+    """
     s = read_settings(kit / f"{name}.json")
     plan = schedule(
         s["torque"], start_time=s["start_time"], stop_time=s["stop_time"], step_size=s["step_size"], ramp=s["ramp"]

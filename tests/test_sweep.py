@@ -1,6 +1,7 @@
 """Parameter studies on dask: the written study against simulate() and the analytic and scipy
 references, resume, failures, fsspec URLs, a cluster of separate processes, signals and
-concurrent runs, and the studies refused before anything starts."""
+concurrent runs, and the studies refused before anything starts.
+"""
 
 import glob
 import json
@@ -24,7 +25,6 @@ from dask.distributed import Client, LocalCluster
 from fsspec.implementations.local import LocalFileSystem
 
 import benchmarks.scale
-
 from pendulum_fmu import default_fmu
 from pendulum_fmu.cli import main
 from pendulum_fmu.errors import InvalidInput

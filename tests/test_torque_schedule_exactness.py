@@ -3,7 +3,8 @@
 
 The cases are the ones that went wrong: jumps at plain decimal times whose grid point is an ulp
 below them, running-sum times, kinks between communication points under --ramp, per-step arrays,
-and randomized signals over step sizes that include the awkward ones."""
+and randomized signals over step sizes that include the awkward ones.
+"""
 
 from importlib import import_module
 

@@ -3,7 +3,8 @@ Windows, each tagged for what its binaries need, each with the same FMUs and the
 its own platform. Run here where something can: the x86_64 wheel in a venv, the aarch64 wheel in
 Debian's arm64 Python under qemu (tests/arm64_python.py), the Windows wheel's native loop and FMU
 under wine by a C harness (tests/c/cs_loop_harness.c; no Windows Python here). No Mac runs the
-macOS wheel: its files are only read."""
+macOS wheel: its files are only read.
+"""
 
 import json
 import os
@@ -26,8 +27,8 @@ from packaging.utils import parse_wheel_filename
 
 from benchmarks.builds import build_bare_master
 from build_wheels import LEGACY_MANYLINUX, MANYLINUX_GLIBC, WHEELS, WheelhouseError, build_wheels, check_tools, main
-from pendulum_fmu import FMU_FILES, __version__
 from fmu_build import PLATFORMS
+from pendulum_fmu import FMU_FILES, __version__
 from pendulum_fmu.cli import main as cli
 from pendulum_fmu.reference import reference
 from tests.arm64_python import Arm64Python, Unavailable
@@ -73,7 +74,8 @@ def _fmu_binary(wheel: Path, fmu_name: str, folder: str) -> bytes:
 
 def _glibc_needed(elf: bytes, tmp_path: Path) -> tuple[int, int]:
     """The newest GLIBC_x.y version an ELF library needs, read with pyelftools (build_wheels.py
-    asks auditwheel)."""
+    asks auditwheel).
+    """
     path = tmp_path / "elf"
     path.write_bytes(elf)
     with open(path, "rb") as file:
@@ -316,8 +318,9 @@ def test_aarch64_wheel_installs_and_simulates_on_arm64_python_under_qemu(wheelho
 
 
 def _theta_by_harness(platform: str, wheel: Path, folder: Path) -> np.ndarray:
-    """theta at every point from the wheel's native loop stepping the wheel's FMI 2.0 binary for
-    platform, both loaded by tests/c/cs_loop_harness.c built for platform (wine runs win64's)."""
+    """Theta at every point from the wheel's native loop stepping the wheel's FMI 2.0 binary for
+    platform, both loaded by tests/c/cs_loop_harness.c built for platform (wine runs win64's).
+    """
     folder.mkdir()
     name, loop = _native_loop(wheel)
     (folder / Path(name).name).write_bytes(loop)

@@ -1,5 +1,6 @@
 """The pendulum as a Python user would package it: a PythonFMU slave that integrates each
-communication step with scipy's solve_ivp. The benchmark's peer; not part of the package."""
+communication step with scipy's solve_ivp. The benchmark's peer; not part of the package.
+"""
 
 import numpy as np
 from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Real

@@ -14,8 +14,8 @@ each adapter sets and why. The engine modules import their engine, so import the
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 
@@ -53,7 +53,8 @@ def substeps(step_size: np.ndarray, largest: float) -> np.ndarray:
 
 def held_results(plan: TorqueSchedule) -> np.ndarray:
     """A result array with the times and held torques of a schedule filled in; the last row
-    repeats the last step's torque."""
+    repeats the last step's torque.
+    """
     out = results.empty(len(plan.time))
     out["time"] = plan.time
     out["torque"][:-1] = plan.torque
@@ -63,7 +64,8 @@ def held_results(plan: TorqueSchedule) -> np.ndarray:
 
 def runner(tool: str, simulate: Callable[..., np.ndarray], setups: dict) -> Callable[..., np.ndarray]:
     """The uniform run() of an engine module from its simulate(plan, parameters, theta0, omega0,
-    setup) and its setup per mode."""
+    setup) and its setup per mode.
+    """
 
     def run(
         plan: TorqueSchedule,

@@ -28,9 +28,9 @@ from pydrake.multibody.tree import FixedOffsetFrame, RevoluteJoint, SpatialInert
 from pydrake.systems.analysis import ResetIntegratorFromFlags, Simulator
 from pydrake.systems.framework import DiagramBuilder
 
-from . import held_results, runner
 from ..errors import InvalidInput
 from ..torque_schedule import TorqueSchedule
+from . import held_results, runner
 
 
 @dataclass(frozen=True)

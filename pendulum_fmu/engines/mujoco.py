@@ -20,14 +20,15 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from . import held_results, runner, substeps
 from ..torque_schedule import TorqueSchedule
+from . import held_results, runner, substeps
 
 
 @dataclass(frozen=True)
 class Setup:
     """How the adapter drives MuJoCo. The defaults of the fields that are not modes are the
-    correct settings; tests turn each trap back on through them."""
+    correct settings; tests turn each trap back on through them.
+    """
 
     integrator: str
     # The longest internal step; None keeps MuJoCo's own timestep (2 ms) and steps once per

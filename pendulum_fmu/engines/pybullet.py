@@ -30,8 +30,9 @@ import numpy as np
 
 
 def _import_quietly():
-    """import pybullet, which prints its build time on stderr from C, where a user error is
-    one line."""
+    """Import pybullet, which prints its build time on stderr from C, where a user error is
+    one line.
+    """
     sys.stderr.flush()
     saved, devnull = os.dup(2), os.open(os.devnull, os.O_WRONLY)
     os.dup2(devnull, 2)
@@ -46,8 +47,8 @@ def _import_quietly():
 
 pybullet = _import_quietly()
 
-from . import held_results, runner, substeps
 from ..torque_schedule import TorqueSchedule
+from . import held_results, runner, substeps
 
 
 @dataclass(frozen=True)

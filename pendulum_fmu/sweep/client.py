@@ -26,13 +26,15 @@ class SchedulerUnreachable(PendulumFmuError, ConnectionError):
 
 class SchedulerLost(PendulumFmuError, ConnectionError):
     """The dask scheduler went away while the study ran (killed, its host lost); the message
-    says what the output folder keeps and names --resume."""
+    says what the output folder keeps and names --resume.
+    """
 
 
 @contextlib.contextmanager
 def dask_client(scheduler: str | None, workers: int | None, connect_timeout: float):
     """A dask client: on a local cluster of `workers` processes started (and closed) here, or on
-    the scheduler at an address, refused within connect_timeout when it does not answer."""
+    the scheduler at an address, refused within connect_timeout when it does not answer.
+    """
     from dask.distributed import Client, LocalCluster
 
     if scheduler is None:
@@ -71,7 +73,8 @@ def dask_client(scheduler: str | None, workers: int | None, connect_timeout: flo
 def _quiet(logger: logging.Logger):
     """The logger silenced: a lost scheduler has the client log each failed reconnection with its
     traceback (tens of lines), where the sweep reports the loss in one line (SchedulerLost);
-    a local cluster's logs are silenced alike (silence_logs)."""
+    a local cluster's logs are silenced alike (silence_logs).
+    """
     level = logger.level
     logger.setLevel(logging.CRITICAL + 1)
     try:
@@ -112,7 +115,7 @@ def _why_no_scheduler(scheduler: str, timeout: float) -> str | None:
     def ask() -> None:
         try:
             answers.append(asyncio.run(asyncio.wait_for(identity(), timeout)))
-        except (asyncio.TimeoutError, OSError):
+        except (TimeoutError, OSError):
             # Which of the two comes first, dask's connect giving up or the bound here, is chance.
             answers.append("")
         except Exception as error:  # an address dask cannot parse
@@ -158,7 +161,8 @@ def _ctrl_c_held():
 
 class _Lines:
     """tqdm's output for a log: each redraw a line of its own, where a terminal's is redrawn in
-    place (tqdm starts it with a carriage return)."""
+    place (tqdm starts it with a carriage return).
+    """
 
     def __init__(self, stream):
         self.stream = stream
@@ -174,7 +178,8 @@ class _Lines:
 
 def progress_bar(total: int, done: int, enabled: bool):
     """A tqdm bar of the cases on stderr, `done` of them already: redrawn in place on a terminal;
-    elsewhere (a log) a plain line every few seconds, and the last count."""
+    elsewhere (a log) a plain line every few seconds, and the last count.
+    """
     from tqdm import tqdm
 
     # No time: the run's one duration, cluster and figure included, is the summary's (run_sweep's
@@ -221,7 +226,8 @@ class Totals:
 def run_chunks(client, task: Task, chunks: Iterable[tuple[int, int, dict]], bar) -> Totals:
     """Run each chunk (its index, the number of its first case, its values) on a worker,
     committing its parts (only those of this run: task.run) and advancing the bar as each
-    finishes."""
+    finishes.
+    """
     totals = Totals()
     futures = [client.submit(run_chunk, index, first, values, task, pure=False) for index, first, values in chunks]
     # Done callbacks rather than as_completed: on Ctrl-C no waiting coroutine is left to fail,

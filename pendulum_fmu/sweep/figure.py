@@ -1,5 +1,6 @@
 """sweep.png, drawn from the cases table: every trajectory when there are few, else quantile
-bands of the summaries."""
+bands of the summaries.
+"""
 
 from __future__ import annotations
 
@@ -16,7 +17,8 @@ LINES_UP_TO = 20
 
 def draw(store: Store, cases_table, names: list[str], outputs: tuple[str, ...], fmu: str, target: str) -> None:
     """Write target (on the store's file system) from the cases table and, for few cases with
-    theta and omega kept, their trajectories; the axes and labels carry the units fmu declares."""
+    theta and omega kept, their trajectories; the axes and labels carry the units fmu declares.
+    """
     import pyarrow.dataset as ds
 
     from ..plot import plot_case_bands, plot_cases  # here: workers never draw, nor import matplotlib

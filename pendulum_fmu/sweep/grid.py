@@ -43,7 +43,8 @@ def _values(name: str, values) -> np.ndarray:
 
 class Grid(Sequence):
     """Every combination of the axes' values as a sequence of cases ({name: value} dicts), in
-    itertools.product order, computed when asked: a grid of a million cases costs its axes."""
+    itertools.product order, computed when asked: a grid of a million cases costs its axes.
+    """
 
     def __init__(self, axes: dict[str, np.ndarray]):
         self.axes = axes
@@ -115,7 +116,8 @@ def sweep_grid(torques, gravities=(9.81,), extra: dict | None = None) -> Grid:
 
 def check_cases(cases, fmu_path=None) -> list[str]:
     """The cases' common keys, which become the cases table's value columns; InvalidInput for
-    cases that are not all alike, finite and distinct."""
+    cases that are not all alike, finite and distinct.
+    """
     names_allowed, seen = sweepable(fmu_path), {}  # refuses a file that is no pendulum FMU, first
     if isinstance(cases, Grid):
         return list(cases.axes)  # checked when the grid was made

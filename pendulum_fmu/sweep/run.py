@@ -6,8 +6,8 @@ import math
 import numbers
 import os
 import time
-from concurrent.futures import CancelledError
 import uuid
+from concurrent.futures import CancelledError
 from pathlib import Path
 
 import numpy as np
@@ -214,7 +214,8 @@ def _lost(scheduler: str | None, error: CancelledError, url: str, overwrite: boo
 
 def _chunk_cases(held: Held, definition: dict, study: Study, resume: bool, overwrite: bool, output_dir: str) -> int:
     """The cases per chunk of this run: the study's own, or on resume those of the run it
-    continues. StudyExists where the run would replace a study without being asked to."""
+    continues. StudyExists where the run would replace a study without being asked to.
+    """
     if overwrite or not held.entries:
         return study.chunk_cases()
     if held.manifest is None:

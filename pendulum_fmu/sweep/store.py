@@ -48,13 +48,15 @@ class InUse(PendulumFmuError, OSError):
 
 class StudyExists(PendulumFmuError, FileExistsError):
     """The output folder holds a study (or what looks like one) that the run would replace
-    without being asked to; the message says what it holds, and names --resume and --overwrite."""
+    without being asked to; the message says what it holds, and names --resume and --overwrite.
+    """
 
 
 @dataclass(frozen=True)
 class Held:
     """What an output folder holds: its study.json's content (None when there is none that a
-    sweep wrote), the study's entries present, and the chunks done."""
+    sweep wrote), the study's entries present, and the chunks done.
+    """
 
     manifest: dict | None
     entries: tuple[str, ...]
@@ -68,7 +70,8 @@ class Held:
 @dataclass(frozen=True)
 class Store:
     """Where a study's files go: an fsspec file system, the folder's path on it, the tables'
-    format."""
+    format.
+    """
 
     filesystem: object  # fsspec
     root: str
@@ -83,7 +86,8 @@ class Store:
 
     def write_table(self, name: str, index: int, columns: dict, run: str, split: tuple = ()) -> int:
         """Write one part of a table, staged for run (see commit); returns its size in bytes.
-        split: float columns stored byte-stream-split, as smooth series compress best."""
+        split: float columns stored byte-stream-split, as smooth series compress best.
+        """
         import pyarrow as pa
 
         arrays = {column: pa.array(values) for column, values in columns.items()}
@@ -115,7 +119,8 @@ class Store:
 
     def commit(self, index: int, run: str, tables: tuple[str, ...]) -> None:
         """Move run's staged parts of a chunk into place: the chunk is then done. Only the parts
-        staged under this run's token: a part another run staged stays out of the study."""
+        staged under this run's token: a part another run staged stays out of the study.
+        """
         for table in tables:  # the cases part last: it marks the chunk done
             self.filesystem.mv(self.staged(table, index, run), self.part(table, index))
 
@@ -136,7 +141,8 @@ class Store:
     def remove_unfinished(self) -> None:
         """What interrupted chunks leave: the temporaries of writes cut short (a killed worker, see
         atomic_files.py), the staged parts no client committed (of this run or any other), and
-        trajectory parts whose chunk did not get to commit its cases part."""
+        trajectory parts whose chunk did not get to commit its cases part.
+        """
         self.remove(
             (
                 TEMPORARY_GLOB,
@@ -170,7 +176,8 @@ class Store:
 
     def start(self, definition: dict, chunk_cases: int, run: str) -> None:
         """Write study.json: what the study is, its cases per chunk, and the token of the run
-        now writing it."""
+        now writing it.
+        """
         with replacing_on(self.filesystem, f"{self.root}/study.json") as file:
             file.write(json.dumps({"study": definition, "chunk_cases": chunk_cases, "run": run}, indent=1).encode())
 
@@ -182,7 +189,8 @@ class Store:
         """Move the staged study into this folder in place of the one it holds, which goes. Ctrl-C
         and SIGTERM wait until the move is done, so they find the old study or the new one; the
         old study.json goes first and the new one comes last, so that even a killed move leaves
-        no study.json over a mix of the two."""
+        no study.json over a mix of the two.
+        """
         fs = self.filesystem
         aside = f"{self.root}/.replaced.{uuid.uuid4().hex}.partial"
         with signals_deferred():
@@ -208,7 +216,8 @@ class Store:
         once (InUse) while the first runs. A lock held on a local folder, which the operating
         system releases however the run ends, so a killed run leaves at most a file that locks
         nothing; on other file systems (object stores have no locks) keeping runs apart is the
-        user's part."""
+        user's part.
+        """
         from filelock import FileLock, Timeout
         from fsspec.implementations.local import LocalFileSystem
 

@@ -46,7 +46,8 @@ class Runner:
     what a restart costs.
 
     A case is the start values of a restart: the parameters, theta and omega, and the torque,
-    which then stays as it was set, so the native loop sets no input per step."""
+    which then stays as it was set, so the native loop sets no input per step.
+    """
 
     def __init__(self, fmu_simulator):
         self.simulator, fmu = fmu_simulator, fmu_simulator.fmu_path
@@ -70,7 +71,8 @@ class Runner:
         """theta, omega and alpha of each case (a row of start_values) at every communication
         point into outputs (3 x cases x points). Returns per case "" or why the FMU refused it
         (its values then NaN); the next case's restart starts from fmi2Reset, whatever state the
-        refusal left."""
+        refusal left.
+        """
         if self.stepper is not None:
             return self.stepper.run_cases(points, start_values, outputs)
         messages = [""] * len(start_values)
@@ -173,7 +175,8 @@ _tiled_times = threading.local()
 
 def _tiled(times: np.ndarray, cases: int) -> np.ndarray:
     """The time column of a chunk of cases: times once per case. Kept per thread for the last
-    shape asked, as a study's chunks all have one (but its last), so it is built once per study."""
+    shape asked, as a study's chunks all have one (but its last), so it is built once per study.
+    """
     last = getattr(_tiled_times, "column", None)
     if last is None or len(last) != len(times) * cases or not np.array_equal(last[: len(times)], times):
         last = _tiled_times.column = np.tile(times, cases)

@@ -1,12 +1,12 @@
 """A pendulum as another tool would export it, for tests/test_compare_tools.py: FMI 3.0, Model Exchange
 and Co-Simulation (pythonfmu3), angles in degrees, its own names (tau, phi, w, a; m, L, J, g, c),
 the start angle and rate as parameters of their own. A Co-Simulation step integrates with
-scipy's DOP853 at 1e-12, in degrees."""
+scipy's DOP853 at 1e-12, in degrees.
+"""
 
 import math
-from typing import List
 
-from pythonfmu3 import CoSimulation, Fmi3Causality, Fmi3Initial, Fmi3SlaveBase, Fmi3Variability, Float64, ModelExchange
+from pythonfmu3 import CoSimulation, Float64, Fmi3Causality, Fmi3Initial, Fmi3SlaveBase, Fmi3Variability, ModelExchange
 from scipy.integrate import solve_ivp
 
 DEGREE = math.pi / 180
@@ -60,7 +60,7 @@ class DegreesPendulum(Fmi3SlaveBase, ModelExchange, CoSimulation):
     def exit_initialization_mode(self):
         self.phi, self.w = self.phi_start, self.w_start
 
-    def get_continuous_state_derivatives(self) -> List[float]:
+    def get_continuous_state_derivatives(self) -> list[float]:
         self.der_phi, self.der_w = self.w, self.a
         return [self.der_phi, self.der_w]
 
