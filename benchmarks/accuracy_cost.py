@@ -99,7 +99,7 @@ def plot(points: list[Point], oracle_error: float, figure_path: Path) -> Path:
     figure, axes = plt.subplots(figsize=(7, 5))
     # Hollow markers of different shapes and sizes: small steps cost the same at every tolerance,
     # so their points pile up, and each must stay visible under the others.
-    for h, marker, size in zip(STEP_SIZES, "soD^", (12, 9, 6, 4)):
+    for h, marker, size in zip(STEP_SIZES, "soD^", (12, 9, 6, 4), strict=False):
         line = sorted((p for p in points if p.step_size == h), key=lambda p: p.tolerance)
         drawn = axes.loglog(
             [p.instructions_per_step for p in line],

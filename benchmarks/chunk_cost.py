@@ -58,7 +58,7 @@ def chunk_cpu(outputs: tuple[str, ...]) -> tuple[float, float, float]:
         run_chunk(0, 0, _values(), task)  # the FMU unzipped and instantiated once, as on a worker
         for _ in range(ROUNDS):
             chunks = [run_chunk(index, 0, _values(), task)[3:] for index in range(CHUNKS)]
-            written, cpu, stepping = (sum(column) / (CHUNKS * CASES) for column in zip(*chunks))
+            written, cpu, stepping = (sum(column) / (CHUNKS * CASES) for column in zip(*chunks, strict=False))
             rounds.append((cpu, stepping, written))
     return min(rounds)
 

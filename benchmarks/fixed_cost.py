@@ -72,9 +72,10 @@ def fixed_cost_rows(fmu: BuiltFmu, repetitions: int) -> list[Row]:
         Row(PART, f"simulate() of 1 s in 1 ms steps, {case}", microseconds(seconds["simulate 1 s"])),
     ]
     if not opensim:
-        return rows + [skipped(PART, "OpenSim 4.6 on 1 s", "the opensim package is not installed")]
+        return [*rows, skipped(PART, "OpenSim 4.6 on 1 s", "the opensim package is not installed")]
     lead = seconds["opensim 1 s"] / seconds["simulate 1 s"]
-    return rows + [
+    return [
+        *rows,
         Row(
             PART,
             f"OpenSim opensim_simulate() of 1 s in 1 ms steps, end to end, {case}",

@@ -107,7 +107,9 @@ class Kit:
         start = [self.signal.after(t) for t in times[:-1]]
         if not self.settings["ramp"]:
             return start, [0.0] * len(start)
-        return start, [(self.signal.before(t1) - u) / (t1 - t0) for u, t0, t1 in zip(start, times[:-1], times[1:])]
+        return start, [
+            (self.signal.before(t1) - u) / (t1 - t0) for u, t0, t1 in zip(start, times[:-1], times[1:], strict=False)
+        ]
 
     def start_values(self) -> dict[str, float]:
         s = self.settings
@@ -117,7 +119,7 @@ class Kit:
         path = self.folder / self.settings["output"]
         with open(path, "w", newline="") as file:
             file.write("time," + ",".join(OUTPUTS) + "\n")
-            for t, row in zip(times, rows):
+            for t, row in zip(times, rows, strict=False):
                 file.write(",".join(repr(float(v)) for v in (t, *row)) + "\n")
         return path
 
@@ -152,16 +154,18 @@ def co_simulation(kit: Kit, mistake: str | None = None) -> Path:
         times = np.r_[clock.astype(float), kit.settings["stop_time"]]
     torque, slope = kit.torques(times)
     if mistake == "late":  # step k gets what step k - 1 should
-        torque, slope = [torque[0]] + torque[:-1], [slope[0]] + slope[:-1]
+        torque, slope = [torque[0], *torque[:-1]], [slope[0], *slope[:-1]]
     elif mistake == "early":
-        torque, slope = torque[1:] + [torque[-1]], slope[1:] + [0.0]
+        torque, slope = [*torque[1:], torque[-1]], [*slope[1:], 0.0]
     elif mistake == "late_once":  # only the first change of the torque reaches the FMU a step late
         k = next(k for k in range(1, len(torque)) if torque[k] != torque[k - 1])
-        torque = torque[:k] + [torque[k - 1]] + torque[k + 1 :]
+        torque = [*torque[:k], torque[k - 1], *torque[k + 1 :]]
     elif mistake == "scaled":  # a unit slip: 1 % too much torque
         torque = [1.01 * u for u in torque]
     elif mistake == "ramped":  # a slope towards the next step's value where the signal holds
-        slope = [(b - a) / (t1 - t0) for a, b, t0, t1 in zip(torque, torque[1:], times, times[1:])] + [0.0]
+        slope = [(b - a) / (t1 - t0) for a, b, t0, t1 in zip(torque, torque[1:], times, times[1:], strict=False)] + [
+            0.0
+        ]
     elif mistake == "held":  # no input derivatives where the run asks for a ramp
         slope = [0.0] * len(torque)
     ramps = any(slope)
@@ -169,7 +173,7 @@ def co_simulation(kit: Kit, mistake: str | None = None) -> Path:
     slave = _slave(kit, times[0], "first")
     torque_vr, outputs = [kit.vr["torque"]], [kit.vr[n] for n in OUTPUTS]
     rows = []
-    for k, (t, h) in enumerate(zip(times[:-1], np.diff(times))):
+    for k, (t, h) in enumerate(zip(times[:-1], np.diff(times), strict=False)):
         if resume is not None and abs(t - resume) < 1e-9 * kit.step:
             state = slave.getFMUstate()
             blob = slave.serializeFMUstate(state)
@@ -220,7 +224,7 @@ def model_exchange(kit: Kit, method: str) -> Path:
 
     torque, _ = kit.torques(kit.times)
     outputs, rows = [kit.vr[n] for n in OUTPUTS], []
-    for t, h, u in zip(kit.times[:-1], np.diff(kit.times), torque):
+    for t, h, u in zip(kit.times[:-1], np.diff(kit.times), torque, strict=False):
         model.setReal([kit.vr["torque"]], [u])
         slope = f(t, x)
         rows.append(model.getReal(outputs))

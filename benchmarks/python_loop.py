@@ -31,12 +31,12 @@ def fmpy_schedule_loop(slave: FMU2Slave, plan: TorqueSchedule) -> np.ndarray:
     out = results.empty(len(plan.time))
     out["time"] = plan.time
     rows = []
-    for t, h, torque in zip(plan.time[:-1], plan.step_size, plan.torque):
+    for t, h, torque in zip(plan.time[:-1], plan.step_size, plan.torque, strict=False):
         slave.setReal(torque_vr, [torque])
         rows.append((torque, *slave.getReal(output_vrs)))
         slave.doStep(t, h)
     rows.append((*slave.getReal(torque_vr), *slave.getReal(output_vrs)))
-    for field, column in zip(("torque", "theta", "omega", "alpha"), zip(*rows)):
+    for field, column in zip(("torque", "theta", "omega", "alpha"), zip(*rows, strict=False), strict=False):
         out[field] = column
     return out
 

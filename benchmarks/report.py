@@ -84,7 +84,7 @@ def as_text(table: Table) -> str:
     lines = [table.header, *table.cells]
     widths = [max(len(line[i]) for line in lines) for i in range(len(table.header))]
     rule = "  ".join("-" * w for w in widths)
-    body = ["  ".join(cell.ljust(w) for cell, w in zip(line, widths)).rstrip() for line in lines]
+    body = ["  ".join(cell.ljust(w) for cell, w in zip(line, widths, strict=False)).rstrip() for line in lines]
     return "\n".join([table.title, rule, body[0], rule, *body[1:], rule])
 
 

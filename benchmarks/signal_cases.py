@@ -31,7 +31,7 @@ def random_step_rows(rng: np.random.Generator, stop_time: float = 4.0, running_s
     times = times[times < stop_time]
     levels = rng.uniform(-40, 40, size=len(times) + 1)
     rows = [(0.0, levels[0])]
-    for t, before, after in zip(times, levels, levels[1:]):
+    for t, before, after in zip(times, levels, levels[1:], strict=False):
         rows += [(repr(float(t)), before), (repr(float(t)), after)]
     rows.append((stop_time, levels[len(times)]))
     return rows

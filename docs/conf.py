@@ -18,7 +18,7 @@ ROOT = DOCS.parent
 # The checkout's package is documented, whatever is installed; _ext holds this site's extension.
 sys.path[:0] = [str(ROOT), str(DOCS / "_ext")]
 
-import pendulum_fmu  # noqa: E402  (after the path above)
+import pendulum_fmu
 
 project = "pendulum-fmu"
 author = "the pendulum-fmu developers"

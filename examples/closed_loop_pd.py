@@ -25,7 +25,7 @@ def run(setpoint=0.5, kp=270.0, kd=180.0, stop_time=3.0, step_size=1e-3):
     """Returns (time, theta, omega, torque applied over each step)."""
     theta_vr, omega_vr, torque_vr = (value_reference(n) for n in ("theta", "omega", "torque"))
     slave = open_fmu()
-    steps = int(round(stop_time / step_size))
+    steps = round(stop_time / step_size)
     time = step_size * np.arange(steps + 1)
     theta, omega, torque = np.zeros(steps + 1), np.zeros(steps + 1), np.zeros(steps)
     try:
@@ -62,9 +62,12 @@ def main(argv=None):
     )
     result = np.zeros(len(time), dtype=[("time", "f8"), ("theta", "f8"), ("omega", "f8")])
     result["time"], result["theta"], result["omega"] = time, theta, omega
-    print(
-        f"wrote {plot_overlay({'PD-controlled pendulum': result}, f'{args.output_dir}/closed_loop.png', 'Closed loop: PD controller in a Python master')}"
+    figure = plot_overlay(
+        {"PD-controlled pendulum": result},
+        f"{args.output_dir}/closed_loop.png",
+        "Closed loop: PD controller in a Python master",
     )
+    print(f"wrote {figure}")
 
 
 if __name__ == "__main__":

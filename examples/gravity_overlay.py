@@ -13,7 +13,8 @@ def run(torque=20.0, stop_time=3.0, output_dir="out/gravity_overlay"):
     }
     for label, run_ in runs.items():
         print(
-            f"{label}: theta({stop_time:g} s) = {run_['theta'][-1]:.6f} rad, max omega = {run_['omega'].max():.6f} rad/s"
+            f"{label}: theta({stop_time:g} s) = {run_['theta'][-1]:.6f} rad, "
+            f"max omega = {run_['omega'].max():.6f} rad/s"
         )
     figure = plot_overlay(
         runs,

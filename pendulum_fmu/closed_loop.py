@@ -197,7 +197,7 @@ def sampled_loop_reference(
     p = resolve_parameters(parameters)
     inverse_inertia = 1.0 / total_inertia(p)
     gravity_moment = p["mass"] * p["gravity"] * p["length"]
-    n = int(round(stop_time / step_size))
+    n = round(stop_time / step_size)
     out = np.zeros(n + 1, dtype=[("time", "f8"), ("theta", "f8"), ("omega", "f8"), ("torque", "f8")])
     state, integral = np.zeros(2), 0.0
     previous = state  # theta, omega at the last communication point, what a Jacobi master last sent
@@ -222,12 +222,7 @@ def sampled_loop_reference(
             break
         rhs = lambda t, y, u=torque: (
             y[1],
-            (
-                u
-                - gravity_moment * np.sin(y[0])
-                - p["damping"] * y[1]
-            )
-            * inverse_inertia,
+            (u - gravity_moment * np.sin(y[0]) - p["damping"] * y[1]) * inverse_inertia,
         )
         integral, previous = next_integral, state
         state = solve_ivp(rhs, (0.0, step_size), state, method="DOP853", rtol=rtol, atol=rtol).y[:, -1]

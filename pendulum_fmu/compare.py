@@ -117,7 +117,9 @@ def write_trajectories(runs: dict[str, np.ndarray], path: str | Path) -> Path:
     with replacing(path, newline="") as file:
         writer = csv.writer(file)
         writer.writerow(columns)
-        writer.writerows(zip(*(map(repr, np.asarray(values, dtype=float).tolist()) for values in columns.values())))
+        writer.writerows(
+            zip(*(map(repr, np.asarray(values, dtype=float).tolist()) for values in columns.values()), strict=False)
+        )
     return Path(path)
 
 

@@ -39,7 +39,7 @@ def _input_rows() -> list[tuple[float, float]]:
     for jump_time, after in JUMPS:
         rows += [(jump_time, before), (jump_time, after)]
         before = after
-    return rows + [(STOP_TIME, before)]
+    return [*rows, (STOP_TIME, before)]
 
 
 def _write_csv(path: Path, header, rows) -> None:
@@ -95,7 +95,7 @@ def write_cross_check(output_dir: str | Path, fmu_path: str | Path | None = None
     )
     reference_rows = [
         [repr(float(t)), *(repr(float(v)) for v in values)]
-        for t, *values in zip(run["time"], *(run[name] for name in OUTPUTS))
+        for t, *values in zip(run["time"], *(run[name] for name in OUTPUTS), strict=False)
     ]
     computed_on = fmpy.platform_tuple  # this machine, as FMI 3.0 names platforms
     for folder in folders:

@@ -352,7 +352,7 @@ def _euler(plan: TorqueSchedule, acceleration, theta0: float, omega0: float, sem
     out = results.empty(len(plan.time))
     out["time"] = plan.time
     theta, omega = theta0, omega0
-    for k, (h, u) in enumerate(zip(plan.step_size.tolist(), plan.torque.tolist())):
+    for k, (h, u) in enumerate(zip(plan.step_size.tolist(), plan.torque.tolist(), strict=False)):
         out["theta"][k], out["omega"][k] = theta, omega
         alpha = acceleration(theta, omega, u)
         if semi_implicit:

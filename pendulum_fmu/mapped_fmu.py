@@ -248,7 +248,9 @@ class MappedFmu:
             else:
                 slave.enterInitializationMode()
             slave.exitInitializationMode()
-            for k, (t, h, u) in enumerate(zip(plan.time.tolist(), plan.step_size.tolist(), plan.torque.tolist())):
+            for k, (t, h, u) in enumerate(
+                zip(plan.time.tolist(), plan.step_size.tolist(), plan.torque.tolist(), strict=False)
+            ):
                 call = f"the step from t = {t:.17g}"
                 set_values(torque_vr, [u / torque.factor])
                 recorded[k] = get_values(output_vrs)

@@ -225,7 +225,7 @@ def plot_cases(runs: dict[str, np.ndarray], path: str | Path, title: str) -> Pat
     fig, axes = plt.subplots(2, 1, figsize=(10, 6), sharex=True)
     colors = plt.cm.viridis(np.linspace(0, 0.9, max(len(runs), 1)))
     labelled = len(runs) <= 12
-    for color, (label, run) in zip(colors, runs.items()):
+    for color, (label, run) in zip(colors, runs.items(), strict=False):
         axes[0].plot(run["time"], run["theta"], color=color, linewidth=1.5, label=label if labelled else None)
         axes[1].plot(run["time"], run["omega"], color=color, linewidth=1.5)
     axes[0].set_ylabel(THETA_LABEL)
@@ -300,7 +300,9 @@ def plot_case_bands(
             if len(levels) == np.count_nonzero(keep):  # one case per value: no spread to show
                 ax.plot(levels, median, color="C0", marker=".", label=once("one case per value"))
                 continue
-            for (low, high), (q_low, q_high), alpha in zip(QUANTILE_BANDS, zip(bands[::2], bands[1::2]), (0.25, 0.45)):
+            for (low, high), (q_low, q_high), alpha in zip(
+                QUANTILE_BANDS, zip(bands[::2], bands[1::2], strict=False), (0.25, 0.45), strict=False
+            ):
                 ax.fill_between(
                     levels,
                     q_low,

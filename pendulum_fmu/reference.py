@@ -4,8 +4,9 @@
 beyond its checks of what it is given (a file that is no signal, a run length, refused in the
 same words), never how it reads or samples a signal. It reads a CSV with its own small reader,
 keeps the times as exact fractions of the decimals written in the file, and finds the
-communication points and the torque of each step from the written definition. A schedule that does not carry the user's signal to the tools then shows as a
-difference between them and this oracle. `reference_schedule()` integrates a given schedule, to
+communication points and the torque of each step from the written definition. A schedule that
+does not carry the user's signal to the tools then shows as a difference between them and this
+oracle. `reference_schedule()` integrates a given schedule, to
 judge a tool on exactly the torques it was fed.
 
 Both integrate the equation of motion with solve_ivp (DOP853, rtol = atol = 1e-12) over pieces
@@ -16,6 +17,7 @@ from __future__ import annotations
 
 import bisect
 import csv
+import itertools
 import math
 import numbers
 from collections.abc import Callable
@@ -102,7 +104,7 @@ class _TorqueFile:
         return value if math.isfinite(value) else u0 * (1 - share) + u1 * share
 
     def jumps(self) -> list[Fraction]:
-        return sorted({a for a, b in zip(self.times, self.times[1:]) if a == b})
+        return sorted({a for a, b in zip(self.times, self.times[1:], strict=False) if a == b})
 
     def latest_event_near(self, t: Fraction, step: Fraction) -> Fraction:
         """t, or the latest row time within the tolerance of t: that event is at t."""
@@ -122,7 +124,7 @@ def _grid(start: Fraction, stop: Fraction, step: Fraction) -> list[Fraction]:
         points.append(point)
         k += 1
         point = start + k * step
-    return points + [stop]
+    return [*points, stop]
 
 
 def _with_events(grid: list[Fraction], events: list[Fraction], step: Fraction) -> list[Fraction]:
@@ -165,7 +167,7 @@ def _signal_pieces(torque, start: Fraction, stop: Fraction | None, step: Fractio
             # The file's own piecewise-linear signal: a piece between consecutive row times.
             points = sorted({start, stop} | {t for t in signal.times if start < t < stop})
             u0 = [signal.after(a) for a in points[:-1]]
-            rate = [(signal.before(b) - signal.after(a)) / float(b - a) for a, b in zip(points, points[1:])]
+            rate = [(signal.before(b) - signal.after(a)) / float(b - a) for a, b in itertools.pairwise(points)]
             return _Pieces(
                 points[:-1],
                 stop,
@@ -188,7 +190,7 @@ def _signal_pieces(torque, start: Fraction, stop: Fraction | None, step: Fractio
         sample = torque if callable(torque) else (lambda t, u=torque: u)
         values = [_torque(sample(float(p)), f"at t = {float(p)}") for p in points]
     if ramp:
-        rate = [(b - a) / float(t1 - t0) for a, b, t0, t1 in zip(values, values[1:], points, points[1:])]
+        rate = [(b - a) / float(t1 - t0) for a, b, t0, t1 in zip(values, values[1:], points, points[1:], strict=False)]
     else:
         rate = [0.0] * (len(points) - 1)
     u0 = values[: len(points) - 1]
@@ -250,7 +252,7 @@ def _integrate(
     parameters = resolve_parameters(parameters, fmu_path)
     acceleration = equation_of_motion(parameters)
     starts = [float(s) for s in pieces.starts]
-    ends = starts[1:] + [float(pieces.stop)]
+    ends = [*starts[1:], float(pieces.stop)]
     # Each reported time belongs to the first piece that reaches it (a time a rounding past the
     # end of the run belongs to the last).
     owner = np.minimum(np.searchsorted(ends, at, side="left"), len(ends) - 1)

@@ -92,9 +92,9 @@ def _random_steps(seed: int, stop_time: float, amplitude: float) -> tuple[tuple[
     jumps = [int(ms) / 1000 for ms in jumps_ms if ms < stop_time * 1000]
     levels = [round(float(level), 3) for level in rng.uniform(-amplitude, amplitude, len(jumps) + 1)]
     rows = [(0.0, levels[0])]
-    for t, before, after in zip(jumps, levels, levels[1:]):
+    for t, before, after in zip(jumps, levels, levels[1:], strict=False):
         rows += [(t, before), (t, after)]
-    return tuple(rows + [(stop_time, levels[-1])])
+    return tuple([*rows, (stop_time, levels[-1])])
 
 
 SCENARIOS = (
@@ -356,7 +356,7 @@ def _ssv(scenario: Scenario, parameters: dict) -> bytes:
     FMU's own variables, so the set applies as-is.
     """
     ElementTree.register_namespace("ssv", SSV_NAMESPACE)
-    tag = lambda name: f"{{{SSV_NAMESPACE}}}{name}"  # noqa: E731
+    tag = lambda name: f"{{{SSV_NAMESPACE}}}{name}"
     root = ElementTree.Element(tag("ParameterSet"), {"version": "1.0", "name": scenario.name})
     listed = ElementTree.SubElement(root, tag("Parameters"))
     values = {**parameters, START_VALUES["theta0"]: scenario.theta0, START_VALUES["omega0"]: scenario.omega0}

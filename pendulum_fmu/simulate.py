@@ -278,7 +278,7 @@ def _result(plan: TorqueSchedule, recorded_names: tuple[str, ...], recorded: np.
     """The result array of a schedule from the columns recorded_names at every point."""
     out = results.empty(len(plan.time), recorded_names)
     out["time"] = plan.time
-    for name, column in zip(recorded_names, recorded.T):
+    for name, column in zip(recorded_names, recorded.T, strict=False):
         out[name] = column
     return out
 
@@ -328,10 +328,12 @@ def run_schedule_python(slave: FmuInstance, plan: TorqueSchedule) -> np.ndarray:
         if fmi3
         else ()
     )
-    step_arguments = (component, time, step, ctypes.c_bool(True) if fmi3 else no_rollback) + step_report
+    step_arguments = (component, time, step, ctypes.c_bool(True) if fmi3 else no_rollback, *step_report)
 
     rows = array.array("d")  # 32 bytes a step, not a Python list of floats
-    for t, h, u, r in zip(plan.time.tolist(), plan.step_size.tolist(), plan.torque.tolist(), plan.torque_rate.tolist()):
+    for t, h, u, r in zip(
+        plan.time.tolist(), plan.step_size.tolist(), plan.torque.tolist(), plan.torque_rate.tolist(), strict=False
+    ):
         torque[0] = u
         status = set_real(*torque_arguments)
         if status > 1:

@@ -167,7 +167,7 @@ def _first_bad_row(path: Path, lines: list[str], columns: tuple[int, int]) -> To
         if not line.strip():
             continue
         cells = next(csv.reader([line]))  # as pyarrow reads it: "1,5" is one quoted cell
-        for column, name in zip(columns, ("time", "torque")):
+        for column, name in zip(columns, ("time", "torque"), strict=False):
             cell = cells[column].strip() if column < len(cells) else ""
             try:
                 # Python's float takes 1_0 and fullwidth digits, which pyarrow refuses.
@@ -280,7 +280,9 @@ def write_torque_csv(path: str | Path, plan: TorqueSchedule) -> Path:
 
     end = plan.torque + plan.torque_rate * plan.step_size
     points = []
-    for t0, t1, u0, u1 in zip(plan.time[:-1].tolist(), plan.time[1:].tolist(), plan.torque.tolist(), end.tolist()):
+    for t0, t1, u0, u1 in zip(
+        plan.time[:-1].tolist(), plan.time[1:].tolist(), plan.torque.tolist(), end.tolist(), strict=False
+    ):
         if not points or points[-1] != (t0, u0):
             points.append((t0, u0))
         points.append((t1, u1))

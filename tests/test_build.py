@@ -81,7 +81,7 @@ def test_eight_builds_into_one_path_at_once_all_succeed(tmp_path):
         for _ in range(8)
     ]
     for build in builds:
-        out, err = build.communicate(timeout=300)
+        _out, err = build.communicate(timeout=300)
         assert build.returncode == 0, err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["Pendulum.fmu"]  # no temporaries left
     with zipfile.ZipFile(target) as fmu:

@@ -18,7 +18,7 @@ THETA0, OMEGA0 = 0.3, -0.5
 
 def random_steps(stop_time, *, seed=1, hold=0.1, amplitude=300.0, step_size=1e-3):
     """A torque that jumps to a new uniform random level every `hold` seconds."""
-    levels = np.random.default_rng(seed).uniform(-amplitude, amplitude, int(round(stop_time / hold)))
+    levels = np.random.default_rng(seed).uniform(-amplitude, amplitude, round(stop_time / hold))
     return schedule(
         lambda t: levels[min(int(t / hold + 1e-9), len(levels) - 1)], stop_time=stop_time, step_size=step_size
     )

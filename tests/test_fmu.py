@@ -91,7 +91,7 @@ def test_stepwise_torque_with_variable_steps(fmu, tmp_path):
 
 
 def test_torque_held_per_step_from_a_callable(fmu):
-    signal = lambda t: 30 * np.sin(4 * t)  # noqa: E731
+    signal = lambda t: 30 * np.sin(4 * t)
     result = simulate(signal, step_size=0.01, fmu_path=fmu)
     expected = reference(signal, step_size=0.01)
     assert np.array_equal(result["torque"][:-1], 30 * np.sin(4 * result["time"][:-1]))
@@ -108,7 +108,7 @@ def test_ramped_torque_is_the_exact_cubic(fmu):
 
 def test_ramped_torque_with_gravity_matches_scipy(fmu):
     # 20 ms steps at the default 1e-10 drift by ~3e-13 a step; ask for what the test checks.
-    signal = lambda t: 40 * np.cos(3 * t)  # noqa: E731
+    signal = lambda t: 40 * np.cos(3 * t)
     result = simulate(signal, step_size=0.02, ramp=True, tolerance=1e-12, fmu_path=fmu)
     expected = reference(signal, step_size=0.02, ramp=True)
     assert np.max(np.abs(result["theta"] - expected["theta"])) < 1e-10
@@ -203,8 +203,8 @@ def test_serialized_state_restores_in_another_instance(fmu):
 
 
 def test_two_instances_are_independent(fmu):
-    a, run_a = _stepper(fmu, instance_name="a")
-    b, run_b = _stepper(fmu, instance_name="b", parameters={"damping": 3.0})
+    _a, run_a = _stepper(fmu, instance_name="a")
+    _b, run_b = _stepper(fmu, instance_name="b", parameters={"damping": 3.0})
     interleaved_a, interleaved_b = [], []
     for k in range(3000):
         interleaved_a.append(run_a(k * 1e-3, 1, torque=20.0)[0])

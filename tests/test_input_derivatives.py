@@ -105,7 +105,7 @@ def _closed_loop(fmu, controller_fmu, stop_time, h, extrapolate):
     names = {v.name: v.valueReference for v in read_model_description(str(controller_fmu)).modelVariables}
     inputs = [names["theta"], names["omega"]]
     theta = []
-    for k in range(int(round(stop_time / h)) + 1):
+    for k in range(round(stop_time / h) + 1):
         measured = pendulum.getReal([THETA, OMEGA])
         theta.append(measured[0])
         if k * h >= stop_time - h / 2:
@@ -130,7 +130,7 @@ def _loop_with_exact_integral(stop_time, h):
     gravity_moment, inverse_inertia = p["mass"] * p["gravity"] * p["length"], 1.0 / total_inertia(p)
     state = np.zeros(3)
     theta = [0.0]
-    for _ in range(int(round(stop_time / h))):
+    for _ in range(round(stop_time / h)):
         torque = gains["kp"] * (gains["setpoint"] - state[0]) + gains["ki"] * state[2] - gains["kd"] * state[1]
         rhs = lambda t, y, u=torque: (
             y[1],

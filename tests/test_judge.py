@@ -126,7 +126,7 @@ def test_the_command_exits_0_on_pass_and_1_on_fail_and_writes_json_and_plot(kit,
     assert set(summary["candidates"]) == {LATE, EARLY, INTERPOLATED, HELD, DRIFT, NOT_RESTORED, INTEGRATION}
     assert (tmp_path / "j.png").read_bytes()[:4] == b"\x89PNG"
     run(kit, "decimal_steps")
-    assert main(arguments + ["--tol", "1e-9"]) == 0
+    assert main([*arguments, "--tol", "1e-9"]) == 0
     assert f"pass: {AGREES}" in capsys.readouterr().out
     assert not list(tmp_path.glob(".*"))
 

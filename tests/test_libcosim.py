@@ -5,17 +5,17 @@ import pytest
 
 libcosim = pytest.importorskip("libcosimpy", reason="libcosimpy not installed: pip install -e '.[test]'")
 
-from fmpy import read_model_description  # noqa: E402
-from libcosimpy.CosimEnums import CosimVariableType  # noqa: E402
-from libcosimpy.CosimExecution import CosimExecution  # noqa: E402
-from libcosimpy.CosimLogging import CosimLogLevel, log_output_level  # noqa: E402
-from libcosimpy.CosimManipulator import CosimManipulator  # noqa: E402
-from libcosimpy.CosimObserver import CosimObserver  # noqa: E402
-from libcosimpy.CosimSlave import CosimLocalSlave  # noqa: E402
+from fmpy import read_model_description
+from libcosimpy.CosimEnums import CosimVariableType
+from libcosimpy.CosimExecution import CosimExecution
+from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+from libcosimpy.CosimManipulator import CosimManipulator
+from libcosimpy.CosimObserver import CosimObserver
+from libcosimpy.CosimSlave import CosimLocalSlave
 
-from fmu_build import build_pid_controller  # noqa: E402
-from pendulum_fmu.closed_loop import WIRES, sampled_loop_reference  # noqa: E402
-from pendulum_fmu.reference import reference  # noqa: E402
+from fmu_build import build_pid_controller
+from pendulum_fmu.closed_loop import WIRES, sampled_loop_reference
+from pendulum_fmu.reference import reference
 
 STEP_NS = 1_000_000  # libcosim counts time in nanoseconds: a 1 ms master step
 
@@ -38,7 +38,7 @@ def test_override_manipulator_and_observer_match_the_reference(fmu):
     observer = CosimObserver.create_last_value()
     execution.add_observer(observer)
     # A step-wise torque: the override each step holds over that step, as overrideActuation does.
-    signal = lambda t: 20.0 if t < 1.0 else (-30.0 if t < 2.0 else 10.0)  # noqa: E731
+    signal = lambda t: 20.0 if t < 1.0 else (-30.0 if t < 2.0 else 10.0)
     theta = [0.0]
     for k in range(3000):
         manipulator.slave_real_values(pendulum, [vr["torque"]], [signal(k * 1e-3)])

@@ -44,7 +44,7 @@ def test_stepwise_signal_with_damping_and_start_values(fmu, tmp_path):
 
 def test_tutorial_loop_verbatim_fails_on_opensim_46():
     # Why opensim_simulate calls manager.initialize(state) before each integrate().
-    model, coordinate, actuator = _build_pendulum_model(osim, 40.0, 0.5, 20.0, 9.81, 0.0)
+    model, _coordinate, actuator = _build_pendulum_model(osim, 40.0, 0.5, 20.0, 9.81, 0.0)
     state = model.initSystem()
     actuator.overrideActuation(state, True)
     manager = osim.Manager(model)

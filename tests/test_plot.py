@@ -45,7 +45,7 @@ def test_one_case_per_value_draws_the_cases_not_bands(drawn, tmp_path):
     summaries = {"max |theta| in rad": torque / 100, "final theta in rad": torque / 200}
     plot.plot_case_bands({"torque": torque}, summaries, tmp_path / "one.png", "t", units={"torque": "N.m"})
     _, axes, _ = drawn[0]
-    for ax, y in zip(axes, summaries.values()):
+    for ax, y in zip(axes, summaries.values(), strict=False):
         assert len(ax.collections) == 0, "no band where each value has one case"
         (line,) = ax.get_lines()
         assert line.get_xdata().tolist() == [5.0, 10.0, 20.0, 40.0]
@@ -157,7 +157,7 @@ def test_values_too_large_to_draw_are_left_out_and_said(drawn, tmp_path):
     far["theta"] = 1e308
     plot.plot_comparison({"reference": base, "far": far}, tmp_path / "far.png", "t")
     _, axes, _ = drawn[0]
-    theta, theta_difference, omega, omega_difference = axes
+    theta, theta_difference, omega, _omega_difference = axes
     assert _legend(theta) == ["reference"]
     assert [text.get_text() for text in theta.texts] == ["far reaches 1e+308: too large to draw"]
     assert all(abs(limit) <= 1.1 for limit in theta.get_ylim())  # scaled to what is drawn: 0 to 1

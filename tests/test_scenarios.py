@@ -3,6 +3,7 @@ solution, and every scenario run through fmpy (a master on FMU2Slave, benchmarks
 simulate_fmu) and through this package's own native loop, each judged a pass.
 """
 
+import itertools
 import json
 import re
 import shutil
@@ -78,13 +79,13 @@ def test_steps_on_grid_reference_is_the_analytic_solution(kit):
     """Gravity off: theta is theta0 + omega0 t + the double integral of the held torque / I."""
     settings = json.loads((kit / "steps_on_grid.json").read_text())
     rows = [line.split(",") for line in (kit / "steps_on_grid_in.csv").read_text().split()[1:]]
-    jumps = [(Fraction(t), float(u)) for (t, _), (t2, u) in zip(rows, rows[1:]) if t == t2]
+    jumps = [(Fraction(t), float(u)) for (t, _), (t2, u) in itertools.pairwise(rows) if t == t2]
     inertia = total_inertia(settings["parameters"])
     alphas = [float(rows[0][1]) / inertia] + [u / inertia for _, u in jumps]
     reference = np.genfromtxt(kit / "steps_on_grid_ref.csv", delimiter=",", names=True)
-    for t, theta in zip(reference["time"][::97], reference["theta"][::97]):
+    for t, theta in zip(reference["time"][::97], reference["theta"][::97], strict=False):
         exact = settings["theta0"] + settings["omega0"] * t + alphas[0] * t**2 / 2
-        for (when, _), before, after in zip(jumps, alphas, alphas[1:]):
+        for (when, _), before, after in zip(jumps, alphas, alphas[1:], strict=False):
             if float(when) <= t:  # from a jump on, the change of alpha adds its own parabola
                 exact += (after - before) * (t - float(when)) ** 2 / 2
         assert abs(theta - exact) < 1e-12, t

@@ -45,7 +45,7 @@ def _fresh_fmpy_run(fmu, plan, parameters, theta0, omega0, tolerance, tmp_path):
     slave.exitInitializationMode()
     recorded = [refs[name] for name in RECORDED]
     rows = []
-    for t, h, u, rate in zip(plan.time[:-1], np.diff(plan.time), plan.torque, plan.torque_rate):
+    for t, h, u, rate in zip(plan.time[:-1], np.diff(plan.time), plan.torque, plan.torque_rate, strict=False):
         slave.setReal([refs["torque"]], [float(u)])
         if plan.torque_rate.any():
             slave.setRealInputDerivatives([refs["torque"]], [1], [float(rate)])

@@ -736,7 +736,7 @@ def test_a_signal_stops_a_sweep_cleanly(tmp_path, signal_number, code, word):
         time.sleep(0.05)
     children = psutil.Process(process.pid).children(recursive=True)
     os.kill(process.pid, signal_number)
-    out, err = process.communicate(timeout=60)
+    _out, err = process.communicate(timeout=60)
     assert process.returncode == code
     assert err.startswith(f"pendulum-fmu sweep: {word}; ") and err.count("\n") == 1, err
     _, alive = psutil.wait_procs(children, timeout=10)
@@ -814,7 +814,7 @@ def test_eight_sweeps_into_eight_directories_at_once(tmp_path):
         for i in range(8)
     ]
     for i, process in enumerate(processes):
-        out, err = process.communicate(timeout=300)
+        _out, err = process.communicate(timeout=300)
         assert process.returncode == 0, err
         table = _table(tmp_path / f"study{i}" / "cases")
         for number, torque in enumerate((i + 1.0, i + 2.0)):
@@ -841,7 +841,7 @@ def test_a_second_run_into_a_folder_in_use_is_refused_and_the_first_is_whole(tmp
     )
     refusal = capsys.readouterr().err.strip().splitlines()
     assert len(refusal) == 1 and "is in use by another run" in refusal[0], refusal
-    out, err = first.communicate(timeout=300)
+    _out, err = first.communicate(timeout=300)
     assert first.returncode == 0, err
     table = _table(tmp_path / "cases")
     assert table["torque"].tolist() == [float(t) for t in range(1, 201)]

@@ -57,7 +57,7 @@ def wheelhouse(tmp_path_factory):
     except WheelhouseError as missing:
         pytest.skip(str(missing))
     wheels = build_wheels(tmp_path_factory.mktemp("wheelhouse"))
-    return {target.platform: wheel for target, wheel in zip(WHEELS, wheels)}
+    return {target.platform: wheel for target, wheel in zip(WHEELS, wheels, strict=False)}
 
 
 def _native_loop(wheel: Path) -> tuple[str, bytes]:

@@ -94,7 +94,7 @@ def simulate(plan: TorqueSchedule, parameters: dict, theta0: float, omega0: floa
 
     data.ctrl[0] = out["torque"][0]
     record(0, True)
-    for k, (h, n) in enumerate(zip(plan.step_size.tolist(), counts.tolist())):
+    for k, (h, n) in enumerate(zip(plan.step_size.tolist(), counts.tolist(), strict=False)):
         if setup.largest_step is not None:
             model.opt.timestep = h / n
         for _ in range(n):

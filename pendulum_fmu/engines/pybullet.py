@@ -129,7 +129,7 @@ def _step_through(plan, parameters, theta0, omega0, setup, client, body):
     counts = substeps(plan.step_size, setup.largest_step)
     out["theta"][0], out["omega"][0] = theta0, omega0
     applied = None
-    for k, (h, n, u) in enumerate(zip(plan.step_size.tolist(), counts.tolist(), plan.torque.tolist())):
+    for k, (h, n, u) in enumerate(zip(plan.step_size.tolist(), counts.tolist(), plan.torque.tolist(), strict=False)):
         # One stepSimulation per substep: PyBullet's numSubSteps would be faster, but Bullet then
         # counts substeps from accumulated time and drops or adds one when that rounds.
         pybullet.setTimeStep(h / n, physicsClientId=client)

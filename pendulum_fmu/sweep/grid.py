@@ -64,7 +64,7 @@ class Grid(Sequence):
     def columns(self, start: int, stop: int) -> dict[str, np.ndarray]:
         """The values of cases start..stop-1, one array per name."""
         positions = np.unravel_index(np.arange(start, stop), self._shape)
-        return {name: values[p] for (name, values), p in zip(self.axes.items(), positions)}
+        return {name: values[p] for (name, values), p in zip(self.axes.items(), positions, strict=False)}
 
 
 def sweep_grid(torques, gravities=(9.81,), extra: dict | None = None) -> Grid:

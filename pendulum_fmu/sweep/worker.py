@@ -79,7 +79,7 @@ class Runner:
         for case, values in enumerate(start_values.tolist()):
             self.simulator.slave.messages.lines.clear()
             try:
-                self._run_python(dict(zip(self.defaults, values)), points, outputs[:, case])
+                self._run_python(dict(zip(self.defaults, values, strict=False)), points, outputs[:, case])
             except FmuError as error:
                 messages[case] = str(error)
                 outputs[:, case] = np.nan
@@ -161,7 +161,7 @@ def run_chunk(index: int, first: int, values: dict[str, np.ndarray], task: Task)
         {
             "case": numbers,
             **values,
-            **dict(zip(SUMMARIES, summaries)),
+            **dict(zip(SUMMARIES, summaries, strict=False)),
             "status": np.where(ok, "ok", "failed").tolist(),
             "message": messages,
         },
