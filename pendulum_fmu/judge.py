@@ -44,8 +44,7 @@ from .mapped_fmu import as_map
 from .parameters import variables
 from .reference import equation_of_motion, reference, reference_schedule
 from .regression_tools import format_verdicts, regression_verdicts
-from .scenarios import JUDGE_TOLERANCE as DEFAULT_TOLERANCE
-from .scenarios import read_settings, settings_files
+from .scenarios import JUDGE_TOLERANCE as DEFAULT_TOLERANCE, read_settings, settings_files
 from .simulate import resolve_parameters
 from .torque_schedule import TorqueSchedule, TorqueTable, event_tolerance, read_torque_csv, schedule
 
