@@ -24,7 +24,7 @@ from scipy.integrate import solve_ivp
 
 from ._checkout import ROOT, build_tool
 from .atomic_files import replacing
-from .errors import InvalidInput
+from .errors import InvalidInput, MissingFile
 from .parameters import total_inertia
 from .simulate import resolve_parameters
 
@@ -37,8 +37,20 @@ WIRES = (
 
 
 def controller_defaults() -> dict[str, float]:
-    """setpoint, kp, ki, kd as the controller's modelDescription.xml sets them."""
-    variables = read_model_description(str(ROOT / "fmu_src" / "pid_controller" / "modelDescription.xml")).modelVariables
+    """setpoint, kp, ki, kd as the controller's modelDescription.xml sets them.
+
+    Raises
+    ------
+    MissingFile
+        In an installed package, which carries the pendulum's FMU but not the controller's sources.
+    """
+    description = ROOT / "fmu_src" / "pid_controller" / "modelDescription.xml"
+    if not description.is_file():
+        raise MissingFile(
+            f"the PID controller's sources ({description}) are not here: the closed loop (export-ssp, "
+            "scenarios --closed-loop, its reference) needs a clone of pendulum-fmu or its unpacked sdist"
+        )
+    variables = read_model_description(str(description)).modelVariables
     return {v.name: float(v.start) for v in variables if v.causality == "parameter"}
 
 

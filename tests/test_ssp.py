@@ -193,3 +193,12 @@ def test_the_kits_closed_loop_names_each_couplings_reference_as_that_coupling(tm
         assert (verdict.coupling, verdict.problems) == (coupling, [])
     assert main(["scenarios", "--output-dir", str(kit), "--closed-loop"]) == 2
     assert "--overwrite" in capsys.readouterr().err
+
+
+def test_an_installed_package_without_the_controller_s_sources_is_one_line(tmp_path, monkeypatch, capsys):
+    # An installed package sits where no fmu_src/ is beside it (what the wheel installs).
+    monkeypatch.setattr("pendulum_fmu.closed_loop.ROOT", tmp_path)
+    assert main(["export-ssp", str(tmp_path / "ClosedLoop.ssp")]) == 2
+    [line] = capsys.readouterr().err.strip().splitlines()
+    assert line.startswith("pendulum-fmu export-ssp: error: the PID controller's sources")
+    assert "needs a clone of pendulum-fmu" in line and not (tmp_path / "ClosedLoop.ssp").exists()
