@@ -37,7 +37,7 @@ from pathlib import Path
 
 from fmu_build import PLATFORMS, BuildError, check_toolchain, compile_native_loop
 from pendulum_fmu import FMU_FILES
-from pendulum_fmu.atomic_files import replacing_path
+from pendulum_fmu._atomic_files import replacing_path
 
 ROOT = Path(__file__).resolve().parent
 OBJDUMP = "llvm-objdump-14"

@@ -4,7 +4,7 @@
   source tree (a clone or the unpacked sdist), for every platform whose compiler is installed.
 - build_ext builds the native co-simulation loop, pendulum_fmu/_cs_loop.c, through the project's
   one build description (CMakeLists.txt, driven by fmu_build/) with this machine's
-  compiler. It is plain C loaded with ctypes (pendulum_fmu/cs_loop.py), not a CPython module:
+  compiler. It is plain C loaded with ctypes (pendulum_fmu/_native_loop.py), not a CPython module:
   it has the platform's plain name (_cs_loop.so, _cs_loop.pyd) and the wheel is tagged
   py3-none-<platform>, one wheel for every Python 3 on a platform.
 - bdist_wheel --linux-glibc 2.17 has both build the Linux binaries with zig for that oldest glibc
@@ -38,8 +38,8 @@ class BuildPyWithFmu(build_py):
             return
         from fmu_build import build_fmu
         from pendulum_fmu import FMU_FILES, __version__
-        from pendulum_fmu.errors import PlatformSkipped
-        from pendulum_fmu.export import fmu_platforms
+        from pendulum_fmu._errors import PlatformSkipped
+        from pendulum_fmu._export import fmu_platforms
 
         data = Path(self.build_lib, "pendulum_fmu", "data")
         for fmi_version, name in FMU_FILES.items():

@@ -26,10 +26,10 @@ import pyarrow.parquet as pq
 from fsspec.implementations.local import LocalFileSystem
 
 from pendulum_fmu import default_fmu
+from pendulum_fmu._torque_schedule import communication_points
 from pendulum_fmu.sweep.store import Store
 from pendulum_fmu.sweep.study import OUTPUTS
 from pendulum_fmu.sweep.worker import Task, _runner, run_chunk
-from pendulum_fmu.torque_schedule import communication_points
 
 CHUNKS, CASES, STOP_TIME, STEP_SIZE = 10, 64, 3.0, 1e-3
 ROUNDS = 5  # each figure the least of this many: other work on a shared machine only adds

@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import importlib.util
 
-from pendulum_fmu.simulate import open_fmu, run_schedule, simulate
-from pendulum_fmu.torque_schedule import schedule
+from pendulum_fmu._simulate import open_fmu, run_schedule, simulate
+from pendulum_fmu._torque_schedule import schedule
 
 from .builds import BuiltFmu
 from .report import Row, microseconds, ratio, skipped

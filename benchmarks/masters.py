@@ -1,5 +1,5 @@
 """Masters written as a vendor would, on fmpy's FMU2Slave and FMU2Model, that run a scenario of
-the kit (pendulum_fmu.scenarios) and write NAME_out.csv: a correct one, and ones that make each
+the kit (pendulum_fmu._scenarios) and write NAME_out.csv: a correct one, and ones that make each
 mistake the judge names on purpose. tests/test_scenarios.py and tests/test_judge.py run them;
 this prints what the judge says of each (the README's table and the thresholds of judge.py):
 
@@ -253,8 +253,8 @@ def main() -> int:
     """Every wrong master of WRONG_MASTERS on a fresh kit, and what the judge says of it."""
     import tempfile
 
-    from pendulum_fmu.judge import judge
-    from pendulum_fmu.scenarios import read_settings, write_scenarios
+    from pendulum_fmu._judge import judge
+    from pendulum_fmu._scenarios import read_settings, write_scenarios
 
     # residual: of the diagnosis (for integration error without a variant, the difference
     # itself); others: the smallest residual of every other candidate; both as fractions of

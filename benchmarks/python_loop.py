@@ -8,10 +8,10 @@ from __future__ import annotations
 import numpy as np
 from fmpy.fmi2 import FMU2Slave
 
-from pendulum_fmu import cs_loop, results
-from pendulum_fmu.parameters import value_reference
-from pendulum_fmu.simulate import open_fmu, run_schedule, run_schedule_python
-from pendulum_fmu.torque_schedule import TorqueSchedule, schedule
+from pendulum_fmu import _native_loop as cs_loop, _results as results
+from pendulum_fmu._parameters import value_reference
+from pendulum_fmu._simulate import open_fmu, run_schedule, run_schedule_python
+from pendulum_fmu._torque_schedule import TorqueSchedule, schedule
 
 from . import tutorial
 from .builds import BuiltFmu

@@ -8,11 +8,10 @@ import argparse
 
 import numpy as np
 
-from pendulum_fmu.parameters import default_parameters, value_reference
-from pendulum_fmu.plot import plot_overlay
-from pendulum_fmu.simulate import open_fmu
+from pendulum_fmu import fmu_model, open_fmu, plot_overlay
 
-P = default_parameters()
+MODEL = fmu_model()
+P = MODEL.default_parameters
 # Feed-forward of the gravity moment at the measured angle leaves the PD terms only the error.
 GRAVITY_MOMENT = P["mass"] * P["gravity"] * P["length"]
 
@@ -23,8 +22,8 @@ def pd_torque(theta, omega, setpoint, kp, kd):
 
 def run(setpoint=0.5, kp=270.0, kd=180.0, stop_time=3.0, step_size=1e-3):
     """Returns (time, theta, omega, torque applied over each step)."""
-    theta_vr, omega_vr, torque_vr = (value_reference(n) for n in ("theta", "omega", "torque"))
-    slave = open_fmu()
+    theta_vr, omega_vr, torque_vr = (MODEL.value_reference(n) for n in ("theta", "omega", "torque"))
+    slave = open_fmu(MODEL)
     steps = round(stop_time / step_size)
     time = step_size * np.arange(steps + 1)
     theta, omega, torque = np.zeros(steps + 1), np.zeros(steps + 1), np.zeros(steps)

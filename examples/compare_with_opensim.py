@@ -7,7 +7,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from pendulum_fmu.compare import compare, format_table
+from pendulum_fmu import compare, format_table
 
 # A torque that steps every half second: the kind of signal users compare across tools.
 STEPWISE_TORQUE = "time,torque\n0,20\n0.5,20\n0.5,-10\n1,-10\n1,35\n1.5,35\n1.5,0\n2,0\n2,15\n3,15\n"

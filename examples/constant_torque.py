@@ -6,10 +6,7 @@ import argparse
 
 import numpy as np
 
-from pendulum_fmu.parameters import default_parameters, total_inertia
-from pendulum_fmu.plot import plot_overlay
-from pendulum_fmu.reference import reference
-from pendulum_fmu.simulate import simulate
+from pendulum_fmu import fmu_model, plot_overlay, reference, simulate, total_inertia
 
 
 def run(torque=20.0, stop_time=3.0, step_size=1e-3, output_dir="out/constant_torque"):
@@ -23,7 +20,7 @@ def run(torque=20.0, stop_time=3.0, step_size=1e-3, output_dir="out/constant_tor
             f"theta({stop_time:g} s) = {fmu['theta'][-1]:.10f} rad"
         )
         if gravity == 0.0:
-            parabola = 0.5 * torque / total_inertia(default_parameters()) * fmu["time"] ** 2
+            parabola = 0.5 * torque / total_inertia(fmu_model().default_parameters) * fmu["time"] ** 2
             print(f"  against theta = tau t^2 / (2 I): {np.max(np.abs(fmu['theta'] - parabola)):.2e} rad")
         figure = plot_overlay(
             {"FMU": fmu, "Rigid-body ODE (scipy)": oracle},

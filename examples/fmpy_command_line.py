@@ -9,9 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pendulum_fmu import default_fmu
-from pendulum_fmu.reference import reference
-from pendulum_fmu.torque_schedule import schedule, write_torque_csv
+from pendulum_fmu import default_fmu, reference, schedule, write_torque_csv
 
 
 def run(stop_time=3.0, output_dir="out/fmpy_command_line"):

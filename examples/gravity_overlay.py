@@ -2,8 +2,7 @@
 
 import argparse
 
-from pendulum_fmu.plot import plot_overlay
-from pendulum_fmu.simulate import simulate
+from pendulum_fmu import plot_overlay, simulate
 
 
 def run(torque=20.0, stop_time=3.0, output_dir="out/gravity_overlay"):

@@ -36,8 +36,8 @@ from pathlib import Path
 from fmpy import read_model_description
 
 from pendulum_fmu import FMU_FILES, __version__
-from pendulum_fmu.atomic_files import check_writable, replacing_path
-from pendulum_fmu.errors import BuildError, PlatformSkipped
+from pendulum_fmu._atomic_files import check_writable, replacing_path
+from pendulum_fmu._errors import BuildError, PlatformSkipped
 
 from . import fmi3
 from .macho import MachOError, merge_universal

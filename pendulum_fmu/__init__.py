@@ -1,40 +1,69 @@
 """A torque-driven pendulum as an FMI 2.0 Co-Simulation FMU, and the tools to compare it.
 
-The API is this package's names; each is imported from its module on first use, so that
-``import pendulum_fmu`` loads neither numpy, fmpy, scipy, matplotlib nor dask::
+The API is this package's names; its modules are private (``_simulate``, ``_judge``, ...). Each
+name is imported from its module on first use, so that ``import pendulum_fmu`` loads neither
+numpy, fmpy, scipy, matplotlib nor dask::
 
     from pendulum_fmu import compare, default_fmu, judge, reference, run_sweep, simulate, Study
-
-Four of the names are also the names of the modules that hold them (simulate, reference, compare,
-judge): ``pendulum_fmu.simulate`` is the function; the module is ``import_module("pendulum_fmu.simulate")``,
-and ``from pendulum_fmu.simulate import ...`` works as ever.
 """
-
-import sys
-import types
 
 # The package version's one source: pyproject.toml reads it, the FMU's generationTool carries it.
 __version__ = "0.1.0"
 
 # Nothing else is imported here at import time, not even the standard library's
-# importlib.resources: the program (pendulum_fmu.entry) sets its signal handlers as soon as this
+# importlib.resources: the program (pendulum_fmu._entry) sets its signal handlers as soon as this
 # package is loaded, before anything that takes a noticeable time.
 
-# The public name -> the module that holds it, imported on first use (__getattr__ below).
+# The public name -> the private module that holds it, imported on first use (__getattr__ below).
 _LAZY = {
-    "simulate": "simulate",
-    "reference": "reference",
-    "compare": "compare",
-    "Comparison": "compare",
-    "judge": "judge",
-    "judge_kit": "judge",
-    "Judgement": "judge",
+    # running the FMU
+    "simulate": "_simulate",
+    "open_fmu": "_simulate",
+    "FmuError": "_simulate",
+    "fmu_model": "_model",
+    "FmuModel": "_model",
+    "FmuInstance": "_model",
+    "FmuFileError": "_model",
+    "total_inertia": "_parameters",
+    # torque signals
+    "schedule": "_torque_schedule",
+    "TorqueSchedule": "_torque_schedule",
+    "write_torque_csv": "_torque_schedule",
+    "TorqueFileError": "_torque_schedule",
+    # references and comparisons
+    "reference": "_reference",
+    "reference_schedule": "_reference",
+    "compare": "_compare",
+    "Comparison": "_compare",
+    "format_table": "_compare",
+    "plot_overlay": "_plot",
+    # judging a master's result, and the kit of scenarios to judge
+    "judge": "_judge",
+    "judge_kit": "_judge",
+    "Judgement": "_judge",
+    "ResultFileError": "_judge",
+    "write_scenarios": "_scenarios",
+    "read_settings": "_scenarios",
+    # sweeps
     "run_sweep": "sweep",
     "sweep_grid": "sweep",
     "Study": "sweep",
     "SweepResult": "sweep",
-    "write_scenarios": "scenarios",
-    "PendulumFmuError": "errors",
+    # what a user hands on: the FMU, the closed loop, the SSP
+    "export_fmu": "_export",
+    "create_closed_loop_fmu": "_closed_loop",
+    "export_ssp": "_ssp",
+    # errors and warnings
+    "PendulumFmuError": "_errors",
+    "InvalidInput": "_errors",
+    "WrongType": "_errors",
+    "MissingFile": "_errors",
+    "CannotWrite": "_errors",
+    "MissingDependency": "_errors",
+    "BuildError": "_errors",
+    "PlatformSkipped": "_errors",
+    "NotComputed": "_errors",
+    "Skipped": "_errors",
 }
 __all__ = ["FMU_FILES", "__version__", "default_fmu", *_LAZY]
 
@@ -53,22 +82,6 @@ def __getattr__(name: str):
 def __dir__() -> list[str]:
     return sorted({*globals(), *__all__})
 
-
-class _Package(types.ModuleType):
-    """The package's module type, which keeps its functions from being hidden by their modules.
-
-    The import system sets every submodule it loads as an attribute of its package: for the modules
-    named like the function they hold, ``pendulum_fmu.simulate`` would be the module after any
-    ``import pendulum_fmu.simulate``.
-    """
-
-    def __setattr__(self, name: str, value) -> None:
-        if name in _LAZY and isinstance(value, types.ModuleType):
-            return
-        super().__setattr__(name, value)
-
-
-sys.modules[__name__].__class__ = _Package
 
 # FMI version -> the FMU's file name, in a checkout's dist/ and in the installed package's data/:
 # the one list of the FMI versions this package builds.
@@ -118,7 +131,7 @@ def default_fmu(fmi_version: int = 2):
     from pathlib import Path
 
     from ._checkout import build_tool, is_source_checkout
-    from .errors import InvalidInput, MissingFile
+    from ._errors import InvalidInput, MissingFile
 
     if fmi_version not in FMU_FILES:
         raise InvalidInput(f"no FMI {fmi_version} FMU: the FMI versions are {', '.join(map(str, FMU_FILES))}")

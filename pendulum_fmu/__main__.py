@@ -1,6 +1,6 @@
 """python -m pendulum_fmu: the pendulum-fmu program."""
 
-from .entry import run
+from ._entry import run
 
 if __name__ == "__main__":
     run()

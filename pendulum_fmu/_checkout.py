@@ -45,7 +45,7 @@ def build_tool():
     if loaded is not None and loaded.__file__ and Path(loaded.__file__).resolve() == BUILD_TOOL:
         return loaded
     if not is_source_checkout():
-        from .errors import BuildError
+        from ._errors import BuildError
 
         raise BuildError(
             f"pendulum_fmu at {ROOT / 'pendulum_fmu'} is installed, not in a checkout: building "

@@ -7,7 +7,7 @@
    allocated here, so the cost of a step is the FMU's own work plus four indirect calls, and the
    cost of a restart is the FMU's own.
 
-   The call sequence is the one of the Python code in pendulum_fmu/simulate.py (initialize and
+   The call sequence is the one of the Python code in pendulum_fmu/_simulate.py (initialize and
    the loop of run_schedule_python, the readable reference), so the two give bit-identical
    results: per step k, set the inputs, set their first derivatives (when rates are given), read
    the outputs, step from time[k] by time[k+1] - time[k]; after the last step read the outputs

@@ -20,7 +20,7 @@ if __name__ == "__main__":  # a script documents the clone it is in, whatever pa
 from fmpy.fmi2 import fmi2CallbackFunctions
 from fmpy.fmi3 import fmi3LogMessageCallback
 
-from pendulum_fmu.simulate import MessageLog
+from pendulum_fmu._simulate import MessageLog
 
 OK, WARNING, DISCARD, ERROR = 0, 1, 2, 3
 STATUS_NAMES = ["fmi2OK", "fmi2Warning", "fmi2Discard", "fmi2Error", "fmi2Fatal", "fmi2Pending"]
@@ -1533,7 +1533,7 @@ def main(argv=None):
                 Path(tmp) / str(version) / f"binaries/{folder}/Pendulum.so", read_model_description(str(fmu)).guid
             )
             tables.append([(case, *run_case(harness, case)) for case in cases])
-    from pendulum_fmu.atomic_files import replacing
+    from pendulum_fmu._atomic_files import replacing
 
     with replacing(out) as file:
         file.write(markdown(*tables))

@@ -549,14 +549,20 @@ CASES = [
 
 # What the calls below have in scope.
 API_IMPORTS = """\
-from pendulum_fmu import default_fmu
-from pendulum_fmu.closed_loop import create_closed_loop_fmu
-from pendulum_fmu.compare import compare
-from pendulum_fmu.judge import judge
-from pendulum_fmu.reference import reference, reference_schedule
-from pendulum_fmu.scenarios import read_settings, write_scenarios
-from pendulum_fmu.simulate import simulate
-from pendulum_fmu.sweep import Study, run_sweep, sweep_grid"""
+from pendulum_fmu import (
+    Study,
+    compare,
+    create_closed_loop_fmu,
+    default_fmu,
+    judge,
+    read_settings,
+    reference,
+    reference_schedule,
+    run_sweep,
+    simulate,
+    sweep_grid,
+    write_scenarios,
+)"""
 
 
 @dataclass(frozen=True)
@@ -963,7 +969,7 @@ def markdown(rows: list[tuple[Case, int, str]], calls: list[tuple[Call, str, str
         API_IMPORTS,
         "```",
         "",
-        "and raises a subclass of `pendulum_fmu.errors.PendulumFmuError` (each also derives "
+        "and raises a subclass of `pendulum_fmu._errors.PendulumFmuError` (each also derives "
         "from the built-in exception a caller expects: `ValueError`, `TypeError`, `OSError`, "
         "...) whose message is one line; no numpy, scipy or fmpy error gets through. "
         "Nothing is written when a call is refused.",
@@ -985,7 +991,7 @@ def main(argv=None):
         write_files(Path(folder))
         rows = [(case, *run_case(case, Path(folder))) for case in CASES]
         calls = [(call, *raised(run_call(call, Path(folder)), Path(folder))) for call in CALLS]
-    from pendulum_fmu.atomic_files import replacing
+    from pendulum_fmu._atomic_files import replacing
 
     with replacing(out) as file:
         file.write(markdown(rows, calls))

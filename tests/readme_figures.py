@@ -85,7 +85,7 @@ def _wrapped(text: str) -> str:
 
 def sweeps() -> str:
     """The sweep's limits and the figure's kinds, from the package."""
-    from pendulum_fmu.plot import QUANTILE_BANDS
+    from pendulum_fmu._plot import QUANTILE_BANDS
     from pendulum_fmu.sweep import DEFAULT_MAX_CASES
     from pendulum_fmu.sweep.figure import LINES_UP_TO
 
@@ -234,7 +234,7 @@ def problems(text: str) -> list[str]:
 
 
 def update(measure: bool) -> None:
-    from pendulum_fmu.atomic_files import replacing
+    from pendulum_fmu._atomic_files import replacing
 
     for document in DOCUMENTS:
         text = document.read_text(encoding="utf-8")

@@ -11,8 +11,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from pendulum_fmu._reference import reference
 from pendulum_fmu.cli import main
-from pendulum_fmu.reference import reference
 from tests.arm64_python import ROOT, Arm64Python, Unavailable
 
 pytestmark = pytest.mark.packaging
@@ -57,7 +57,7 @@ def test_the_checkout_package_simulates_on_arm64_as_on_x86_64(arm64, fmu, tmp_pa
     ran = arm64.run(
         [
             "-c",
-            "import sys; sys.argv[0] = 'pendulum-fmu'; from pendulum_fmu.entry import run; run()",
+            "import sys; sys.argv[0] = 'pendulum-fmu'; from pendulum_fmu._entry import run; run()",
             "simulate",
             "--torque",
             "20",

@@ -8,8 +8,8 @@ import sys
 import fsspec
 import pytest
 
-from pendulum_fmu.atomic_files import check_writable, replacing, replacing_on
-from pendulum_fmu.errors import CannotWrite, PendulumFmuError
+from pendulum_fmu._atomic_files import check_writable, replacing, replacing_on
+from pendulum_fmu._errors import CannotWrite, PendulumFmuError
 
 
 def test_a_failed_write_leaves_the_old_file_and_no_temporary(tmp_path):

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 from bad_inputs import CALLS, CASES, markdown, raised, run_call, run_case, write_files
 
-from pendulum_fmu import errors
+from pendulum_fmu import _errors as errors
 
 ROOT = Path(__file__).resolve().parent.parent
 

@@ -5,7 +5,7 @@ from fmpy import simulate_fmu
 from fmpy.validation import validate_fmu
 
 from fmu_build import build_pid_controller
-from pendulum_fmu.closed_loop import create_closed_loop_fmu, sampled_loop_reference
+from pendulum_fmu._closed_loop import create_closed_loop_fmu, sampled_loop_reference
 
 
 def test_controller_fmu_is_valid(tmp_path):

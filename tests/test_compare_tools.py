@@ -11,13 +11,13 @@ import numpy as np
 import pytest
 
 from fmu_build import MODEL_DESCRIPTION, PENDULUM_DIR, SOURCE_DIR, build_fmu
-from pendulum_fmu import compare_tools
+from pendulum_fmu import _compare_tools as compare_tools
+from pendulum_fmu._compare import run_tools
+from pendulum_fmu._errors import NotComputed, Skipped
+from pendulum_fmu._mapped_fmu import MapError, Mapped, MappedFmu, parse_map
+from pendulum_fmu._reference import reference_schedule
+from pendulum_fmu._torque_schedule import schedule
 from pendulum_fmu.cli import main
-from pendulum_fmu.compare import run_tools
-from pendulum_fmu.errors import NotComputed, Skipped
-from pendulum_fmu.mapped_fmu import MapError, Mapped, MappedFmu, parse_map
-from pendulum_fmu.reference import reference_schedule
-from pendulum_fmu.torque_schedule import schedule
 
 RENAMES = {
     "torque": "u",

@@ -7,14 +7,14 @@ from importlib import import_module
 import numpy as np
 import pytest
 
-from pendulum_fmu import cs_loop
-from pendulum_fmu.parameters import value_reference
-from pendulum_fmu.reference import reference_schedule
+from pendulum_fmu import _native_loop as cs_loop
+from pendulum_fmu._parameters import value_reference
+from pendulum_fmu._reference import reference_schedule
+from pendulum_fmu._torque_schedule import TorqueTable, schedule
 from pendulum_fmu.sweep import OUTPUTS
-from pendulum_fmu.torque_schedule import TorqueTable, schedule
 
 # The module; the package's attribute of that name is its function.
-simulate = import_module("pendulum_fmu.simulate")
+simulate = import_module("pendulum_fmu._simulate")
 
 
 def test_the_native_loop_is_built():

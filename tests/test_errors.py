@@ -8,7 +8,7 @@ import inspect
 import pkgutil
 
 import pendulum_fmu
-from pendulum_fmu.errors import PendulumFmuError
+from pendulum_fmu._errors import PendulumFmuError
 
 # Engines whose Python package is missing here cannot be imported; the others are checked.
 # (_cs_loop is a plain C library, not a Python module; __main__ runs the program.)
@@ -34,10 +34,10 @@ def test_every_exception_class_of_the_package_is_a_user_error():
             ):
                 defined[f"{value.__module__}.{name}"] = value
     assert {
-        "pendulum_fmu.torque_schedule.TorqueFileError",
-        "pendulum_fmu.simulate.FmuError",
-        "pendulum_fmu.model.FmuFileError",
-        "pendulum_fmu.errors.BuildError",
+        "pendulum_fmu._torque_schedule.TorqueFileError",
+        "pendulum_fmu._simulate.FmuError",
+        "pendulum_fmu._model.FmuFileError",
+        "pendulum_fmu._errors.BuildError",
         "pendulum_fmu.sweep.store.InUse",
     } <= set(defined)
     assert [name for name, value in defined.items() if not issubclass(value, PendulumFmuError)] == []

@@ -16,11 +16,11 @@ from fmpy.fmi3 import FMU3Model
 from fmpy.validation import validate_fmu
 
 from fmu_build import MODEL_DESCRIPTION
+from pendulum_fmu._parameters import default_parameters, total_inertia
+from pendulum_fmu._reference import reference, reference_schedule
+from pendulum_fmu._simulate import open_fmu, run_schedule, simulate
+from pendulum_fmu._torque_schedule import TorqueSchedule, schedule
 from pendulum_fmu.cli import main
-from pendulum_fmu.parameters import default_parameters, total_inertia
-from pendulum_fmu.reference import reference, reference_schedule
-from pendulum_fmu.simulate import open_fmu, run_schedule, simulate
-from pendulum_fmu.torque_schedule import TorqueSchedule, schedule
 
 TORQUE, THETA, OMEGA, ALPHA, MASS, DAMPING = 0, 1, 2, 3, 4, 8
 TIME = 10  # the independent variable's value reference in the FMI 3.0 description
@@ -273,7 +273,7 @@ def test_fmpy_validate_on_the_command_line(fmu3):
 def test_compare_and_sweep_take_the_fmi3_fmu(fmu, fmu3, tmp_path):
     import pyarrow.parquet as pq
 
-    from pendulum_fmu.compare import run_tools
+    from pendulum_fmu._compare import run_tools
     from pendulum_fmu.sweep import Study, run_sweep
 
     plan = schedule(lambda t: 20.0 if t < 0.5 else -5.0, stop_time=1.0)

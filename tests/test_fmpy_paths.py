@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 from fmpy import simulate_fmu
 
-from pendulum_fmu.reference import reference
-from pendulum_fmu.simulate import simulate
+from pendulum_fmu._reference import reference
+from pendulum_fmu._simulate import simulate
 
 
 def write(path, rows):

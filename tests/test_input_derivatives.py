@@ -12,9 +12,9 @@ from fmpy.fmi2 import FMU2Slave
 from scipy.integrate import solve_ivp
 
 from fmu_build import build_pid_controller
-from pendulum_fmu.closed_loop import controller_defaults, sampled_loop_reference
-from pendulum_fmu.parameters import default_parameters, total_inertia
-from pendulum_fmu.simulate import MessageLog, _unzipped, open_fmu
+from pendulum_fmu._closed_loop import controller_defaults, sampled_loop_reference
+from pendulum_fmu._parameters import default_parameters, total_inertia
+from pendulum_fmu._simulate import MessageLog, _unzipped, open_fmu
 
 TORQUE, THETA, OMEGA = 0, 1, 2
 I_TOTAL = total_inertia(default_parameters())

@@ -107,7 +107,7 @@ def test_ctrl_c_while_the_program_starts_is_one_line_too(tmp_path, delay):
 
 HANDLER_IN_A_GC_CALLBACK = """
 import gc, signal, time
-from pendulum_fmu.stop_signals import Stopped, restore_signals, stop_on_signals
+from pendulum_fmu._stop_signals import Stopped, restore_signals, stop_on_signals
 
 previous = stop_on_signals()
 fired = []

@@ -10,8 +10,7 @@ import numpy as np
 import pytest
 
 from benchmarks.masters import WRONG_MASTERS, run
-from pendulum_fmu.cli import main
-from pendulum_fmu.judge import (
+from pendulum_fmu._judge import (
     AGREES,
     DRIFT,
     EARLY,
@@ -27,9 +26,10 @@ from pendulum_fmu.judge import (
     judge,
     read_result,
 )
-from pendulum_fmu.parameters import total_inertia
-from pendulum_fmu.plot import _log_difference
-from pendulum_fmu.scenarios import KIT_FMU, read_settings, write_scenarios
+from pendulum_fmu._parameters import total_inertia
+from pendulum_fmu._plot import _log_difference
+from pendulum_fmu._scenarios import KIT_FMU, read_settings, write_scenarios
+from pendulum_fmu.cli import main
 
 
 @pytest.fixture(scope="module")

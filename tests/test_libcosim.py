@@ -14,8 +14,8 @@ from libcosimpy.CosimObserver import CosimObserver
 from libcosimpy.CosimSlave import CosimLocalSlave
 
 from fmu_build import build_pid_controller
-from pendulum_fmu.closed_loop import WIRES, sampled_loop_reference
-from pendulum_fmu.reference import reference
+from pendulum_fmu._closed_loop import WIRES, sampled_loop_reference
+from pendulum_fmu._reference import reference
 
 STEP_NS = 1_000_000  # libcosim counts time in nanoseconds: a 1 ms master step
 

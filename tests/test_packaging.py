@@ -27,7 +27,7 @@ from packaging.requirements import Requirement
 from readme_figures import measured_figures
 
 from pendulum_fmu import FMU_FILES, __version__
-from pendulum_fmu.reference import reference
+from pendulum_fmu._reference import reference
 
 pytestmark = pytest.mark.packaging
 

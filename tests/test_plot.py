@@ -5,9 +5,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pendulum_fmu import plot, results
+from pendulum_fmu import _plot as plot, _results as results
+from pendulum_fmu._reference import reference
 from pendulum_fmu.cli import main
-from pendulum_fmu.reference import reference
 
 
 @pytest.fixture

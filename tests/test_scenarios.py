@@ -17,12 +17,11 @@ from fmpy import simulate_fmu
 from fmpy.validation import validate_fmu
 
 from benchmarks.masters import run
-from pendulum_fmu import cs_loop
-from pendulum_fmu.cli import main
-from pendulum_fmu.errors import InvalidInput
-from pendulum_fmu.judge import AGREES, judge, judge_kit
-from pendulum_fmu.parameters import default_parameters, total_inertia
-from pendulum_fmu.scenarios import (
+from pendulum_fmu import _native_loop as cs_loop
+from pendulum_fmu._errors import InvalidInput
+from pendulum_fmu._judge import AGREES, judge, judge_kit
+from pendulum_fmu._parameters import default_parameters, total_inertia
+from pendulum_fmu._scenarios import (
     KIT_FMU,
     LS_REF_FOLDER,
     LS_REF_VERSION,
@@ -32,8 +31,9 @@ from pendulum_fmu.scenarios import (
     read_settings,
     write_scenarios,
 )
-from pendulum_fmu.simulate import open_fmu, run_schedule
-from pendulum_fmu.torque_schedule import TorqueSchedule, schedule
+from pendulum_fmu._simulate import open_fmu, run_schedule
+from pendulum_fmu._torque_schedule import TorqueSchedule, schedule
+from pendulum_fmu.cli import main
 
 NAMES = [s.name for s in SCENARIOS]
 # The role values of the FMI-LS-REF 1.0.0-beta.1 schema (fmi3LayeredStandardReferenceManifest.xsd).
@@ -248,7 +248,7 @@ def test_a_folder_without_a_kit_is_written_into(tmp_path):
 
 
 def test_a_kit_that_fails_to_write_leaves_the_folder_as_it_was(tmp_path, monkeypatch):
-    from pendulum_fmu import scenarios
+    from pendulum_fmu import _scenarios as scenarios
 
     write_scenarios(tmp_path)
     before = {path.name: path.read_bytes() for path in tmp_path.iterdir()}

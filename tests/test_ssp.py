@@ -12,10 +12,10 @@ import lxml.etree
 import numpy as np
 import pytest
 
+from pendulum_fmu._closed_loop import COUPLINGS, controller_defaults, sampled_loop_reference
+from pendulum_fmu._ssp import DEFAULT_SETPOINT, export_ssp, read_ssp
+from pendulum_fmu._ssp_judge import judge_coupling
 from pendulum_fmu.cli import main
-from pendulum_fmu.closed_loop import COUPLINGS, controller_defaults, sampled_loop_reference
-from pendulum_fmu.ssp import DEFAULT_SETPOINT, export_ssp, read_ssp
-from pendulum_fmu.ssp_judge import judge_coupling
 
 SCHEMAS = os.path.join(os.path.dirname(fmpy.__file__), "ssp", "schema")
 
@@ -98,7 +98,7 @@ def test_libcosim_runs_the_ssp_as_it_is_jacobi_with_its_parameter_sets(ssp):
     pytest.importorskip("libcosimpy")
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
 
-    from pendulum_fmu.ssp_masters import run_libcosim
+    from pendulum_fmu._ssp_masters import run_libcosim
 
     log_output_level(CosimLogLevel.WARNING)
     time, theta = run_libcosim(ssp)
@@ -111,7 +111,7 @@ def test_libcosim_runs_the_ssp_as_it_is_jacobi_with_its_parameter_sets(ssp):
 
 
 def test_fmpy_ssp_is_jacobi_without_the_first_exchange_and_ignores_the_bound_sets(ssp):
-    from pendulum_fmu.ssp_masters import run_fmpy_ssp
+    from pendulum_fmu._ssp_masters import run_fmpy_ssp
 
     settings = read_ssp(ssp)
     for given, applied in ((False, False), (True, True)):
@@ -132,7 +132,7 @@ def test_fmpy_ssp_is_jacobi_without_the_first_exchange_and_ignores_the_bound_set
 
 def test_fmucontainer_is_jacobi_and_ignores_the_parameter_bindings(ssp):
     pytest.importorskip("fmu_manipulation_toolbox")
-    from pendulum_fmu.ssp_masters import run_fmucontainer
+    from pendulum_fmu._ssp_masters import run_fmucontainer
 
     settings = read_ssp(ssp)
     time, theta = run_fmucontainer(ssp)
@@ -197,7 +197,7 @@ def test_the_kits_closed_loop_names_each_couplings_reference_as_that_coupling(tm
 
 def test_an_installed_package_without_the_controller_s_sources_is_one_line(tmp_path, monkeypatch, capsys):
     # An installed package sits where no fmu_src/ is beside it (what the wheel installs).
-    monkeypatch.setattr("pendulum_fmu.closed_loop.ROOT", tmp_path)
+    monkeypatch.setattr("pendulum_fmu._closed_loop.ROOT", tmp_path)
     assert main(["export-ssp", str(tmp_path / "ClosedLoop.ssp")]) == 2
     [line] = capsys.readouterr().err.strip().splitlines()
     assert line.startswith("pendulum-fmu export-ssp: error: the PID controller's sources")

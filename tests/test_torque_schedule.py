@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pendulum_fmu.torque_schedule import (
+from pendulum_fmu._torque_schedule import (
     BYTES_PER_STEP,
     TorqueFileError,
     read_torque_csv,

@@ -29,8 +29,8 @@ from benchmarks.builds import build_bare_master
 from build_wheels import LEGACY_MANYLINUX, MANYLINUX_GLIBC, WHEELS, WheelhouseError, build_wheels, check_tools, main
 from fmu_build import PLATFORMS
 from pendulum_fmu import FMU_FILES, __version__
+from pendulum_fmu._reference import reference
 from pendulum_fmu.cli import main as cli
-from pendulum_fmu.reference import reference
 from tests.arm64_python import Arm64Python, Unavailable
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -291,7 +291,7 @@ def test_x86_64_wheel_installs_and_simulates_in_a_venv(wheelhouse, x86_64_csv, t
         text=True,
         env=ENVIRONMENT,
     )
-    assert loaded.stdout.split() == [str(site_packages / "pendulum_fmu/cs_loop.py"), "True"]
+    assert loaded.stdout.split() == [str(site_packages / "pendulum_fmu/_native_loop.py"), "True"]
     subprocess.run(
         [venv / "bin/pendulum-fmu", "simulate", "--torque", "20", "--output", "out.csv"],
         check=True,

@@ -75,7 +75,7 @@ def write_examples_page(app) -> None:
     page = folder / "index.md"
     # Rewritten only when it changed, so that Sphinx rereads it only then.
     if not page.exists() or page.read_text(encoding="utf-8") != text:
-        from pendulum_fmu.atomic_files import replacing
+        from pendulum_fmu._atomic_files import replacing
 
         with replacing(page, encoding="utf-8") as file:
             file.write(text)

@@ -17,8 +17,8 @@ import warnings
 
 from .. import __version__
 from .._checkout import is_source_checkout
-from ..errors import NotComputed, PendulumFmuError, PlatformSkipped, Skipped
-from ..stop_signals import STOPPING_SIGNALS, Stopped, restore_signals, stop_on_signals
+from .._errors import NotComputed, PendulumFmuError, PlatformSkipped, Skipped
+from .._stop_signals import STOPPING_SIGNALS, Stopped, restore_signals, stop_on_signals
 from . import build, compare, cross_check, demo, export, export_ssp, judge, scenarios, simulate, sweep
 from ._stdout import UntilTheReaderIsGone
 

@@ -5,8 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..errors import InvalidInput
-from ..torque_schedule import DEFAULT_MAX_STEPS
+from .._errors import InvalidInput
+from .._torque_schedule import DEFAULT_MAX_STEPS
 
 
 def assignment(text: str) -> tuple[str, str]:
@@ -115,12 +115,12 @@ def check_outputs(outputs: dict, inputs: dict) -> None:
     it too, or when it is a file the command reads (option -> path): writing it would destroy the
     input.
     """
-    from ..atomic_files import check_writable
+    from .._atomic_files import check_writable
 
     given = {option: Path(path) for option, path in outputs.items() if path}
     check_writable(*given.values())
     if given.get("--plot"):
-        from ..plot import check_figure_path  # here: matplotlib only for a command that draws
+        from .._plot import check_figure_path  # here: matplotlib only for a command that draws
 
         check_figure_path(given["--plot"])
     read = {option: Path(path) for option, path in inputs.items() if path}

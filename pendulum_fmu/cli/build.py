@@ -10,7 +10,7 @@ import argparse
 import zipfile
 
 from .._checkout import build_tool
-from ..errors import BuildError
+from .._errors import BuildError
 from ._arguments import output_path
 
 

@@ -63,7 +63,7 @@ def add_parser(commands) -> argparse.ArgumentParser:
 
 def run(args) -> int:
     """Run `pendulum-fmu compare` with the parsed arguments; returns the exit status."""
-    from ..compare import compare, format_comparison
+    from .._compare import compare, format_comparison
 
     comparison = compare(
         torque_signal(args),

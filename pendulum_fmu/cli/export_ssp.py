@@ -55,7 +55,7 @@ def add_parser(commands) -> argparse.ArgumentParser:
 
 def run(args) -> int:
     """Run `pendulum-fmu export-ssp` with the parsed arguments; returns the exit status."""
-    from ..ssp import export_ssp
+    from .._ssp import export_ssp
 
     written = export_ssp(
         args.output,

@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from ..errors import InvalidInput
+from .._errors import InvalidInput
 from ._arguments import (
     add_signal_arguments,
     check_outputs,
@@ -18,7 +18,7 @@ from ._arguments import (
 )
 
 if TYPE_CHECKING:
-    from ..judge import Judgement
+    from .._judge import Judgement
 
 
 def add_parser(commands) -> argparse.ArgumentParser:
@@ -95,11 +95,11 @@ def add_parser(commands) -> argparse.ArgumentParser:
 
 def run(args) -> int:
     """Run `pendulum-fmu judge` with the parsed arguments; returns the exit status."""
-    from ..judge import format_judgement, format_kit, judge, judge_kit, write_json
-    from ..plot import plot_judgement
+    from .._judge import format_judgement, format_kit, judge, judge_kit, write_json
+    from .._plot import plot_judgement
 
     if args.ssp is not None:
-        from ..ssp_judge import format_ssp_verdict, judge_ssp_result
+        from .._ssp_judge import format_ssp_verdict, judge_ssp_result
 
         if args.result is None or args.calls is not None:
             raise InvalidInput(
@@ -162,9 +162,9 @@ def run(args) -> int:
 
 
 def _judge_calls(args, signal) -> int:
-    """`judge --calls LOG`: the master's calls against the intended run (pendulum_fmu.calls)."""
-    from ..calls import IntendedRun, format_calls, judge_calls, write_calls_json
-    from ..parameters import variables
+    """`judge --calls LOG`: the master's calls against the intended run (pendulum_fmu._calls)."""
+    from .._calls import IntendedRun, format_calls, judge_calls, write_calls_json
+    from .._parameters import variables
 
     if args.result is not None:
         raise InvalidInput(f"--calls judges a log, not a result: leave out {args.result}")
@@ -184,7 +184,7 @@ def _judge_calls(args, signal) -> int:
     judged = judge_calls(args.calls, intended, names)
     print(format_calls(judged))
     if args.plot:
-        from ..plot import plot_calls
+        from .._plot import plot_calls
 
         print(f"wrote {plot_calls(judged, args.plot, args.calls.name)}")
     if args.json:

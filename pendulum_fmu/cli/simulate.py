@@ -42,8 +42,8 @@ def add_parser(commands) -> argparse.ArgumentParser:
 
 def run(args) -> int:
     """Run `pendulum-fmu simulate` with the parsed arguments; returns the exit status."""
-    from .. import results
-    from ..simulate import simulate
+    from .. import _results as results
+    from .._simulate import simulate
 
     check_outputs(
         {"--output": args.output, "--plot": args.plot}, {"--torque-file": args.torque_file, "--fmu": args.fmu}
@@ -59,7 +59,7 @@ def run(args) -> int:
         results.write_csv(run, args.output)
         print(f"wrote {args.output} ({','.join(results.FIELDS)}; units {', '.join(results.UNITS.values())})")
     if args.plot:
-        from ..plot import case_title, plot_overlay
+        from .._plot import case_title, plot_overlay
 
         title = case_title(torque_signal(args), parameters_of(args.assignments), args.theta0, args.omega0, args.fmu)
         print(f"wrote {plot_overlay({'FMU': run}, args.plot, title)}")

@@ -7,9 +7,9 @@ import signal
 import sys
 from pathlib import Path
 
-from ..errors import InvalidInput
-from ..stop_signals import STOPPING_SIGNALS, Stopped
-from ..torque_schedule import DEFAULT_MAX_CASES
+from .._errors import InvalidInput
+from .._stop_signals import STOPPING_SIGNALS, Stopped
+from .._torque_schedule import DEFAULT_MAX_CASES
 from ._arguments import add_fmu_argument, assignment, float_number, output_location, positive_int
 
 

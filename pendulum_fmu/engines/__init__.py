@@ -19,11 +19,11 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import results
-from ..errors import InvalidInput
-from ..model import FmuModel
-from ..simulate import resolve_parameters
-from ..torque_schedule import TorqueSchedule
+from .. import _results as results
+from .._errors import InvalidInput
+from .._model import FmuModel
+from .._simulate import resolve_parameters
+from .._torque_schedule import TorqueSchedule
 
 MODES = ("accurate", "default")
 

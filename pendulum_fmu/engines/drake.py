@@ -28,8 +28,8 @@ from pydrake.multibody.tree import FixedOffsetFrame, RevoluteJoint, SpatialInert
 from pydrake.systems.analysis import ResetIntegratorFromFlags, Simulator
 from pydrake.systems.framework import DiagramBuilder
 
-from ..errors import InvalidInput
-from ..torque_schedule import TorqueSchedule
+from .._errors import InvalidInput
+from .._torque_schedule import TorqueSchedule
 from . import held_results, runner
 
 

@@ -15,9 +15,9 @@ import os
 
 import numpy as np
 
-from .. import results
-from ..errors import InvalidInput, MissingDependency
-from ..torque_schedule import TorqueSchedule
+from .. import _results as results
+from .._errors import InvalidInput, MissingDependency
+from .._torque_schedule import TorqueSchedule
 from . import runner
 
 

@@ -47,7 +47,7 @@ def _import_quietly():
 
 pybullet = _import_quietly()
 
-from ..torque_schedule import TorqueSchedule
+from .._torque_schedule import TorqueSchedule
 from . import held_results, runner, substeps
 
 

@@ -16,7 +16,7 @@ import threading
 from collections.abc import Iterable
 from dataclasses import dataclass
 
-from ..errors import PendulumFmuError
+from .._errors import PendulumFmuError
 from .worker import Task, run_chunk
 
 

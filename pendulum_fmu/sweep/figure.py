@@ -7,8 +7,8 @@ from __future__ import annotations
 import tempfile
 from pathlib import Path
 
-from ..atomic_files import replacing_on
-from ..parameters import unit
+from .._atomic_files import replacing_on
+from .._parameters import unit
 from .store import Store
 
 # Up to this many cases the figure draws every trajectory; above, quantile bands of the summaries.
@@ -21,7 +21,7 @@ def draw(store: Store, cases_table, names: list[str], outputs: tuple[str, ...], 
     """
     import pyarrow.dataset as ds
 
-    from ..plot import plot_case_bands, plot_cases  # here: workers never draw, nor import matplotlib
+    from .._plot import plot_case_bands, plot_cases  # here: workers never draw, nor import matplotlib
 
     title = f"Parameter study: {cases_table.num_rows} cases of the torque-driven pendulum"
     units = {name: unit(name, fmu) for name in names}

@@ -12,8 +12,8 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from ..errors import InvalidInput, WrongType
-from ..parameters import START_VALUES, default_parameters
+from .._errors import InvalidInput, WrongType
+from .._parameters import START_VALUES, default_parameters
 
 
 def sweepable(fmu_path=None) -> list[str]:

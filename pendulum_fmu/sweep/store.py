@@ -28,9 +28,9 @@ import uuid
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..atomic_files import TEMPORARY_GLOB, make_folder, replacing_on
-from ..errors import CannotWrite, PendulumFmuError
-from ..stop_signals import signals_deferred
+from .._atomic_files import TEMPORARY_GLOB, make_folder, replacing_on
+from .._errors import CannotWrite, PendulumFmuError
+from .._stop_signals import signals_deferred
 
 SUMMARIES = ("final_theta", "final_omega", "final_alpha", "max_abs_theta")
 # What a study is made of in its folder: study.json first, so that what a study holds is known

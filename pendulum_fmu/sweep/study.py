@@ -11,9 +11,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import results
-from ..errors import InvalidInput, WrongType
-from ..torque_schedule import communication_points
+from .. import _results as results
+from .._errors import InvalidInput, WrongType
+from .._torque_schedule import communication_points
 from .grid import Grid, check_cases, columns
 
 OUTPUTS = results.FIELDS[2:]  # theta, omega, alpha: what a case records besides time and torque

@@ -15,10 +15,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import cs_loop
-from ..parameters import START_VALUES, value_reference
-from ..simulate import FmuError, initialize, run_schedule_python, simulator
-from ..torque_schedule import TorqueSchedule, communication_points
+from .. import _native_loop as cs_loop
+from .._parameters import START_VALUES, value_reference
+from .._simulate import FmuError, initialize, run_schedule_python, simulator
+from .._torque_schedule import TorqueSchedule, communication_points
 from .store import SUMMARIES, Store
 from .study import OUTPUTS
 

@@ -22,11 +22,11 @@ from fmpy.container_fmu.config import Component, Configuration, Connection
 from fmpy.model_description import CoSimulation, DefaultExperiment, ModelDescription, ModelVariable
 from scipy.integrate import solve_ivp
 
+from ._atomic_files import replacing
 from ._checkout import ROOT, build_tool
-from .atomic_files import replacing
-from .errors import InvalidInput, MissingFile
-from .parameters import total_inertia
-from .simulate import resolve_parameters
+from ._errors import InvalidInput, MissingFile
+from ._parameters import total_inertia
+from ._simulate import resolve_parameters
 
 # Pendulum output -> controller input, and back.
 WIRES = (

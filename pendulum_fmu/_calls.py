@@ -33,12 +33,12 @@ from pathlib import Path
 
 import numpy as np
 
-from .atomic_files import replacing
-from .errors import InvalidInput, MissingFile
-from .parameters import default_parameters
-from .reference import reference_schedule
-from .regression_tools import format_verdicts, regression_verdicts
-from .torque_schedule import TorqueSchedule, TorqueSignal, schedule
+from ._atomic_files import replacing
+from ._errors import InvalidInput, MissingFile
+from ._parameters import default_parameters
+from ._reference import reference_schedule
+from ._regression_tools import format_verdicts, regression_verdicts
+from ._torque_schedule import TorqueSchedule, TorqueSignal, schedule
 
 MARKER = "[pendulum-calls]"
 INPUT = "torque"

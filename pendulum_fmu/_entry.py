@@ -9,7 +9,7 @@ import os
 import signal
 import sys
 
-from .stop_signals import STOPPING_SIGNALS
+from ._stop_signals import STOPPING_SIGNALS
 
 
 def _while_starting(number, frame):

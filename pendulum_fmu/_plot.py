@@ -15,9 +15,9 @@ import numpy as np
 from matplotlib.backend_bases import FigureCanvasBase
 from matplotlib.lines import Line2D
 
-from .atomic_files import replacing_path
-from .errors import InvalidInput
-from .parameters import merged_parameters, unit
+from ._atomic_files import replacing_path
+from ._errors import InvalidInput
+from ._parameters import merged_parameters, unit
 
 THETA_LABEL = r"Position $\theta$ in rad"
 OMEGA_LABEL = r"Velocity $\omega$ in rad/s"
@@ -382,7 +382,7 @@ def plot_calls(judged: dict, path: str | Path, title: str) -> Path:
     Parameters
     ----------
     judged : dict
-        As pendulum_fmu.calls.judge_calls returns it.
+        As pendulum_fmu._calls.judge_calls returns it.
     path : str or Path
         The figure's file.
     title : str

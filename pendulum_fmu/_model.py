@@ -21,7 +21,7 @@ from pathlib import Path
 import fmpy
 from fmpy import extract, read_model_description
 
-from .errors import InvalidInput, MissingFile, WrongType
+from ._errors import InvalidInput, MissingFile, WrongType
 
 # The start values a user gives, and the FMU's variables they start.
 START_VALUES = {"theta0": "theta", "omega0": "omega"}
@@ -83,7 +83,7 @@ class FmuModel:
 
     Examples
     --------
-    >>> from pendulum_fmu.model import fmu_model
+    >>> from pendulum_fmu._model import fmu_model
     >>> model = fmu_model()          # the default FMU
     >>> model.value_reference("theta") == model.variables["theta"].valueReference
     True
@@ -249,14 +249,14 @@ class FmuInstance:
     ----------
     slave : fmpy.fmi2.FMU2Slave or fmpy.fmi3.FMU3Slave
         Instantiated with messages as its logger.
-    messages : pendulum_fmu.simulate.MessageLog
+    messages : pendulum_fmu._simulate.MessageLog
         Keeps what the FMU logs (and its logger callback alive as long as the instance).
     model : FmuModel
         The FMU the slave was made from.
 
     Examples
     --------
-    >>> from pendulum_fmu.simulate import open_fmu
+    >>> from pendulum_fmu._simulate import open_fmu
     >>> instance = open_fmu()
     >>> instance.model.fmi_version, instance.fmi_version
     (2, 2)

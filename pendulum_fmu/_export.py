@@ -14,8 +14,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from . import FMU_FILES, default_fmu
-from .atomic_files import check_writable, replacing_path
-from .errors import PendulumFmuError
+from ._atomic_files import check_writable, replacing_path
+from ._errors import PendulumFmuError
 
 
 class FmuExists(PendulumFmuError, FileExistsError):

@@ -18,7 +18,7 @@ import tempfile
 import uuid
 from pathlib import Path
 
-from .errors import CannotWrite
+from ._errors import CannotWrite
 
 # Every temporary a writer here leaves if it is killed (SIGKILL, a lost worker) matches this, so
 # that whoever owns the folder can sweep them up.

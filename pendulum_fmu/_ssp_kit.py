@@ -20,10 +20,10 @@ import json
 import os
 from pathlib import Path
 
-from .atomic_files import make_folder, replacing
-from .closed_loop import COUPLINGS, sampled_loop_reference
-from .scenarios import KitExists
-from .ssp import export_ssp, read_ssp
+from ._atomic_files import make_folder, replacing
+from ._closed_loop import COUPLINGS, sampled_loop_reference
+from ._scenarios import KitExists
+from ._ssp import export_ssp, read_ssp
 
 CLOSED_LOOP_FILES = ("ClosedLoop.ssp", "ClosedLoop.json", "ClosedLoop_ref.csv")
 JUDGE_COMMAND = "pendulum-fmu judge ClosedLoop_out.csv --ssp ClosedLoop.ssp"

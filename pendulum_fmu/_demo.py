@@ -11,11 +11,11 @@ from pathlib import Path
 
 import numpy as np
 
-from .compare import compare, format_comparison
-from .compare_tools import installed_defaults
-from .errors import PendulumFmuError
-from .parameters import default_parameters, total_inertia
-from .plot import plot_overlay
+from ._compare import compare, format_comparison
+from ._compare_tools import installed_defaults
+from ._errors import PendulumFmuError
+from ._parameters import default_parameters, total_inertia
+from ._plot import plot_overlay
 from .sweep import Study, run_sweep, sweep_grid
 
 # The tutorial's constant torque, N.m.

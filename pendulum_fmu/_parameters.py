@@ -12,10 +12,10 @@ import numbers
 from collections.abc import Mapping
 from pathlib import Path
 
-from .errors import InvalidInput, WrongType
+from ._errors import InvalidInput, WrongType
 
 # The names that lived here before the model object: re-exported, so that their imports still work.
-from .model import (
+from ._model import (
     FMI_VERSIONS as FMI_VERSIONS,
     PENDULUM_VARIABLES as PENDULUM_VARIABLES,
     START_VALUES as START_VALUES,

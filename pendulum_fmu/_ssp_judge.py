@@ -16,9 +16,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .closed_loop import COUPLINGS, sampled_loop_reference
-from .judge import ResultFileError, read_result
-from .ssp import SspSettings, read_ssp
+from ._closed_loop import COUPLINGS, sampled_loop_reference
+from ._judge import ResultFileError, read_result
+from ._ssp import SspSettings, read_ssp
 
 # The masters here match their coupling's reference to 1e-15 rad; the couplings differ from one
 # another by 1e-4 rad and more at the tutorial's setpoints (5.5e-4 between Gauss-Seidel and Jacobi

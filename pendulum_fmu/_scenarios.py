@@ -46,13 +46,13 @@ from xml.etree import ElementTree
 
 import numpy as np
 
-from . import __version__, results
-from .atomic_files import check_writable, make_folder, replacing, replacing_path
-from .errors import InvalidInput, PendulumFmuError
-from .parameters import START_VALUES, fmu_file, model_description
-from .reference import reference
-from .simulate import resolve_parameters
-from .stop_signals import signals_deferred
+from . import __version__, _results as results
+from ._atomic_files import check_writable, make_folder, replacing, replacing_path
+from ._errors import InvalidInput, PendulumFmuError
+from ._parameters import START_VALUES, fmu_file, model_description
+from ._reference import reference
+from ._simulate import resolve_parameters
+from ._stop_signals import signals_deferred
 
 LS_REF_NAME = "org.fmi-standard.fmi-ls-ref"
 LS_REF_VERSION = "1.0.0-beta.1"

@@ -37,16 +37,16 @@ from pathlib import Path
 
 import numpy as np
 
-from . import results
-from .atomic_files import replacing
-from .errors import InvalidInput
-from .mapped_fmu import as_map
-from .parameters import variables
-from .reference import equation_of_motion, reference, reference_schedule
-from .regression_tools import format_verdicts, regression_verdicts
-from .scenarios import JUDGE_TOLERANCE as DEFAULT_TOLERANCE, read_settings, settings_files
-from .simulate import resolve_parameters
-from .torque_schedule import TorqueSchedule, TorqueTable, event_tolerance, read_torque_csv, schedule
+from . import _results as results
+from ._atomic_files import replacing
+from ._errors import InvalidInput
+from ._mapped_fmu import as_map
+from ._parameters import variables
+from ._reference import equation_of_motion, reference, reference_schedule
+from ._regression_tools import format_verdicts, regression_verdicts
+from ._scenarios import JUDGE_TOLERANCE as DEFAULT_TOLERANCE, read_settings, settings_files
+from ._simulate import resolve_parameters
+from ._torque_schedule import TorqueSchedule, TorqueTable, event_tolerance, read_torque_csv, schedule
 
 AGREES = "agrees"
 LATE, EARLY = "input one step late", "input one step early"
@@ -114,7 +114,7 @@ class Judgement:
     >>> import tempfile
     >>> from pathlib import Path
     >>> from pendulum_fmu import judge, simulate
-    >>> from pendulum_fmu.results import write_csv
+    >>> from pendulum_fmu._results import write_csv
     >>> late = simulate(lambda t: 0.0 if t < 0.251 else 20.0, stop_time=0.5)
     >>> judgement = judge(write_csv(late, Path(tempfile.mkdtemp()) / "late.csv"),
     ...                   lambda t: 0.0 if t < 0.25 else 20.0, stop_time=0.5)
@@ -523,7 +523,7 @@ def judge(
     >>> import tempfile
     >>> from pathlib import Path
     >>> from pendulum_fmu import judge, simulate
-    >>> from pendulum_fmu.results import write_csv
+    >>> from pendulum_fmu._results import write_csv
     >>> result = write_csv(simulate(20.0, stop_time=1.0), Path(tempfile.mkdtemp()) / "fmu.csv")
     >>> judgement = judge(result, 20.0, stop_time=1.0)
     >>> judgement.passed, judgement.diagnosis

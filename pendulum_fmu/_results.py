@@ -21,13 +21,13 @@ from pathlib import Path
 
 import numpy as np
 
-from .atomic_files import replacing
-from .errors import NotComputed
+from ._atomic_files import replacing
+from ._errors import NotComputed
 
 
 @lru_cache(maxsize=1)
 def _default_recorded() -> tuple[str, ...]:
-    from .model import fmu_model
+    from ._model import fmu_model
 
     return fmu_model().recorded
 
@@ -39,7 +39,7 @@ def __getattr__(name: str):
     if name == "DTYPE":
         return dtype(_default_recorded())
     if name == "UNITS":
-        from .model import fmu_model
+        from ._model import fmu_model
 
         return {"time": "s", **{field: fmu_model().unit(field) for field in _default_recorded()}}
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

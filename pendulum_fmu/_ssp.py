@@ -19,11 +19,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from xml.etree import ElementTree
 
+from ._atomic_files import replacing
 from ._checkout import build_tool
-from .atomic_files import replacing
-from .closed_loop import WIRES, controller_defaults
-from .errors import InvalidInput, MissingFile, PendulumFmuError
-from .simulate import resolve_parameters
+from ._closed_loop import WIRES, controller_defaults
+from ._errors import InvalidInput, MissingFile, PendulumFmuError
+from ._simulate import resolve_parameters
 
 NAMESPACES = {
     "ssd": "http://ssp-standard.org/SSP1/SystemStructureDescription",

@@ -23,10 +23,10 @@ from fmpy.fmi1 import printLogMessage
 from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
 from fmpy.fmi3 import FMU3Slave
 
-from . import cs_loop, default_fmu, results
-from .errors import InvalidInput, PendulumFmuError
-from .model import FmuInstance, fmu_model
-from .parameters import (
+from . import _native_loop as cs_loop, _results as results, default_fmu
+from ._errors import InvalidInput, PendulumFmuError
+from ._model import FmuInstance, fmu_model
+from ._parameters import (
     default_parameters,
     file_version,
     fmu_file,
@@ -34,7 +34,7 @@ from .parameters import (
     merged_with,
     start_value,
 )
-from .torque_schedule import TorqueSchedule, TorqueSignal, schedule
+from ._torque_schedule import TorqueSchedule, TorqueSignal, schedule
 
 _STATUS = ["OK", "WARNING", "DISCARD", "ERROR", "FATAL", "PENDING"]
 

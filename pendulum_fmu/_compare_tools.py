@@ -31,13 +31,13 @@ from pathlib import Path
 
 import numpy as np
 
-from . import results
+from . import _results as results
+from ._errors import InvalidInput, Skipped, WrongType
+from ._model import FmuModel, fmu_model
+from ._reference import reference_schedule
+from ._simulate import simulate_plan
+from ._torque_schedule import TorqueSchedule
 from .engines import MODES, check_mode
-from .errors import InvalidInput, Skipped, WrongType
-from .model import FmuModel, fmu_model
-from .reference import reference_schedule
-from .simulate import simulate_plan
-from .torque_schedule import TorqueSchedule
 
 
 class ToolSpecError(InvalidInput):
@@ -134,8 +134,8 @@ class Kind:
 
 
 KINDS = {
-    "fmu": Kind("pendulum_fmu.compare_tools:run_fmu"),
-    "reference": Kind("pendulum_fmu.compare_tools:run_reference"),
+    "fmu": Kind("pendulum_fmu._compare_tools:run_fmu"),
+    "reference": Kind("pendulum_fmu._compare_tools:run_reference"),
     "opensim": Kind("pendulum_fmu.engines.opensim:run", "opensim", "opensim", MODES),
     "mujoco": Kind("pendulum_fmu.engines.mujoco:run", "mujoco", "mujoco", MODES),
     "drake": Kind("pendulum_fmu.engines.drake:run", "pydrake", "drake", MODES),
@@ -186,7 +186,7 @@ def installed_defaults() -> list[str]:
 
 
 def _mapped_fmu(label: str, path: str, mapping: str | None, fmu: str | Path | FmuModel | None) -> Tool:
-    from .mapped_fmu import MappedFmu
+    from ._mapped_fmu import MappedFmu
 
     if not _LABEL.match(label) or label.split(":")[0] in KINDS:
         raise ToolSpecError(

@@ -18,14 +18,14 @@ from pathlib import Path
 
 import numpy as np
 
-from .atomic_files import check_writable, replacing
-from .compare_tools import ToolSpecError, installed_defaults, parse_tools
-from .errors import InvalidInput, WrongType
-from .model import fmu_model
-from .plot import case_title, plot_comparison
-from .reference import reference
-from .simulate import resolve_parameters
-from .torque_schedule import TorqueSchedule, TorqueSignal, schedule
+from ._atomic_files import check_writable, replacing
+from ._compare_tools import ToolSpecError, installed_defaults, parse_tools
+from ._errors import InvalidInput, WrongType
+from ._model import fmu_model
+from ._plot import case_title, plot_comparison
+from ._reference import reference
+from ._simulate import resolve_parameters
+from ._torque_schedule import TorqueSchedule, TorqueSignal, schedule
 
 REFERENCE = "reference"
 # The torque a tool received may differ from the signal by rounding only (relative to the

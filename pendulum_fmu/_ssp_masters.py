@@ -17,9 +17,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import MissingDependency
-from .ssp import read_ssp
-from .ssp_judge import judge_coupling
+from ._errors import MissingDependency
+from ._ssp import read_ssp
+from ._ssp_judge import judge_coupling
 
 NANOSECONDS = 10**9  # libcosim counts time in ns
 
@@ -207,7 +207,7 @@ def masters_table(ssp: str | os.PathLike) -> str:
 
 
 def main(argv=None) -> int:
-    """Print the masters' table for an SSP (python -m pendulum_fmu.ssp_masters [ClosedLoop.ssp]).
+    """Print the masters' table for an SSP (python -m pendulum_fmu._ssp_masters [ClosedLoop.ssp]).
 
     Parameters
     ----------
@@ -223,7 +223,7 @@ def main(argv=None) -> int:
     --------
     >>> main([])  # doctest: +SKIP
     """
-    from .ssp import export_ssp
+    from ._ssp import export_ssp
 
     try:
         from libcosimpy.CosimLogging import CosimLogLevel, log_output_level

@@ -42,7 +42,7 @@ from typing import Union
 import numpy as np
 import psutil
 
-from .errors import InvalidInput
+from ._errors import InvalidInput
 
 TorqueSignal = Union[float, int, Callable[[float], float], str, Path, Sequence[float], np.ndarray, "TorqueTable"]
 
@@ -276,7 +276,7 @@ def write_torque_csv(path: str | Path, plan: TorqueSchedule) -> Path:
     ends, so a held torque reads as steps and a ramp as a line. Times are written with 17
     significant digits, so they read back as the same doubles.
     """
-    from .atomic_files import replacing
+    from ._atomic_files import replacing
 
     end = plan.torque + plan.torque_rate * plan.step_size
     points = []

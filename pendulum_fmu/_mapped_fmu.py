@@ -30,12 +30,12 @@ from fmpy import simulate_fmu
 from fmpy.fmi2 import FMU2Slave
 from fmpy.fmi3 import FMU3Slave
 
+from ._errors import InvalidInput, WrongType
+from ._model import fmu_model
+from ._parameters import START_VALUES, FmuFileError, default_parameters
+from ._simulate import FmuError, MessageLog, fmi2_library, instantiate, resolve_parameters
+from ._torque_schedule import TorqueSchedule
 from .engines import check_held, check_mode, held_results
-from .errors import InvalidInput, WrongType
-from .model import fmu_model
-from .parameters import START_VALUES, FmuFileError, default_parameters
-from .simulate import FmuError, MessageLog, fmi2_library, instantiate, resolve_parameters
-from .torque_schedule import TorqueSchedule
 
 REQUIRED = ("torque", "theta")
 # accurate: the tolerance the FMU or CVode is asked for; default: what it uses when not asked.
