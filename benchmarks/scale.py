@@ -20,6 +20,7 @@ import socket
 import subprocess
 import sys
 import tempfile
+from collections.abc import Sequence
 from pathlib import Path
 
 from .builds import BuiltFmu
@@ -51,19 +52,23 @@ def dask_processes(workers: int):
 
 
 @contextlib.contextmanager
-def dask_process_handles(workers: int, nanny: bool = True):
+def dask_process_handles(
+    workers: int, nanny: bool = True, host: str = "127.0.0.1", places: Sequence[tuple[Sequence[str], str]] = ()
+):
     """(address, [the scheduler's process, each worker's]) of a cluster as dask_processes
     starts it; nanny=False: each worker is the process that runs its tasks (no nanny restarts
-    it), for the fault tests to stop or kill.
+    it), for the fault tests to stop or kill. host: the scheduler's (and by default each
+    worker's) address; places: each worker's (command prefix, host) instead, e.g. a worker in
+    another network namespace, for the fault tests to cut its link.
     """
     from dask.distributed import Client
 
     port = free_port()
-    address = f"tcp://127.0.0.1:{port}"
+    address = f"tcp://{host}:{port}"
     quiet = dict(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     processes = [
         subprocess.Popen(
-            [sys.executable, "-m", "dask", "scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard"],
+            [sys.executable, "-m", "dask", "scheduler", "--host", host, "--port", str(port), "--no-dashboard"],
             **quiet,
         )
     ]
@@ -71,13 +76,14 @@ def dask_process_handles(workers: int, nanny: bool = True):
         processes += [
             subprocess.Popen(
                 [
+                    *prefix,
                     sys.executable,
                     "-m",
                     "dask",
                     "worker",
                     address,
                     "--host",
-                    "127.0.0.1",
+                    worker_host,
                     "--nthreads",
                     "1",
                     "--no-dashboard",
@@ -85,7 +91,7 @@ def dask_process_handles(workers: int, nanny: bool = True):
                 ],
                 **quiet,
             )
-            for _ in range(workers)
+            for prefix, worker_host in places or [((), host)] * workers
         ]
         with Client(address, timeout=60) as client:
             client.wait_for_workers(workers, timeout=60)

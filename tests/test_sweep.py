@@ -3,6 +3,7 @@ references, resume, failures, fsspec URLs, a cluster of separate processes, sign
 concurrent runs, and the studies refused before anything starts.
 """
 
+import contextlib
 import glob
 import json
 import logging
@@ -31,7 +32,7 @@ from pendulum_fmu._reference import reference
 from pendulum_fmu.cli import main
 from pendulum_fmu.sweep import OUTPUTS, Study, run_sweep, sweep_grid
 from pendulum_fmu.sweep.store import Store, StudyExists
-from pendulum_fmu.sweep.worker import Task, run_chunk
+from pendulum_fmu.sweep.worker import Task, kept_points, run_chunk
 
 # The module; the package's attribute of that name is its function.
 simulate = import_module("pendulum_fmu._simulate")
@@ -667,6 +668,176 @@ def test_a_worker_stopped_mid_study_and_continued_after_an_overwrite_changes_not
     assert not list(tmp_path.glob("*/_part-*"))
 
 
+def _assert_every_case_once(folder, torques, stop_time: float, stride: int = 1, sample: int = 4) -> None:
+    """The study of these torques (gravity 9.81, every output, every stride-th step) whole in
+    folder: every case once in both tables, every case's rows, and a sample of the cases'
+    trajectories bit-identical to simulate()'s.
+    """
+    table, trajectories = _table(folder / "cases"), _table(folder / "trajectories")
+    assert table["case"].tolist() == list(range(len(torques))) and set(table["status"]) == {"ok"}
+    assert table["torque"].tolist() == [float(t) for t in torques]
+    points = len(kept_points(round(stop_time / STEP_SIZE) + 1, stride))
+    assert np.bincount(trajectories["case"]).tolist() == [points] * len(torques)
+    for number in np.linspace(0, len(torques) - 1, sample).round().astype(int):
+        run = simulate.simulate(float(torques[number]), stop_time=stop_time)
+        expected = run[kept_points(len(run), stride)]
+        rows = trajectories["case"] == number
+        for name in ("time", *OUTPUTS):
+            assert np.array_equal(trajectories[name][rows], expected[name]), (number, name)
+        assert table["final_theta"][number] == run["theta"][-1]
+
+
+def _computing(nanny: subprocess.Popen) -> psutil.Process:
+    """The process a `dask worker`'s nanny started to run its tasks."""
+    return next(c for c in psutil.Process(nanny.pid).children() if "spawn_main" in " ".join(c.cmdline()))
+
+
+def _wait_till_busy(process: psutil.Process, folder, study: threading.Thread) -> None:
+    """Until the study has written a chunk and the worker process is computing one."""
+    deadline = time.monotonic() + 120
+    while not (list(folder.glob("cases/part-*")) and process.cpu_percent(0.1) > 30):
+        assert study.is_alive() and time.monotonic() < deadline
+
+
+def _study_thread(study: Study, folder, address: str) -> tuple[threading.Thread, list]:
+    """run_sweep of the study on the scheduler at address, started in a thread; its result
+    lands in the list.
+    """
+    results = []
+    thread = threading.Thread(
+        target=lambda: results.append(run_sweep(study, output_dir=folder, scheduler=address, progress=False))
+    )
+    thread.start()
+    return thread, results
+
+
+# Dask's own timeout, short, so that a fault test outlasts it within seconds: the scheduler drops
+# a worker silent for 2 s.
+SHORT_DASK_TIMEOUTS = {"DASK_DISTRIBUTED__SCHEDULER__WORKER_TTL": "2s"}
+FAULT_TORQUES = list(np.linspace(1.0, 40.0, 128))  # 64 chunks of 2 cases
+
+
+@pytest.fixture
+def network_namespace():
+    """(the host's address, a command prefix that runs a command in a network namespace of its
+    own, its address there, the host's end of the link between them): a veth pair, as two hosts
+    on one network.
+    """
+    if os.geteuid() != 0:
+        pytest.skip("cutting a worker's link needs root (network namespaces)")
+    name, tag = f"sweep{os.getpid()}", os.getpid() % 250
+    host_end, far_end = f"sw{os.getpid()}h", f"sw{os.getpid()}n"
+    host, far = f"10.213.{tag}.1", f"10.213.{tag}.2"
+    commands = [
+        ["ip", "netns", "add", name],
+        ["ip", "link", "add", host_end, "type", "veth", "peer", "name", far_end],
+        ["ip", "link", "set", far_end, "netns", name],
+        ["ip", "addr", "add", f"{host}/24", "dev", host_end],
+        ["ip", "link", "set", host_end, "up"],
+        ["ip", "netns", "exec", name, "ip", "addr", "add", f"{far}/24", "dev", far_end],
+        ["ip", "netns", "exec", name, "ip", "link", "set", far_end, "up"],
+        ["ip", "netns", "exec", name, "ip", "link", "set", "lo", "up"],
+    ]
+    try:
+        for command in commands:
+            done = subprocess.run(command, capture_output=True, text=True)
+            if done.returncode:
+                pytest.skip(f"no network namespaces here: {' '.join(command)}: {done.stderr.strip()}")
+        yield host, ("ip", "netns", "exec", name), far, host_end
+    finally:
+        subprocess.run(["ip", "link", "del", host_end], capture_output=True)
+        subprocess.run(["ip", "netns", "del", name], capture_output=True)
+
+
+def test_a_workers_link_cut_mid_study_changes_nothing(tmp_path, monkeypatch, network_namespace):
+    # Issue 32, a fault survived: the link of a worker on another host cut while it computes a
+    # chunk, for longer than the scheduler waits for a silent worker, then restored.
+    for name, value in SHORT_DASK_TIMEOUTS.items():
+        monkeypatch.setenv(name, value)
+    host, elsewhere, far, link = network_namespace
+    study = Study(sweep_grid(FAULT_TORQUES, [9.81]), stop_time=300.0, output_interval=1.0)
+    places = [((), host), (elsewhere, far)]
+    with benchmarks.scale.dask_process_handles(2, host=host, places=places) as (address, processes):
+        far_worker = _computing(processes[2])
+        first, results = _study_thread(study, tmp_path, address)
+        _wait_till_busy(far_worker, tmp_path, first)
+        subprocess.run(["ip", "link", "set", link, "down"], check=True)
+        time.sleep(5)  # over twice the scheduler's 2 s for a silent worker
+        subprocess.run(["ip", "link", "set", link, "up"], check=True)
+        first.join(timeout=300)
+    assert results[0].cases == 128 and results[0].failed == 0 and results[0].chunks_run == 64
+    _assert_every_case_once(tmp_path, FAULT_TORQUES, 300.0, stride=1000)
+
+
+@pytest.mark.skipif(not hasattr(signal, "SIGSTOP"), reason="no SIGSTOP on this platform")
+def test_a_worker_stopped_mid_study_under_a_nanny_changes_nothing(tmp_path, monkeypatch):
+    # Issue 32, a fault survived: a worker (the process its nanny started) stopped while it
+    # computes a chunk; the study finishes without it, and it is continued afterwards.
+    for name, value in SHORT_DASK_TIMEOUTS.items():
+        monkeypatch.setenv(name, value)
+    study = Study(sweep_grid(FAULT_TORQUES, [9.81]), stop_time=300.0, output_interval=1.0)
+    with benchmarks.scale.dask_process_handles(2) as (address, processes):
+        stopped = _computing(processes[2])
+        first, results = _study_thread(study, tmp_path, address)
+        _wait_till_busy(stopped, tmp_path, first)
+        stopped.suspend()
+        first.join(timeout=300)
+        assert results[0].cases == 128 and results[0].failed == 0
+        parts = {p: p.read_bytes() for p in tmp_path.glob("*/part-*")}
+        with contextlib.suppress(psutil.NoSuchProcess):  # its nanny may have ended it
+            stopped.resume()
+        # Till it ends (its nanny, told it is gone, stops it) or writes the chunk it held.
+        deadline = time.monotonic() + 10
+        while stopped.is_running() and stopped.status() != psutil.STATUS_ZOMBIE and time.monotonic() < deadline:
+            if list(tmp_path.glob("cases/_part-*.staged")):
+                break
+            time.sleep(0.05)
+    assert {p: p.read_bytes() for p in tmp_path.glob("*/part-*")} == parts
+    _assert_every_case_once(tmp_path, FAULT_TORQUES, 300.0, stride=1000)
+
+
+@pytest.fixture
+def small_disk(tmp_path):
+    """A 4 MB file system of its own (tmpfs), mounted on a folder and unmounted after."""
+    if os.geteuid() != 0:
+        pytest.skip("filling a disk needs root (mounting a small tmpfs)")
+    disk = tmp_path / "disk"
+    disk.mkdir()
+    done = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=4m", "tmpfs", str(disk)], capture_output=True, text=True)
+    if done.returncode:
+        pytest.skip(f"cannot mount a tmpfs here: {done.stderr.strip()}")
+    try:
+        yield disk
+    finally:
+        subprocess.run(["umount", "-l", str(disk)], check=True)
+
+
+def test_a_disk_filling_mid_study_is_one_line_and_resume_finishes_it(small_disk):
+    # Issue 32, a fault survived: the output's disk fills while the workers write. One line,
+    # only whole chunks kept; once space is freed, --resume runs the rest.
+    filler = small_disk / "filler"
+    filler.write_bytes(b"\0" * 3_000_000)  # about 1 MB left: some chunks fit, not all
+    folder = small_disk / "study"
+    torques = [f"{t:g}" for t in np.linspace(1.0, 40.0, 64)]
+    arguments = ("--torque", *torques, "--stop-time", "1", "--workers", "1")
+    full = subprocess.run(_sweep_command(folder, *arguments), capture_output=True, text=True, timeout=300)
+    assert full.returncode == 2 and full.stdout == "", (full.stdout, full.stderr)
+    lines = [line for line in full.stderr.splitlines() if not line.startswith("sweep: ")]  # progress
+    assert len(lines) == 1 and "No space left on device" in lines[0], full.stderr
+    cases, trajectories = (sorted(p.name for p in folder.glob(f"{t}/*")) for t in ("cases", "trajectories"))
+    # No staged or temporary file, no trajectories without their cases part, and what is kept reads.
+    assert 0 < len(cases) < 64 and cases == trajectories and all(n.startswith("part-") for n in cases), cases
+    assert len(_table(folder / "cases")["case"]) == len(cases)
+    filler.unlink()
+    resumed = subprocess.run(
+        _sweep_command(folder, *arguments, "--resume"), capture_output=True, text=True, timeout=300
+    )
+    assert resumed.returncode == 0, resumed.stderr
+    assert f"({64 - len(cases)} of 64 chunks run;" in resumed.stdout
+    _assert_every_case_once(folder, torques, 1.0)
+    assert not list(folder.glob("**/.*"))
+
+
 def test_an_unreachable_silent_or_wrong_scheduler_is_one_line_within_the_timeout(tmp_path, capsys):
     closed = f"tcp://127.0.0.1:{benchmarks.scale.free_port()}"
     held = []  # the silent server's connections, open till the test ends
@@ -846,6 +1017,7 @@ def test_a_second_run_into_a_folder_in_use_is_refused_and_the_first_is_whole(tmp
     table = _table(tmp_path / "cases")
     assert table["torque"].tolist() == [float(t) for t in range(1, 201)]
     assert table["final_theta"][9] == simulate.simulate(10.0, stop_time=0.5)["theta"][-1]
+    _assert_every_case_once(tmp_path, range(1, 201), 0.5)
 
 
 # --- refused before any cluster starts ------------------------------------------------------
