@@ -179,7 +179,8 @@ class Store:
         now writing it.
         """
         with replacing_on(self.filesystem, f"{self.root}/study.json") as file:
-            file.write(json.dumps({"study": definition, "chunk_cases": chunk_cases, "run": run}, indent=1).encode())
+            # One line: json's C encoder (indent= takes its Python one, 0.2 s for 50,000 values).
+            file.write(json.dumps({"study": definition, "chunk_cases": chunk_cases, "run": run}).encode())
 
     def staging(self) -> Store:
         """A new hidden folder inside this one, where a study that replaces this one is written."""
