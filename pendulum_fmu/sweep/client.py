@@ -232,7 +232,7 @@ def run_chunks(client, task: Task, chunks: Iterable[tuple[int, int, dict]], bar)
     futures = [client.submit(run_chunk, index, first, values, task, pure=False) for index, first, values in chunks]
     # Done callbacks rather than as_completed: on Ctrl-C no waiting coroutine is left to fail,
     # with a traceback, when the cluster closes.
-    finished = queue.SimpleQueue()
+    finished: queue.SimpleQueue = queue.SimpleQueue()
     for future in futures:
         future.add_done_callback(finished.put)
     for _ in futures:

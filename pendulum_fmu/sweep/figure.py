@@ -5,6 +5,7 @@ bands of the summaries.
 from __future__ import annotations
 
 import tempfile
+from collections.abc import Sequence
 from pathlib import Path
 
 from .._atomic_files import replacing_on
@@ -15,7 +16,7 @@ from .store import Store
 LINES_UP_TO = 20
 
 
-def draw(store: Store, cases_table, names: list[str], outputs: tuple[str, ...], fmu: str, target: str) -> None:
+def draw(store: Store, cases_table, names: list[str], outputs: Sequence[str], fmu: str, target: str) -> None:
     """Write target (on the store's file system) from the cases table and, for few cases with
     theta and omega kept, their trajectories; the axes and labels carry the units fmu declares.
     """

@@ -118,7 +118,8 @@ def check_cases(cases, fmu_path=None) -> list[str]:
     """The cases' common keys, which become the cases table's value columns; InvalidInput for
     cases that are not all alike, finite and distinct.
     """
-    names_allowed, seen = sweepable(fmu_path), {}  # refuses a file that is no pendulum FMU, first
+    names_allowed = sweepable(fmu_path)  # refuses a file that is no pendulum FMU, first
+    seen: dict[tuple, int] = {}
     if isinstance(cases, Grid):
         return list(cases.axes)  # checked when the grid was made
     if not cases:

@@ -126,7 +126,7 @@ def run_sweep(
             store=store,
             stop_time=float(study.stop_time),
             step_size=float(study.step_size),
-            outputs=study.outputs,
+            outputs=tuple(study.outputs),
             stride=study.stride,
             run=uuid.uuid4().hex,
         )

@@ -25,8 +25,10 @@ import contextlib
 import json
 import os
 import uuid
+from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from .._atomic_files import TEMPORARY_GLOB, make_folder, replacing_on
 from .._errors import CannotWrite, PendulumFmuError
@@ -63,8 +65,10 @@ class Held:
     done_chunks: int
 
     def chunks(self) -> int:
-        study = self.manifest["study"]
-        return -(-study["cases"] // self.manifest["chunk_cases"])
+        """The chunks of the study the folder holds (its study.json's cases and cases per chunk)."""
+        if self.manifest is None:
+            raise ValueError("the folder holds no study.json of a sweep: it has no chunks")
+        return -(-self.manifest["study"]["cases"] // self.manifest["chunk_cases"])
 
 
 @dataclass(frozen=True)
@@ -73,11 +77,12 @@ class Store:
     format.
     """
 
-    filesystem: object  # fsspec
+    filesystem: Any  # an fsspec AbstractFileSystem (fsspec ships no types)
     root: str
     format: str
 
     def part(self, table: str, index: int) -> str:
+        """Where a chunk's committed part of a table is."""
         return f"{self.root}/{table}/part-{index:06d}.{self.format}"
 
     def staged(self, table: str, index: int, run: str) -> str:
@@ -130,9 +135,11 @@ class Store:
         return {int(Path(path).stem.split("-")[1]): path for path in self.filesystem.glob(pattern)}
 
     def done_chunks(self) -> set[int]:
+        """The chunks whose cases part was committed: those done."""
         return set(self.parts("cases"))
 
-    def remove(self, patterns) -> None:
+    def remove(self, patterns: Iterable[str]) -> None:
+        """Remove what matches each glob pattern (relative to the folder), if it is there."""
         for pattern in patterns:
             for path in self.filesystem.glob(f"{self.root}/{pattern}"):
                 with contextlib.suppress(FileNotFoundError):

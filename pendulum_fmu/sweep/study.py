@@ -87,7 +87,7 @@ class Study:
     stride: int = field(init=False, compare=False)  # keep every stride-th point (and the last)
 
     def __post_init__(self):
-        derived = {"names": check_cases(self.cases, self.fmu_path)}
+        derived: dict[str, object] = {"names": check_cases(self.cases, self.fmu_path)}
         # Refuses a bad stop time or step size with simulate()'s words.
         derived["points"] = len(communication_points(0.0, self.stop_time, self.step_size))
         if isinstance(self.outputs, str):
@@ -110,6 +110,7 @@ class Study:
 
     def definition(self, fmu: str) -> dict:
         """What makes two runs the same study, for --resume (study.json keeps it)."""
+        values: dict[str, list] | str
         if isinstance(self.cases, Grid):
             values = {name: axis.tolist() for name, axis in self.cases.axes.items()}
         else:
