@@ -2,7 +2,7 @@
 
 import pytest
 
-from pendulum_fmu.sweep import sweep_grid
+from pendulum_fmu.sweep import Study, sweep_grid
 
 
 @pytest.mark.parametrize(
@@ -31,3 +31,18 @@ def test_a_grid_is_the_product_of_its_axes():
     assert grid[7] == {"torque": 2.0, "gravity": 0.0, "damping": 1.5}
     with pytest.raises(IndexError):
         grid[12]
+
+
+@pytest.mark.parametrize(
+    "cases, stop_time, chunk_cases",
+    [
+        (100_000, 0.01, 1_563),  # short cases: about 64 chunks, as their steps allow
+        (4_096, 3.0, 64),  # about 64 chunks
+        (1_000_000, 3.0, 256),  # at most 256 3-s cases (768,000 steps) in a chunk
+        (256, 600.0, 4),  # long cases: still about 64 chunks, never fewer cases than 256 allow
+        (100, 2_000.0, 1),  # a chunk's recordings within 64 MB: a 2,000-s case's 3 x 2,000,001 doubles are 48 MB
+    ],
+)
+def test_a_study_is_cut_into_chunks_of_a_bounded_size(cases, stop_time, chunk_cases):
+    study = Study(sweep_grid([float(t) for t in range(1, cases + 1)]), stop_time=stop_time)
+    assert study.chunk_cases() == chunk_cases
