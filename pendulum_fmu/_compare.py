@@ -91,6 +91,33 @@ COLUMNS = (
 
 
 def format_table(rows: list[dict]) -> str:
+    """The differences of a comparison as the table compare's command line prints.
+
+    Parameters
+    ----------
+    rows : list of dict
+        Rows as in Comparison.differences: tool, against, theta_max, theta_rms, omega_max,
+        alpha_max, torque_max and, optionally, seconds_per_step (None or absent: left blank).
+
+    Returns
+    -------
+    str
+        A header line, then one line per row.
+
+    Raises
+    ------
+    KeyError
+        A row without one of the columns.
+
+    Examples
+    --------
+    >>> from pendulum_fmu import format_table
+    >>> row = {"tool": "fmu", "against": "reference", "theta_max": 8.9e-13, "theta_rms": 3.9e-13,
+    ...        "omega_max": 1.8e-13, "alpha_max": 5.8e-12, "torque_max": 0.0, "seconds_per_step": 2.1e-05}
+    >>> print(format_table([row]))
+    tool         against      max|dtheta| rad rms dtheta max|domega| rad/s max|dalpha| max|dtorque| N.m   s/step
+    fmu          reference          8.900e-13   3.90e-13         1.800e-13    5.80e-12         0.00e+00  2.1e-05
+    """
     width = max([12, *(len(row["tool"]) + 1 for row in rows), *(len(row["against"]) + 1 for row in rows)])
     lines = [
         f"{'tool':<{width}} {'against':<{width}} {'max|dtheta| rad':>15} {'rms dtheta':>10} "
