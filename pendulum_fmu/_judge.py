@@ -80,7 +80,7 @@ OPTIONAL = ("omega", "alpha")
 
 
 class ResultFileError(InvalidInput):
-    """A result file, or a kit's folder, that cannot be judged; the message names the file, the
+    r"""A result file, or a kit's folder, that cannot be judged; the message names the file, the
     line and the problem.
 
     Examples
@@ -89,7 +89,7 @@ class ResultFileError(InvalidInput):
     >>> from pathlib import Path
     >>> from pendulum_fmu import ResultFileError, judge
     >>> result = Path(tempfile.mkdtemp(), "result.csv")
-    >>> _ = result.write_text("time,theta\\n0,0\\n0.5,x\\n")
+    >>> _ = result.write_text("time,theta\n0,0\n0.5,x\n")
     >>> try:
     ...     judge(result, 20.0, stop_time=1.0)
     ... except ResultFileError as error:

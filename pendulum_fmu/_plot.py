@@ -154,7 +154,7 @@ def _finish(fig, axes, title: str, path: str | Path) -> Path:
 
 @_drawing
 def plot_overlay(runs: dict[str, np.ndarray], path: str | Path, title: str) -> Path:
-    """Theta and omega of each run, overlaid (dashed after the first, so coincident lines show).
+    r"""Theta and omega of each run, overlaid (dashed after the first, so coincident lines show).
 
     Parameters
     ----------
@@ -185,7 +185,7 @@ def plot_overlay(runs: dict[str, np.ndarray], path: str | Path, title: str) -> P
     >>> runs = {"fmu": simulate(20.0, stop_time=1.0), "reference": reference(20.0, stop_time=1.0)}
     >>> figure = plot_overlay(runs, Path(tempfile.mkdtemp(), "overlay.png"), "20 N.m from rest")
     >>> figure.name, figure.read_bytes()[:4]
-    ('overlay.png', b'\\x89PNG')
+    ('overlay.png', b'\x89PNG')
     """
     fig, axes = plt.subplots(2, 1, figsize=(10, 6), sharex=True)
     for i, (label, run) in enumerate(runs.items()):

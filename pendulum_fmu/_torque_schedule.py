@@ -85,7 +85,7 @@ def _nearest(points: np.ndarray, t: np.ndarray) -> np.ndarray:
 
 
 class TorqueFileError(InvalidInput):
-    """A torque CSV that cannot be read; the message names the file, line and problem.
+    r"""A torque CSV that cannot be read; the message names the file, line and problem.
 
     Examples
     --------
@@ -93,7 +93,7 @@ class TorqueFileError(InvalidInput):
     >>> from pathlib import Path
     >>> from pendulum_fmu import TorqueFileError, schedule
     >>> table = Path(tempfile.mkdtemp(), "torque.csv")
-    >>> _ = table.write_text("time,torque\\n0,1\\n1,x\\n")
+    >>> _ = table.write_text("time,torque\n0,1\n1,x\n")
     >>> try:
     ...     schedule(table)
     ... except TorqueFileError as error:
