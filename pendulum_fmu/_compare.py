@@ -55,6 +55,7 @@ def run_tools(
 
 
 def check_tolerance(tolerance: float) -> float:
+    """The tolerance as a float; InvalidInput unless it is a positive finite number."""
     if not (math.isfinite(tolerance) and tolerance > 0):
         raise InvalidInput(f"the tolerance {tolerance} must be a positive finite number (rad, rad/s)")
     return float(tolerance)
@@ -151,6 +152,7 @@ def write_trajectories(runs: dict[str, np.ndarray], path: str | Path) -> Path:
 
 
 def write_differences(rows: list[dict], path: str | Path) -> Path:
+    """Write differences.csv: the rows of COLUMNS, then any other output's differences."""
     with replacing(path, newline="") as file:
         fields = [*COLUMNS, *(key for key in (rows[0] if rows else {}) if key not in COLUMNS)]
         writer = csv.DictWriter(file, fieldnames=fields)
@@ -207,10 +209,12 @@ class Comparison:
 
     @property
     def torque_limit(self) -> float:
+        """The rounding allowed between the torque a tool received and the signal, in N.m."""
         return TORQUE_ROUNDING * (1.0 + float(np.max(np.abs(self.runs[REFERENCE]["torque"]))))
 
     @property
     def agree(self) -> bool:
+        """Whether every tool is within the tolerance and received the signal's torque."""
         return self.worst <= self.tolerance and self.torque_worst <= self.torque_limit
 
 

@@ -129,6 +129,7 @@ class Kind:
     modes: tuple[str, ...] = ("accurate",)
 
     def load(self) -> Callable[..., np.ndarray]:
+        """The tool's runner, its module imported now."""
         module, function = self.runner.split(":")
         return getattr(importlib.import_module(module), function)
 
