@@ -186,7 +186,7 @@ def list_tools() -> list[ToolInfo]:
     Returns
     -------
     list of ToolInfo
-        In the order of --tools' help: fmu, reference, then the engines.
+        fmu, reference, then the engines: opensim, mujoco, drake, pybullet.
 
     Raises
     ------
