@@ -49,6 +49,9 @@ numpydoc_show_class_members = False
 numpydoc_class_members_toctree = False
 # numpydoc's own checks of the docstrings' sections, as warnings (errors under -W).
 numpydoc_validation_checks = {"GL08"}  # every documented object has a docstring
+# ... but a class's __init__ (a dataclass's made by Python): its class's docstring describes it,
+# as ruff's D107 ignore says.
+numpydoc_validation_exclude = {r"\.__init__$"}
 
 html_theme = "pydata_sphinx_theme"
 html_title = f"pendulum-fmu {release}"

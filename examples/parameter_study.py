@@ -6,8 +6,7 @@ import argparse
 
 import pyarrow.parquet as pq
 
-from pendulum_fmu import PendulumFmuError
-from pendulum_fmu.sweep import Study, run_sweep, sweep_grid
+from pendulum_fmu import PendulumFmuError, Study, run_sweep, sweep_grid
 
 
 def run(

@@ -55,6 +55,7 @@ def run_tools(
 
 
 def check_tolerance(tolerance: float) -> float:
+    """The tolerance as a float; InvalidInput unless it is a positive finite number."""
     if not (math.isfinite(tolerance) and tolerance > 0):
         raise InvalidInput(f"the tolerance {tolerance} must be a positive finite number (rad, rad/s)")
     return float(tolerance)
@@ -91,6 +92,33 @@ COLUMNS = (
 
 
 def format_table(rows: list[dict]) -> str:
+    """The differences of a comparison as the table compare's command line prints.
+
+    Parameters
+    ----------
+    rows : list of dict
+        Rows as in Comparison.differences: tool, against, theta_max, theta_rms, omega_max,
+        alpha_max, torque_max and, optionally, seconds_per_step (None or absent: left blank).
+
+    Returns
+    -------
+    str
+        A header line, then one line per row.
+
+    Raises
+    ------
+    KeyError
+        A row without one of the columns.
+
+    Examples
+    --------
+    >>> from pendulum_fmu import format_table
+    >>> row = {"tool": "fmu", "against": "reference", "theta_max": 8.9e-13, "theta_rms": 3.9e-13,
+    ...        "omega_max": 1.8e-13, "alpha_max": 5.8e-12, "torque_max": 0.0, "seconds_per_step": 2.1e-05}
+    >>> print(format_table([row]))
+    tool         against      max|dtheta| rad rms dtheta max|domega| rad/s max|dalpha| max|dtorque| N.m   s/step
+    fmu          reference          8.900e-13   3.90e-13         1.800e-13    5.80e-12         0.00e+00  2.1e-05
+    """
     width = max([12, *(len(row["tool"]) + 1 for row in rows), *(len(row["against"]) + 1 for row in rows)])
     lines = [
         f"{'tool':<{width}} {'against':<{width}} {'max|dtheta| rad':>15} {'rms dtheta':>10} "
@@ -124,6 +152,7 @@ def write_trajectories(runs: dict[str, np.ndarray], path: str | Path) -> Path:
 
 
 def write_differences(rows: list[dict], path: str | Path) -> Path:
+    """Write differences.csv: the rows of COLUMNS, then any other output's differences."""
     with replacing(path, newline="") as file:
         fields = [*COLUMNS, *(key for key in (rows[0] if rows else {}) if key not in COLUMNS)]
         writer = csv.DictWriter(file, fieldnames=fields)
@@ -180,10 +209,12 @@ class Comparison:
 
     @property
     def torque_limit(self) -> float:
+        """The rounding allowed between the torque a tool received and the signal, in N.m."""
         return TORQUE_ROUNDING * (1.0 + float(np.max(np.abs(self.runs[REFERENCE]["torque"]))))
 
     @property
     def agree(self) -> bool:
+        """Whether every tool is within the tolerance and received the signal's torque."""
         return self.worst <= self.tolerance and self.torque_worst <= self.torque_limit
 
 

@@ -191,6 +191,7 @@ class MappedFmu:
         omega0: float = 0.0,
         mode: str = "accurate",
     ) -> np.ndarray:
+        """The FMU's result for a held schedule, mapped to the pendulum's quantities (see Tool.run)."""
         check_held(plan, self.label)
         check_mode(mode, self.label)
         start = self._start_values(parameters, theta0, omega0)

@@ -154,7 +154,39 @@ def _finish(fig, axes, title: str, path: str | Path) -> Path:
 
 @_drawing
 def plot_overlay(runs: dict[str, np.ndarray], path: str | Path, title: str) -> Path:
-    """Theta and omega of each run, overlaid (dashed after the first, so coincident lines show)."""
+    r"""Theta and omega of each run, overlaid (dashed after the first, so coincident lines show).
+
+    Parameters
+    ----------
+    runs : dict of str to numpy.ndarray
+        Result arrays (as simulate() and reference() return them) by their labels in the legend.
+    path : str or Path
+        The figure to write, whole or not at all; its extension says the format (none: PNG).
+    title : str
+        The figure's title.
+
+    Returns
+    -------
+    Path
+        path.
+
+    Raises
+    ------
+    InvalidInput
+        An extension no figure format has (such as .csv).
+    CannotWrite
+        path cannot be written.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from pendulum_fmu import plot_overlay, reference, simulate
+    >>> runs = {"fmu": simulate(20.0, stop_time=1.0), "reference": reference(20.0, stop_time=1.0)}
+    >>> figure = plot_overlay(runs, Path(tempfile.mkdtemp(), "overlay.png"), "20 N.m from rest")
+    >>> figure.name, figure.read_bytes()[:4]
+    ('overlay.png', b'\x89PNG')
+    """
     fig, axes = plt.subplots(2, 1, figsize=(10, 6), sharex=True)
     for i, (label, run) in enumerate(runs.items()):
         style = dict(linewidth=2 if i == 0 else 1.5, linestyle="-" if i == 0 else "--")

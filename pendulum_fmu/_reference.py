@@ -450,8 +450,20 @@ def reference_schedule(
 
     Raises
     ------
+    WrongType
+        plan is no TorqueSchedule.
     InvalidInput
-        Parameters the FMU refuses, or values with which solve_ivp fails.
+        Parameters the FMU refuses, times in `at` outside the run, or values with which
+        solve_ivp fails.
+
+    Examples
+    --------
+    20 N.m for 1 s with gravity off: theta(1 s) = 20 / (2 * 30 kg.m^2) = 1/3 rad.
+
+    >>> from pendulum_fmu import reference_schedule, schedule
+    >>> run = reference_schedule(schedule(20.0, stop_time=1.0), parameters={"gravity": 0.0})
+    >>> run.dtype.names, len(run), round(float(run["theta"][-1]), 12)
+    (('time', 'torque', 'theta', 'omega', 'alpha'), 1001, 0.333333333333)
     """
     if not isinstance(plan, TorqueSchedule):
         raise WrongType(f"plan is a TorqueSchedule (torque_schedule.schedule(...)), not a {type(plan).__name__}")

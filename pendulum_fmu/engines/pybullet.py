@@ -77,6 +77,7 @@ _NO_VELOCITY_LIMIT = 1e12
 
 
 def urdf(parameters: dict) -> str:
+    """The URDF of the pendulum with these parameters."""
     p = parameters
     inertia = repr(p["inertia"])
     return f"""<robot name="pendulum">
