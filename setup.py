@@ -18,6 +18,7 @@ import sys
 import tempfile
 import warnings
 from pathlib import Path
+from typing import ClassVar
 
 from setuptools import Extension, setup
 from setuptools.command.bdist_wheel import bdist_wheel
@@ -70,7 +71,7 @@ class BuildNativeLoop(build_ext):
 
 
 class PlatformWheel(bdist_wheel):
-    user_options = [
+    user_options: ClassVar[list[tuple[str, str | None, str]]] = [
         *bdist_wheel.user_options,
         (
             "linux-glibc=",
