@@ -3,7 +3,7 @@ the kit (pendulum_fmu._scenarios) and write NAME_out.csv: a correct one, and one
 mistake the judge names on purpose.
 
 tests/test_scenarios.py and tests/test_judge.py run them; this prints what the judge says of
-each (the README's table and the thresholds of judge.py):
+each (the README's table and the thresholds of _judge.py):
 
     python -m benchmarks.masters
 
