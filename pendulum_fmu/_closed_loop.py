@@ -255,10 +255,10 @@ def sampled_loop_reference(
         out[k] = (k * step_size, state[0], state[1], torque)
         if k == n:
             break
-        rhs = lambda t, y, u=torque: (
-            y[1],
-            (u - gravity_moment * np.sin(y[0]) - p["damping"] * y[1]) * inverse_inertia,
-        )
+
+        def rhs(t, y, u=torque):
+            return y[1], (u - gravity_moment * np.sin(y[0]) - p["damping"] * y[1]) * inverse_inertia
+
         integral, previous = next_integral, state
         state = solve_ivp(rhs, (0.0, step_size), state, method="DOP853", rtol=rtol, atol=rtol).y[:, -1]
     return out

@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from . import _results as results
 from ._atomic_files import check_writable, replacing
 from ._compare_tools import ToolSpecError, installed_defaults, parse_tools
 from ._errors import InvalidInput, WrongType
@@ -41,16 +42,16 @@ def run_tools(
     theta0: float = 0.0,
     omega0: float = 0.0,
     fmu_path: str | Path | None = None,
-    mapping: str | None = None,
+    mapping: str | dict | None = None,
 ) -> dict[str, np.ndarray]:
     """{tool label: result array} for the same schedule, parameters and start values; tools as
     --tools gives them (see _compare_tools.py), mapping the --map of other FMUs. "reference" here is
     reference_schedule: the schedule's own torques through scipy.
     """
-    fmu_path = fmu_model(fmu_path)  # read once, passed to every tool
-    parsed = parse_tools(tools, mapping=mapping, fmu_path=fmu_path)
+    model = fmu_model(fmu_path)  # read once, passed to every tool
+    parsed = parse_tools(tools, mapping=mapping, fmu_path=model)
     # Every tool gets the whole set, so the defaults are fmu_path's for all of them.
-    parameters = resolve_parameters(parameters, fmu_path)
+    parameters = resolve_parameters(parameters, model)
     return {tool.label: tool.run(plan, parameters=parameters, theta0=theta0, omega0=omega0) for tool in parsed}
 
 
@@ -69,7 +70,7 @@ def differences(run: np.ndarray, judge: np.ndarray) -> dict[str, float]:
     # A tool whose numbers run past the largest double (a --map factor of 1e308) differs by inf:
     # that is its verdict, and numpy's overflow warnings on the way say nothing more.
     with np.errstate(over="ignore", invalid="ignore"):
-        for name in run.dtype.names[2:]:
+        for name in results.fields(run)[2:]:
             difference = np.abs(run[name] - judge[name])
             row[f"{name}_max"] = float(np.max(difference))
             row[f"{name}_rms"] = float(np.sqrt(np.mean(difference**2)))
@@ -140,7 +141,7 @@ def write_trajectories(runs: dict[str, np.ndarray], path: str | Path) -> Path:
     """
     columns = {"time": next(iter(runs.values()))["time"]}
     for tool, run in runs.items():
-        for name in run.dtype.names[1:]:
+        for name in results.fields(run)[1:]:
             columns[f"{name}_{tool}"] = run[name]
     with replacing(path, newline="") as file:
         writer = csv.writer(file)
@@ -299,15 +300,15 @@ def compare(
     """
     if not isinstance(output_dir, str | os.PathLike):
         raise WrongType(f"output_dir is a folder's path, not {output_dir!r}")
-    fmu_path = fmu_model(fmu_path)  # read once, passed to every tool
-    parsed = parse_tools(installed_defaults() if tools is None else tools, mapping=mapping, fmu_path=fmu_path)
+    model = fmu_model(fmu_path)  # read once, passed to every tool
+    parsed = parse_tools(installed_defaults() if tools is None else tools, mapping=mapping, fmu_path=model)
     if len(parsed) < 2:
         raise ToolSpecError(f"compare needs at least two tools, got {parsed[0].label}: e.g. --tools fmu,{REFERENCE}")
     tolerance = check_tolerance(tolerance)
-    shown = case_title(torque, parameters, theta0, omega0, fmu_path)  # the user's own parameters
+    shown = case_title(torque, parameters, theta0, omega0, model)  # the user's own parameters
     # Refused here before any tool runs; and every tool gets the whole set, so the defaults are
     # fmu_path's for all of them.
-    parameters = resolve_parameters(parameters, fmu_path)
+    parameters = resolve_parameters(parameters, model)
     plan = schedule(
         torque, start_time=start_time, stop_time=stop_time, step_size=step_size, ramp=ramp, max_steps=max_steps
     )
@@ -326,7 +327,7 @@ def compare(
         theta0=theta0,
         omega0=omega0,
         at=plan.time,
-        fmu_path=fmu_path,
+        fmu_path=model,
     )
     for tool in parsed:
         if tool.label != REFERENCE:  # the judge above takes the reference's place

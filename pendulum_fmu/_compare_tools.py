@@ -258,7 +258,7 @@ def installed_defaults() -> list[str]:
     return [name for name in DEFAULT_TOOLS if name not in missing]
 
 
-def _mapped_fmu(label: str, path: str, mapping: str | None, fmu: str | Path | FmuModel | None) -> Tool:
+def _mapped_fmu(label: str, path: str, mapping: str | dict | None, fmu: str | Path | FmuModel | None) -> Tool:
     from ._mapped_fmu import MappedFmu
 
     if not _LABEL.match(label) or label.split(":")[0] in KINDS:
@@ -287,11 +287,12 @@ def _named(item: str, fmu_path: str | Path | FmuModel | None) -> Tool:
 
 
 def parse_tools(
-    spec: str | Sequence[str], *, mapping: str | None = None, fmu_path: str | Path | FmuModel | None = None
+    spec: str | Sequence[str], *, mapping: str | dict | None = None, fmu_path: str | Path | FmuModel | None = None
 ) -> list[Tool]:
     """The tools of a --tools list (a comma-separated string or its items), in order.
 
-    mapping is the --map for the tools given as LABEL=PATH; fmu_path the FMU that "fmu" runs.
+    mapping is the --map for the tools given as LABEL=PATH (its text, or a dict as
+    mapped_fmu.as_map takes it); fmu_path the FMU that "fmu" runs.
     """
     if isinstance(spec, str):
         spec = spec.split(",")

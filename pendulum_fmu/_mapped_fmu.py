@@ -165,7 +165,7 @@ class MappedFmu:
             mapping[quantity] = mapped
         return mapping
 
-    def _start_values(self, parameters: dict, theta0: float, omega0: float) -> dict[str, float]:
+    def _start_values(self, parameters: dict | None, theta0: float, omega0: float) -> dict[str, float]:
         """{FMU variable: value in the FMU's units} for the parameters and start values."""
         values = {**resolve_parameters(parameters), "theta0": theta0, "omega0": omega0}
         defaults = default_parameters()

@@ -14,10 +14,11 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.backend_bases import FigureCanvasBase
 from matplotlib.lines import Line2D
+from numpy.typing import ArrayLike
 
 from ._atomic_files import replacing_path
 from ._errors import InvalidInput
-from ._parameters import merged_parameters, unit
+from ._parameters import Fmu, merged_parameters, unit
 
 THETA_LABEL = r"Position $\theta$ in rad"
 OMEGA_LABEL = r"Velocity $\omega$ in rad/s"
@@ -29,7 +30,7 @@ def case_title(
     parameters: dict[str, float] | None = None,
     theta0: float = 0.0,
     omega0: float = 0.0,
-    fmu_path: str | Path | None = None,
+    fmu_path: Fmu = None,
 ) -> str:
     """'Torque-driven pendulum: torque 20 N.m, gravity 9.81 m/s2', then every parameter the user
     set and a start value other than 0, each with the unit the FMU declares.
@@ -92,6 +93,7 @@ def _leave_out_undrawable(ax) -> None:
     """
     notes = []
     for artist in [*ax.lines, *ax.collections]:
+        values: tuple[ArrayLike, ...]  # one array for an axhline, two for a line, one per path else
         if isinstance(artist, Line2D):
             if artist.get_transform() is not ax.transData:  # axhline: its x is the panel's width
                 values = (artist.get_ydata(),)

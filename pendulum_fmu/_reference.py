@@ -29,7 +29,7 @@ from scipy.integrate import solve_ivp
 
 from . import _results as results
 from ._errors import InvalidInput, WrongType
-from ._parameters import start_value, total_inertia
+from ._parameters import Fmu, start_value, total_inertia
 from ._simulate import resolve_parameters
 from ._torque_schedule import TorqueSchedule, read_torque_csv, step_count
 
@@ -241,7 +241,7 @@ def _integrate(
     omega0: float,
     rtol: float,
     atol: float,
-    fmu_path: str | Path | None,
+    fmu_path: Fmu,
     method: str = "DOP853",
     max_step: float = np.inf,
 ) -> np.ndarray:
@@ -281,7 +281,7 @@ def _integrate(
             # show, not numpy's warnings on the way to it.
             with np.errstate(over="ignore", invalid="ignore"):
                 solution = solve_ivp(
-                    lambda t, y: (y[1], acceleration(y[0], y[1], u0 + rate * (t - t0))),
+                    lambda t, y, u0=u0, rate=rate, t0=t0: (y[1], acceleration(y[0], y[1], u0 + rate * (t - t0))),
                     (t0, t1),
                     state,
                     method=method,
@@ -337,7 +337,7 @@ def reference(
     at: np.ndarray | None = None,
     rtol: float = 1e-12,
     atol: float = 1e-12,
-    fmu_path: str | Path | None = None,
+    fmu_path: Fmu = None,
     method: str = "DOP853",
     max_step: float = np.inf,
 ) -> np.ndarray:
@@ -428,7 +428,7 @@ def reference_schedule(
     at: np.ndarray | None = None,
     rtol: float = 1e-12,
     atol: float = 1e-12,
-    fmu_path: str | Path | None = None,
+    fmu_path: Fmu = None,
 ) -> np.ndarray:
     """Integrate exactly the torques of a schedule, reported at its communication points (or at
     the times `at`): the judge of a tool that was fed that schedule, and the judge's variants of

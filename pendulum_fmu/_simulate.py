@@ -25,7 +25,7 @@ from fmpy.fmi3 import FMU3Slave
 
 from . import _native_loop as cs_loop, _results as results, default_fmu
 from ._errors import InvalidInput, PendulumFmuError
-from ._model import FmuInstance, fmu_model
+from ._model import FmuInstance, FmuModel, fmu_model
 from ._parameters import (
     default_parameters,
     file_version,
@@ -498,7 +498,7 @@ def simulate_plan(
     theta0: float = 0.0,
     omega0: float = 0.0,
     tolerance: float | None = None,
-    fmu_path: str | Path | None = None,
+    fmu_path: str | Path | FmuModel | None = None,
 ) -> np.ndarray:
     """A schedule through this thread's Simulator of the FMU (see simulate)."""
     runner = simulator(fmu_path)
@@ -510,7 +510,7 @@ def simulate_plan(
 
 
 def resolve_parameters(
-    overrides: dict[str, float] | None = None, fmu_path: str | Path | None = None
+    overrides: dict[str, float] | None = None, fmu_path: str | Path | FmuModel | None = None
 ) -> dict[str, float]:
     """parameters.merged_parameters, and a set the FMU accepts.
 

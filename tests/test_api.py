@@ -72,7 +72,7 @@ def test_a_name_that_is_also_a_module_stays_the_function_once_the_module_is_impo
 
 def test_a_name_the_api_has_not_is_an_attribute_error():
     with pytest.raises(AttributeError, match="has no attribute 'simulat'"):
-        pendulum_fmu.simulat
+        _ = pendulum_fmu.simulat
 
 
 @pytest.mark.parametrize("name", [name for name in pendulum_fmu.__all__ if callable(getattr(pendulum_fmu, name))])
