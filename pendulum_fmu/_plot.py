@@ -8,11 +8,9 @@ import os
 from pathlib import Path
 
 import matplotlib
-
-matplotlib.use("Agg")  # files only: works on machines without a display
-import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.backend_bases import FigureCanvasBase
+from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from numpy.typing import ArrayLike
 
@@ -136,6 +134,12 @@ def _drawing(plot):
     return quietly
 
 
+def _figure(width: float, height: float) -> Figure:
+    # A Figure of its own, not pyplot's: no backend is chosen or changed (a notebook's inline
+    # plots stay as they are), no display is needed, and nothing is kept once the file is written.
+    return Figure(figsize=(width, height))
+
+
 def _finish(fig, axes, title: str, path: str | Path) -> Path:
     for ax in np.ravel(axes):
         _leave_out_undrawable(ax)
@@ -146,11 +150,8 @@ def _finish(fig, axes, title: str, path: str | Path) -> Path:
     fig.tight_layout()
     path = Path(path)
     check_figure_path(path)
-    try:
-        with replacing_path(path) as partial:
-            fig.savefig(partial, dpi=120, format=path.suffix.lstrip(".") or "png")
-    finally:
-        plt.close(fig)
+    with replacing_path(path) as partial:
+        fig.savefig(partial, dpi=120, format=path.suffix.lstrip(".") or "png")
     return path
 
 
@@ -189,7 +190,8 @@ def plot_overlay(runs: dict[str, np.ndarray], path: str | Path, title: str) -> P
     >>> figure.name, figure.read_bytes()[:4]
     ('overlay.png', b'\x89PNG')
     """
-    fig, axes = plt.subplots(2, 1, figsize=(10, 6), sharex=True)
+    fig = _figure(10, 6)
+    axes = fig.subplots(2, 1, sharex=True)
     for i, (label, run) in enumerate(runs.items()):
         style = dict(linewidth=2 if i == 0 else 1.5, linestyle="-" if i == 0 else "--")
         axes[0].plot(run["time"], run["theta"], label=label, **style)
@@ -233,7 +235,8 @@ def plot_comparison(runs: dict[str, np.ndarray], path: str | Path, title: str) -
     """Left: theta and omega of every tool overlaid. Right: |difference| of each tool against
     the first one, on a log scale, where agreement to 1e-10 is visible.
     """
-    fig, axes = plt.subplots(2, 2, figsize=(14, 6), sharex=True)
+    fig = _figure(14, 6)
+    axes = fig.subplots(2, 2, sharex=True)
     labels = list(runs)
     base = runs[labels[0]]
     for i, label in enumerate(labels):
@@ -256,8 +259,9 @@ def plot_comparison(runs: dict[str, np.ndarray], path: str | Path, title: str) -
 @_drawing
 def plot_cases(runs: dict[str, np.ndarray], path: str | Path, title: str) -> Path:
     """Theta and omega of many cases, coloured along a colormap; labelled when few enough."""
-    fig, axes = plt.subplots(2, 1, figsize=(10, 6), sharex=True)
-    colors = plt.cm.viridis(np.linspace(0, 0.9, max(len(runs), 1)))
+    fig = _figure(10, 6)
+    axes = fig.subplots(2, 1, sharex=True)
+    colors = matplotlib.colormaps["viridis"](np.linspace(0, 0.9, max(len(runs), 1)))
     labelled = len(runs) <= 12
     for color, (label, run) in zip(colors, runs.items(), strict=False):
         axes[0].plot(run["time"], run["theta"], color=color, linewidth=1.5, label=label if labelled else None)
@@ -310,7 +314,8 @@ def plot_case_bands(
     units: {swept name: unit} for the axes.
     """
     swept = {name: column for name, column in values.items() if len(np.unique(column)) > 1} or values
-    fig, axes = plt.subplots(len(summaries), len(swept), figsize=(4.5 * len(swept) + 1, 6), squeeze=False, sharey="row")
+    fig = _figure(4.5 * len(swept) + 1, 6)
+    axes = fig.subplots(len(summaries), len(swept), squeeze=False, sharey="row")
     labelled = set()
 
     def once(text):  # each legend entry on the first panel that draws it
@@ -370,7 +375,8 @@ def plot_judgement(judgement, path: str | Path, title: str) -> Path:
     """
     result, reference, variant = judgement.result, judgement.reference, judgement.explanation
     time = result["time"]
-    fig, axes = plt.subplots(3, 1, figsize=(10, 8), sharex=True)
+    fig = _figure(10, 8)
+    axes = fig.subplots(3, 1, sharex=True)
     axes[0].step(time, reference["torque"], where="post", linewidth=2, label="the run's torque")
     if variant is not None and not np.array_equal(variant["torque"], reference["torque"]):
         axes[0].step(
@@ -429,7 +435,8 @@ def plot_calls(judged: dict, path: str | Path, title: str) -> Path:
     --------
     >>> plot_calls(judge_calls("run.log", None, {0: "torque"}), "calls.png", "run.log")  # doctest: +SKIP
     """
-    fig, axes = plt.subplots(len(judged), 1, figsize=(10, 3 + 2.5 * len(judged)), squeeze=False)
+    fig = _figure(10, 3 + 2.5 * len(judged))
+    axes = fig.subplots(len(judged), 1, squeeze=False)
     for ax, (name, result) in zip(axes[:, 0], judged.items(), strict=True):
         steps = result["steps"]
         time = [step["time"] for step in steps]
