@@ -50,6 +50,7 @@ SETUPS = {"accurate": ACCURATE, "default": DEFAULT}
 
 
 def model_xml(parameters: dict, setup: Setup) -> str:
+    """The MJCF of the pendulum with these parameters, set up for a mode."""
     p = parameters
     limits = (
         'ctrllimited="false"'
@@ -73,7 +74,7 @@ def model_xml(parameters: dict, setup: Setup) -> str:
 
 
 def simulate(plan: TorqueSchedule, parameters: dict, theta0: float, omega0: float, setup: Setup) -> np.ndarray:
-    """The schedule through MuJoCo as setup says; the result array of results.py."""
+    """The schedule through MuJoCo as setup says; the result array of _results.py."""
     model = mujoco.MjModel.from_xml_string(model_xml(parameters, setup))
     data = mujoco.MjData(model)
     data.qpos[0], data.qvel[0] = theta0, omega0

@@ -82,7 +82,7 @@ class Store:
     format: str
 
     def part(self, table: str, index: int) -> str:
-        """Where a chunk's committed part of a table is."""
+        """The path of a table's part for a chunk."""
         return f"{self.root}/{table}/part-{index:06d}.{self.format}"
 
     def staged(self, table: str, index: int, run: str) -> str:
@@ -135,11 +135,11 @@ class Store:
         return {int(Path(path).stem.split("-")[1]): path for path in self.filesystem.glob(pattern)}
 
     def done_chunks(self) -> set[int]:
-        """The chunks whose cases part was committed: those done."""
+        """The indices of the chunks whose cases are written."""
         return set(self.parts("cases"))
 
     def remove(self, patterns: Iterable[str]) -> None:
-        """Remove what matches each glob pattern (relative to the folder), if it is there."""
+        """Remove every file or folder under the root that the glob patterns match."""
         for pattern in patterns:
             for path in self.filesystem.glob(f"{self.root}/{pattern}"):
                 with contextlib.suppress(FileNotFoundError):
@@ -147,7 +147,7 @@ class Store:
 
     def remove_unfinished(self) -> None:
         """What interrupted chunks leave: the temporaries of writes cut short (a killed worker, see
-        atomic_files.py), the staged parts no client committed (of this run or any other), and
+        _atomic_files.py), the staged parts no client committed (of this run or any other), and
         trajectory parts whose chunk did not get to commit its cases part.
         """
         self.remove(
