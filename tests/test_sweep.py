@@ -699,6 +699,22 @@ def _wait_till_busy(process: psutil.Process, folder, study: threading.Thread) ->
         assert study.is_alive() and time.monotonic() < deadline
 
 
+def _worker_address(scheduler: str, process: psutil.Process) -> str:
+    """The address the scheduler knows the worker running in process by."""
+    with Client(scheduler) as client:
+        pids = client.run(os.getpid)
+    return next(address for address, pid in pids.items() if pid == process.pid)
+
+
+def _dropped(scheduler: str, worker: str) -> bool:
+    """Whether the scheduler removed the worker as lost (not closed by its own wish): its event
+    log, which says so for a worker silent past the scheduler's time for one.
+    """
+    with Client(scheduler) as client:
+        events = client.get_events(worker)
+    return any(event["action"] == "remove-worker" and not event["expected"] for _, event in events)
+
+
 def _study_thread(study: Study, folder, address: str) -> tuple[threading.Thread, list]:
     """run_sweep of the study on the scheduler at address, started in a thread; its result
     lands in the list.
@@ -759,12 +775,14 @@ def test_a_workers_link_cut_mid_study_changes_nothing(tmp_path, monkeypatch, net
     places = [((), host), (elsewhere, far)]
     with benchmarks.scale.dask_process_handles(2, host=host, places=places) as (address, processes):
         far_worker = _computing(processes[2])
+        far_address = _worker_address(address, far_worker)
         first, results = _study_thread(study, tmp_path, address)
         _wait_till_busy(far_worker, tmp_path, first)
         subprocess.run(["ip", "link", "set", link, "down"], check=True)
         time.sleep(5)  # over twice the scheduler's 2 s for a silent worker
         subprocess.run(["ip", "link", "set", link, "up"], check=True)
         first.join(timeout=300)
+        assert _dropped(address, far_address)  # the fault took: its chunks went to the other worker
     assert results[0].cases == 128 and results[0].failed == 0 and results[0].chunks_run == 64
     _assert_every_case_once(tmp_path, FAULT_TORQUES, 300.0, stride=1000)
 
@@ -778,10 +796,12 @@ def test_a_worker_stopped_mid_study_under_a_nanny_changes_nothing(tmp_path, monk
     study = Study(sweep_grid(FAULT_TORQUES, [9.81]), stop_time=300.0, output_interval=1.0)
     with benchmarks.scale.dask_process_handles(2) as (address, processes):
         stopped = _computing(processes[2])
+        stopped_address = _worker_address(address, stopped)
         first, results = _study_thread(study, tmp_path, address)
         _wait_till_busy(stopped, tmp_path, first)
         stopped.suspend()
         first.join(timeout=300)
+        assert _dropped(address, stopped_address)
         assert results[0].cases == 128 and results[0].failed == 0
         parts = {p: p.read_bytes() for p in tmp_path.glob("*/part-*")}
         with contextlib.suppress(psutil.NoSuchProcess):  # its nanny may have ended it
