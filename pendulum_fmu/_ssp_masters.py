@@ -2,12 +2,17 @@
 
 Each runner takes the SSP as a user would hand it over and returns the pendulum's theta at the
 times the master reports, as the master labels them; ssp_judge then says what the master did.
+Where the SSP's pendulum set names a callRecordFile (export_ssp's call_record), each runner has
+the pendulum's record of its FMI calls written there, in the way that master allows, for
+ssp_calls to judge: libcosim applies the set itself; fmpy.ssp is handed it as its parameter_set;
+fmucontainer ignores the set, so its container runs with logging on and its log is the record.
 OMSimulator is not among them: its PyPI sdist downloads binaries at install time (docs/ssp.md
 gives its command).
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
 import shutil
 import subprocess
@@ -17,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ._atomic_files import replacing
 from ._errors import MissingDependency
 from ._ssp import read_ssp
 from ._ssp_judge import judge_coupling
@@ -93,14 +99,46 @@ def run_fmpy_ssp(ssp: str | os.PathLike, *, parameter_set: bool = False) -> tupl
     from fmpy.ssp.ssd import Parameter, ParameterSet
 
     settings = read_ssp(ssp)
-    given = None
+    given = ParameterSet()
+    if settings.call_record:  # first, so that the record holds the parameters set after it
+        given.parameters.append(Parameter(name="pendulum.callRecordFile", type="String", value=settings.call_record))
     if parameter_set:
-        given = ParameterSet()
         for component, values in (("controller", settings.controller), ("pendulum", settings.pendulum)):
             for name, value in values.items():
                 given.parameters.append(Parameter(name=f"{component}.{name}", type="Real", value=value))
-    result = simulate_ssp(str(ssp), stop_time=settings.stop_time, step_size=settings.step_size, parameter_set=given)
+    with _fmpy_ssp_sets_strings():
+        result = simulate_ssp(
+            str(ssp),
+            stop_time=settings.stop_time,
+            step_size=settings.step_size,
+            parameter_set=given if given.parameters else None,
+        )
     return result["time"], result["pendulum.theta"]
+
+
+@contextlib.contextmanager
+def _fmpy_ssp_sets_strings():
+    """fmpy.ssp with String parameters in its parameter_set, for the pendulum's callRecordFile.
+
+    fmpy 0.3's fmpy.ssp.simulation.set_value refuses any type but Real, Integer and Boolean: while
+    this lasts, a String goes to the FMU's fmi2SetString and every other type to fmpy's own.
+    """
+    from fmpy.ssp import simulation
+
+    own = simulation.set_value
+
+    def set_value(component, name, value):
+        variable = component.variables[name]
+        if variable.type == "String":
+            component.fmu.setString([variable.valueReference], [str(value)])
+        else:
+            own(component, name, value)
+
+    simulation.set_value = set_value
+    try:
+        yield
+    finally:
+        simulation.set_value = own
 
 
 def run_fmucontainer(ssp: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
@@ -150,9 +188,16 @@ def run_fmucontainer(ssp: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
             check=True,
             capture_output=True,
         )
-        result = simulate_fmu(
-            str(copy.with_suffix(".fmu")), stop_time=settings.stop_time, output_interval=settings.step_size
-        )
+        container = str(copy.with_suffix(".fmu"))
+        if not settings.call_record:
+            result = simulate_fmu(container, stop_time=settings.stop_time, output_interval=settings.step_size)
+        else:
+            # The container passes no parameter set on, but forwards its FMUs' log messages: with
+            # logging on, its log (fmpy prints it) holds the pendulum's record.
+            with replacing(settings.call_record) as log, contextlib.redirect_stdout(log):
+                result = simulate_fmu(
+                    container, stop_time=settings.stop_time, output_interval=settings.step_size, debug_logging=True
+                )
     return result["time"], result["pendulum.theta"]
 
 
