@@ -13,15 +13,14 @@ from __future__ import annotations
 import math
 import numbers
 import os
-import tempfile
 import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 from xml.etree import ElementTree
 
+from . import default_fmu
 from ._atomic_files import replacing
-from ._checkout import build_tool
-from ._closed_loop import WIRES, controller_defaults
+from ._closed_loop import WIRES, controller_defaults, controller_fmu
 from ._errors import InvalidInput, MissingFile, PendulumFmuError
 from ._simulate import resolve_parameters
 
@@ -235,8 +234,10 @@ def export_ssp(
         a controller parameter the controller does not have, or pendulum parameters it refuses.
     CannotWrite
         out_file cannot be written.
+    MissingFile
+        An installed package without its packaged FMUs.
     BuildError
-        The FMUs cannot be built here.
+        A checkout whose FMUs are stale and cannot be rebuilt here.
 
     Examples
     --------
@@ -259,18 +260,14 @@ def export_ssp(
     pendulum = resolve_parameters(parameters)
     if out_file.exists() and not overwrite:
         raise SspExists(f"{out_file} exists: pass --overwrite to replace it, or name another file")
-    with tempfile.TemporaryDirectory(prefix="pendulum_fmu_ssp_") as tmp:
-        fmus = {
-            "pendulum": build_tool().build_fmu(Path(tmp) / "Pendulum.fmu"),
-            "controller": build_tool().build_pid_controller(Path(tmp) / "PIDController.fmu"),
-        }
-        with replacing(out_file, "wb") as file, zipfile.ZipFile(file, "w", zipfile.ZIP_DEFLATED) as archive:
-            archive.writestr("SystemStructure.ssd", system_structure_xml(stop_time, step_size))
-            for name, (source, _) in COMPONENTS.items():
-                archive.write(fmus[name], source)
-            archive.writestr("resources/controller.ssv", parameter_set_xml("controller", gains))
-            record = {} if call_record is None else {"callRecordFile": os.fspath(call_record)}
-            archive.writestr("resources/pendulum.ssv", parameter_set_xml("pendulum", pendulum, record))
+    fmus = {"pendulum": default_fmu(), "controller": controller_fmu()}
+    with replacing(out_file, "wb") as file, zipfile.ZipFile(file, "w", zipfile.ZIP_DEFLATED) as archive:
+        archive.writestr("SystemStructure.ssd", system_structure_xml(stop_time, step_size))
+        for name, (source, _) in COMPONENTS.items():
+            archive.write(fmus[name], source)
+        archive.writestr("resources/controller.ssv", parameter_set_xml("controller", gains))
+        record = {} if call_record is None else {"callRecordFile": os.fspath(call_record)}
+        archive.writestr("resources/pendulum.ssv", parameter_set_xml("pendulum", pendulum, record))
     return out_file
 
 

@@ -197,18 +197,22 @@ def test_the_kits_closed_loop_names_each_couplings_reference_as_that_coupling(tm
     assert "--overwrite" in capsys.readouterr().err
 
 
-def test_an_installed_package_without_the_controller_s_sources_is_one_line(tmp_path, monkeypatch, capsys):
-    # An installed package sits where no fmu_src/ is beside it (what the wheel installs).
+def test_an_installed_package_without_its_packaged_controller_is_one_line(tmp_path, monkeypatch, capsys):
+    # An installed package (no fmu_src/ beside it) whose data/ lacks the controller: reinstall.
     monkeypatch.setattr("pendulum_fmu._closed_loop.ROOT", tmp_path)
+    monkeypatch.setattr("pendulum_fmu._closed_loop.is_source_checkout", lambda: False)
+    monkeypatch.setattr("pendulum_fmu.CONTROLLER_FMU_FILE", "Absent.fmu")
     assert main(["export-ssp", str(tmp_path / "ClosedLoop.ssp")]) == 2
     [line] = capsys.readouterr().err.strip().splitlines()
-    assert line.startswith("pendulum-fmu export-ssp: error: the PID controller's sources")
-    assert "needs a clone of pendulum-fmu" in line and not (tmp_path / "ClosedLoop.ssp").exists()
-
+    assert line.startswith("pendulum-fmu export-ssp: error: pendulum_fmu ")
+    assert "has neither its packaged data/Absent.fmu" in line and "reinstall it" in line
+    assert not (tmp_path / "ClosedLoop.ssp").exists()
 
 def _with_sets(ssp, out, call_record, controller=None):
-    """A copy of the SSP whose pendulum set names call_record as its callRecordFile (as export-ssp
-    --call-record writes it), with another controller set where given."""
+    """A copy of the SSP whose pendulum set names call_record as its callRecordFile.
+
+    As export-ssp --call-record writes it; with another controller set where given.
+    """
     settings = read_ssp(ssp)
     with zipfile.ZipFile(ssp) as source, zipfile.ZipFile(out, "w") as copy:
         for name in source.namelist():
