@@ -271,6 +271,61 @@ def export_ssp(
     return out_file
 
 
+def rebind_ssp(
+    ssp: str | os.PathLike,
+    out_file: str | os.PathLike,
+    *,
+    call_record: str | os.PathLike | None = None,
+    controller: dict[str, float] | None = None,
+) -> Path:
+    """A copy of the closed loop's SSP with the pendulum's callRecordFile or the controller's set replaced.
+
+    Parameters
+    ----------
+    ssp : str or PathLike
+        An SSP export_ssp wrote.
+    out_file : str or PathLike
+        The copy to write (replaced when it exists).
+    call_record : str or PathLike, optional
+        The pendulum's callRecordFile in the copy's pendulum set (as export_ssp's call_record).
+    controller : dict, optional
+        The copy's whole controller set, in place of the SSP's (a parameter left out is one the
+        controller takes its own default for).
+
+    Returns
+    -------
+    Path
+        out_file.
+
+    Raises
+    ------
+    MissingFile, SspFileError
+        As read_ssp.
+    CannotWrite
+        out_file cannot be written.
+
+    Examples
+    --------
+    >>> rebind_ssp("ClosedLoop.ssp", "Recorded.ssp", call_record="calls.log")  # doctest: +SKIP
+    PosixPath('Recorded.ssp')
+    """
+    settings = read_ssp(ssp)
+    replaced = {}
+    if call_record is not None:
+        record = {"callRecordFile": os.fspath(call_record)}
+        replaced["resources/pendulum.ssv"] = parameter_set_xml("pendulum", settings.pendulum, record)
+    if controller is not None:
+        replaced["resources/controller.ssv"] = parameter_set_xml("controller", controller)
+    with (
+        zipfile.ZipFile(ssp) as source,
+        replacing(out_file, "wb") as file,
+        zipfile.ZipFile(file, "w", zipfile.ZIP_DEFLATED) as copy,
+    ):
+        for name in source.namelist():
+            copy.writestr(name, replaced.get(name) or source.read(name))
+    return Path(out_file)
+
+
 def _attribute(element: ElementTree.Element, path: str, attribute: str) -> str:
     """The attribute of the element at path under element; a KeyError naming both when either is missing."""
     found = element if path == "." else element.find(path, NAMESPACES)

@@ -24,7 +24,8 @@ import numpy as np
 
 from ._atomic_files import replacing
 from ._errors import MissingDependency
-from ._ssp import read_ssp
+from ._ssp import read_ssp, rebind_ssp
+from ._ssp_calls import judge_ssp_calls
 from ._ssp_judge import judge_coupling
 
 NANOSECONDS = 10**9  # libcosim counts time in ns
@@ -209,45 +210,59 @@ MASTERS = {
 }
 
 
-def masters_table(ssp: str | os.PathLike) -> str:
+def masters_table(ssp: str | os.PathLike, records: str | os.PathLike | None = None) -> str:
     """Run the SSP in every master here and tabulate what the judge says of each (Markdown).
 
     Parameters
     ----------
     ssp : str or PathLike
         The closed loop's SSP.
+    records : str or PathLike, optional
+        A folder: each master runs a copy of the SSP there whose pendulum writes its call record
+        beside it (MASTER_NUMBER.log), and the row adds what the judge reads from that record.
 
     Returns
     -------
     str
         One row per master: theta at the stop time, the coupling, whether the parameter set was
-        applied, the distance from that coupling's reference and the problems found; a master
-        that is not installed says so in its row.
+        applied, the distance from that coupling's reference and the problems found; with records,
+        the coupling, the controller parameters that did not arrive, the pendulum parameters set
+        and the problems the call record shows. A master that is not installed says so in its row.
 
     Examples
     --------
     >>> print(masters_table("ClosedLoop.ssp"))  # doctest: +SKIP
     """
     settings = read_ssp(ssp)
-    rows = [
-        "| master | theta at stop time | coupling | parameter set applied | from its reference | problems |",
-        "|---|---|---|---|---|---|",
-    ]
-    for name, run in MASTERS.items():
+    header = "| master | theta at stop time | coupling | parameter set applied | from its reference | problems |"
+    if records is not None:
+        header += " call record: coupling | controller parameters missing | pendulum parameters set | problems |"
+    columns = header.count("|") - 1
+    rows = [header, "|---" * columns + "|"]
+    for number, (name, run) in enumerate(MASTERS.items()):
+        record = None if records is None else Path(records, f"master_{number}.log")
+        ran = ssp if record is None else rebind_ssp(ssp, record.with_suffix(".ssp"), call_record=record)
         try:
-            time, theta = run(ssp)
+            time, theta = run(ran)
         except MissingDependency as missing:
-            rows.append(f"| {name} | not run: {missing} | | | | |")
+            rows.append(f"| {name} | not run: {missing} |" + " |" * (columns - 2))
             continue
         verdict = judge_coupling(time, theta, settings)
         # fmpy.ssp labels each value with its step's start: the value at the stop time is the one
         # labelled a step earlier.
         at_stop = np.interp(settings.stop_time - verdict.labelled_at_step_start * verdict.step_size, time, theta)
-        rows.append(
+        row = (
             f"| {name} | {float(at_stop)!r} | {verdict.coupling} | "
             f"{'yes' if verdict.parameter_set_applied else 'no'} | {verdict.max_error:.2g} rad | "
             f"{'; '.join(verdict.problems) or 'none'} |"
         )
+        if record is not None:
+            recorded = judge_ssp_calls(record, settings)
+            row += (
+                f" {recorded.coupling} | {', '.join(recorded.controller_missing) or 'none'} | "
+                f"{', '.join(recorded.pendulum_set) or 'none'} | {'; '.join(recorded.problems) or 'none'} |"
+            )
+        rows.append(row)
     return "\n".join(rows)
 
 
@@ -279,7 +294,7 @@ def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     with tempfile.TemporaryDirectory(prefix="pendulum_fmu_ssp_") as tmp:
         ssp = argv[0] if argv else export_ssp(Path(tmp) / "ClosedLoop.ssp")
-        print(masters_table(ssp))
+        print(masters_table(ssp, records=tmp))
     return 0
 
 

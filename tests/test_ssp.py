@@ -14,7 +14,7 @@ import pytest
 
 from pendulum_fmu._calls import read_calls, reconstruct
 from pendulum_fmu._closed_loop import COUPLINGS, controller_defaults, sampled_loop_reference
-from pendulum_fmu._ssp import DEFAULT_SETPOINT, export_ssp, parameter_set_xml, read_ssp
+from pendulum_fmu._ssp import DEFAULT_SETPOINT, export_ssp, read_ssp, rebind_ssp
 from pendulum_fmu._ssp_calls import judge_ssp_calls
 from pendulum_fmu._ssp_judge import judge_coupling
 from pendulum_fmu.cli import main
@@ -208,22 +208,6 @@ def test_an_installed_package_without_its_packaged_controller_is_one_line(tmp_pa
     assert "has neither its packaged data/Absent.fmu" in line and "reinstall it" in line
     assert not (tmp_path / "ClosedLoop.ssp").exists()
 
-def _with_sets(ssp, out, call_record, controller=None):
-    """A copy of the SSP whose pendulum set names call_record as its callRecordFile.
-
-    As export-ssp --call-record writes it; with another controller set where given.
-    """
-    settings = read_ssp(ssp)
-    with zipfile.ZipFile(ssp) as source, zipfile.ZipFile(out, "w") as copy:
-        for name in source.namelist():
-            data = source.read(name)
-            if name == "resources/pendulum.ssv":
-                data = parameter_set_xml("pendulum", settings.pendulum, {"callRecordFile": str(call_record)})
-            elif name == "resources/controller.ssv" and controller is not None:
-                data = parameter_set_xml("controller", controller)
-            copy.writestr(name, data)
-    return out
-
 
 def _recorded_torques(log):
     """The torque held over each step of the pendulum's instance, read from its record."""
@@ -265,7 +249,7 @@ def test_the_pendulums_call_record_names_each_masters_coupling_and_sets(master, 
     coupling, applied, one_step_more = MASTERS_AS_KNOWN[master]
     settings = read_ssp(ssp)
     log = tmp_path / "calls.log"
-    time, theta = run(_with_sets(ssp, tmp_path / "ClosedLoop.ssp", log))
+    time, theta = run(rebind_ssp(ssp, tmp_path / "ClosedLoop.ssp", call_record=log))
     # The torques the record holds are the coupling's, by the reference alone.
     torques = _recorded_torques(log)
     steps = round(settings.stop_time / settings.step_size) + one_step_more
@@ -316,7 +300,7 @@ def test_a_doctored_record_with_a_late_torque_and_no_setpoint_is_named(ssp, tmp_
     log = tmp_path / "calls.log"
     # The master ran a set without the setpoint (the controller's own 0.5 in force) ...
     without_setpoint = {name: value for name, value in settings.controller.items() if name != "setpoint"}
-    run_libcosim(_with_sets(ssp, tmp_path / "NoSetpoint.ssp", log, controller=without_setpoint))
+    run_libcosim(rebind_ssp(ssp, tmp_path / "NoSetpoint.ssp", call_record=log, controller=without_setpoint))
     # ... and set the torque of step 700 after that step.
     _one_torque_a_step_late(log, 700)
     torques = _recorded_torques(log)
