@@ -180,7 +180,7 @@ class Judgement:
 
 
 def read_result(path: str | Path, mapping: str | dict | None = None) -> np.ndarray:
-    """A result CSV as a result array (results.py); omega and alpha are NaN where it has none.
+    """A result CSV as a result array (_results.py); omega and alpha are NaN where it has none.
 
     Parameters
     ----------
@@ -669,7 +669,7 @@ def judge_kit(
     mapping: str | None = None,
     fmu_path: str | Path | None = None,
 ) -> dict[str, Judgement | None]:
-    """Judge every NAME_out.csv beside the settings NAME.json of a scenario kit (scenarios.py).
+    """Judge every NAME_out.csv beside the settings NAME.json of a scenario kit (_scenarios.py).
 
     Parameters
     ----------
