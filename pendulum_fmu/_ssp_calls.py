@@ -6,7 +6,7 @@ LOG is the pendulum's call record (its callRecordFile, export-ssp --call-record)
 log holding it (docs/calls.md). The record shows what reached the pendulum: the parameters set
 before initialization ended, and each step's time, size and the torque held over it. The torques
 are the controller's, so they carry what the record cannot show directly: each is held against
-the closed loop's reference of every coupling (closed_loop.COUPLINGS), run with the pendulum's
+the closed loop's reference of every coupling (_closed_loop.COUPLINGS), run with the pendulum's
 parameters as the record shows them and with the SSP's controller set, or with any of the set's
 values the controller's own default instead (a value that did not arrive). The candidate most
 of whose torques agree names the coupling and the controller parameters that arrived; each step

@@ -4,7 +4,7 @@ Each runner takes the SSP as a user would hand it over and returns the pendulum'
 times the master reports, as the master labels them; ssp_judge then says what the master did.
 Where the SSP's pendulum set names a callRecordFile (export_ssp's call_record), each runner has
 the pendulum's record of its FMI calls written there, in the way that master allows, for
-ssp_calls to judge: libcosim applies the set itself; fmpy.ssp is handed it as its parameter_set;
+_ssp_calls.py to judge: libcosim applies the set itself; fmpy.ssp is handed it as its parameter_set;
 fmucontainer ignores the set, so its container runs with logging on and its log is the record.
 OMSimulator is not among them: its PyPI sdist downloads binaries at install time (docs/ssp.md
 gives its command).
