@@ -157,7 +157,7 @@ def test_installed_package_runs_from_an_empty_folder(installed, tmp_path):
     )
     assert fmu == package / "data" / "Pendulum.fmu"
     assert read_model_description(str(fmu)).generationTool == f"pendulum_fmu {__version__}"
-    _run([python, "-c", "from pendulum_fmu import cs_loop; assert cs_loop.available()"], cwd=tmp_path)
+    _run([python, "-c", "from pendulum_fmu import _native_loop; assert _native_loop.available()"], cwd=tmp_path)
 
     expected = reference(20.0, stop_time=3.0, step_size=1e-3)
     _run([cli, "simulate", "--torque", "20", "--output", "simulated.csv"], cwd=tmp_path)
@@ -221,7 +221,7 @@ SSP_SCHEMAS = Path(fmpy.__file__).parent / "ssp" / "schema"
 def _closed_loop_ssp_from_the_installed_package(python, cli, folder):
     """export-ssp in an empty folder: an SSP that validates and that fmpy.ssp runs as its coupling's reference."""
     folder.mkdir()
-    assert _run([cli, "export-ssp", "--stop-time", "1"], cwd=folder).stdout == "wrote ClosedLoop.ssp\n"
+    assert _run([cli, "export-ssp", "--stop-time", "2"], cwd=folder).stdout == "wrote ClosedLoop.ssp\n"
     with zipfile.ZipFile(folder / "ClosedLoop.ssp") as archive:
         for name, schema in (
             ("SystemStructure.ssd", "SystemStructureDescription.xsd"),
@@ -235,15 +235,16 @@ def _closed_loop_ssp_from_the_installed_package(python, cli, folder):
             python,
             "-c",
             "from fmpy.ssp.simulation import simulate_ssp; from fmpy.util import write_csv; "
-            "write_csv('ssp.csv', simulate_ssp('ClosedLoop.ssp', stop_time=1.0, step_size=1e-3))",
+            "write_csv('ssp.csv', simulate_ssp('ClosedLoop.ssp', stop_time=2.0, step_size=1e-3))",
         ],
         cwd=folder,
     )
     result = _csv_columns(folder / "ssp.csv")
     # fmpy.ssp applies no bound set (the controller's own setpoint 0.5), holds torque 0 over the
-    # first step and labels each row with the start of the step whose end it holds.
-    expected = sampled_loop_reference(1.001, 1e-3, coupling="jacobi-first-exchange-missing")
-    assert len(result["time"]) == 1001
+    # first step and labels each row with the start of the step whose end it holds; to 2 s its
+    # summed time takes one step more (tests/test_ssp.py).
+    expected = sampled_loop_reference(2.001, 1e-3, coupling="jacobi-first-exchange-missing")
+    assert len(result["time"]) == 2001
     assert np.max(np.abs(result["pendulum.theta"] - expected["theta"][1:])) < 1e-12
 
 
