@@ -115,6 +115,30 @@ def _torque_problems(applied: np.ndarray, reference: np.ndarray, times: np.ndarr
     return [found + (f"; {more} later step{'s' * (more > 1)} differ too" if more else "")]
 
 
+def _closest(
+    applied: np.ndarray, step_size: float, controller: dict, controller_default: dict, pendulum: tuple
+) -> tuple[str, tuple, np.ndarray]:
+    """The coupling and the controller parameters missing whose reference torques most steps hold.
+
+    Every coupling, with the SSP's controller set and with each subset of its values that differ
+    from the controller's defaults at those defaults; ties go to the smaller median difference.
+    Returns the coupling, the missing parameters and that reference's torque per step.
+    """
+    showing = [name for name, value in controller.items() if value != controller_default.get(name)]
+    scores = {}
+    for coupling in COUPLINGS:
+        for count in range(len(showing) + 1):
+            for missing in itertools.combinations(showing, count):
+                gains = {**controller, **{name: controller_default[name] for name in missing}}
+                reference = reference_run(
+                    len(applied) * step_size, step_size, coupling, tuple(sorted(gains.items())), pendulum
+                )["torque"][: len(applied)]
+                agreeing = int(_agreeing(applied, reference).sum())
+                scores[coupling, missing] = (-agreeing, float(np.median(np.abs(applied - reference))), reference)
+    (coupling, missing), (_, _, reference) = min(scores.items(), key=lambda item: item[1][:2])
+    return coupling, missing, reference
+
+
 def judge_ssp_calls(log: str | os.PathLike, ssp: str | os.PathLike | SspSettings) -> SspCallsVerdict:
     """Name the coupling, the parameters that arrived and each wrong torque from the pendulum's record.
 
@@ -155,19 +179,7 @@ def judge_ssp_calls(log: str | os.PathLike, ssp: str | os.PathLike | SspSettings
     pendulum_set = {name: value for name, value in record.set_before_start.items() if name in defaults}
     pendulum_used = tuple(sorted({**defaults, **pendulum_set}.items()))
     controller_default = controller_defaults()
-    showing = [name for name, value in settings.controller.items() if value != controller_default.get(name)]
-    scores = {}
-    for coupling in COUPLINGS:
-        for count in range(len(showing) + 1):
-            for missing in itertools.combinations(showing, count):
-                gains = {**settings.controller, **{name: controller_default[name] for name in missing}}
-                reference = reference_run(
-                    len(steps) * step_size, step_size, coupling, tuple(sorted(gains.items())), pendulum_used
-                )["torque"][: len(steps)]
-                agree = _agreeing(applied, reference)
-                difference = np.abs(applied - reference)
-                scores[coupling, missing] = (-int(agree.sum()), float(np.median(difference)), reference)
-    (coupling, missing), (_, _, reference) = min(scores.items(), key=lambda item: item[1][:2])
+    coupling, missing, reference = _closest(applied, step_size, settings.controller, controller_default, pendulum_used)
     agree = _agreeing(applied, reference)
     problems = _torque_problems(applied, reference, times, coupling)
     problems += [

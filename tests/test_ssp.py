@@ -318,3 +318,29 @@ def test_a_doctored_record_with_a_late_torque_and_no_setpoint_is_named(ssp, tmp_
         "the SSP's set has 0.3" in printed
     )
     assert printed[-1] == "FAIL"
+
+
+def test_fmpys_container_fmu_read_from_its_log_is_gauss_seidel_pendulum_first(ssp, tmp_path):
+    # fmpy's container (create_closed_loop_fmu) is the Gauss-Seidel master here: it takes no
+    # parameter set, and with logging on its log carries both FMUs' records.
+    import contextlib
+
+    from fmpy import simulate_fmu
+
+    from pendulum_fmu._closed_loop import create_closed_loop_fmu
+
+    container, log = create_closed_loop_fmu(tmp_path / "ClosedLoop.fmu"), tmp_path / "container.log"
+    with open(log, "w") as file, contextlib.redirect_stdout(file):
+        simulate_fmu(str(container), stop_time=2.0, output_interval=1e-3, debug_logging=True)
+    expected = sampled_loop_reference(2.0, 1e-3, coupling="gauss-seidel-pendulum-first")["torque"][:-1]
+    assert np.max(np.abs(_recorded_torques(log) - expected)) < 1e-9
+    verdict = judge_ssp_calls(log, read_ssp(ssp))
+    assert (verdict.instance, verdict.coupling, verdict.controller_missing) == (
+        "pendulum",
+        "gauss-seidel-pendulum-first",
+        ("setpoint",),
+    )
+    assert [problem.split(":")[0] for problem in verdict.problems] == [
+        "the controller's setpoint did not arrive",
+        "the pendulum's parameter set did not arrive",
+    ]
