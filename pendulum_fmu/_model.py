@@ -33,6 +33,21 @@ FMI_VERSIONS = ("2.0", "3.0")
 class FmuFileError(InvalidInput):
     """The file given as an FMU is none this package can run: not a zip, no modelDescription.xml,
     not FMI 2.0 or 3.0, or not a pendulum; the message names the file and what to do.
+
+    Examples
+    --------
+    A text file given as an FMU:
+
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from pendulum_fmu import FmuFileError, simulate
+    >>> not_an_fmu = Path(tempfile.mkdtemp(), "notes.fmu")
+    >>> _ = not_an_fmu.write_text("not a zip")
+    >>> try:
+    ...     simulate(20.0, fmu_path=not_an_fmu)
+    ... except FmuFileError as error:
+    ...     print(str(error).replace(str(not_an_fmu), "notes.fmu"))
+    notes.fmu is not an FMU (an FMU is a zip archive with a modelDescription.xml): check the path
     """
 
 
@@ -228,8 +243,12 @@ def fmu_model(fmu: str | os.PathLike | FmuModel | None = None) -> FmuModel:
 
     Examples
     --------
-    >>> fmu_model("dist/Pendulum.fmu").fmi_version
-    2
+    >>> from pendulum_fmu import default_fmu, fmu_model
+    >>> model = fmu_model(default_fmu())
+    >>> model.fmi_version, model.default_parameters
+    (2, {'mass': 40.0, 'length': 0.5, 'inertia': 20.0, 'gravity': 9.81, 'damping': 0.0})
+    >>> fmu_model(default_fmu()) is model  # made once per file version
+    True
     """
     if isinstance(fmu, FmuModel):
         return fmu
@@ -245,6 +264,8 @@ class FmuInstance:
     fmpy's calls (doStep, getReal, setFloat64, terminate, freeInstance, dll, component, ...) pass
     through to the slave, so an instance is used as the slave would be.
 
+    Made by open_fmu(), which instantiates and initializes it.
+
     Parameters
     ----------
     slave : fmpy.fmi2.FMU2Slave or fmpy.fmi3.FMU3Slave
@@ -254,13 +275,28 @@ class FmuInstance:
     model : FmuModel
         The FMU the slave was made from.
 
+    Attributes
+    ----------
+    slave : fmpy.fmi2.FMU2Slave or fmpy.fmi3.FMU3Slave
+        fmpy's instance, which the calls pass through to.
+    messages : pendulum_fmu._simulate.MessageLog
+        What the FMU logged.
+    model : FmuModel
+        The FMU's model object: value references, parameters, outputs.
+    fmi_version : {2, 3}
+        The FMI standard of the FMU.
+    dll, component
+        fmpy's loaded library and the FMI component, as the native loop binds them.
+
     Examples
     --------
-    >>> from pendulum_fmu._simulate import open_fmu
+    >>> from pendulum_fmu import open_fmu
     >>> instance = open_fmu()
-    >>> instance.model.fmi_version, instance.fmi_version
-    (2, 2)
-    >>> instance.terminate(); instance.freeInstance()
+    >>> type(instance).__name__, instance.fmi_version, instance.model.outputs
+    ('FmuInstance', 2, ('theta', 'omega', 'alpha'))
+    >>> instance.getReal([instance.model.value_reference("theta")])
+    [0.0]
+    >>> status = instance.terminate(); instance.freeInstance()
     """
 
     def __init__(self, slave, messages, model: FmuModel):

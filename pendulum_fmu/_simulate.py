@@ -25,7 +25,7 @@ from fmpy.fmi3 import FMU3Slave
 
 from . import _native_loop as cs_loop, _results as results, default_fmu
 from ._errors import InvalidInput, PendulumFmuError
-from ._model import FmuInstance, fmu_model
+from ._model import FmuInstance, FmuModel, fmu_model
 from ._parameters import (
     default_parameters,
     file_version,
@@ -48,7 +48,19 @@ def __getattr__(name: str):
 
 
 class FmuError(PendulumFmuError, RuntimeError):
-    """An FMI call failed; the message carries what the FMU logged."""
+    """An FMI call failed, or the FMU refused a value; the message carries what the FMU logged.
+
+    Examples
+    --------
+    A relative tolerance the FMU refuses when it is set up:
+
+    >>> from pendulum_fmu import FmuError, simulate
+    >>> try:
+    ...     simulate(20.0, tolerance=2.0)
+    ... except FmuError as error:
+    ...     print(error)
+    initialization failed: [ERROR] fmi2SetupExperiment: tolerance 2 must be in (0, 1)
+    """
 
 
 def _log_to_instance(environment, instance_name, status, category, message):
@@ -163,21 +175,58 @@ def open_fmu(
     start_time: float = 0.0,
     instance_name: str = "pendulum",
 ):
-    """An initialized FmuInstance (in step mode, the FMI version read from the FMU's model
-    description; instance.fmi_version says which), with its message log as instance.messages and
-    its model as instance.model; fmpy's calls pass through to its FMU2Slave or FMU3Slave.
+    """An FMU instance, initialized and in step mode, to drive call by call with fmpy's calls.
 
-    fmu_path (a path, a model.FmuModel, or None for pendulum_fmu.default_fmu()) names the FMU;
-    parameters and value references are that FMU's own. The caller frees it with
-    instance.terminate(); instance.freeInstance().
+    The FMI version is read from the FMU's model description (instance.fmi_version says which);
+    fmpy's calls (doStep, getReal, setReal, setFloat64, ...) pass through to its FMU2Slave or
+    FMU3Slave. The caller frees it with ``instance.terminate(); instance.freeInstance()``.
+
+    Parameters
+    ----------
+    fmu_path : str, Path, FmuModel or None, optional
+        The FMU; None: pendulum_fmu.default_fmu(). Its parameters and value references apply.
+    parameters : dict, optional
+        The FMU's parameters over its defaults (mass, length, inertia, gravity, damping).
+    theta0, omega0 : float, optional
+        Start angle (rad) and rate (rad/s).
+    tolerance : float, optional
+        The relative tolerance handed to the FMU (None: the FMU's own).
+    start_time : float, optional
+        The time of the first communication point, in s.
+    instance_name : str, optional
+        The FMI instance name, which the FMU's log messages carry.
+
+    Returns
+    -------
+    FmuInstance
+        With its message log as instance.messages and its model as instance.model.
 
     Raises
     ------
-    MissingFile, parameters.FmuFileError
+    MissingFile, FmuFileError
         No file at fmu_path, or none that is a pendulum FMU this machine can run (checked before
         anything is unzipped or loaded).
+    InvalidInput
+        A parameter or start value that is no finite number, or one the FMU refuses.
     FmuError
-        The FMU refused the parameters or start values; the message carries what it logged.
+        The FMU refused the tolerance or the start time; the message carries what it logged.
+
+    Examples
+    --------
+    One 0.1 s step with 20 N.m from theta = 0.1 rad:
+
+    >>> from pendulum_fmu import open_fmu
+    >>> instance = open_fmu(theta0=0.1)
+    >>> theta, omega, torque = (instance.model.value_reference(name) for name in ("theta", "omega", "torque"))
+    >>> instance.fmi_version, instance.getReal([theta, omega])
+    (2, [0.1, 0.0])
+    >>> instance.setReal([torque], [20.0])
+    >>> instance.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.1)
+    >>> [round(value, 6) for value in instance.getReal([theta, omega])]
+    [0.100068, 0.001361]
+    >>> instance.terminate()  # fmpy returns the FMI status: 0, OK
+    0
+    >>> instance.freeInstance()
     """
     slave = _instantiated(fmu_model(fmu_path), instance_name)
     try:
@@ -449,7 +498,7 @@ def simulate_plan(
     theta0: float = 0.0,
     omega0: float = 0.0,
     tolerance: float | None = None,
-    fmu_path: str | Path | None = None,
+    fmu_path: str | Path | FmuModel | None = None,
 ) -> np.ndarray:
     """A schedule through this thread's Simulator of the FMU (see simulate)."""
     runner = simulator(fmu_path)
@@ -461,7 +510,7 @@ def simulate_plan(
 
 
 def resolve_parameters(
-    overrides: dict[str, float] | None = None, fmu_path: str | Path | None = None
+    overrides: dict[str, float] | None = None, fmu_path: str | Path | FmuModel | None = None
 ) -> dict[str, float]:
     """parameters.merged_parameters, and a set the FMU accepts.
 
