@@ -46,7 +46,8 @@ from ._reference import equation_of_motion, reference, reference_schedule
 from ._regression_tools import format_verdicts, regression_verdicts
 from ._scenarios import JUDGE_TOLERANCE as DEFAULT_TOLERANCE, read_settings, settings_files
 from ._simulate import resolve_parameters
-from ._torque_schedule import TorqueSchedule, TorqueTable, event_tolerance, read_torque_csv, schedule
+from ._time_grid import event_tolerance
+from ._torque_schedule import TorqueSchedule, TorqueTable, read_torque_csv, schedule
 
 AGREES = "agrees"
 LATE, EARLY = "input one step late", "input one step early"

@@ -403,7 +403,7 @@ def simulate(
     fmu_path : str or Path, optional
         The FMU to run (default: pendulum_fmu.default_fmu()); its own parameters apply.
     max_steps : int, optional
-        The longest run accepted (default torque_schedule.DEFAULT_MAX_STEPS); a longer one, or
+        The longest run accepted (default _time_grid.DEFAULT_MAX_STEPS); a longer one, or
         one that would not fit in memory, is refused before anything is allocated.
 
     Returns

@@ -14,7 +14,7 @@ import numpy as np
 
 from .._errors import InvalidInput, MissingDependency, WrongType
 from .._parameters import fmu_file, pendulum_variables
-from .._torque_schedule import DEFAULT_MAX_CASES
+from .._time_grid import DEFAULT_MAX_CASES
 from .client import SchedulerLost, dask_client, progress_bar, run_chunks
 from .figure import draw
 from .grid import columns

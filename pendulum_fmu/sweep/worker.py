@@ -18,7 +18,8 @@ import numpy as np
 from .. import _native_loop as cs_loop
 from .._parameters import START_VALUES, value_reference
 from .._simulate import FmuError, initialize, run_schedule_python, simulator
-from .._torque_schedule import TorqueSchedule, communication_points
+from .._time_grid import communication_points
+from .._torque_schedule import TorqueSchedule
 from .store import SUMMARIES, Store
 from .study import OUTPUTS
 
