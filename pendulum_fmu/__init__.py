@@ -41,7 +41,7 @@ _LAZY = {
     "judge": "_judge",
     "judge_kit": "_judge",
     "Judgement": "_judge",
-    "ResultFileError": "_judge",
+    "ResultFileError": "_result_file",
     "write_scenarios": "_scenarios",
     "read_settings": "_scenarios",
     # sweeps

@@ -11,7 +11,7 @@ OSError for a file, ...). The kinds that belong to one module live there:
     model.FmuFileError                a file given as an FMU that is none this package can run
     compare_tools.ToolSpecError       a --tools list that names no runnable tool
     mapped_fmu.MapError               a --map, or an FMU that does not fit it
-    judge.ResultFileError             a result file, or a kit's folder, that cannot be judged
+    result_file.ResultFileError       a result file, or a kit's folder, that cannot be judged
     scenarios.KitExists               an output folder holding a scenario kit the run was not asked to replace
     ssp.SspExists                     an SSP the export was not asked to replace
     ssp.SspFileError                  a file given as the closed loop's SSP that is not one

@@ -18,8 +18,9 @@ from fmpy.validation import validate_fmu
 
 from benchmarks.masters import run
 from pendulum_fmu import _native_loop as cs_loop
+from pendulum_fmu._diagnoses import AGREES
 from pendulum_fmu._errors import InvalidInput
-from pendulum_fmu._judge import AGREES, judge, judge_kit
+from pendulum_fmu._judge import judge, judge_kit
 from pendulum_fmu._parameters import default_parameters, total_inertia
 from pendulum_fmu._scenarios import (
     KIT_FMU,
