@@ -43,7 +43,7 @@ _LAZY = {
     "Judgement": "_judge",
     "ResultFileError": "_result_file",
     "write_scenarios": "_scenarios",
-    "read_settings": "_scenarios",
+    "read_settings": "_scenario_settings",
     # sweeps
     "run_sweep": "sweep",
     "sweep_grid": "sweep",

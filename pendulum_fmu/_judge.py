@@ -43,7 +43,7 @@ from ._parameters import variables
 from ._reference import reference
 from ._regression_tools import format_verdicts, regression_verdicts
 from ._result_file import OPTIONAL, ResultFileError, read_result
-from ._scenarios import JUDGE_TOLERANCE as DEFAULT_TOLERANCE, read_settings, settings_files
+from ._scenario_settings import JUDGE_TOLERANCE as DEFAULT_TOLERANCE, read_settings, settings_files
 from ._simulate import resolve_parameters
 from ._time_grid import event_tolerance
 from ._torque_schedule import TorqueSchedule, schedule

@@ -27,7 +27,8 @@ from pendulum_fmu._judge import judge
 from pendulum_fmu._parameters import total_inertia
 from pendulum_fmu._plot import _log_difference
 from pendulum_fmu._result_file import ResultFileError, read_result
-from pendulum_fmu._scenarios import KIT_FMU, read_settings, write_scenarios
+from pendulum_fmu._scenario_settings import KIT_FMU, read_settings
+from pendulum_fmu._scenarios import write_scenarios
 from pendulum_fmu.cli import main
 
 
