@@ -18,11 +18,11 @@ __version__ = "0.1.0"
 _LAZY = {
     # running the FMU
     "simulate": "_simulate",
-    "open_fmu": "_simulate",
-    "FmuError": "_simulate",
+    "open_fmu": "_instance",
+    "FmuError": "_instance",
     "fmu_model": "_model",
     "FmuModel": "_model",
-    "FmuInstance": "_model",
+    "FmuInstance": "_instance",
     "FmuFileError": "_model",
     "total_inertia": "_parameters",
     # torque signals

@@ -20,7 +20,8 @@ import numpy as np
 
 from . import __version__
 from ._atomic_files import check_writable, replacing, replacing_path
-from ._parameters import fmu_file, model_description, pendulum_variables
+from ._model import fmu_file
+from ._parameters import model_description, pendulum_variables
 from ._simulate import simulate
 from ._torque_schedule import TorqueTable
 

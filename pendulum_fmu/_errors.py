@@ -7,7 +7,7 @@ derives from the built-in exception a Python caller would expect (ValueError for
 OSError for a file, ...). The kinds that belong to one module live there:
 
     torque_schedule.TorqueFileError   a torque CSV that is not a signal
-    simulate.FmuError                 an FMI call failed or the FMU refused a value
+    instance.FmuError                 an FMI call failed or the FMU refused a value
     model.FmuFileError                a file given as an FMU that is none this package can run
     compare_tools.ToolSpecError       a --tools list that names no runnable tool
     mapped_fmu.MapError               a --map, or an FMU that does not fit it

@@ -45,7 +45,8 @@ from xml.etree import ElementTree
 from . import __version__, _results as results
 from ._atomic_files import check_writable, make_folder, replacing, replacing_path
 from ._errors import InvalidInput, PendulumFmuError
-from ._parameters import START_VALUES, fmu_file, model_description
+from ._model import START_VALUES, fmu_file
+from ._parameters import model_description
 from ._reference import reference
 from ._scenario_list import SCENARIOS, Scenario
 from ._scenario_settings import KIT_FMU, RELATIVE_TOLERANCE, scenario_settings

@@ -16,8 +16,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _native_loop as cs_loop
-from .._parameters import START_VALUES, value_reference
-from .._simulate import FmuError, initialize, run_schedule_python, simulator
+from .._instance import FmuError, initialize
+from .._model import START_VALUES
+from .._parameters import value_reference
+from .._simulate import run_schedule_python, simulator
 from .._time_grid import communication_points
 from .._torque_schedule import TorqueSchedule
 from .store import SUMMARIES, Store
