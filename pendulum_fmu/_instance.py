@@ -144,13 +144,32 @@ def open_fmu(
     start_time: float = 0.0,
     instance_name: str = "pendulum",
 ):
-    """An initialized FmuInstance (in step mode, the FMI version read from the FMU's model
-    description; instance.fmi_version says which), with its message log as instance.messages and
-    its model as instance.model; fmpy's calls pass through to its FMU2Slave or FMU3Slave.
+    """An initialized FmuInstance of an FMU, in step mode, for a master's own loop.
 
-    fmu_path (a path, a model.FmuModel, or None for pendulum_fmu.default_fmu()) names the FMU;
-    parameters and value references are that FMU's own. The caller frees it with
+    The FMI version is read from the FMU's model description (instance.fmi_version says which);
+    the instance carries its message log as instance.messages and its model as instance.model,
+    and fmpy's calls pass through to its FMU2Slave or FMU3Slave. The caller frees it with
     instance.terminate(); instance.freeInstance().
+
+    Parameters
+    ----------
+    fmu_path : str, Path, FmuModel or None
+        The FMU (None: pendulum_fmu.default_fmu()); its parameters and value references apply.
+    parameters : dict, optional
+        Overrides of the FMU's parameters (mass, length, inertia, gravity, damping).
+    theta0, omega0 : float, optional
+        Start angle in rad and rate in rad/s.
+    tolerance : float, optional
+        Relative tolerance of the FMU's integrator (None: the FMU's own).
+    start_time : float, optional
+        In s.
+    instance_name : str, optional
+        The name the FMU is instantiated with (its messages and call record show it).
+
+    Returns
+    -------
+    FmuInstance
+        Initialized, ready for its first doStep.
 
     Raises
     ------
@@ -159,6 +178,14 @@ def open_fmu(
         anything is unzipped or loaded).
     FmuError
         The FMU refused the parameters or start values; the message carries what it logged.
+
+    Examples
+    --------
+    >>> from pendulum_fmu import open_fmu
+    >>> instance = open_fmu(parameters={"damping": 1.0}, theta0=0.1)
+    >>> instance.fmi_version, instance.getReal([instance.model.value_reference("theta")])
+    (2, [0.1])
+    >>> _ = instance.terminate(); instance.freeInstance()
     """
     slave = instantiated(fmu_model(fmu_path), instance_name)
     try:
@@ -244,7 +271,7 @@ class FmuInstance:
     >>> instance = open_fmu()
     >>> instance.model.fmi_version, instance.fmi_version
     (2, 2)
-    >>> instance.terminate(); instance.freeInstance()
+    >>> _ = instance.terminate(); instance.freeInstance()
     """
 
     def __init__(self, slave, messages, model: FmuModel):
