@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from . import _results as results
+from ._model import FmuModel
 from ._reference import equation_of_motion, reference_schedule
 from ._time_grid import event_tolerance
 from ._torque_schedule import TorqueSchedule, TorqueTable, read_torque_csv
@@ -152,7 +153,7 @@ class Run:
     parameters: dict
     theta0: float
     omega0: float
-    fmu_path: str | Path | None
+    model: FmuModel
 
     def integrate(self, plan: TorqueSchedule, at: np.ndarray | None = None) -> np.ndarray:
         """The schedule from the run's initial state, exactly, at the result's times (or at)."""
@@ -162,7 +163,7 @@ class Run:
             theta0=self.theta0,
             omega0=self.omega0,
             at=self.times if at is None else at,
-            fmu_path=self.fmu_path,
+            fmu_path=self.model,
         )
 
 

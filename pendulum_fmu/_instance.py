@@ -235,7 +235,8 @@ def initialize(
         "theta": start_value("theta0", theta0, "rad"),
         "omega": start_value("omega0", omega0, "rad/s"),
     }
-    references = [slave.model.value_reference(n) for n in start]
+    value_references = slave.model.value_references
+    references = [value_references[n] for n in start]
     try:
         if slave.fmi_version == 3:
             slave.enterInitializationMode(tolerance=tolerance, startTime=start_time)

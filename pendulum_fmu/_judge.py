@@ -39,7 +39,7 @@ import numpy as np
 from ._atomic_files import replacing
 from ._diagnoses import AGREES, INPUT_TIMING, Run, candidate_variants, diagnose
 from ._errors import InvalidInput
-from ._parameters import variables
+from ._model import FmuModel, fmu_model
 from ._reference import reference
 from ._regression_tools import format_verdicts, regression_verdicts
 from ._result_file import OPTIONAL, ResultFileError, read_result
@@ -189,7 +189,7 @@ def judge(
     omega0: float = 0.0,
     tolerance: float | None = None,
     mapping: str | dict | None = None,
-    fmu_path: str | Path | None = None,
+    fmu_path: str | Path | FmuModel | None = None,
     max_steps: int | None = None,
 ) -> Judgement:
     """Judge a result from any tool against the independent reference, and diagnose a failure.
@@ -202,7 +202,8 @@ def judge(
         The run's signal, as simulate() takes it: a constant (N.m), a callable of time or a
         time,torque CSV (docs/signals.md).
     start_time, stop_time, step_size, ramp, parameters, theta0, omega0, max_steps, fmu_path
-        The run's definition, as simulate() takes it.
+        The run's definition, as simulate() takes it; fmu_path may also be the FMU's model
+        (fmu_model), looked up once here and passed to everything the judgement runs.
     tolerance : float, optional
         The largest ``|dtheta|`` (rad) that passes (default: DEFAULT_TOLERANCE, 1e-9 rad).
     mapping : str or dict, optional
@@ -246,7 +247,8 @@ def judge(
             "a map renames and scales a result file's columns: an array result is "
             "judged as it is, in the fields time and theta (rad); leave out mapping"
         )
-    parameters = resolve_parameters(parameters, fmu_path)
+    model = fmu_model(fmu_path)
+    parameters = resolve_parameters(parameters, model)
     plan = schedule(
         torque, start_time=start_time, stop_time=stop_time, step_size=step_size, ramp=ramp, max_steps=max_steps
     )
@@ -262,13 +264,13 @@ def judge(
         theta0=theta0,
         omega0=omega0,
         at=times,
-        fmu_path=fmu_path,
+        fmu_path=model,
     )
     difference = np.abs(result["theta"] - correct["theta"])
     raw = float(np.max(difference))
     worst_time = float(times[int(np.argmax(difference))])
-    run = Run(plan, times, step_size, parameters, theta0, omega0, fmu_path)
-    start_torque = float(variables(fmu_path)["torque"].start or 0.0)
+    run = Run(plan, times, step_size, parameters, theta0, omega0, model)
+    start_torque = float(model.variables["torque"].start or 0.0)
     held = schedule(torque, start_time=start_time, stop_time=stop_time, step_size=step_size) if ramp else None
     variants = candidate_variants(run, torque, held, correct, result, tolerance, start_torque)
     scores, best_variant, timing_effects = {}, {}, []
@@ -373,7 +375,7 @@ def judge_kit(
     *,
     tolerance: float | None = None,
     mapping: str | None = None,
-    fmu_path: str | Path | None = None,
+    fmu_path: str | Path | FmuModel | None = None,
 ) -> dict[str, Judgement | None]:
     """Judge every NAME_out.csv beside the settings NAME.json of a scenario kit (scenarios.py).
 
@@ -417,7 +419,8 @@ def judge_kit(
             f"{folder}: no scenario settings (NAME.json) in this folder; write a kit "
             "with pendulum-fmu scenarios --output-dir FOLDER"
         )
-    verdicts = {}
+    model = None  # the FMU's model, looked up once, for the first result there is
+    verdicts: dict[str, Judgement | None] = {}
     for name, settings_path in found.items():
         settings = read_settings(settings_path)
         output = folder / settings.pop("output")
@@ -426,7 +429,8 @@ def judge_kit(
             continue
         if tolerance is not None:
             settings["tolerance"] = tolerance
-        verdicts[name] = judge(output, mapping=mapping, fmu_path=fmu_path, **settings)
+        model = model or fmu_model(fmu_path)
+        verdicts[name] = judge(output, mapping=mapping, fmu_path=model, **settings)
     if all(v is None for v in verdicts.values()):
         raise ResultFileError(
             f"{folder}: no result to judge: run each scenario and write NAME_out.csv "

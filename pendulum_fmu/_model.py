@@ -152,11 +152,18 @@ class FmuModel:
         """
         return tuple(name for name, v in self.variables.items() if v.causality in ("input", "output"))
 
+    @cached_property
+    def value_references(self) -> dict[str, int]:
+        """{name: value reference} of every variable of a pendulum FMU, made once per model so a
+        run looks each one up in a dict; raises as pendulum_variables.
+        """
+        return {name: v.valueReference for name, v in self.pendulum_variables.items()}
+
     def value_reference(self, name: str) -> int:
         """The value reference of a pendulum variable; raises as pendulum_variables, KeyError
         for a name it does not have.
         """
-        return self.pendulum_variables[name].valueReference
+        return self.value_references[name]
 
     def unit(self, name: str) -> str:
         """The declared unit of a variable, parameter or start value (theta0: theta's), '' where

@@ -45,8 +45,7 @@ from xml.etree import ElementTree
 from . import __version__, _results as results
 from ._atomic_files import check_writable, make_folder, replacing, replacing_path
 from ._errors import InvalidInput, PendulumFmuError
-from ._model import START_VALUES, fmu_file
-from ._parameters import model_description
+from ._model import START_VALUES, FmuModel, fmu_model
 from ._reference import reference
 from ._scenario_list import SCENARIOS, Scenario
 from ._scenario_settings import KIT_FMU, RELATIVE_TOLERANCE, scenario_settings
@@ -274,7 +273,9 @@ def _check_replaceable(folder: Path, overwrite: bool) -> None:
         )
 
 
-def write_scenarios(output_dir: str | Path, fmu_path: str | Path | None = None, overwrite: bool = False) -> list[Path]:
+def write_scenarios(
+    output_dir: str | Path, fmu_path: str | Path | FmuModel | None = None, overwrite: bool = False
+) -> list[Path]:
     """Write the scenario kit (see the module's docstring).
 
     The kit is written into a hidden folder inside output_dir and moved into place once whole, so
@@ -284,8 +285,9 @@ def write_scenarios(output_dir: str | Path, fmu_path: str | Path | None = None, 
     ----------
     output_dir : str or Path
         The kit's folder; results a user put there (NAME_out.csv) are left alone.
-    fmu_path : str or Path, optional
-        The FMI 2.0 FMU to carry and whose parameters apply (default: pendulum_fmu.default_fmu()).
+    fmu_path : str, Path or FmuModel, optional
+        The FMI 2.0 FMU to carry and whose parameters apply, or its model (default:
+        pendulum_fmu.default_fmu()).
     overwrite : bool, optional
         Replace the files of a kit the folder already holds (kit_files()); without it such a
         folder is refused. Other files in it are kept either way.
@@ -312,11 +314,11 @@ def write_scenarios(output_dir: str | Path, fmu_path: str | Path | None = None, 
     >>> sorted(path.name for path in written if path.name.startswith("ramp"))
     ['ramp.json', 'ramp_in.csv', 'ramp_ref.csv']
     """
-    fmu = fmu_file(fmu_path)
-    version = model_description(fmu).fmiVersion
+    model = fmu_model(fmu_path)
+    version = model.description.fmiVersion
     if version != "2.0":
         raise InvalidInput(
-            f"{fmu} is FMI {version}: the kit is for the FMI 2.0 FMU (its ramp scenario needs input derivatives)"
+            f"{model.path} is FMI {version}: the kit is for the FMI 2.0 FMU (its ramp scenario needs input derivatives)"
         )
     folder = Path(output_dir)
     _check_replaceable(folder, overwrite)
@@ -325,7 +327,7 @@ def write_scenarios(output_dir: str | Path, fmu_path: str | Path | None = None, 
     make_folder(folder, folder, "output directory")
     staging = folder / f".scenarios.{uuid.uuid4().hex}.partial"
     try:
-        names = _write_kit(staging, fmu)
+        names = _write_kit(staging, model)
         with signals_deferred():
             for name in names:
                 os.replace(staging / name, folder / name)
@@ -334,12 +336,12 @@ def write_scenarios(output_dir: str | Path, fmu_path: str | Path | None = None, 
     return [folder / name for name in names]
 
 
-def _write_kit(folder: Path, fmu: Path) -> list[str]:
+def _write_kit(folder: Path, model: FmuModel) -> list[str]:
     """Write the kit into folder; returns the names written, the FMU first."""
     written, carried, steps = [], {}, {}
     for scenario in SCENARIOS:
         name = scenario.name
-        parameters = resolve_parameters(scenario.parameters, fmu)
+        parameters = resolve_parameters(scenario.parameters, model)
         signal = folder / f"{name}_in.csv"
         files = {signal.name: _csv_text(("time", "torque"), scenario.rows)}
         _write(signal, files[signal.name])
@@ -353,7 +355,7 @@ def _write_kit(folder: Path, fmu: Path) -> list[str]:
             parameters=parameters,
             theta0=scenario.theta0,
             omega0=scenario.omega0,
-            fmu_path=fmu,
+            fmu_path=model,
         )
         steps[name] = len(solution) - 1
         files[f"{name}_ref.csv"] = _csv_text(results.FIELDS, (tuple(row) for row in solution.tolist()))
@@ -374,7 +376,7 @@ def _write_kit(folder: Path, fmu: Path) -> list[str]:
     )
     _write(folder / "ReadMe.md", readme)
     written.append("ReadMe.md")
-    with zipfile.ZipFile(fmu) as original, replacing_path(folder / KIT_FMU) as partial:
+    with zipfile.ZipFile(model.path) as original, replacing_path(folder / KIT_FMU) as partial:
         with zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as archive:
             for item in original.infolist():
                 # A kit FMU given as the source: its old kit files give way to the new ones.

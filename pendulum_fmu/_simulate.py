@@ -20,8 +20,8 @@ import numpy as np
 from . import _native_loop as cs_loop, _results as results, default_fmu
 from ._errors import InvalidInput
 from ._instance import FmuError, FmuInstance, initialize, instantiated, open_fmu
-from ._model import file_version, fmu_file, fmu_model
-from ._parameters import default_parameters, merged_parameters, merged_with, start_value
+from ._model import FmuModel, file_version, fmu_file, fmu_model
+from ._parameters import merged_with, start_value
 from ._torque_schedule import TorqueSchedule, TorqueSignal, schedule
 
 
@@ -49,9 +49,10 @@ def _stepper(slave, start_names: tuple[str, ...] = ()) -> cs_loop.Stepper:
     """The native loop bound to an instance: the torque in, its model's recorded variables out,
     a restart setting start_names.
     """
+    value_references = slave.model.value_references
 
     def references(names):
-        return np.array([slave.model.value_reference(name) for name in names], np.uint32)
+        return np.array([value_references[name] for name in names], np.uint32)
 
     return cs_loop.Stepper(slave, references(["torque"]), references(slave.model.recorded), references(start_names))
 
@@ -99,8 +100,9 @@ def run_schedule_python(slave: FmuInstance, plan: TorqueSchedule) -> np.ndarray:
     component = ctypes.c_void_p(slave.component)
     recorded_names = slave.model.recorded
     count = len(recorded_names)
-    torque_vr = (ctypes.c_uint * 1)(slave.model.value_reference("torque"))
-    recorded_vr = (ctypes.c_uint * count)(*(slave.model.value_reference(n) for n in recorded_names))
+    value_references = slave.model.value_references
+    torque_vr = (ctypes.c_uint * 1)(value_references["torque"])
+    recorded_vr = (ctypes.c_uint * count)(*(value_references[n] for n in recorded_names))
     one, recorded_count = ctypes.c_size_t(1), ctypes.c_size_t(count)
     first_order = (ctypes.c_int * 1)(1)
     no_rollback = ctypes.c_int(1)
@@ -253,27 +255,31 @@ def simulate_plan(
 
 
 def resolve_parameters(
-    overrides: dict[str, float] | None = None, fmu_path: str | Path | None = None
+    overrides: dict[str, float] | None = None, fmu_path: str | Path | FmuModel | None = None
 ) -> dict[str, float]:
-    """parameters.merged_parameters, and a set the FMU accepts.
+    """The FMU's parameters with overrides applied (parameters.merged_with), and a set it accepts.
+
+    fmu_path is the FMU: a path, its model (fmu_model), or None for the default FMU.
 
     The physical checks (mass > 0, an inertia about the pivot > 0, ...) live in one place, the
     FMU's model.c, and every tool goes through them here: the FMU, the scipy reference, OpenSim,
     the engines. Each refuses a bad set with the FMU's own message, word for word.
     """
-    parameters = merged_parameters(overrides, fmu_path)
-    path = fmu_file(fmu_path)
-    refusal = _refusal(str(path.resolve()), file_version(path), tuple(parameters.items()))
+    model = fmu_model(fmu_path)
+    parameters = merged_with(model.default_parameters, overrides)
+    refusal = _refusal(model, tuple(parameters.items()))
     if refusal:
         raise InvalidInput(refusal)
     return parameters
 
 
 @lru_cache(maxsize=256)
-def _refusal(fmu: str, version: tuple, items: tuple) -> str | None:
-    """What the FMU says when it refuses these parameters at initialization, or None."""
+def _refusal(model: FmuModel, items: tuple) -> str | None:
+    """What the FMU says when it refuses these parameters at initialization, or None; asked once
+    per model (a file rebuilt or replaced is another model) and set of parameters.
+    """
     try:
-        slave = open_fmu(fmu, parameters=dict(items))
+        slave = open_fmu(model, parameters=dict(items))
     except FmuError as error:
         # "initialization failed: [ERROR] fmi2ExitInitializationMode: mass must be > 0"
         return f"the FMU refuses the parameters: {str(error).rsplit(': ', 1)[-1]}"
@@ -297,7 +303,7 @@ class Simulator:
     def __init__(self, fmu_path: Path, version: tuple):
         self.fmu_path, self.version = fmu_path, version
         self.slave = instantiated(fmu_model(fmu_path), "pendulum")
-        self.defaults = default_parameters(self.slave.model)
+        self.defaults = dict(self.slave.model.default_parameters)
         self.stepper = (
             _stepper(self.slave, (*self.defaults, *self.START_STATES)) if cs_loop.drives(self.slave) else None
         )

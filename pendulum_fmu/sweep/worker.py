@@ -53,7 +53,7 @@ class Runner:
     """
 
     def __init__(self, fmu_simulator):
-        self.simulator, fmu = fmu_simulator, fmu_simulator.fmu_path
+        self.simulator, fmu = fmu_simulator, fmu_simulator.slave.model
         self.defaults = {**fmu_simulator.defaults, "theta": 0.0, "omega": 0.0, "torque": 0.0}
         start_references = np.array([value_reference(n, fmu) for n in self.defaults], np.uint32)
         outputs = np.array([value_reference(name, fmu) for name in OUTPUTS], np.uint32)
