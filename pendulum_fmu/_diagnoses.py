@@ -216,7 +216,7 @@ def candidate_variants(
         LATE: [run.integrate(p) for p in _late(plan, start_torque)],
         EARLY: [run.integrate(p) for p in _early(plan)],
         INTERPOLATED: [] if ramp else [run.integrate(p) for p in _interpolated(plan)],
-        HELD: [run.integrate(held)] if ramp else [],
+        HELD: [run.integrate(held)] if held is not None else [],
         DRIFT: [run.integrate(p) for p in _drifted(torque, run.times, ramp)] if off_grid else [],
         NOT_RESTORED: _not_restored(run, correct, int(wrong[0])) if len(wrong) else [],
         INTEGRATION: _integration(run),

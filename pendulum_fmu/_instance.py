@@ -135,7 +135,7 @@ def fmi2_library(folder: str, model_identifier: str) -> str | None:
 
 
 def open_fmu(
-    fmu_path: str | Path | None = None,
+    fmu_path: str | Path | FmuModel | None = None,
     *,
     parameters: dict | None = None,
     theta0: float = 0.0,
@@ -198,9 +198,9 @@ def open_fmu(
     return slave
 
 
-def instantiated(model, instance_name: str) -> FmuInstance:
+def instantiated(model: FmuModel, instance_name: str) -> FmuInstance:
     """An instantiated FmuInstance of a model, not yet initialized (see open_fmu)."""
-    model.pendulum_variables  # FmuFileError when it is no pendulum FMU this machine runs
+    _ = model.pendulum_variables  # FmuFileError when it is no pendulum FMU this machine runs
     folder, description, fmi_version = model.folder, model.description, model.fmi_version
     messages = MessageLog(fmi_version)
     arguments = dict(

@@ -114,7 +114,7 @@ class Judgement:
         """What --json writes: plain numbers, rad and s."""
         worst = {}
         for name in OPTIONAL:
-            given = self.result[name] if name in self.result.dtype.names else np.nan
+            given = self.result[name] if name in (self.result.dtype.names or ()) else np.nan
             if np.all(np.isfinite(given)):
                 worst[f"max_abs_d{name}"] = float(np.max(np.abs(given - self.reference[name])))
         return {
@@ -273,7 +273,9 @@ def judge(
     start_torque = float(model.variables["torque"].start or 0.0)
     held = schedule(torque, start_time=start_time, stop_time=stop_time, step_size=step_size) if ramp else None
     variants = candidate_variants(run, torque, held, correct, result, tolerance, start_torque)
-    scores, best_variant, timing_effects = {}, {}, []
+    scores: dict[str, dict | None] = {}
+    best_variant: dict[str, np.ndarray] = {}
+    timing_effects: list[float] = []
     for name, made in variants.items():
         if not made:
             scores[name] = None

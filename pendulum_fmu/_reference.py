@@ -29,6 +29,7 @@ from scipy.integrate import solve_ivp
 
 from . import _results as results
 from ._errors import InvalidInput, WrongType
+from ._model import FmuModel
 from ._parameters import start_value, total_inertia
 from ._simulate import resolve_parameters
 from ._time_grid import step_count
@@ -242,7 +243,7 @@ def _integrate(
     omega0: float,
     rtol: float,
     atol: float,
-    fmu_path: str | Path | None,
+    fmu_path: str | Path | FmuModel | None,
     method: str = "DOP853",
     max_step: float = np.inf,
 ) -> np.ndarray:
@@ -338,7 +339,7 @@ def reference(
     at: np.ndarray | None = None,
     rtol: float = 1e-12,
     atol: float = 1e-12,
-    fmu_path: str | Path | None = None,
+    fmu_path: str | Path | FmuModel | None = None,
     method: str = "DOP853",
     max_step: float = np.inf,
 ) -> np.ndarray:
@@ -429,7 +430,7 @@ def reference_schedule(
     at: np.ndarray | None = None,
     rtol: float = 1e-12,
     atol: float = 1e-12,
-    fmu_path: str | Path | None = None,
+    fmu_path: str | Path | FmuModel | None = None,
 ) -> np.ndarray:
     """Integrate exactly the torques of a schedule, reported at its communication points (or at
     the times `at`): the judge of a tool that was fed that schedule, and the judge's variants of

@@ -70,7 +70,10 @@ def _ssv(scenario: Scenario, parameters: dict) -> bytes:
     FMU's own variables, so the set applies as-is.
     """
     ElementTree.register_namespace("ssv", SSV_NAMESPACE)
-    tag = lambda name: f"{{{SSV_NAMESPACE}}}{name}"
+
+    def tag(name: str) -> str:
+        return f"{{{SSV_NAMESPACE}}}{name}"
+
     root = ElementTree.Element(tag("ParameterSet"), {"version": "1.0", "name": scenario.name})
     listed = ElementTree.SubElement(root, tag("Parameters"))
     values = {**parameters, START_VALUES["theta0"]: scenario.theta0, START_VALUES["omega0"]: scenario.omega0}

@@ -14,6 +14,7 @@ import threading
 from collections import OrderedDict
 from functools import lru_cache
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -96,7 +97,9 @@ def run_schedule_python(slave: FmuInstance, plan: TorqueSchedule) -> np.ndarray:
         if fmi3
         else ("fmi2SetReal", "fmi2GetReal", "fmi2SetRealInputDerivatives", "fmi2DoStep")
     )
-    set_real, get_real, set_rate, do_step = (dll[name] if name else None for name in names)
+    # ctypes functions of the library (FMI 3.0 has no input derivatives: no set_rate, never called).
+    set_real, get_real, do_step = dll[names[0]], dll[names[1]], dll[names[3]]
+    set_rate: Any = dll[names[2]] if names[2] else None
     component = ctypes.c_void_p(slave.component)
     recorded_names = slave.model.recorded
     count = len(recorded_names)
@@ -353,8 +356,8 @@ def _default_fmu() -> Path:
 
 
 def simulator(fmu_path: str | Path | None = None) -> Simulator:
-    """This thread's Simulator of an FMU file, made on first use and again whenever the file is
-    rebuilt or replaced (its file_version changes).
+    """The Simulator of an FMU file kept by the calling thread, made on first use and again
+    whenever the file is rebuilt or replaced (its file_version changes).
 
     Parameters
     ----------

@@ -36,7 +36,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
-from typing import Union
+from typing import Literal, Union
 
 import numpy as np
 
@@ -68,7 +68,7 @@ class TorqueTable:
         """The torque just before each t: at a jump, the value before it."""
         return self._values(np.asarray(t, dtype=float), "left")
 
-    def _values(self, t: np.ndarray, side: str) -> np.ndarray:
+    def _values(self, t: np.ndarray, side: Literal["left", "right"]) -> np.ndarray:
         # np.interp takes the last of equal times, so look the segment up ourselves. Just after
         # t (side "right") the segment is time[i-1] <= t < time[i]; just before it,
         # time[i-1] < t <= time[i]: either way a segment of positive length, never the jump.
@@ -213,8 +213,8 @@ def read_torque_csv(path: str | Path) -> TorqueTable:
     data = _parse_numbers(raw, header, columns)
     if data is None or not all(np.all(np.isfinite(column)) for column in data):
         lines = _decode(path, raw).splitlines()
-        error = _first_bad_row(path, lines, columns)
-        raise error or TorqueFileError(f"{path}: rows must have as many columns as the header ({len(header)})")
+        bad_row = _first_bad_row(path, lines, columns)
+        raise bad_row or TorqueFileError(f"{path}: rows must have as many columns as the header ({len(header)})")
     times, torques = data
     if len(times) == 0:
         raise TorqueFileError(f"{path}: no data rows after the header")
@@ -244,7 +244,7 @@ def write_torque_csv(path: str | Path, plan: TorqueSchedule) -> Path:
     from ._atomic_files import replacing
 
     end = plan.torque + plan.torque_rate * plan.step_size
-    points = []
+    points: list[tuple[float, float]] = []
     for t0, t1, u0, u1 in zip(
         plan.time[:-1].tolist(), plan.time[1:].tolist(), plan.torque.tolist(), end.tolist(), strict=False
     ):
@@ -368,7 +368,8 @@ def schedule(
             samples = np.array([_sample(torque, t) for t in _takes_time(torque, time.tolist())])
         else:
             try:
-                samples = np.full(len(time), float(torque))
+                # Whatever else it is is tried as a number: float() refuses what is none.
+                samples = np.full(len(time), float(torque))  # type: ignore[arg-type]
             except (TypeError, ValueError):
                 raise InvalidInput(
                     f"a torque is a number, a callable of time, a per-step array or a CSV "
