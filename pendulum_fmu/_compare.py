@@ -44,7 +44,7 @@ def run_tools(
     mapping: str | None = None,
 ) -> dict[str, np.ndarray]:
     """{tool label: result array} for the same schedule, parameters and start values; tools as
-    --tools gives them (see compare_tools.py), mapping the --map of other FMUs. "reference" here is
+    --tools gives them (see _compare_tools.py), mapping the --map of other FMUs. "reference" here is
     reference_schedule: the schedule's own torques through scipy.
     """
     fmu_path = fmu_model(fmu_path)  # read once, passed to every tool
@@ -139,7 +139,7 @@ class Comparison:
     Attributes
     ----------
     runs : dict of str to numpy.ndarray
-        Each tool's results array (results.py), by its label; "reference" is the judge.
+        Each tool's results array (_results.py), by its label; "reference" is the judge.
     differences : list of dict
         The rows of differences.csv: each tool against the reference, then each pair of tools.
     tolerance : float
@@ -216,7 +216,7 @@ def compare(
     torque : float, callable, sequence of float, str or Path
         The signal, as simulate() takes it.
     tools : str or sequence of str, optional
-        As --tools gives them (compare_tools.py): fmu, reference, opensim, mujoco, drake,
+        As --tools gives them (_compare_tools.py): fmu, reference, opensim, mujoco, drake,
         pybullet (NAME:default for an engine's own defaults), LABEL=path/to/Their.fmu. By default
         fmu, reference and opensim, those of them that are installed; the others are left out
         with a warning (errors.Skipped) that says how to install them.

@@ -5,9 +5,9 @@
 
 An item is a tool's name, optionally with a mode (accurate, the default, or default: what the
 engine does with its own settings), or LABEL=PATH for any other FMU, run through the --map (see
-mapped_fmu.py). Every tool has the same runner:
+_mapped_fmu.py). Every tool has the same runner:
 
-    tool.run(plan, parameters=..., theta0=..., omega0=...) -> results array (results.py)
+    tool.run(plan, parameters=..., theta0=..., omega0=...) -> results array (_results.py)
 
 A tool returns the time, the torque and the outputs it computes; Tool.run hands back the outputs
 asked for (the FMU's, FmuModel.outputs, unless told otherwise), one it cannot compute as NaN with a
@@ -79,7 +79,7 @@ class Tool:
         Returns
         -------
         numpy.ndarray
-            A result array (results.py): time, torque, then outputs in that order.
+            A result array (_results.py): time, torque, then outputs in that order.
 
         Warns
         -----
@@ -114,7 +114,7 @@ def run_reference(
     mode: str = "accurate",
     fmu_path: str | Path | FmuModel | None = None,
 ) -> np.ndarray:
-    """The schedule's own torques through scipy (reference.py); fmu_path's defaults apply."""
+    """The schedule's own torques through scipy (_reference.py); fmu_path's defaults apply."""
     check_mode(mode, "reference")
     return reference_schedule(plan, parameters=parameters, theta0=theta0, omega0=omega0, fmu_path=fmu_path)
 

@@ -27,10 +27,10 @@
 #endif
 
 /* Changes whenever cs_loop_run's or cs_loop_run_cases' arguments do, so that Python never calls a stale build with
-   the wrong arguments (cs_loop.py checks it). */
+   the wrong arguments (_native_loop.py checks it). */
 CS_LOOP_EXPORT int cs_loop_interface(void) { return 6; }
 
-/* The FMU's functions, in this order (cs_loop.py passes them as an array of addresses). */
+/* The FMU's functions, in this order (_native_loop.py passes them as an array of addresses). */
 typedef struct {
     fmi2ResetTYPE *reset;
     fmi2SetupExperimentTYPE *setup_experiment;

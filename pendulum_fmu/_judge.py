@@ -379,7 +379,7 @@ def judge_kit(
     mapping: str | None = None,
     fmu_path: str | Path | FmuModel | None = None,
 ) -> dict[str, Judgement | None]:
-    """Judge every NAME_out.csv beside the settings NAME.json of a scenario kit (scenarios.py).
+    """Judge every NAME_out.csv beside the settings NAME.json of a scenario kit (_scenarios.py).
 
     Parameters
     ----------

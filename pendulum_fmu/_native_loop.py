@@ -6,7 +6,7 @@ initialization with new start values, as _instance.initialize does), then every 
 schedule (fmi2SetReal, fmi2SetRealInputDerivatives, fmi2GetReal, fmi2DoStep), writing into the
 caller's numpy buffers; or a chunk of restarted cases in one call (Stepper.run_cases). `pip install` (or
 `pip install -e .` in a checkout) compiles it; without it `available()` is
-False and callers use the Python loop in simulate.py, which gives the same numbers bit for bit.
+False and callers use the Python loop in _simulate.py, which gives the same numbers bit for bit.
 """
 
 from __future__ import annotations

@@ -2,7 +2,7 @@
 
 Every function takes the FMU it is about (a path, a model.FmuModel, or None for
 pendulum_fmu.default_fmu()), so another build of the pendulum brings its own parameters; the
-model object (model.py) parses each file once, and a caller that holds one passes it on.
+model object (_model.py) parses each file once, and a caller that holds one passes it on.
 """
 
 from __future__ import annotations

@@ -434,7 +434,7 @@ def reference_schedule(
 ) -> np.ndarray:
     """Integrate exactly the torques of a schedule, reported at its communication points (or at
     the times `at`): the judge of a tool that was fed that schedule, and the judge's variants of
-    a run with a mistake made (judge.py).
+    a run with a mistake made (_judge.py).
 
     Parameters
     ----------

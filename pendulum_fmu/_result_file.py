@@ -27,7 +27,7 @@ class ResultFileError(InvalidInput):
 
 
 def read_result(path: str | Path, mapping: str | dict | None = None) -> np.ndarray:
-    """A result CSV as a result array (results.py); omega and alpha are NaN where it has none.
+    """A result CSV as a result array (_results.py); omega and alpha are NaN where it has none.
 
     Parameters
     ----------

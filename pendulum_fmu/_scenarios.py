@@ -11,7 +11,7 @@ writes into kit/:
 - ReadMe.md: what a master's vendor does with it.
 
 A master runs each scenario and writes NAME_out.csv beside its input; `pendulum-fmu judge kit`
-judges each one (judge.py).
+judges each one (_judge.py).
 
 FMI-LS-REF, the layered standard for related files in an FMU, followed as of its v1.0.0-beta.1
 (github.com/modelica/fmi-ls-ref, tag v1.0.0-beta.1, 2026-07-01): the FMU carries

@@ -36,9 +36,9 @@ def __getattr__(name: str):
 
 def run_schedule(slave: FmuInstance, plan: TorqueSchedule) -> np.ndarray:
     """Feed a schedule to an initialized slave (from open_fmu); returns the result array (see
-    results.py).
+    _results.py).
 
-    One call into the native loop (cs_loop.py) when it was compiled and the FMU is FMI 2.0, else
+    One call into the native loop (_native_loop.py) when it was compiled and the FMU is FMI 2.0, else
     the Python loop, the readable reference; the two give the same numbers bit for bit.
     """
     if not cs_loop.drives(slave):
@@ -173,7 +173,7 @@ def simulate(
 ) -> np.ndarray:
     """Simulate the pendulum FMU under a torque signal, one communication step at a time.
 
-    The whole schedule runs in one call into the native loop (cs_loop.py) when it was compiled
+    The whole schedule runs in one call into the native loop (_native_loop.py) when it was compiled
     and the FMU is FMI 2.0, else in the Python loop; the two give the same numbers bit for bit.
     It runs through this thread's instance of the FMU (simulator()), restarted for the run: after
     the first call in a thread, a call costs tens of microseconds besides its steps.
@@ -207,7 +207,7 @@ def simulate(
     -------
     numpy.ndarray
         A structured array with fields time, torque, theta, omega, alpha, one row per
-        communication point (see results.py); torque is what the FMU received.
+        communication point (see _results.py); torque is what the FMU received.
 
     Raises
     ------

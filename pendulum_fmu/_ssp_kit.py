@@ -10,7 +10,7 @@ adds to kit/:
   (closed_loop.sampled_loop_reference), one column per coupling.
 
 A master runs ClosedLoop.ssp and writes ClosedLoop_out.csv (time,theta); `pendulum-fmu judge
-ClosedLoop_out.csv --ssp ClosedLoop.ssp` names its coupling (ssp_judge.py). The controller FMU is
+ClosedLoop_out.csv --ssp ClosedLoop.ssp` names its coupling (_ssp_judge.py). The controller FMU is
 built from this project's sources, so the closed loop needs a source checkout.
 """
 

@@ -1,6 +1,6 @@
 """The signals that stop the program, SIGINT and SIGTERM, and what each does.
 
-While the program starts (entry.py) a signal ends it at once, since nothing is being written
+While the program starts (_entry.py) a signal ends it at once, since nothing is being written
 yet. While a command runs (cli.main) it raises Stopped where the program is, so that every file
 being written is cleaned up on the way out, and cli.main prints one line. A few steps that must
 not be cut in two (moving a study into place) hold the signals off until they are done.

@@ -1,4 +1,4 @@
-"""plot.py: what each figure draws and says, read back from the matplotlib figure."""
+"""_plot.py: what each figure draws and says, read back from the matplotlib figure."""
 
 from pathlib import Path
 
@@ -12,7 +12,7 @@ from pendulum_fmu.cli import main
 
 @pytest.fixture
 def drawn(monkeypatch):
-    """Every figure plot.py finishes, as (figure, its axes, title), and still written."""
+    """Every figure _plot.py finishes, as (figure, its axes, title), and still written."""
     figures = []
     finish = plot._finish
 

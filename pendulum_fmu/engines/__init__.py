@@ -4,7 +4,7 @@
 
 Every runner builds the pendulum of the FMU (mass, length, inertia of the head about its own
 centre, gravity, damping) in its engine, holds plan.torque[k] over step k, and fills the outputs
-it computes (theta, omega, alpha) in a results.empty(N+1) array with the convention of results.py;
+it computes (theta, omega, alpha) in a results.empty(N+1) array with the convention of _results.py;
 an output of the FMU it does not compute stays NaN. fmu_path (a path, a model or None) is the FMU
 whose defaults fill the parameters not given. mode "accurate" sets the engine's
 best integrator tight; "default" keeps the engine's own integrator and settings, stepping once per

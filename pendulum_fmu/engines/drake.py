@@ -73,7 +73,7 @@ def build(parameters: dict, time_step: float, sampled_outputs: bool):
 
 
 def simulate(plan: TorqueSchedule, parameters: dict, theta0: float, omega0: float, setup: Setup) -> np.ndarray:
-    """The schedule through Drake as setup says; the result array of results.py."""
+    """The schedule through Drake as setup says; the result array of _results.py."""
     time_step = 0.0
     if setup.discrete:
         time_step = float(plan.step_size[0])

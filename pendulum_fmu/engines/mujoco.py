@@ -73,7 +73,7 @@ def model_xml(parameters: dict, setup: Setup) -> str:
 
 
 def simulate(plan: TorqueSchedule, parameters: dict, theta0: float, omega0: float, setup: Setup) -> np.ndarray:
-    """The schedule through MuJoCo as setup says; the result array of results.py."""
+    """The schedule through MuJoCo as setup says; the result array of _results.py."""
     model = mujoco.MjModel.from_xml_string(model_xml(parameters, setup))
     data = mujoco.MjData(model)
     data.qpos[0], data.qvel[0] = theta0, omega0

@@ -90,7 +90,7 @@ def urdf(parameters: dict) -> str:
 
 
 def simulate(plan: TorqueSchedule, parameters: dict, theta0: float, omega0: float, setup: Setup) -> np.ndarray:
-    """The schedule through PyBullet as setup says; the result array of results.py."""
+    """The schedule through PyBullet as setup says; the result array of _results.py."""
     client = pybullet.connect(pybullet.DIRECT)
     try:
         with tempfile.TemporaryDirectory(prefix="pendulum_pybullet_") as folder:

@@ -140,7 +140,7 @@ class Store:
 
     def remove_unfinished(self) -> None:
         """What interrupted chunks leave: the temporaries of writes cut short (a killed worker, see
-        atomic_files.py), the staged parts no client committed (of this run or any other), and
+        _atomic_files.py), the staged parts no client committed (of this run or any other), and
         trajectory parts whose chunk did not get to commit its cases part.
         """
         self.remove(

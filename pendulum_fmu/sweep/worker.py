@@ -1,7 +1,7 @@
 """What a dask worker does with a chunk of cases: simulate each, write the chunk's two parts.
 
 A worker thread steps its cases through its thread's FMU instance (simulate.simulator),
-restarted between cases, the whole chunk in one call into the native loop (cs_loop.py), into one
+restarted between cases, the whole chunk in one call into the native loop (_native_loop.py), into one
 preallocated (outputs, cases, points) array, whose series are the trajectories table's columns as
 they are; the FMI 3.0 FMU, or a machine without the native
 loop, runs each case through fmpy's calls.

@@ -17,7 +17,7 @@
 #define MASTER_TOKEN "GUID"
 #include "bare_master.h"
 
-/* What cs_loop.py checks too: the arguments below are those of this interface. */
+/* What _native_loop.py checks too: the arguments below are those of this interface. */
 #define CS_LOOP_INTERFACE 6
 
 typedef int CsLoopInterface(void);
@@ -29,7 +29,7 @@ typedef int CsLoopRun(void *const *functions, fmi2Component component,
                       const fmi2Integer *input_orders, const double *input_rates,
                       double *outputs, size_t *failed_step, int *failed_call);
 
-/* The FMU's functions in the order of CsFunctions in _cs_loop.c, as cs_loop.py passes them. */
+/* The FMU's functions in the order of CsFunctions in _cs_loop.c, as _native_loop.py passes them. */
 static const char *const LOOP_FUNCTIONS[] = {
     "fmi2Reset", "fmi2SetupExperiment", "fmi2EnterInitializationMode", "fmi2ExitInitializationMode",
     "fmi2SetReal", "fmi2SetRealInputDerivatives", "fmi2GetReal", "fmi2DoStep"};
