@@ -11,7 +11,6 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
-from . import _results as results
 from ._errors import InvalidInput
 from ._scenario_list import Scenario
 
@@ -21,8 +20,10 @@ RELATIVE_TOLERANCE, JUDGE_TOLERANCE = 1e-10, 1e-9
 KIT_FMU = "Pendulum.fmu"
 
 
-def scenario_settings(scenario: Scenario, parameters: dict) -> dict:
-    """What NAME.json holds for a scenario run with these parameters (every one of the FMU's)."""
+def scenario_settings(scenario: Scenario, parameters: dict, units: dict[str, str]) -> dict:
+    """What NAME.json holds for a scenario run with these parameters (every one of the FMU's);
+    units: the result's (_results.UNITS).
+    """
     name = scenario.name
     return {
         "name": name,
@@ -41,7 +42,7 @@ def scenario_settings(scenario: Scenario, parameters: dict) -> dict:
         "omega0": scenario.omega0,
         "relative_tolerance": RELATIVE_TOLERANCE,
         "tolerance": JUDGE_TOLERANCE,
-        "units": {**results.UNITS, "step_size": "s", "tolerance": "rad"},
+        "units": {**units, "step_size": "s", "tolerance": "rad"},
     }
 
 
