@@ -62,6 +62,7 @@ class WheelPlatform:
 
     @property
     def native_loop(self) -> str:
+        """The native loop's file name in the wheel."""
         return "_cs_loop.pyd" if self.system == "windows" else "_cs_loop.so"
 
 
@@ -199,7 +200,7 @@ def macos_tag(binaries: list[Path]) -> str:
 
 
 def _build_base_wheel(out_dir: Path) -> Path:
-    """This machine's wheel, the FMUs inside, built as pip would (an isolated environment)."""
+    """The wheel of this machine, the FMUs inside, built as pip would (an isolated environment)."""
     command = [
         sys.executable,
         "-m",
@@ -280,6 +281,7 @@ def build_wheels(output_dir: str | os.PathLike = ROOT / "wheelhouse") -> list[Pa
 
 
 def main(argv: list[str] | None = None) -> int:
+    """The command line: build_wheels into --output-dir; 0, or 2 after one line saying what failed."""
     parser = argparse.ArgumentParser(prog="build_wheels.py", description=__doc__.split("\n\n")[0])
     parser.add_argument(
         "--output-dir",

@@ -18,6 +18,7 @@ import sys
 import tempfile
 import warnings
 from pathlib import Path
+from typing import ClassVar
 
 from setuptools import Extension, setup
 from setuptools.command.bdist_wheel import bdist_wheel
@@ -32,6 +33,7 @@ class BuildPyWithFmu(build_py):
     """build_py, then the FMI 2.0 and 3.0 FMUs into <build_lib>/pendulum_fmu/data/."""
 
     def run(self):
+        """Copy the package as build_py does, then build both FMUs into its data/."""
         super().run()
         # An editable install runs from the checkout, which builds dist/Pendulum.fmu on demand.
         if getattr(self, "editable_mode", False):
@@ -56,6 +58,7 @@ class BuildNativeLoop(build_ext):
     """The native loop by CMake, for the platform of this machine."""
 
     def build_extension(self, extension):
+        """Build the native loop with fmu_build for this machine's platform, into extension's place."""
         from fmu_build import PLATFORMS, compile_native_loop
 
         [platform] = [name for name, platform in PLATFORMS.items() if platform.native]
@@ -65,12 +68,15 @@ class BuildNativeLoop(build_ext):
             shutil.copyfile(compile_native_loop(platform, out_dir, _linux_glibc(self)), target)
 
     def get_ext_filename(self, fullname):
+        """The native loop's plain name (_cs_loop.so, _cs_loop.pyd), not one CPython's own."""
         # The last suffix is the one every CPython of the platform loads: .so, .pyd.
         return str(Path(*fullname.split("."))) + importlib.machinery.EXTENSION_SUFFIXES[-1]
 
 
 class PlatformWheel(bdist_wheel):
-    user_options = [
+    """bdist_wheel tagged py3-none-<platform>, with --linux-glibc for the zig builds."""
+
+    user_options: ClassVar[list[tuple[str, str | None, str]]] = [
         *bdist_wheel.user_options,
         (
             "linux-glibc=",
@@ -81,10 +87,12 @@ class PlatformWheel(bdist_wheel):
     ]
 
     def initialize_options(self):
+        """bdist_wheel's options, and --linux-glibc unset (gcc, the build machine's glibc)."""
         super().initialize_options()
         self.linux_glibc = None
 
     def get_tag(self):
+        """py3, none and bdist_wheel's platform tag: one wheel for every Python 3 on a platform."""
         return "py3", "none", super().get_tag()[2]
 
 

@@ -1,6 +1,8 @@
 """What a user's set-up costs: the wheel, `pip install` of it, the `[opensim]` extra, and the
-first commands from that install. Prints the paragraph the README's Set up shows (its wording is
-TEMPLATE; tests/readme_figures.py holds the README to it):
+first commands from that install.
+
+Prints the paragraph the README's Set up shows (its wording is TEMPLATE; tests/readme_figures.py
+holds the README to it):
 
     .venv/bin/python -m benchmarks.install
 

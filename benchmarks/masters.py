@@ -1,7 +1,9 @@
 """Masters written as a vendor would, on fmpy's FMU2Slave and FMU2Model, that run a scenario of
 the kit (pendulum_fmu._scenarios) and write NAME_out.csv: a correct one, and ones that make each
-mistake the judge names on purpose. tests/test_scenarios.py and tests/test_judge.py run them;
-this prints what the judge says of each (the README's table and the thresholds of _judge.py):
+mistake the judge names on purpose.
+
+tests/test_scenarios.py and tests/test_judge.py run them; this prints what the judge says of
+each (the README's table and the thresholds of _judge.py):
 
     python -m benchmarks.masters
 

@@ -17,6 +17,7 @@ GRAVITY_MOMENT = P["mass"] * P["gravity"] * P["length"]
 
 
 def pd_torque(theta, omega, setpoint, kp, kd):
+    """The controller's torque: the gravity moment at theta, plus kp times the angle's error, less kd times omega."""
     return GRAVITY_MOMENT * np.sin(theta) + kp * (setpoint - theta) - kd * omega
 
 
@@ -46,6 +47,7 @@ def settling_time(time, theta, setpoint, band=0.02):
 
 
 def main(argv=None):
+    """The command line: run the loop, print its final angle, settling time and torque, draw it."""
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--setpoint", type=float, default=0.5, help="rad (default: %(default)s)")
     parser.add_argument("--kp", type=float, default=270.0, help="N.m/rad (default: %(default)s)")

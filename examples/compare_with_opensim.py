@@ -14,6 +14,7 @@ STEPWISE_TORQUE = "time,torque\n0,20\n0.5,20\n0.5,-10\n1,-10\n1,35\n1.5,35\n1.5,
 
 
 def run(torque_file=None, stop_time=3.0, output_dir="out/compare_with_opensim", tol=1e-9):
+    """The Comparison of the three tools on torque_file (default: STEPWISE_TORQUE), its table printed."""
     output_dir = Path(output_dir)
     if torque_file is None:
         output_dir.mkdir(parents=True, exist_ok=True)
@@ -28,6 +29,7 @@ def run(torque_file=None, stop_time=3.0, output_dir="out/compare_with_opensim", 
 
 
 def main(argv=None):
+    """The command line; exit status 0 when the tools agree within --tol, else 1."""
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument(
         "--torque-file",

@@ -33,6 +33,7 @@ def run(torque=20.0, stop_time=3.0, step_size=1e-3, output_dir="out/constant_tor
 
 
 def main(argv=None):
+    """The command line: run() with its options."""
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--torque", type=float, default=20.0, help="N.m (default: %(default)s)")
     parser.add_argument("--stop-time", type=float, default=3.0, help="s (default: %(default)s)")

@@ -13,6 +13,7 @@ from pendulum_fmu import default_fmu, reference, schedule, write_torque_csv
 
 
 def run(stop_time=3.0, output_dir="out/fmpy_command_line"):
+    """Largest |theta - scipy's| in rad, at the times fmpy simulate wrote, for a three-level torque."""
     output_dir = Path(output_dir)
     plan = schedule(
         lambda t: 20.0 if t < stop_time / 3 else (-10.0 if t < 2 * stop_time / 3 else 5.0),
@@ -48,6 +49,7 @@ def run(stop_time=3.0, output_dir="out/fmpy_command_line"):
 
 
 def main(argv=None):
+    """The command line: run() with its options."""
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--stop-time", type=float, default=3.0, help="s (default: %(default)s)")
     parser.add_argument("--output-dir", default="out/fmpy_command_line", help="where the CSVs go")

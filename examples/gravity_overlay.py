@@ -6,6 +6,7 @@ from pendulum_fmu import plot_overlay, simulate
 
 
 def run(torque=20.0, stop_time=3.0, output_dir="out/gravity_overlay"):
+    """{label: result} of the runs with gravity off and on, after drawing both in one figure."""
     runs = {
         "No gravity": simulate(torque, stop_time=stop_time, parameters={"gravity": 0.0}),
         "With gravity": simulate(torque, stop_time=stop_time),
@@ -25,6 +26,7 @@ def run(torque=20.0, stop_time=3.0, output_dir="out/gravity_overlay"):
 
 
 def main(argv=None):
+    """The command line: run() with its options."""
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--torque", type=float, default=20.0, help="N.m (default: %(default)s)")
     parser.add_argument("--stop-time", type=float, default=3.0, help="s (default: %(default)s)")

@@ -6,8 +6,7 @@ import argparse
 
 import pyarrow.parquet as pq
 
-from pendulum_fmu import PendulumFmuError
-from pendulum_fmu.sweep import Study, run_sweep, sweep_grid
+from pendulum_fmu import PendulumFmuError, Study, run_sweep, sweep_grid
 
 
 def run(
@@ -39,6 +38,7 @@ def run(
 
 
 def main(argv=None):
+    """The command line: run() with its options; a study it refuses is one line, exit status 2."""
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--torque", type=float, nargs="+", default=[5.0, 10.0, 20.0, 40.0], help="N.m")
     parser.add_argument("--stop-time", type=float, default=3.0, help="s (default: %(default)s)")

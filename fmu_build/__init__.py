@@ -97,6 +97,7 @@ class Target:
 
     @property
     def native(self) -> bool:
+        """Whether this machine builds the target with its own compiler (its system and machine)."""
         return sys.platform == self.system and (not self.machines or host.machine() in self.machines)
 
     @property
@@ -152,10 +153,12 @@ class Platform:
 
     @property
     def windows(self) -> bool:
+        """Whether the FMU's library is a Windows DLL."""
         return self.suffix == ".dll"
 
     @property
     def native(self) -> bool:
+        """Whether this machine builds every target of the platform with its own compiler."""
         return all(target.native for target in self.targets)
 
 

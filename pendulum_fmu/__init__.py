@@ -36,6 +36,7 @@ _LAZY = {
     "compare": "_compare",
     "Comparison": "_compare",
     "format_table": "_compare",
+    "list_tools": "_compare_tools",
     "plot_overlay": "_plot",
     # judging a master's result, and the kit of scenarios to judge
     "judge": "_judge",

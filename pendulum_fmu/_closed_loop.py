@@ -84,8 +84,31 @@ def create_closed_loop_fmu(out_file: str | Path, *, step_size: float = 1e-3) -> 
         A step size that is not a positive number.
     CannotWrite
         out_file cannot be written.
+    MissingFile
+        In an installed package, which carries the pendulum's FMU but not the controller's sources.
     BuildError
         The pendulum or the controller cannot be built here.
+
+    Examples
+    --------
+    A step size is checked before anything is built:
+
+    >>> from pendulum_fmu import InvalidInput, create_closed_loop_fmu
+    >>> try:
+    ...     create_closed_loop_fmu("ClosedLoop.fmu", step_size=0)
+    ... except InvalidInput as error:
+    ...     print(error)
+    step size 0 must be a positive number of seconds
+
+    The build itself compiles both FMUs for every platform (about a minute), too long for a
+    doctest; tests/test_closed_loop.py runs it:
+
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from fmpy import read_model_description
+    >>> loop = create_closed_loop_fmu(Path(tempfile.mkdtemp(), "ClosedLoop.fmu"))  # doctest: +SKIP
+    >>> [variable.name for variable in read_model_description(loop).modelVariables]  # doctest: +SKIP
+    ['time', 'theta', 'torque']
     """
     if not (isinstance(step_size, numbers.Real) and 0 < step_size < math.inf):
         raise InvalidInput(f"step size {step_size!r} must be a positive number of seconds")
@@ -232,10 +255,10 @@ def sampled_loop_reference(
         out[k] = (k * step_size, state[0], state[1], torque)
         if k == n:
             break
-        rhs = lambda t, y, u=torque: (
-            y[1],
-            (u - gravity_moment * np.sin(y[0]) - p["damping"] * y[1]) * inverse_inertia,
-        )
+
+        def rhs(t, y, u=torque):
+            return y[1], (u - gravity_moment * np.sin(y[0]) - p["damping"] * y[1]) * inverse_inertia
+
         integral, previous = next_integral, state
         state = solve_ivp(rhs, (0.0, step_size), state, method="DOP853", rtol=rtol, atol=rtol).y[:, -1]
     return out

@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from . import _results as results
 from ._atomic_files import check_writable, replacing
 from ._compare_tools import ToolSpecError, installed_defaults, parse_tools
 from ._errors import InvalidInput, WrongType
@@ -41,20 +42,21 @@ def run_tools(
     theta0: float = 0.0,
     omega0: float = 0.0,
     fmu_path: str | Path | None = None,
-    mapping: str | None = None,
+    mapping: str | dict | None = None,
 ) -> dict[str, np.ndarray]:
     """{tool label: result array} for the same schedule, parameters and start values; tools as
     --tools gives them (see _compare_tools.py), mapping the --map of other FMUs. "reference" here is
     reference_schedule: the schedule's own torques through scipy.
     """
-    fmu_path = fmu_model(fmu_path)  # read once, passed to every tool
-    parsed = parse_tools(tools, mapping=mapping, fmu_path=fmu_path)
+    model = fmu_model(fmu_path)  # read once, passed to every tool
+    parsed = parse_tools(tools, mapping=mapping, fmu_path=model)
     # Every tool gets the whole set, so the defaults are fmu_path's for all of them.
-    parameters = resolve_parameters(parameters, fmu_path)
+    parameters = resolve_parameters(parameters, model)
     return {tool.label: tool.run(plan, parameters=parameters, theta0=theta0, omega0=omega0) for tool in parsed}
 
 
 def check_tolerance(tolerance: float) -> float:
+    """The tolerance as a float; InvalidInput unless it is a positive finite number."""
     if not (math.isfinite(tolerance) and tolerance > 0):
         raise InvalidInput(f"the tolerance {tolerance} must be a positive finite number (rad, rad/s)")
     return float(tolerance)
@@ -68,7 +70,7 @@ def differences(run: np.ndarray, judge: np.ndarray) -> dict[str, float]:
     # A tool whose numbers run past the largest double (a --map factor of 1e308) differs by inf:
     # that is its verdict, and numpy's overflow warnings on the way say nothing more.
     with np.errstate(over="ignore", invalid="ignore"):
-        for name in run.dtype.names[2:]:
+        for name in results.fields(run)[2:]:
             difference = np.abs(run[name] - judge[name])
             row[f"{name}_max"] = float(np.max(difference))
             row[f"{name}_rms"] = float(np.sqrt(np.mean(difference**2)))
@@ -91,6 +93,33 @@ COLUMNS = (
 
 
 def format_table(rows: list[dict]) -> str:
+    """The differences of a comparison as the table compare's command line prints.
+
+    Parameters
+    ----------
+    rows : list of dict
+        Rows as in Comparison.differences: tool, against, theta_max, theta_rms, omega_max,
+        alpha_max, torque_max and, optionally, seconds_per_step (None or absent: left blank).
+
+    Returns
+    -------
+    str
+        A header line, then one line per row.
+
+    Raises
+    ------
+    KeyError
+        A row without one of the columns.
+
+    Examples
+    --------
+    >>> from pendulum_fmu import format_table
+    >>> row = {"tool": "fmu", "against": "reference", "theta_max": 8.9e-13, "theta_rms": 3.9e-13,
+    ...        "omega_max": 1.8e-13, "alpha_max": 5.8e-12, "torque_max": 0.0, "seconds_per_step": 2.1e-05}
+    >>> print(format_table([row]))
+    tool         against      max|dtheta| rad rms dtheta max|domega| rad/s max|dalpha| max|dtorque| N.m   s/step
+    fmu          reference          8.900e-13   3.90e-13         1.800e-13    5.80e-12         0.00e+00  2.1e-05
+    """
     width = max([12, *(len(row["tool"]) + 1 for row in rows), *(len(row["against"]) + 1 for row in rows)])
     lines = [
         f"{'tool':<{width}} {'against':<{width}} {'max|dtheta| rad':>15} {'rms dtheta':>10} "
@@ -112,7 +141,7 @@ def write_trajectories(runs: dict[str, np.ndarray], path: str | Path) -> Path:
     """
     columns = {"time": next(iter(runs.values()))["time"]}
     for tool, run in runs.items():
-        for name in run.dtype.names[1:]:
+        for name in results.fields(run)[1:]:
             columns[f"{name}_{tool}"] = run[name]
     with replacing(path, newline="") as file:
         writer = csv.writer(file)
@@ -124,6 +153,7 @@ def write_trajectories(runs: dict[str, np.ndarray], path: str | Path) -> Path:
 
 
 def write_differences(rows: list[dict], path: str | Path) -> Path:
+    """Write differences.csv: the rows of COLUMNS, then any other output's differences."""
     with replacing(path, newline="") as file:
         fields = [*COLUMNS, *(key for key in (rows[0] if rows else {}) if key not in COLUMNS)]
         writer = csv.DictWriter(file, fieldnames=fields)
@@ -180,10 +210,12 @@ class Comparison:
 
     @property
     def torque_limit(self) -> float:
+        """The rounding allowed between the torque a tool received and the signal, in N.m."""
         return TORQUE_ROUNDING * (1.0 + float(np.max(np.abs(self.runs[REFERENCE]["torque"]))))
 
     @property
     def agree(self) -> bool:
+        """Whether every tool is within the tolerance and received the signal's torque."""
         return self.worst <= self.tolerance and self.torque_worst <= self.torque_limit
 
 
@@ -268,15 +300,15 @@ def compare(
     """
     if not isinstance(output_dir, str | os.PathLike):
         raise WrongType(f"output_dir is a folder's path, not {output_dir!r}")
-    fmu_path = fmu_model(fmu_path)  # read once, passed to every tool
-    parsed = parse_tools(installed_defaults() if tools is None else tools, mapping=mapping, fmu_path=fmu_path)
+    model = fmu_model(fmu_path)  # read once, passed to every tool
+    parsed = parse_tools(installed_defaults() if tools is None else tools, mapping=mapping, fmu_path=model)
     if len(parsed) < 2:
         raise ToolSpecError(f"compare needs at least two tools, got {parsed[0].label}: e.g. --tools fmu,{REFERENCE}")
     tolerance = check_tolerance(tolerance)
-    shown = case_title(torque, parameters, theta0, omega0, fmu_path)  # the user's own parameters
+    shown = case_title(torque, parameters, theta0, omega0, model)  # the user's own parameters
     # Refused here before any tool runs; and every tool gets the whole set, so the defaults are
     # fmu_path's for all of them.
-    parameters = resolve_parameters(parameters, fmu_path)
+    parameters = resolve_parameters(parameters, model)
     plan = schedule(
         torque, start_time=start_time, stop_time=stop_time, step_size=step_size, ramp=ramp, max_steps=max_steps
     )
@@ -295,7 +327,7 @@ def compare(
         theta0=theta0,
         omega0=omega0,
         at=plan.time,
-        fmu_path=fmu_path,
+        fmu_path=model,
     )
     for tool in parsed:
         if tool.label != REFERENCE:  # the judge above takes the reference's place

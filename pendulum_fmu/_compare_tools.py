@@ -100,7 +100,7 @@ def run_fmu(
     mode: str = "accurate",
     fmu_path: str | Path | FmuModel | None = None,
 ) -> np.ndarray:
-    """This project's FMU (the checkout's, or fmu_path) through fmpy; ramps are passed on."""
+    """The project's FMU (the checkout's, or fmu_path) through fmpy; ramps are passed on."""
     check_mode(mode, "fmu")
     return simulate_plan(plan, parameters=parameters, theta0=theta0, omega0=omega0, fmu_path=fmu_path)
 
@@ -129,6 +129,7 @@ class Kind:
     modes: tuple[str, ...] = ("accurate",)
 
     def load(self) -> Callable[..., np.ndarray]:
+        """The tool's runner, its module imported now."""
         module, function = self.runner.split(":")
         return getattr(importlib.import_module(module), function)
 
@@ -144,6 +145,78 @@ KINDS = {
 # The tools compare runs when none are named: of these, the ones installed here.
 DEFAULT_TOOLS = ("fmu", "reference", "opensim")
 _LABEL = re.compile(r"^[A-Za-z_][A-Za-z0-9_.-]*$")
+
+
+def _label(name: str, mode: str) -> str:
+    """The tool's label in --tools, tables and figures: its name, with the mode unless accurate."""
+    return name if mode == "accurate" else f"{name}:{mode}"
+
+
+@dataclass(frozen=True)
+class ToolInfo:
+    """One tool compare() runs by name, as list_tools() describes it.
+
+    Attributes
+    ----------
+    name : str
+        The tool's name: fmu, reference, opensim, mujoco, drake or pybullet.
+    installed : bool
+        Whether its Python package can be imported here.
+    labels : tuple of str
+        What compare's tools (and --tools) take to run it, one per mode, such as "mujoco" (its
+        accurate mode) and "mujoco:default"; each is also the run's label in tables and figures.
+    install : str or None
+        The pip command that installs what it needs; None when it needs nothing beyond this package.
+    """
+
+    name: str
+    installed: bool
+    labels: tuple[str, ...]
+    install: str | None
+
+
+def list_tools() -> list[ToolInfo]:
+    """Every tool compare() runs by name: whether it is installed here, and how to install it.
+
+    Parameters
+    ----------
+    None
+        It takes no arguments; an FMU given as LABEL=path/to/Their.fmu is a tool too, not listed.
+
+    Returns
+    -------
+    list of ToolInfo
+        fmu, reference, then the engines: opensim, mujoco, drake, pybullet.
+
+    Raises
+    ------
+    Nothing
+        A tool that is not installed is listed with installed False.
+
+    Examples
+    --------
+    >>> from pendulum_fmu import list_tools
+    >>> [(tool.name, tool.labels) for tool in list_tools()][:3]
+    [('fmu', ('fmu',)), ('reference', ('reference',)), ('opensim', ('opensim', 'opensim:default'))]
+    >>> mujoco = next(tool for tool in list_tools() if tool.name == "mujoco")
+    >>> mujoco.install
+    'pip install ".[mujoco]" in a clone of pendulum-fmu (or "WHEEL.whl[mujoco]" for its wheel)'
+
+    The installed engines, as compare's tools:
+
+    >>> tools = [label for tool in list_tools() if tool.installed for label in tool.labels]
+    >>> tools[:2]
+    ['fmu', 'reference']
+    """
+    return [
+        ToolInfo(
+            name,
+            installed(name),
+            tuple(_label(name, mode) for mode in kind.modes),
+            None if kind.package is None else install_hint(name),
+        )
+        for name, kind in KINDS.items()
+    ]
 
 
 def installed(name: str) -> bool:
@@ -185,7 +258,7 @@ def installed_defaults() -> list[str]:
     return [name for name in DEFAULT_TOOLS if name not in missing]
 
 
-def _mapped_fmu(label: str, path: str, mapping: str | None, fmu: str | Path | FmuModel | None) -> Tool:
+def _mapped_fmu(label: str, path: str, mapping: str | dict | None, fmu: str | Path | FmuModel | None) -> Tool:
     from ._mapped_fmu import MappedFmu
 
     if not _LABEL.match(label) or label.split(":")[0] in KINDS:
@@ -210,15 +283,16 @@ def _named(item: str, fmu_path: str | Path | FmuModel | None) -> Tool:
         raise ToolSpecError(f"--tools {name}: {kind.package} is not installed; install it with: {install_hint(name)}")
     # Every runner takes the FMU whose defaults (and, for fmu, whose binary) apply.
     runner = partial(kind.load(), mode=mode, fmu_path=fmu_path)
-    return Tool(name if mode == "accurate" else f"{name}:{mode}", runner, fmu_path)
+    return Tool(_label(name, mode), runner, fmu_path)
 
 
 def parse_tools(
-    spec: str | Sequence[str], *, mapping: str | None = None, fmu_path: str | Path | FmuModel | None = None
+    spec: str | Sequence[str], *, mapping: str | dict | None = None, fmu_path: str | Path | FmuModel | None = None
 ) -> list[Tool]:
     """The tools of a --tools list (a comma-separated string or its items), in order.
 
-    mapping is the --map for the tools given as LABEL=PATH; fmu_path the FMU that "fmu" runs.
+    mapping is the --map for the tools given as LABEL=PATH (its text, or a dict as
+    mapped_fmu.as_map takes it); fmu_path the FMU that "fmu" runs.
     """
     if isinstance(spec, str):
         spec = spec.split(",")

@@ -19,6 +19,7 @@ def _while_starting(number, frame):
 
 
 def run() -> None:
+    """The pendulum-fmu program: the command line, with its stopping signals handled from the start."""
     for number in STOPPING_SIGNALS:
         signal.signal(number, _while_starting)
     from .cli import main  # sets the command's own handlers while it runs

@@ -46,39 +46,135 @@ class PendulumFmuError(Exception):
 class InvalidInput(PendulumFmuError, ValueError):
     """An argument, option, parameter or case the package refuses: a time, a step, a tolerance,
     a parameter's name or value, a sweep's values.
+
+    Examples
+    --------
+    >>> from pendulum_fmu import InvalidInput, simulate
+    >>> try:
+    ...     simulate(20.0, step_size=0)
+    ... except InvalidInput as error:
+    ...     print(error)
+    step size 0 must be positive
+    >>> issubclass(InvalidInput, ValueError)
+    True
     """
 
 
 class WrongType(PendulumFmuError, TypeError):
     """An argument of a kind the function does not take (None for a folder, a list for a Study);
     the message says what it takes.
+
+    Examples
+    --------
+    >>> from pendulum_fmu import WrongType, simulate
+    >>> try:
+    ...     simulate(20.0, parameters=[("mass", 2.0)])
+    ... except WrongType as error:
+    ...     print(error)
+    parameters is a dict {name: value}, e.g. {'gravity': 0}; got a list
+    >>> issubclass(WrongType, TypeError)
+    True
     """
 
 
 class MissingFile(PendulumFmuError, FileNotFoundError):
-    """A file the user named, or the FMU the package needs, is not there."""
+    """A file the user named, or the FMU the package needs, is not there.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from pendulum_fmu import MissingFile, simulate
+    >>> absent = Path(tempfile.mkdtemp(), "absent.fmu")
+    >>> try:
+    ...     simulate(20.0, fmu_path=absent)
+    ... except MissingFile as error:
+    ...     print(str(error).replace(str(absent), "absent.fmu"))
+    FMU absent.fmu: No such file or directory
+    >>> issubclass(MissingFile, FileNotFoundError)
+    True
+    """
 
 
 class CannotWrite(PendulumFmuError, OSError):
     """An output cannot be written where it was asked for (a file where a folder must be, no
     permission, a full disk).
+
+    Examples
+    --------
+    A file where the output's folder must be:
+
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from pendulum_fmu import CannotWrite, schedule, write_torque_csv
+    >>> notes = Path(tempfile.mkdtemp(), "notes.txt")
+    >>> _ = notes.write_text("a file, not a folder")
+    >>> try:
+    ...     write_torque_csv(notes / "torque.csv", schedule(1.0))
+    ... except CannotWrite as error:
+    ...     print(str(error).replace(str(notes), "notes.txt"))
+    cannot write notes.txt/torque.csv: notes.txt is a file, not a folder; choose another output path
+    >>> issubclass(CannotWrite, OSError)
+    True
     """
 
 
 class MissingDependency(PendulumFmuError, ImportError):
-    """An optional package a tool needs is not installed; the message gives the pip command."""
+    """An optional package a tool needs is not installed; the message says what to install.
+
+    Examples
+    --------
+    A sweep's output folder on Azure, whose fsspec package (adlfs) no extra installs:
+
+    >>> from pendulum_fmu import MissingDependency, Study, run_sweep, sweep_grid
+    >>> try:
+    ...     run_sweep(Study(sweep_grid([1.0])), output_dir="abfs://container/study")
+    ... except MissingDependency as error:
+    ...     print(error)
+    output directory abfs://container/study: Install adlfs to access Azure ...
+    >>> issubclass(MissingDependency, ImportError)
+    True
+    """
 
 
 class BuildError(PendulumFmuError, RuntimeError):
     """The FMU could not be built; the message says why. Raised by the repository's build tool
     (fmu_build/, beside the package in a checkout), and defined here so that the package's callers
     catch it without that tool.
+
+    Examples
+    --------
+    In a checkout, default_fmu() rebuilds a stale FMU, and raises it when that fails:
+
+    >>> from pendulum_fmu import BuildError, PendulumFmuError, default_fmu
+    >>> try:
+    ...     fmu = default_fmu()
+    ... except BuildError as error:
+    ...     print(error)
+    >>> fmu.name, issubclass(BuildError, (PendulumFmuError, RuntimeError))
+    ('Pendulum.fmu', True)
     """
 
 
 class PlatformSkipped(UserWarning):
     """A platform left out of a default build because its compiler is missing (the build tool
     warns; the command line shows it in one line).
+
+    Examples
+    --------
+    A warning, not an error: a caller that needs every platform makes it one.
+
+    >>> import warnings
+    >>> from pendulum_fmu import PlatformSkipped
+    >>> issubclass(PlatformSkipped, UserWarning)
+    True
+    >>> with warnings.catch_warnings():
+    ...     warnings.simplefilter("error", PlatformSkipped)
+    ...     try:
+    ...         warnings.warn("win64 skipped: no cross compiler", PlatformSkipped)
+    ...     except PlatformSkipped as warning:
+    ...         print(warning)
+    win64 skipped: no cross compiler
     """
 
 
@@ -86,6 +182,15 @@ class NotComputed(UserWarning):
     """A tool was asked for an output it cannot compute (one the FMU has and the tool does not
     model): its column is NaN, never zeros. The message is one line naming the tool and the
     outputs; the command line prints it as that line and goes on.
+
+    Examples
+    --------
+    A warning, so the comparison goes on; a caller that needs every output makes it an error
+    (``warnings.simplefilter("error", NotComputed)``), as PlatformSkipped shows.
+
+    >>> from pendulum_fmu import NotComputed
+    >>> issubclass(NotComputed, UserWarning)
+    True
     """
 
 
@@ -93,4 +198,19 @@ class Skipped(UserWarning):
     """A part of the run left out because this machine lacks what it needs (a tool's package); the
     message is one line saying which part and how to get it. The command line prints it as that
     line and goes on.
+
+    Examples
+    --------
+    compare() without tools runs the default tools installed here and warns which it left out:
+
+    >>> import tempfile, warnings
+    >>> from pendulum_fmu import Skipped, compare
+    >>> issubclass(Skipped, UserWarning)
+    True
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always", Skipped)
+    ...     comparison = compare(20.0, output_dir=tempfile.mkdtemp(), stop_time=0.01)
+    >>> skipped = [str(warning.message) for warning in caught if warning.category is Skipped]
+    >>> sorted(comparison.runs) == sorted(["fmu", "reference", *([] if skipped else ["opensim"])])
+    True
     """

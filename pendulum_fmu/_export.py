@@ -99,9 +99,12 @@ def export_fmu(
 
     Examples
     --------
-    >>> exported = export_fmu("Pendulum.fmu")  # doctest: +SKIP
-    >>> exported.platforms  # doctest: +SKIP
-    ('aarch64-linux', 'darwin64', 'linux64', 'win64')
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from pendulum_fmu import export_fmu
+    >>> exported = export_fmu(Path(tempfile.mkdtemp(), "Pendulum.fmu"))
+    >>> exported.path.name, exported.platforms
+    ('Pendulum.fmu', ('aarch64-linux', 'darwin64', 'linux64', 'win64'))
     """
     source = default_fmu(fmi_version)  # first: it says which FMI versions there are
     output = Path(FMU_FILES[fmi_version] if output is None else output)

@@ -25,7 +25,19 @@ _STATUS = ["OK", "WARNING", "DISCARD", "ERROR", "FATAL", "PENDING"]
 
 
 class FmuError(PendulumFmuError, RuntimeError):
-    """An FMI call failed; the message carries what the FMU logged."""
+    """An FMI call failed, or the FMU refused a value; the message carries what the FMU logged.
+
+    Examples
+    --------
+    A relative tolerance the FMU refuses when it is set up:
+
+    >>> from pendulum_fmu import FmuError, simulate
+    >>> try:
+    ...     simulate(20.0, tolerance=2.0)
+    ... except FmuError as error:
+    ...     print(error)
+    initialization failed: [ERROR] fmi2SetupExperiment: tolerance 2 must be in (0, 1)
+    """
 
 
 def _log_to_instance(environment, instance_name, status, category, message):
@@ -144,48 +156,59 @@ def open_fmu(
     start_time: float = 0.0,
     instance_name: str = "pendulum",
 ):
-    """An initialized FmuInstance of an FMU, in step mode, for a master's own loop.
+    """An FMU instance, initialized and in step mode, to drive call by call with fmpy's calls.
 
     The FMI version is read from the FMU's model description (instance.fmi_version says which);
-    the instance carries its message log as instance.messages and its model as instance.model,
-    and fmpy's calls pass through to its FMU2Slave or FMU3Slave. The caller frees it with
-    instance.terminate(); instance.freeInstance().
+    fmpy's calls (doStep, getReal, setReal, setFloat64, ...) pass through to its FMU2Slave or
+    FMU3Slave. The caller frees it with ``instance.terminate(); instance.freeInstance()``.
 
     Parameters
     ----------
-    fmu_path : str, Path, FmuModel or None
-        The FMU (None: pendulum_fmu.default_fmu()); its parameters and value references apply.
+    fmu_path : str, Path, FmuModel or None, optional
+        The FMU; None: pendulum_fmu.default_fmu(). Its parameters and value references apply.
     parameters : dict, optional
-        Overrides of the FMU's parameters (mass, length, inertia, gravity, damping).
+        The FMU's parameters over its defaults (mass, length, inertia, gravity, damping).
     theta0, omega0 : float, optional
-        Start angle in rad and rate in rad/s.
+        Start angle (rad) and rate (rad/s).
     tolerance : float, optional
-        Relative tolerance of the FMU's integrator (None: the FMU's own).
+        The relative tolerance handed to the FMU (None: the FMU's own).
     start_time : float, optional
-        In s.
+        The time of the first communication point, in s.
     instance_name : str, optional
-        The name the FMU is instantiated with (its messages and call record show it).
+        The FMI instance name, which the FMU's log messages carry.
 
     Returns
     -------
     FmuInstance
-        Initialized, ready for its first doStep.
+        With its message log as instance.messages and its model as instance.model.
 
     Raises
     ------
     MissingFile, FmuFileError
         No file at fmu_path, or none that is a pendulum FMU this machine can run (checked before
         anything is unzipped or loaded).
+    InvalidInput
+        A parameter or start value that is no finite number, or a parameter the FMU has not.
     FmuError
-        The FMU refused the parameters or start values; the message carries what it logged.
+        The FMU refused the parameters, start values, tolerance or start time; the message
+        carries what it logged.
 
     Examples
     --------
+    One 0.1 s step with 20 N.m from theta = 0.1 rad:
+
     >>> from pendulum_fmu import open_fmu
-    >>> instance = open_fmu(parameters={"damping": 1.0}, theta0=0.1)
-    >>> instance.fmi_version, instance.getReal([instance.model.value_reference("theta")])
-    (2, [0.1])
-    >>> _ = instance.terminate(); instance.freeInstance()
+    >>> instance = open_fmu(theta0=0.1)
+    >>> theta, omega, torque = (instance.model.value_reference(name) for name in ("theta", "omega", "torque"))
+    >>> instance.fmi_version, instance.getReal([theta, omega])
+    (2, [0.1, 0.0])
+    >>> instance.setReal([torque], [20.0])
+    >>> instance.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.1)
+    >>> [round(value, 6) for value in instance.getReal([theta, omega])]
+    [0.100068, 0.001361]
+    >>> instance.terminate()  # fmpy returns the FMI status: 0, OK
+    0
+    >>> instance.freeInstance()
     """
     slave = instantiated(fmu_model(fmu_path), instance_name)
     try:
@@ -257,6 +280,8 @@ class FmuInstance:
     fmpy's calls (doStep, getReal, setFloat64, terminate, freeInstance, dll, component, ...) pass
     through to the slave, so an instance is used as the slave would be.
 
+    Made by open_fmu(), which instantiates and initializes it.
+
     Parameters
     ----------
     slave : fmpy.fmi2.FMU2Slave or fmpy.fmi3.FMU3Slave
@@ -266,13 +291,28 @@ class FmuInstance:
     model : FmuModel
         The FMU the slave was made from.
 
+    Attributes
+    ----------
+    slave : fmpy.fmi2.FMU2Slave or fmpy.fmi3.FMU3Slave
+        fmpy's instance, which the calls pass through to.
+    messages : MessageLog
+        What the FMU logged.
+    model : FmuModel
+        The FMU's model object: value references, parameters, outputs.
+    fmi_version : {2, 3}
+        The FMI standard of the FMU.
+    dll, component
+        fmpy's loaded library and the FMI component, as the native loop binds them.
+
     Examples
     --------
-    >>> from pendulum_fmu._instance import open_fmu
+    >>> from pendulum_fmu import open_fmu
     >>> instance = open_fmu()
-    >>> instance.model.fmi_version, instance.fmi_version
-    (2, 2)
-    >>> _ = instance.terminate(); instance.freeInstance()
+    >>> type(instance).__name__, instance.fmi_version, instance.model.outputs
+    ('FmuInstance', 2, ('theta', 'omega', 'alpha'))
+    >>> instance.getReal([instance.model.value_reference("theta")])
+    [0.0]
+    >>> status = instance.terminate(); instance.freeInstance()
     """
 
     def __init__(self, slave, messages, model: FmuModel):

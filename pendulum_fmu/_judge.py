@@ -108,6 +108,7 @@ class Judgement:
 
     @property
     def passed(self) -> bool:
+        """Whether the verdict is pass."""
         return self.verdict == "pass"
 
     def summary(self) -> dict:

@@ -166,7 +166,7 @@ class MappedFmu:
             mapping[quantity] = mapped
         return mapping
 
-    def _start_values(self, parameters: dict, theta0: float, omega0: float) -> dict[str, float]:
+    def _start_values(self, parameters: dict | None, theta0: float, omega0: float) -> dict[str, float]:
         """{FMU variable: value in the FMU's units} for the parameters and start values."""
         values = {**resolve_parameters(parameters), "theta0": theta0, "omega0": omega0}
         defaults = default_parameters()
@@ -192,6 +192,7 @@ class MappedFmu:
         omega0: float = 0.0,
         mode: str = "accurate",
     ) -> np.ndarray:
+        """The FMU's result for a held schedule, mapped to the pendulum's quantities (see Tool.run)."""
         check_held(plan, self.label)
         check_mode(mode, self.label)
         start = self._start_values(parameters, theta0, omega0)

@@ -33,6 +33,21 @@ FMI_VERSIONS = ("2.0", "3.0")
 class FmuFileError(InvalidInput):
     """The file given as an FMU is none this package can run: not a zip, no modelDescription.xml,
     not FMI 2.0 or 3.0, or not a pendulum; the message names the file and what to do.
+
+    Examples
+    --------
+    A text file given as an FMU:
+
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from pendulum_fmu import FmuFileError, simulate
+    >>> not_an_fmu = Path(tempfile.mkdtemp(), "notes.fmu")
+    >>> _ = not_an_fmu.write_text("not a zip")
+    >>> try:
+    ...     simulate(20.0, fmu_path=not_an_fmu)
+    ... except FmuFileError as error:
+    ...     print(str(error).replace(str(not_an_fmu), "notes.fmu"))
+    notes.fmu is not an FMU (an FMU is a zip archive with a modelDescription.xml): check the path
     """
 
 
@@ -235,8 +250,12 @@ def fmu_model(fmu: str | os.PathLike | FmuModel | None = None) -> FmuModel:
 
     Examples
     --------
-    >>> fmu_model("dist/Pendulum.fmu").fmi_version
-    2
+    >>> from pendulum_fmu import default_fmu, fmu_model
+    >>> model = fmu_model(default_fmu())
+    >>> model.fmi_version, model.default_parameters
+    (2, {'mass': 40.0, 'length': 0.5, 'inertia': 20.0, 'gravity': 9.81, 'damping': 0.0})
+    >>> fmu_model(default_fmu()) is model  # made once per file version
+    True
     """
     if isinstance(fmu, FmuModel):
         return fmu

@@ -74,6 +74,7 @@ def _library():
 
 
 def available() -> bool:
+    """Whether the native loop (the compiled _cs_loop library) could be loaded here."""
     return _library() is not None
 
 

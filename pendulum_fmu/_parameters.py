@@ -104,5 +104,29 @@ def start_value(name: str, value, unit: str) -> float:
 
 
 def total_inertia(parameters: dict[str, float]) -> float:
-    """Moment of inertia about the pivot: the head's own plus mass*length^2 (parallel axes)."""
+    """Moment of inertia about the pivot: the head's own plus mass*length^2 (parallel axes).
+
+    Parameters
+    ----------
+    parameters : dict of str to float
+        The pendulum's parameters, with inertia (kg.m^2), mass (kg) and length (m) among them.
+
+    Returns
+    -------
+    float
+        inertia + mass * length**2, in kg.m^2.
+
+    Raises
+    ------
+    KeyError
+        parameters lacks inertia, mass or length.
+
+    Examples
+    --------
+    The default FMU's pendulum: 20 + 40 * 0.5**2.
+
+    >>> from pendulum_fmu import fmu_model, total_inertia
+    >>> total_inertia(fmu_model().default_parameters)
+    30.0
+    """
     return parameters["inertia"] + parameters["mass"] * parameters["length"] ** 2

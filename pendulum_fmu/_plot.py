@@ -8,16 +8,15 @@ import os
 from pathlib import Path
 
 import matplotlib
-
-matplotlib.use("Agg")  # files only: works on machines without a display
-import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.backend_bases import FigureCanvasBase
+from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
+from numpy.typing import ArrayLike
 
 from ._atomic_files import replacing_path
 from ._errors import InvalidInput
-from ._parameters import merged_parameters, unit
+from ._parameters import Fmu, merged_parameters, unit
 
 THETA_LABEL = r"Position $\theta$ in rad"
 OMEGA_LABEL = r"Velocity $\omega$ in rad/s"
@@ -29,7 +28,7 @@ def case_title(
     parameters: dict[str, float] | None = None,
     theta0: float = 0.0,
     omega0: float = 0.0,
-    fmu_path: str | Path | None = None,
+    fmu_path: Fmu = None,
 ) -> str:
     """'Torque-driven pendulum: torque 20 N.m, gravity 9.81 m/s2', then every parameter the user
     set and a start value other than 0, each with the unit the FMU declares.
@@ -92,6 +91,7 @@ def _leave_out_undrawable(ax) -> None:
     """
     notes = []
     for artist in [*ax.lines, *ax.collections]:
+        values: tuple[ArrayLike, ...]  # one array for an axhline, two for a line, one per path else
         if isinstance(artist, Line2D):
             if artist.get_transform() is not ax.transData:  # axhline: its x is the panel's width
                 values = (artist.get_ydata(),)
@@ -134,6 +134,12 @@ def _drawing(plot):
     return quietly
 
 
+def _figure(width: float, height: float) -> Figure:
+    # A Figure of its own, not pyplot's: no backend is chosen or changed (a notebook's inline
+    # plots stay as they are), no display is needed, and nothing is kept once the file is written.
+    return Figure(figsize=(width, height))
+
+
 def _finish(fig, axes, title: str, path: str | Path) -> Path:
     for ax in np.ravel(axes):
         _leave_out_undrawable(ax)
@@ -144,18 +150,48 @@ def _finish(fig, axes, title: str, path: str | Path) -> Path:
     fig.tight_layout()
     path = Path(path)
     check_figure_path(path)
-    try:
-        with replacing_path(path) as partial:
-            fig.savefig(partial, dpi=120, format=path.suffix.lstrip(".") or "png")
-    finally:
-        plt.close(fig)
+    with replacing_path(path) as partial:
+        fig.savefig(partial, dpi=120, format=path.suffix.lstrip(".") or "png")
     return path
 
 
 @_drawing
 def plot_overlay(runs: dict[str, np.ndarray], path: str | Path, title: str) -> Path:
-    """Theta and omega of each run, overlaid (dashed after the first, so coincident lines show)."""
-    fig, axes = plt.subplots(2, 1, figsize=(10, 6), sharex=True)
+    r"""Theta and omega of each run, overlaid (dashed after the first, so coincident lines show).
+
+    Parameters
+    ----------
+    runs : dict of str to numpy.ndarray
+        Result arrays (as simulate() and reference() return them) by their labels in the legend.
+    path : str or Path
+        The figure to write, whole or not at all; its extension says the format (none: PNG).
+    title : str
+        The figure's title.
+
+    Returns
+    -------
+    Path
+        path.
+
+    Raises
+    ------
+    InvalidInput
+        An extension no figure format has (such as .csv).
+    CannotWrite
+        path cannot be written.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from pendulum_fmu import plot_overlay, reference, simulate
+    >>> runs = {"fmu": simulate(20.0, stop_time=1.0), "reference": reference(20.0, stop_time=1.0)}
+    >>> figure = plot_overlay(runs, Path(tempfile.mkdtemp(), "overlay.png"), "20 N.m from rest")
+    >>> figure.name, figure.read_bytes()[:4]
+    ('overlay.png', b'\x89PNG')
+    """
+    fig = _figure(10, 6)
+    axes = fig.subplots(2, 1, sharex=True)
     for i, (label, run) in enumerate(runs.items()):
         style = dict(linewidth=2 if i == 0 else 1.5, linestyle="-" if i == 0 else "--")
         axes[0].plot(run["time"], run["theta"], label=label, **style)
@@ -199,7 +235,8 @@ def plot_comparison(runs: dict[str, np.ndarray], path: str | Path, title: str) -
     """Left: theta and omega of every tool overlaid. Right: |difference| of each tool against
     the first one, on a log scale, where agreement to 1e-10 is visible.
     """
-    fig, axes = plt.subplots(2, 2, figsize=(14, 6), sharex=True)
+    fig = _figure(14, 6)
+    axes = fig.subplots(2, 2, sharex=True)
     labels = list(runs)
     base = runs[labels[0]]
     for i, label in enumerate(labels):
@@ -222,8 +259,9 @@ def plot_comparison(runs: dict[str, np.ndarray], path: str | Path, title: str) -
 @_drawing
 def plot_cases(runs: dict[str, np.ndarray], path: str | Path, title: str) -> Path:
     """Theta and omega of many cases, coloured along a colormap; labelled when few enough."""
-    fig, axes = plt.subplots(2, 1, figsize=(10, 6), sharex=True)
-    colors = plt.cm.viridis(np.linspace(0, 0.9, max(len(runs), 1)))
+    fig = _figure(10, 6)
+    axes = fig.subplots(2, 1, sharex=True)
+    colors = matplotlib.colormaps["viridis"](np.linspace(0, 0.9, max(len(runs), 1)))
     labelled = len(runs) <= 12
     for color, (label, run) in zip(colors, runs.items(), strict=False):
         axes[0].plot(run["time"], run["theta"], color=color, linewidth=1.5, label=label if labelled else None)
@@ -276,7 +314,8 @@ def plot_case_bands(
     units: {swept name: unit} for the axes.
     """
     swept = {name: column for name, column in values.items() if len(np.unique(column)) > 1} or values
-    fig, axes = plt.subplots(len(summaries), len(swept), figsize=(4.5 * len(swept) + 1, 6), squeeze=False, sharey="row")
+    fig = _figure(4.5 * len(swept) + 1, 6)
+    axes = fig.subplots(len(summaries), len(swept), squeeze=False, sharey="row")
     labelled = set()
 
     def once(text):  # each legend entry on the first panel that draws it
@@ -336,7 +375,8 @@ def plot_judgement(judgement, path: str | Path, title: str) -> Path:
     """
     result, reference, variant = judgement.result, judgement.reference, judgement.explanation
     time = result["time"]
-    fig, axes = plt.subplots(3, 1, figsize=(10, 8), sharex=True)
+    fig = _figure(10, 8)
+    axes = fig.subplots(3, 1, sharex=True)
     axes[0].step(time, reference["torque"], where="post", linewidth=2, label="the run's torque")
     if variant is not None and not np.array_equal(variant["torque"], reference["torque"]):
         axes[0].step(
@@ -395,7 +435,8 @@ def plot_calls(judged: dict, path: str | Path, title: str) -> Path:
     --------
     >>> plot_calls(judge_calls("run.log", None, {0: "torque"}), "calls.png", "run.log")  # doctest: +SKIP
     """
-    fig, axes = plt.subplots(len(judged), 1, figsize=(10, 3 + 2.5 * len(judged)), squeeze=False)
+    fig = _figure(10, 3 + 2.5 * len(judged))
+    axes = fig.subplots(len(judged), 1, squeeze=False)
     for ax, (name, result) in zip(axes[:, 0], judged.items(), strict=True):
         steps = result["steps"]
         time = [step["time"] for step in steps]

@@ -29,8 +29,7 @@ from scipy.integrate import solve_ivp
 
 from . import _results as results
 from ._errors import InvalidInput, WrongType
-from ._model import FmuModel
-from ._parameters import start_value, total_inertia
+from ._parameters import Fmu, start_value, total_inertia
 from ._simulate import resolve_parameters
 from ._time_grid import step_count
 from ._torque_schedule import TorqueSchedule, read_torque_csv
@@ -243,7 +242,7 @@ def _integrate(
     omega0: float,
     rtol: float,
     atol: float,
-    fmu_path: str | Path | FmuModel | None,
+    fmu_path: Fmu,
     method: str = "DOP853",
     max_step: float = np.inf,
 ) -> np.ndarray:
@@ -283,7 +282,7 @@ def _integrate(
             # show, not numpy's warnings on the way to it.
             with np.errstate(over="ignore", invalid="ignore"):
                 solution = solve_ivp(
-                    lambda t, y: (y[1], acceleration(y[0], y[1], u0 + rate * (t - t0))),
+                    lambda t, y, u0=u0, rate=rate, t0=t0: (y[1], acceleration(y[0], y[1], u0 + rate * (t - t0))),
                     (t0, t1),
                     state,
                     method=method,
@@ -339,7 +338,7 @@ def reference(
     at: np.ndarray | None = None,
     rtol: float = 1e-12,
     atol: float = 1e-12,
-    fmu_path: str | Path | FmuModel | None = None,
+    fmu_path: Fmu = None,
     method: str = "DOP853",
     max_step: float = np.inf,
 ) -> np.ndarray:
@@ -430,7 +429,7 @@ def reference_schedule(
     at: np.ndarray | None = None,
     rtol: float = 1e-12,
     atol: float = 1e-12,
-    fmu_path: str | Path | FmuModel | None = None,
+    fmu_path: Fmu = None,
 ) -> np.ndarray:
     """Integrate exactly the torques of a schedule, reported at its communication points (or at
     the times `at`): the judge of a tool that was fed that schedule, and the judge's variants of
@@ -452,8 +451,20 @@ def reference_schedule(
 
     Raises
     ------
+    WrongType
+        plan is no TorqueSchedule.
     InvalidInput
-        Parameters the FMU refuses, or values with which solve_ivp fails.
+        Parameters the FMU refuses, times in `at` outside the run, or values with which
+        solve_ivp fails.
+
+    Examples
+    --------
+    20 N.m for 1 s with gravity off: theta(1 s) = 20 / (2 * 30 kg.m^2) = 1/3 rad.
+
+    >>> from pendulum_fmu import reference_schedule, schedule
+    >>> run = reference_schedule(schedule(20.0, stop_time=1.0), parameters={"gravity": 0.0})
+    >>> run.dtype.names, len(run), round(float(run["theta"][-1]), 12)
+    (('time', 'torque', 'theta', 'omega', 'alpha'), 1001, 0.333333333333)
     """
     if not isinstance(plan, TorqueSchedule):
         raise WrongType(f"plan is a TorqueSchedule (torque_schedule.schedule(...)), not a {type(plan).__name__}")

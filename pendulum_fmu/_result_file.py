@@ -21,8 +21,21 @@ OPTIONAL = ("omega", "alpha")
 
 
 class ResultFileError(InvalidInput):
-    """A result file, or a kit's folder, that cannot be judged; the message names the file, the
+    r"""A result file, or a kit's folder, that cannot be judged; the message names the file, the
     line and the problem.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from pendulum_fmu import ResultFileError, judge
+    >>> result = Path(tempfile.mkdtemp(), "result.csv")
+    >>> _ = result.write_text("time,theta\n0,0\n0.5,x\n")
+    >>> try:
+    ...     judge(result, 20.0, stop_time=1.0)
+    ... except ResultFileError as error:
+    ...     print(str(error).replace(str(result), "result.csv"))
+    result.csv:3: theta 'x' is not a number
     """
 
 

@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from ._atomic_files import replacing
-from ._errors import NotComputed
+from ._errors import NotComputed, WrongType
 
 
 @lru_cache(maxsize=1)
@@ -90,6 +90,34 @@ def empty(n_points: int, recorded: Sequence[str] | None = None) -> np.ndarray:
     return out
 
 
+def fields(run: np.ndarray) -> tuple[str, ...]:
+    """The fields of a result array: time, then what it records.
+
+    Parameters
+    ----------
+    run : numpy.ndarray
+        A result array (see the module's doc).
+
+    Returns
+    -------
+    tuple of str
+
+    Raises
+    ------
+    WrongType
+        run is no structured array, so no result.
+
+    Examples
+    --------
+    >>> fields(empty(2, ("torque", "theta")))
+    ('time', 'torque', 'theta')
+    """
+    names = run.dtype.names
+    if names is None:
+        raise WrongType(f"a result is a structured array with a field per variable, not an array of {run.dtype}")
+    return names
+
+
 def with_outputs(run: np.ndarray, outputs: Sequence[str], tool: str) -> np.ndarray:
     """A tool's result with exactly the outputs it was asked for: time and the torque, then each
     of outputs, in that order; one it did not compute is NaN, and said so in one line
@@ -120,7 +148,8 @@ def with_outputs(run: np.ndarray, outputs: Sequence[str], tool: str) -> np.ndarr
     >>> with_outputs(run, ("theta",), "reference") is run
     True
     """
-    missing = [name for name in outputs if name not in (run.dtype.names or ()) or np.all(np.isnan(run[name]))]
+    present = fields(run)
+    missing = [name for name in outputs if name not in present or np.all(np.isnan(run[name]))]
     if missing:
         warnings.warn(
             f"{tool} cannot compute {', '.join(missing)}: "
@@ -130,11 +159,11 @@ def with_outputs(run: np.ndarray, outputs: Sequence[str], tool: str) -> np.ndarr
             stacklevel=2,
         )
     recorded = ("torque", *outputs)
-    if run.dtype.names == ("time", *recorded) and not missing:
+    if present == ("time", *recorded) and not missing:
         return run
     out = empty(len(run), recorded)
-    for name in out.dtype.names:
-        if name in run.dtype.names:
+    for name in fields(out):
+        if name in present:
             out[name] = run[name]
     return out
 
@@ -165,7 +194,7 @@ def write_csv(run: np.ndarray, path: str | os.PathLike) -> Path:
             file,
             run.view(np.float64).reshape(len(run), -1),
             delimiter=",",
-            header=",".join(run.dtype.names),
+            header=",".join(fields(run)),
             comments="",
             fmt="%.17g",
         )

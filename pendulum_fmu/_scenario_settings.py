@@ -66,6 +66,18 @@ def read_settings(path: str | Path) -> dict:
         One line naming the file and what is wrong with it: not JSON, not an object, a field
         missing, or a field of the wrong type or out of its range (a time that is not a finite
         number, a step size or tolerance that is not positive, stop_time not after start_time).
+
+    Examples
+    --------
+    A kit's first scenario; ``judge(result, **settings)`` (without output) judges a master's
+    result of it:
+
+    >>> import tempfile
+    >>> from pendulum_fmu import read_settings, write_scenarios
+    >>> kit = write_scenarios(tempfile.mkdtemp())
+    >>> settings = read_settings(next(path for path in kit if path.name == "constant_torque.json"))
+    >>> settings["torque"].name, settings["output"], settings["stop_time"], settings["step_size"]
+    ('constant_torque_in.csv', 'constant_torque_out.csv', 3.0, 0.001)
     """
     path = Path(path)
     try:

@@ -246,7 +246,7 @@ def simulate_plan(
     theta0: float = 0.0,
     omega0: float = 0.0,
     tolerance: float | None = None,
-    fmu_path: str | Path | None = None,
+    fmu_path: str | Path | FmuModel | None = None,
 ) -> np.ndarray:
     """A schedule through this thread's Simulator of the FMU (see simulate)."""
     runner = simulator(fmu_path)
@@ -355,14 +355,14 @@ def _default_fmu() -> Path:
     return default_fmu()
 
 
-def simulator(fmu_path: str | Path | None = None) -> Simulator:
+def simulator(fmu_path: str | Path | FmuModel | None = None) -> Simulator:
     """The Simulator of an FMU file kept by the calling thread, made on first use and again
     whenever the file is rebuilt or replaced (its file_version changes).
 
     Parameters
     ----------
     fmu_path
-        The FMU file; None: pendulum_fmu.default_fmu(), looked up once per process.
+        The FMU file or its model; None: pendulum_fmu.default_fmu(), looked up once per process.
 
     Returns
     -------

@@ -226,8 +226,28 @@ def export_ssp(
 
     Examples
     --------
-    >>> export_ssp("ClosedLoop.ssp", controller={"setpoint": 0.4}, overwrite=True)  # doctest: +SKIP
-    PosixPath('ClosedLoop.ssp')
+    The times are checked before anything is built:
+
+    >>> from pendulum_fmu import InvalidInput, export_ssp
+    >>> try:
+    ...     export_ssp("ClosedLoop.ssp", step_size=5.0)
+    ... except InvalidInput as error:
+    ...     print(error)
+    step size 5.0 s is longer than the stop time 3.0 s
+
+    The export itself builds both FMUs for every platform (about half a minute), too long for a
+    doctest; tests/test_ssp.py runs it:
+
+    >>> import tempfile, zipfile
+    >>> from pathlib import Path
+    >>> ssp = export_ssp(Path(tempfile.mkdtemp(), "ClosedLoop.ssp"), controller={"setpoint": 0.4})  # doctest: +SKIP
+    >>> for name in sorted(zipfile.ZipFile(ssp).namelist()):  # doctest: +SKIP
+    ...     print(name)
+    SystemStructure.ssd
+    resources/PIDController.fmu
+    resources/Pendulum.fmu
+    resources/controller.ssv
+    resources/pendulum.ssv
     """
     out_file = Path(out_file)
     stop_time, step_size = _positive("stop time", stop_time), _positive("step size", step_size)

@@ -11,6 +11,8 @@ import signal
 import sys
 import threading
 import time
+from collections.abc import Callable
+from typing import Any
 
 # The signals that stop the program, and the word its one line says for each.
 STOPPING_SIGNALS = {signal.SIGINT: "interrupted", signal.SIGTERM: "terminated"}
@@ -42,19 +44,26 @@ def stop_on_signals() -> dict:
             signal.signal(name, signal.SIG_IGN)
         raise Stopped(number)
 
-    unraisable_hook = sys.unraisablehook
+    # signal.signal below works in the main thread only, so this is the thread to signal again.
+    sys.unraisablehook = _DeliverAgain(sys.unraisablehook, stop, threading.get_ident())
+    return {name: signal.signal(name, stop) for name in STOPPING_SIGNALS}
 
-    def deliver_again(unraisable):
+
+class _DeliverAgain:
+    """sys.unraisablehook while a command runs: a Stopped that Python could only print is
+    signalled again to the main thread; anything else goes to the hook this one replaced.
+    """
+
+    def __init__(self, replaced: Callable[[Any], object], stop: Callable[[int, Any], None], main_thread: int):
+        self.replaced, self.stop, self.main_thread = replaced, stop, main_thread
+
+    def __call__(self, unraisable: Any) -> None:
         if not isinstance(unraisable.exc_value, Stopped):
-            unraisable_hook(unraisable)
+            self.replaced(unraisable)
             return
         number = unraisable.exc_value.signal_number
-        signal.signal(number, stop)
-        threading.Thread(target=_signal_main_thread, args=(number,), daemon=True).start()
-
-    deliver_again.replaced = unraisable_hook
-    sys.unraisablehook = deliver_again
-    return {name: signal.signal(name, stop) for name in STOPPING_SIGNALS}
+        signal.signal(number, self.stop)
+        threading.Thread(target=_signal_main_thread, args=(self.main_thread, number), daemon=True).start()
 
 
 def restore_signals(previous: dict) -> None:
@@ -63,15 +72,16 @@ def restore_signals(previous: dict) -> None:
     """
     for number, handler in previous.items():
         signal.signal(number, handler)
-    sys.unraisablehook = getattr(sys.unraisablehook, "replaced", sys.unraisablehook)
+    hook = sys.unraisablehook
+    sys.unraisablehook = hook.replaced if isinstance(hook, _DeliverAgain) else hook
 
 
-def _signal_main_thread(number: int) -> None:
+def _signal_main_thread(main_thread: int, number: int) -> None:
     # Later than the hook's return, so that the handler does not run inside the hook itself; to
     # the main thread where the platform can aim a signal, so that it also cuts a wait there short.
     time.sleep(_REDELIVERY_DELAY)
     if hasattr(signal, "pthread_kill"):
-        signal.pthread_kill(threading.main_thread().ident, number)
+        signal.pthread_kill(main_thread, number)
     else:
         signal.raise_signal(number)
 

@@ -50,7 +50,21 @@ DEFAULT_STOP_TIME = 3.0
 
 
 class TorqueFileError(InvalidInput):
-    """A torque CSV that cannot be read; the message names the file, line and problem."""
+    r"""A torque CSV that cannot be read; the message names the file, line and problem.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from pendulum_fmu import TorqueFileError, schedule
+    >>> table = Path(tempfile.mkdtemp(), "torque.csv")
+    >>> _ = table.write_text("time,torque\n0,1\n1,x\n")
+    >>> try:
+    ...     schedule(table)
+    ... except TorqueFileError as error:
+    ...     print(str(error).replace(str(table), "torque.csv"))
+    torque.csv:3: torque 'x' is not a number
+    """
 
 
 @dataclass(frozen=True)
@@ -103,12 +117,38 @@ class TorqueTable:
 
 @dataclass(frozen=True)
 class TorqueSchedule:
+    """What one simulation applies, step by step: made by schedule() (see the module's docstring).
+
+    Step k runs from time[k] to time[k + 1] and applies torque[k] + torque_rate[k] * (t - time[k]).
+
+    Attributes
+    ----------
+    time : numpy.ndarray
+        The N + 1 communication points, in s.
+    torque : numpy.ndarray
+        The N torques at each step's start, in N.m.
+    torque_rate : numpy.ndarray
+        The N rates over each step, in N.m/s (zero where the torque is held).
+    step_size : numpy.ndarray
+        The N step lengths, in s.
+
+    Examples
+    --------
+    >>> from pendulum_fmu import schedule
+    >>> plan = schedule(lambda t: 4.0 * t, stop_time=0.75, step_size=0.25, ramp=True)
+    >>> plan.time.tolist(), plan.torque.tolist(), plan.torque_rate.tolist()
+    ([0.0, 0.25, 0.5, 0.75], [0.0, 1.0, 2.0], [4.0, 4.0, 4.0])
+    >>> plan.step_size.tolist()
+    [0.25, 0.25, 0.25]
+    """
+
     time: np.ndarray
     torque: np.ndarray
     torque_rate: np.ndarray
 
     @cached_property  # works on a frozen dataclass: it writes the instance's __dict__ directly
     def step_size(self) -> np.ndarray:
+        """The length of each step, in s."""
         return np.diff(self.time)
 
 
@@ -237,9 +277,46 @@ def read_torque_csv(path: str | Path) -> TorqueTable:
 
 
 def write_torque_csv(path: str | Path, plan: TorqueSchedule) -> Path:
-    """Write a schedule in fmpy's convention: a row where each run of equal steps starts and
-    ends, so a held torque reads as steps and a ramp as a line. Times are written with 17
-    significant digits, so they read back as the same doubles.
+    """Write a schedule as a torque CSV in fmpy's convention, which schedule() reads back.
+
+    A row where each run of equal steps starts and ends, so a held torque reads as steps and a
+    ramp as a line. Times are written with 17 significant digits, so they read back as the same
+    doubles. The file is written whole or not at all.
+
+    Parameters
+    ----------
+    path : str or Path
+        The CSV to write (replaced if it is there).
+    plan : TorqueSchedule
+        The schedule, from schedule().
+
+    Returns
+    -------
+    Path
+        path.
+
+    Raises
+    ------
+    CannotWrite
+        path cannot be written.
+
+    Examples
+    --------
+    5 N.m for 1 s, then 7 N.m:
+
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from pendulum_fmu import schedule, write_torque_csv
+    >>> plan = schedule([5.0, 5.0, 7.0], step_size=0.5)
+    >>> csv = write_torque_csv(Path(tempfile.mkdtemp(), "torque.csv"), plan)
+    >>> print(csv.read_text(), end="")
+    time,torque
+    0.0,5.0
+    1.0,5.0
+    1.0,7.0
+    1.5,7.0
+    >>> schedule(csv, step_size=0.5).torque.tolist()
+    [5.0, 5.0, 7.0]
     """
     from ._atomic_files import replacing
 
@@ -340,9 +417,47 @@ def schedule(
     ramp: bool = False,
     max_steps: int | None = None,
 ) -> TorqueSchedule:
-    """The schedule of a signal: a constant, a callable of time, a per-step array, or a torque
-    CSV (path or table); see the module's docstring for what each step applies. stop_time
-    defaults to a CSV's last time, an array's last step, or 3 s. max_steps: see step_count.
+    """The schedule of a signal: the communication points and the torque each step applies.
+
+    See the module's docstring (and docs/signals.md) for what each step applies.
+
+    Parameters
+    ----------
+    torque : float, callable, sequence of float, str or Path
+        A constant (N.m), a callable of time (s) sampled at each step's start, a per-step array
+        (one held value per step), or a torque CSV in fmpy's convention (time,torque).
+    start_time : float, optional
+        The first communication point, in s.
+    stop_time : float, optional
+        The last, in s; default: a CSV's last time, an array's last step, or 3 s.
+    step_size : float, optional
+        The communication step, in s; a CSV's jumps between grid points add points.
+    ramp : bool, optional
+        Ramp the torque linearly over each step (a CSV or a callable) instead of holding it.
+    max_steps : int, optional
+        The most steps a run may take (default 10 000 000), against a typo in a time.
+
+    Returns
+    -------
+    TorqueSchedule
+        time (N + 1 points), torque and torque_rate (N steps).
+
+    Raises
+    ------
+    InvalidInput
+        A time, step or signal the package refuses (not finite, not positive, too many steps,
+        a ramp of a per-step array).
+    TorqueFileError
+        A CSV that cannot be read as a signal.
+
+    Examples
+    --------
+    >>> from pendulum_fmu import schedule
+    >>> plan = schedule(20.0, stop_time=0.003)
+    >>> plan.time.tolist(), plan.torque.tolist()
+    ([0.0, 0.001, 0.002, 0.003], [20.0, 20.0, 20.0])
+    >>> schedule([5.0, 7.0], step_size=0.5).time.tolist()  # an array's steps set the stop time
+    [0.0, 0.5, 1.0]
     """
     source = "the torque table"
     if isinstance(torque, (str, Path)):

@@ -13,6 +13,7 @@ import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import ClassVar
 
 if __name__ == "__main__":  # a script documents the clone it is in, whatever package is installed
     sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
@@ -54,7 +55,7 @@ class Harness:
     """The FMU's library through ctypes, with a logger that keeps what the FMU says."""
 
     prefix = "fmi2"
-    state_calls = {
+    state_calls: ClassVar[dict[str, str]] = {
         "get": "fmi2GetFMUstate",
         "set": "fmi2SetFMUstate",
         "size": "fmi2SerializedFMUstateSize",
@@ -136,7 +137,7 @@ class Harness3(Harness):
     """The same for an FMI 3.0 binary: fmi3 entry points, FMI 3.0's logger."""
 
     prefix = "fmi3"
-    state_calls = {
+    state_calls: ClassVar[dict[str, str]] = {
         "get": "fmi3GetFMUState",
         "set": "fmi3SetFMUState",
         "size": "fmi3SerializedFMUStateSize",

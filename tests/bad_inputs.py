@@ -969,7 +969,7 @@ def markdown(rows: list[tuple[Case, int, str]], calls: list[tuple[Call, str, str
         API_IMPORTS,
         "```",
         "",
-        "and raises a subclass of `pendulum_fmu._errors.PendulumFmuError` (each also derives "
+        "and raises a subclass of `pendulum_fmu.PendulumFmuError` (each also derives "
         "from the built-in exception a caller expects: `ValueError`, `TypeError`, `OSError`, "
         "...) whose message is one line; no numpy, scipy or fmpy error gets through. "
         "Nothing is written when a call is refused.",

@@ -4,6 +4,7 @@ The checks of what is loaded run in a fresh interpreter, whose sys.modules holds
 """
 
 import json
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -71,7 +72,7 @@ def test_a_name_that_is_also_a_module_stays_the_function_once_the_module_is_impo
 
 def test_a_name_the_api_has_not_is_an_attribute_error():
     with pytest.raises(AttributeError, match="has no attribute 'simulat'"):
-        pendulum_fmu.simulat
+        _ = pendulum_fmu.simulat
 
 
 @pytest.mark.parametrize("name", [name for name in pendulum_fmu.__all__ if callable(getattr(pendulum_fmu, name))])
@@ -89,3 +90,34 @@ def test_every_api_docstring_has_numpydoc_sections_and_its_examples_give_what_th
     for test in tests:
         runner.run(test)
     assert runner.failures == 0 and runner.tries > 0, name
+
+
+def _autosummary_blocks(page: str) -> list[list[str]]:
+    """The names of each autosummary block of a docs page, in order."""
+    blocks = re.findall(r"^\.\. autosummary::\n(?:   :.*\n)*\n((?:   \S+\n)+)", page, re.MULTILINE)
+    return [block.split() for block in blocks]
+
+
+def _lazy_groups() -> list[list[str]]:
+    """The names of _LAZY in pendulum_fmu/__init__.py, one list per group its comments start."""
+    source = (ROOT / "pendulum_fmu" / "__init__.py").read_text(encoding="utf-8")
+    body = source.split("_LAZY = {\n", 1)[1].split("\n}\n", 1)[0]
+    groups: list[list[str]] = []
+    for line in body.splitlines():
+        if line.strip().startswith("#"):
+            groups.append([])
+        else:
+            groups[-1].append(re.match(r'\s*"(\w+)":', line)[1])
+    return groups
+
+
+def test_the_api_reference_lists_every_public_name_once_grouped_as_the_package_groups_them():
+    blocks = _autosummary_blocks((ROOT / "docs" / "api_reference.md").read_text(encoding="utf-8"))
+    listed = [name for block in blocks for name in block]
+    assert sorted(listed) == sorted(pendulum_fmu.__all__), "docs/api_reference.md and pendulum_fmu.__all__ differ"
+    # The groups of __init__'s _LAZY, each one block of the page, in the same order; before them
+    # the names __init__ defines itself.
+    groups = _lazy_groups()
+    assert sum(map(len, groups)) == len(pendulum_fmu._LAZY) and len(groups) > 1
+    assert [sorted(block) for block in blocks[1:]] == [sorted(group) for group in groups]
+    assert sorted(blocks[0]) == sorted(set(pendulum_fmu.__all__) - set(pendulum_fmu._LAZY))

@@ -26,7 +26,7 @@ def test_a_failed_write_leaves_the_old_file_and_no_temporary(tmp_path):
 
 def test_a_place_that_cannot_hold_the_file_is_the_users_error_in_one_line(tmp_path):
     (tmp_path / "notes.txt").write_text("a file, not a folder\n")
-    with pytest.raises(CannotWrite, match="notes.txt is a file, not a folder; choose another output path"):
+    with pytest.raises(CannotWrite, match=r"notes\.txt is a file, not a folder; choose another output path"):
         with replacing(tmp_path / "notes.txt" / "out.csv") as file:
             file.write("x")
     (tmp_path / "folder").mkdir()

@@ -77,7 +77,7 @@ def test_native_restart_matches_a_fresh_instance_bit_for_bit(fmu):
                 fresh.freeInstance()
             for column, name in enumerate(OUTPUTS):
                 assert np.array_equal(restarted[:, column], expected[name]), (mass, name)
-        with pytest.raises(FmuError, match="initialization failed: .*mass must be > 0"):
+        with pytest.raises(FmuError, match=r"initialization failed: .*mass must be > 0"):
             stepper.run(plan.time, None, None, restarted, start_values=np.array([-1.0, 0.0, 0.0, 0.0]))
     finally:
         slave.freeInstance()

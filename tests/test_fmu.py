@@ -92,7 +92,9 @@ def test_stepwise_torque_with_variable_steps(fmu, tmp_path):
 
 
 def test_torque_held_per_step_from_a_callable(fmu):
-    signal = lambda t: 30 * np.sin(4 * t)
+    def signal(t):
+        return 30 * np.sin(4 * t)
+
     result = simulate(signal, step_size=0.01, fmu_path=fmu)
     expected = reference(signal, step_size=0.01)
     assert np.array_equal(result["torque"][:-1], 30 * np.sin(4 * result["time"][:-1]))
@@ -109,7 +111,9 @@ def test_ramped_torque_is_the_exact_cubic(fmu):
 
 def test_ramped_torque_with_gravity_matches_scipy(fmu):
     # 20 ms steps at the default 1e-10 drift by ~3e-13 a step; ask for what the test checks.
-    signal = lambda t: 40 * np.cos(3 * t)
+    def signal(t):
+        return 40 * np.cos(3 * t)
+
     result = simulate(signal, step_size=0.02, ramp=True, tolerance=1e-12, fmu_path=fmu)
     expected = reference(signal, step_size=0.02, ramp=True)
     assert np.max(np.abs(result["theta"] - expected["theta"])) < 1e-10

@@ -132,11 +132,10 @@ def _loop_with_exact_integral(stop_time, h):
     theta = [0.0]
     for _ in range(round(stop_time / h)):
         torque = gains["kp"] * (gains["setpoint"] - state[0]) + gains["ki"] * state[2] - gains["kd"] * state[1]
-        rhs = lambda t, y, u=torque: (
-            y[1],
-            (u - gravity_moment * np.sin(y[0])) * inverse_inertia,
-            gains["setpoint"] - y[0],
-        )
+
+        def rhs(t, y, u=torque):
+            return (y[1], (u - gravity_moment * np.sin(y[0])) * inverse_inertia, gains["setpoint"] - y[0])
+
         state = solve_ivp(rhs, (0.0, h), state, method="DOP853", rtol=1e-12, atol=1e-12).y[:, -1]
         theta.append(state[0])
     return np.array(theta)

@@ -158,7 +158,7 @@ def test_bad_result_files_get_one_line(tmp_path):
     with pytest.raises(ResultFileError, match="no column 'phi', which --map names for theta"):
         read_result(tmp_path / "bad.csv", "theta=phi")
     (tmp_path / "bad.csv").write_text("time,theta\n0,0\n3.5,0\n")
-    with pytest.raises(ResultFileError, match="time 3.5 is after the run's stop time 3 s"):
+    with pytest.raises(ResultFileError, match=r"time 3\.5 is after the run's stop time 3 s"):
         judge(tmp_path / "bad.csv", 1.0)
 
 
@@ -190,7 +190,7 @@ def test_a_kit_result_cut_short_is_refused_naming_it(kit, tmp_path, capsys):
     cut.write_text("\n".join(lines[:51]) + "\n")  # 50 rows of 100, to 0.441 s
     settings = read_settings(kit / "decimal_steps.json")
     settings.pop("output")
-    with pytest.raises(ResultFileError, match="ends at 0.44.* s, before the run.s stop time 0.9 s, so it covers"):
+    with pytest.raises(ResultFileError, match=r"ends at 0\.44.* s, before the run.s stop time 0\.9 s, so it covers"):
         judge(cut, **settings)
     # Every row but the last, as a master that forgets to write after its last step.
     out.write_text("\n".join(lines[:-1]) + "\n")

@@ -2,20 +2,19 @@
 
 import numpy as np
 import pytest
+from fmpy import read_model_description
+
+from fmu_build import build_pid_controller
+from pendulum_fmu._closed_loop import WIRES, sampled_loop_reference
+from pendulum_fmu._reference import reference
 
 libcosim = pytest.importorskip("libcosimpy", reason="libcosimpy not installed: pip install -e '.[test]'")
-
-from fmpy import read_model_description
 from libcosimpy.CosimEnums import CosimVariableType
 from libcosimpy.CosimExecution import CosimExecution
 from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
 from libcosimpy.CosimManipulator import CosimManipulator
 from libcosimpy.CosimObserver import CosimObserver
 from libcosimpy.CosimSlave import CosimLocalSlave
-
-from fmu_build import build_pid_controller
-from pendulum_fmu._closed_loop import WIRES, sampled_loop_reference
-from pendulum_fmu._reference import reference
 
 STEP_NS = 1_000_000  # libcosim counts time in nanoseconds: a 1 ms master step
 
@@ -37,8 +36,11 @@ def test_override_manipulator_and_observer_match_the_reference(fmu):
     execution.add_manipulator(manipulator)
     observer = CosimObserver.create_last_value()
     execution.add_observer(observer)
+
     # A step-wise torque: the override each step holds over that step, as overrideActuation does.
-    signal = lambda t: 20.0 if t < 1.0 else (-30.0 if t < 2.0 else 10.0)
+    def signal(t):
+        return 20.0 if t < 1.0 else (-30.0 if t < 2.0 else 10.0)
+
     theta = [0.0]
     for k in range(3000):
         manipulator.slave_real_values(pendulum, [vr["torque"]], [signal(k * 1e-3)])

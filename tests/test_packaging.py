@@ -148,7 +148,7 @@ def test_installed_package_runs_from_an_empty_folder(installed, tmp_path):
     )
     assert fmu == package / "data" / "Pendulum.fmu"
     assert read_model_description(str(fmu)).generationTool == f"pendulum_fmu {__version__}"
-    _run([python, "-c", "from pendulum_fmu import cs_loop; assert cs_loop.available()"], cwd=tmp_path)
+    _run([python, "-c", "from pendulum_fmu import _native_loop as cs_loop; assert cs_loop.available()"], cwd=tmp_path)
 
     expected = reference(20.0, stop_time=3.0, step_size=1e-3)
     _run([cli, "simulate", "--torque", "20", "--output", "simulated.csv"], cwd=tmp_path)

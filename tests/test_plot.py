@@ -206,3 +206,20 @@ def test_a_sweep_started_past_drawable_angles_still_writes_its_figure(drawn, tmp
         "torque = 1 N.m, gravity = 9.81 m/s2, theta0 = 1e+308 rad reaches 1e+308: too large to draw"
     ]
     assert Path(done.figure).is_file()
+
+
+def test_drawing_a_figure_leaves_matplotlibs_backend_and_pyplot_alone(tmp_path):
+    # A notebook's inline backend (or any the user chose) must survive plot_overlay: before,
+    # importing _plot switched every process to Agg and its figures went through pyplot.
+    import subprocess
+    import sys
+
+    script = (
+        "import matplotlib; matplotlib.use('svg')\n"
+        "import matplotlib.pyplot as plt\n"
+        "from pendulum_fmu import plot_overlay, reference\n"
+        f"path = plot_overlay({{'reference': reference(20.0, stop_time=0.1)}}, {str(tmp_path / 'o.png')!r}, 't')\n"
+        "print(matplotlib.get_backend(), len(plt.get_fignums()), path.stat().st_size > 10000)\n"
+    )
+    printed = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True).stdout
+    assert printed.split() == ["svg", "0", "True"]

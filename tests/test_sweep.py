@@ -404,7 +404,7 @@ def test_an_unfinished_study_is_refused_too(tmp_path, threads_scheduler):
     # A folder with a study's entries that no sweep's study.json describes is someone else's.
     (tmp_path / "study.json").write_text("my notes")
     with pytest.raises(
-        StudyExists, match="holds study.json, trajectories, cases, sweep.png but no study.json of a sweep"
+        StudyExists, match=r"holds study\.json, trajectories, cases, sweep\.png but no study\.json of a sweep"
     ):
         run_sweep(Study(cases, stop_time=0.05), output_dir=tmp_path, resume=True, progress=False)
 

@@ -76,7 +76,7 @@ def test_bad_arguments():
         schedule(1.0, step_size=0)
     with pytest.raises(ValueError, match="stop time"):
         schedule(1.0, stop_time=-1)
-    with pytest.raises(ValueError, match="the torque is nan at t = 0.0"):
+    with pytest.raises(ValueError, match=r"the torque is nan at t = 0\.0"):
         schedule(lambda t: float("nan"), stop_time=0.1)
 
 
@@ -105,7 +105,7 @@ def test_extra_columns_and_blank_lines_are_ignored(tmp_path):
 def test_errors_after_blank_lines_name_the_file_line(tmp_path):
     csv = tmp_path / "t.csv"
     csv.write_text("time,torque\n0,1\n\n\n2,1\n1,1\n")
-    with pytest.raises(TorqueFileError, match="t.csv:6: time 1 goes backwards"):
+    with pytest.raises(TorqueFileError, match=r"t\.csv:6: time 1 goes backwards"):
         read_torque_csv(csv)
 
 

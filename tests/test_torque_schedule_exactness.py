@@ -115,7 +115,7 @@ def test_a_per_step_array_is_held(fmu):
 
 
 def test_a_per_step_array_of_the_wrong_length_says_so(fmu):
-    with pytest.raises(ValueError, match="has 3 values but 0 to 1 s in steps of 0.1 s is 10 steps"):
+    with pytest.raises(ValueError, match=r"has 3 values but 0 to 1 s in steps of 0\.1 s is 10 steps"):
         simulate([1.0, 2.0, 3.0], step_size=0.1, stop_time=1.0, fmu_path=fmu)
     with pytest.raises(ValueError, match="one value per step"):
         simulate(np.ones((2, 2)), fmu_path=fmu)

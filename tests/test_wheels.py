@@ -284,7 +284,11 @@ def test_x86_64_wheel_installs_and_simulates_in_a_venv(wheelhouse, x86_64_csv, t
         env=ENVIRONMENT,
     )
     loaded = subprocess.run(
-        [venv / "bin/python", "-c", "from pendulum_fmu import cs_loop; print(cs_loop.__file__, cs_loop.available())"],
+        [
+            venv / "bin/python",
+            "-c",
+            "from pendulum_fmu import _native_loop as cs_loop; print(cs_loop.__file__, cs_loop.available())",
+        ],
         check=True,
         cwd=tmp_path,
         capture_output=True,
@@ -309,7 +313,9 @@ def test_aarch64_wheel_installs_and_simulates_on_arm64_python_under_qemu(wheelho
     except Unavailable as missing:
         pytest.skip(str(missing))
     site = arm64.install([wheelhouse["aarch64-linux"]], tmp_path / "site")  # pip there judges the tag
-    loaded = arm64.run(["-c", "from pendulum_fmu import cs_loop; print(cs_loop.available())"], site=site, cwd=tmp_path)
+    loaded = arm64.run(
+        ["-c", "from pendulum_fmu import _native_loop as cs_loop; print(cs_loop.available())"], site=site, cwd=tmp_path
+    )
     assert loaded.stdout.split()[-1:] == ["True"], loaded.stderr
     ran = arm64.run(
         [site / "bin/pendulum-fmu", "simulate", "--torque", "20", "--output", "out.csv"], site=site, cwd=tmp_path

@@ -10,6 +10,7 @@ from .._time_grid import DEFAULT_MAX_STEPS
 
 
 def assignment(text: str) -> tuple[str, str]:
+    """A --set NAME=VALUE as (name, value)."""
     name, equals, value = text.partition("=")
     if not equals or not name or not value:
         raise argparse.ArgumentTypeError(f"expected name=value, got {text!r}")
@@ -17,6 +18,7 @@ def assignment(text: str) -> tuple[str, str]:
 
 
 def output_path(text: str) -> Path:
+    """An output's path, refused when empty."""
     # An empty path would be the current folder: most likely an unset shell variable ("$OUT").
     if not text.strip():
         raise argparse.ArgumentTypeError("an empty path; give a file or folder name (is a shell variable unset?)")
@@ -30,6 +32,7 @@ def output_location(text: str) -> str:
 
 
 def float_number(text: str) -> float:
+    """An option's number."""
     try:
         return float(text)
     except ValueError:
@@ -37,6 +40,7 @@ def float_number(text: str) -> float:
 
 
 def positive_int(text: str) -> int:
+    """An option's whole number, at least 1."""
     try:
         value = int(text)
     except ValueError:
@@ -47,6 +51,7 @@ def positive_int(text: str) -> int:
 
 
 def parameters_of(assignments) -> dict[str, float]:
+    """The --set assignments as {name: value}; InvalidInput for a value that is no number."""
     parameters = {}
     for name, value in assignments or ():
         try:
@@ -57,10 +62,12 @@ def parameters_of(assignments) -> dict[str, float]:
 
 
 def torque_signal(args):
+    """The signal the options name: the --torque-file, or the --torque."""
     return args.torque_file if args.torque_file is not None else args.torque
 
 
 def add_signal_arguments(parser, required: bool = True) -> None:
+    """Add the options of a signal's run: the torque, the times, the parameters, the start values, the FMU."""
     group = parser.add_mutually_exclusive_group(required=required)
     group.add_argument("--torque", type=float_number, help="constant torque in N.m")
     group.add_argument(
@@ -99,6 +106,7 @@ def add_signal_arguments(parser, required: bool = True) -> None:
 
 
 def add_fmu_argument(parser) -> None:
+    """Add --fmu, the FMU to run."""
     parser.add_argument(
         "--fmu",
         type=Path,
@@ -135,6 +143,7 @@ def check_outputs(outputs: dict, inputs: dict) -> None:
 
 
 def same_file(one: Path, other: Path) -> bool:
+    """Whether two paths name the same file, also when it is not there yet."""
     try:
         return one.samefile(other)
     except OSError:  # one of them does not exist yet: the same file only by its name

@@ -33,10 +33,12 @@ class UntilTheReaderIsGone:
             return None
 
     def write(self, text: str) -> int:
+        """Write text, or nothing once the reader is gone; the length of text either way."""
         self._guarded(self._stream.write, text)
         return len(text)
 
     def flush(self) -> None:
+        """Flush, or nothing once the reader is gone."""
         self._guarded(self._stream.flush)
 
     def __getattr__(self, name):

@@ -42,6 +42,7 @@ def check_held(plan: TorqueSchedule, tool: str) -> None:
 
 
 def check_mode(mode: str, tool: str) -> None:
+    """InvalidInput unless mode is one of MODES."""
     if mode not in MODES:
         raise InvalidInput(f"{tool}: unknown mode {mode!r}; choose {' or '.join(MODES)}")
 

@@ -57,17 +57,32 @@ def build(parameters: dict, time_step: float, sampled_outputs: bool):
     """(diagram, plant) of the pendulum; time_step 0 makes the plant continuous."""
     p = parameters
     builder = DiagramBuilder()
-    plant = builder.AddSystem(MultibodyPlant(time_step))
+    plant = MultibodyPlant(time_step)
+    builder.AddSystem(plant)
     if time_step > 0:
         plant.SetUseSampledOutputPorts(sampled_outputs)
     mass, inertia = p["mass"], p["inertia"]
-    head = plant.AddRigidBody("head", SpatialInertia(mass, np.zeros(3), UnitInertia(*(inertia / mass,) * 3)))
-    pin_on_head = plant.AddFrame(
-        FixedOffsetFrame("pin_on_head", head.body_frame(), RigidTransform([0.0, 0.0, p["length"]]))
+    # pydrake's stubs write its 3-vectors in pybind11's notation, numpy.ndarray[numpy.float64[3, 1]],
+    # which mypy reads as an array whose shape is a float: no vector matches it, hence the four
+    # ignores of that error alone below.
+    at_centre = np.zeros(3)
+    head = plant.AddRigidBody(
+        "head",
+        SpatialInertia(mass, at_centre, UnitInertia(*(inertia / mass,) * 3)),  # type: ignore[arg-type]
     )
-    joint = plant.AddJoint(RevoluteJoint("pin", plant.world_frame(), pin_on_head, [0.0, 1.0, 0.0], p["damping"]))
+    pin_on_head = plant.AddFrame(
+        FixedOffsetFrame(
+            "pin_on_head",
+            head.body_frame(),
+            RigidTransform([0.0, 0.0, p["length"]]),  # type: ignore[call-overload]
+        )
+    )
+    y_axis = [0.0, 1.0, 0.0]
+    joint = plant.AddJoint(
+        RevoluteJoint("pin", plant.world_frame(), pin_on_head, y_axis, p["damping"])  # type: ignore[call-overload]
+    )
     plant.AddJointActuator("torque", joint)
-    plant.mutable_gravity_field().set_gravity_vector([0.0, 0.0, -p["gravity"]])
+    plant.mutable_gravity_field().set_gravity_vector([0.0, 0.0, -p["gravity"]])  # type: ignore[arg-type]
     plant.Finalize()
     return builder.Build(), plant
 

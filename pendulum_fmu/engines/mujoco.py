@@ -50,6 +50,7 @@ SETUPS = {"accurate": ACCURATE, "default": DEFAULT}
 
 
 def model_xml(parameters: dict, setup: Setup) -> str:
+    """The MJCF of the pendulum with these parameters, set up for a mode."""
     p = parameters
     limits = (
         'ctrllimited="false"'

@@ -28,6 +28,9 @@ from pathlib import Path
 
 import numpy as np
 
+from .._torque_schedule import TorqueSchedule
+from . import held_results, runner, substeps
+
 
 def _import_quietly():
     """Import pybullet, which prints its build time on stderr from C, where a user error is
@@ -46,9 +49,6 @@ def _import_quietly():
 
 
 pybullet = _import_quietly()
-
-from .._torque_schedule import TorqueSchedule
-from . import held_results, runner, substeps
 
 
 @dataclass(frozen=True)
@@ -77,6 +77,7 @@ _NO_VELOCITY_LIMIT = 1e12
 
 
 def urdf(parameters: dict) -> str:
+    """The URDF of the pendulum with these parameters."""
     p = parameters
     inertia = repr(p["inertia"])
     return f"""<robot name="pendulum">

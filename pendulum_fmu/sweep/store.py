@@ -63,6 +63,7 @@ class Held:
     done_chunks: int
 
     def chunks(self) -> int:
+        """The number of chunks the study's cases make."""
         study = self.manifest["study"]
         return -(-study["cases"] // self.manifest["chunk_cases"])
 
@@ -78,6 +79,7 @@ class Store:
     format: str
 
     def part(self, table: str, index: int) -> str:
+        """The path of a table's part for a chunk."""
         return f"{self.root}/{table}/part-{index:06d}.{self.format}"
 
     def staged(self, table: str, index: int, run: str) -> str:
@@ -130,9 +132,11 @@ class Store:
         return {int(Path(path).stem.split("-")[1]): path for path in self.filesystem.glob(pattern)}
 
     def done_chunks(self) -> set[int]:
+        """The indices of the chunks whose cases are written."""
         return set(self.parts("cases"))
 
     def remove(self, patterns) -> None:
+        """Remove every file or folder under the root that the glob patterns match."""
         for pattern in patterns:
             for path in self.filesystem.glob(f"{self.root}/{pattern}"):
                 with contextlib.suppress(FileNotFoundError):

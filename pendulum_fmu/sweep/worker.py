@@ -105,7 +105,7 @@ _runners = threading.local()
 
 
 def _runner(fmu: str) -> Runner:
-    """This thread's runner for the FMU file, over its Simulator (new when the file changed)."""
+    """The runner of this thread for the FMU file, over its Simulator (new when the file changed)."""
     fmu_simulator = simulator(fmu)
     current = getattr(_runners, "runner", None)
     if current is None or current.simulator is not fmu_simulator:
