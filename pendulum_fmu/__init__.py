@@ -29,7 +29,7 @@ _LAZY = {
     "schedule": "_torque_schedule",
     "TorqueSchedule": "_torque_schedule",
     "write_torque_csv": "_torque_schedule",
-    "TorqueFileError": "_torque_schedule",
+    "TorqueFileError": "_torque_csv",
     # references and comparisons
     "reference": "_reference",
     "reference_schedule": "_reference",

@@ -17,7 +17,8 @@ from . import _results as results
 from ._model import FmuModel
 from ._reference import equation_of_motion, reference_schedule
 from ._time_grid import event_tolerance
-from ._torque_schedule import TorqueSchedule, TorqueTable, read_torque_csv
+from ._torque_csv import TorqueTable, read_torque_csv
+from ._torque_schedule import TorqueSchedule
 
 AGREES = "agrees"
 

@@ -6,7 +6,7 @@ that line (exit 2); anything else is a bug of ours, reported as an internal erro
 derives from the built-in exception a Python caller would expect (ValueError for a bad value,
 OSError for a file, ...). The kinds that belong to one module live there:
 
-    torque_schedule.TorqueFileError   a torque CSV that is not a signal
+    torque_csv.TorqueFileError        a torque CSV that is not a signal
     instance.FmuError                 an FMI call failed or the FMU refused a value
     model.FmuFileError                a file given as an FMU that is none this package can run
     compare_tools.ToolSpecError       a --tools list that names no runnable tool

@@ -11,7 +11,8 @@ from pendulum_fmu import _native_loop as cs_loop
 from pendulum_fmu._instance import FmuError, open_fmu
 from pendulum_fmu._parameters import value_reference
 from pendulum_fmu._reference import reference_schedule
-from pendulum_fmu._torque_schedule import TorqueTable, schedule
+from pendulum_fmu._torque_csv import TorqueTable
+from pendulum_fmu._torque_schedule import schedule
 from pendulum_fmu.sweep import OUTPUTS
 
 # The module; the package's attribute of that name is its function.
