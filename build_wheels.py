@@ -36,7 +36,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from fmu_build import PLATFORMS, BuildError, check_toolchain, compile_native_loop
-from pendulum_fmu import FMU_FILES
+from pendulum_fmu import CONTROLLER_FMU_FILE, FMU_FILES
 from pendulum_fmu._atomic_files import replacing_path
 
 ROOT = Path(__file__).resolve().parent
@@ -46,6 +46,9 @@ OBJDUMP = "llvm-objdump-14"
 MANYLINUX_GLIBC = "2.17"
 # The tags pip before 20.3 knows for the first manylinux_x_y policies.
 LEGACY_MANYLINUX = {(2, 5): "manylinux1", (2, 12): "manylinux2010", (2, 17): "manylinux2014"}
+# Every FMU a wheel carries in pendulum_fmu/data/, by its FMI version: the pendulum's and the
+# closed loop's controller (setup.py builds them all).
+PACKAGED_FMUS = {**{name: version for version, name in FMU_FILES.items()}, CONTROLLER_FMU_FILE: 2}
 # Python packages this command runs, and what installs each.
 TOOLS = {"build": "pip install build", "wheel": "pip install wheel", "auditwheel": "pip install auditwheel"}
 
@@ -116,7 +119,7 @@ def _extract_fmu_binaries(wheel: Path, out_dir: Path) -> None:
     unless they are there for every platform of fmu_build.PLATFORMS.
     """
     with zipfile.ZipFile(wheel) as archive:
-        for fmi_version, name in FMU_FILES.items():
+        for name, fmi_version in PACKAGED_FMUS.items():
             with zipfile.ZipFile(archive.open(f"pendulum_fmu/data/{name}")) as fmu:
                 binaries = [
                     entry for entry in fmu.namelist() if entry.startswith("binaries/") and not entry.endswith("/")
@@ -133,10 +136,10 @@ def _fmu_folders(platform, fmi_version: int) -> tuple[str, ...]:
 
 
 def fmu_binaries_for(platform: str, extracted: Path) -> list[Path]:
-    """The binaries of both FMUs that a wheel for platform loads, from _extract_fmu_binaries."""
+    """The binaries of every packaged FMU that a wheel for platform loads, from _extract_fmu_binaries."""
     return sorted(
         binary
-        for fmi_version, name in FMU_FILES.items()
+        for name, fmi_version in PACKAGED_FMUS.items()
         for folder in _fmu_folders(PLATFORMS[platform], fmi_version)
         for binary in (extracted / name / "binaries" / folder).iterdir()
     )

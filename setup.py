@@ -1,7 +1,8 @@
 """The wheel's build steps; everything else about the package is in pyproject.toml.
 
-- build_py also builds the FMI 2.0 and 3.0 FMUs into the wheel's pendulum_fmu/data/, from this
-  source tree (a clone or the unpacked sdist), for every platform whose compiler is installed.
+- build_py also builds the FMI 2.0 and 3.0 FMUs and the closed loop's PID controller FMU into the
+  wheel's pendulum_fmu/data/, from this source tree (a clone or the unpacked sdist), for every
+  platform whose compiler is installed.
 - build_ext builds the native co-simulation loop, pendulum_fmu/_cs_loop.c, through the project's
   one build description (CMakeLists.txt, driven by fmu_build/) with this machine's
   compiler. It is plain C loaded with ctypes (pendulum_fmu/_native_loop.py), not a CPython module:
@@ -17,6 +18,7 @@ import shutil
 import sys
 import tempfile
 import warnings
+from functools import partial
 from pathlib import Path
 from typing import ClassVar
 
@@ -30,7 +32,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 
 class BuildPyWithFmu(build_py):
-    """build_py, then the FMI 2.0 and 3.0 FMUs into <build_lib>/pendulum_fmu/data/."""
+    """build_py, then the FMI 2.0 and 3.0 FMUs and the PID controller's into <build_lib>/pendulum_fmu/data/."""
 
     def run(self):
         """Copy the package as build_py does, then build both FMUs into its data/."""
@@ -38,19 +40,27 @@ class BuildPyWithFmu(build_py):
         # An editable install runs from the checkout, which builds dist/Pendulum.fmu on demand.
         if getattr(self, "editable_mode", False):
             return
-        from fmu_build import build_fmu
-        from pendulum_fmu import FMU_FILES, __version__
+        from fmu_build import build_fmu, build_pid_controller
+        from pendulum_fmu import CONTROLLER_FMU_FILE, FMU_FILES, __version__
         from pendulum_fmu._errors import PlatformSkipped
         from pendulum_fmu._export import fmu_platforms
 
         data = Path(self.build_lib, "pendulum_fmu", "data")
-        for fmi_version, name in FMU_FILES.items():
+        builds = {
+            **{
+                name: (f"FMI {version}.0 FMU", partial(build_fmu, fmi_version=version))
+                for version, name in FMU_FILES.items()
+            },
+            # The closed loop's controller, so that export-ssp runs from the wheel as from a clone.
+            CONTROLLER_FMU_FILE: ("PID controller FMU", build_pid_controller),
+        }
+        for name, (what, build) in builds.items():
             with warnings.catch_warnings(record=True) as skipped:
                 warnings.simplefilter("always", PlatformSkipped)
-                fmu = build_fmu(data / name, fmi_version=fmi_version, linux_glibc=_linux_glibc(self))
+                fmu = build(data / name, linux_glibc=_linux_glibc(self))
             # A platform this machine cannot build for: one line each, what to install in it.
             for warning in skipped:
-                print(f"pendulum_fmu {__version__}: FMI {fmi_version}.0 FMU without {warning.message}", file=sys.stderr)
+                print(f"pendulum_fmu {__version__}: {what} without {warning.message}", file=sys.stderr)
             print(f"pendulum_fmu {__version__}: built {fmu} ({', '.join(fmu_platforms(fmu))})")
 
 

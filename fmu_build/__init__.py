@@ -35,7 +35,7 @@ from pathlib import Path
 
 from fmpy import read_model_description
 
-from pendulum_fmu import FMU_FILES, __version__
+from pendulum_fmu import CONTROLLER_FMU_FILE, FMU_FILES, __version__
 from pendulum_fmu._atomic_files import check_writable, replacing_path
 from pendulum_fmu._errors import BuildError, PlatformSkipped
 
@@ -54,6 +54,7 @@ FMI_VERSIONS = tuple(FMU_FILES)
 # FMI version -> the FMU a checkout builds and runs when none is named.
 CHECKOUT_FMUS = {version: ROOT / "dist" / name for version, name in FMU_FILES.items()}
 DEFAULT_FMU = CHECKOUT_FMUS[2]
+CHECKOUT_CONTROLLER = ROOT / "dist" / CONTROLLER_FMU_FILE
 MODEL_FILES = ("config.h", "model.c")
 # The FMI standard's own headers, kept in the repository as the Reference FMUs keep them.
 FMI_HEADERS = HEADERS_DIR / "fmi"
@@ -639,10 +640,14 @@ def build_fmu(
     return Path(out_file)
 
 
-def build_pid_controller(out_file: str | os.PathLike) -> Path:
-    """The PID controller FMU that closes the loop around the pendulum in co-simulation."""
+def build_pid_controller(out_file: str | os.PathLike = CHECKOUT_CONTROLLER, **options) -> Path:
+    """The PID controller FMU that closes the loop around the pendulum in co-simulation.
+
+    options are build_fmu's platforms and linux_glibc: the wheel builds it as it builds the
+    pendulum's FMI 2.0 FMU, for the same platforms.
+    """
     model = MODELS["pid_controller"]
-    return build_fmu(out_file, model_dir=model.folder, model_description_file=model.description)
+    return build_fmu(out_file, model_dir=model.folder, model_description_file=model.description, **options)
 
 
 def build_inputs() -> list[Path]:

@@ -87,6 +87,9 @@ def __dir__() -> list[str]:
 # FMI version -> the FMU's file name, in a checkout's dist/ and in the installed package's data/:
 # the one list of the FMI versions this package builds.
 FMU_FILES = {2: "Pendulum.fmu", 3: "Pendulum-fmi3.fmu"}
+# The PID controller FMU that closes the loop around the pendulum (FMI 2.0), beside them: what
+# export-ssp and the closed loop's tools hand a master.
+CONTROLLER_FMU_FILE = "PIDController.fmu"
 # Holds open the real files of packaged FMUs that importlib.resources had to extract (a zipped
 # install); a plain install hands out the files themselves. Made on first use.
 _extracted = None
@@ -125,29 +128,35 @@ def default_fmu(fmi_version: int = 2):
     >>> default_fmu().name
     'Pendulum.fmu'
     """
-    global _extracted
-    import atexit
-    import contextlib
-    from importlib import resources
-    from pathlib import Path
-
     from ._checkout import build_tool, is_source_checkout
-    from ._errors import InvalidInput, MissingFile
+    from ._errors import InvalidInput
 
     if fmi_version not in FMU_FILES:
         raise InvalidInput(f"no FMI {fmi_version} FMU: the FMI versions are {', '.join(map(str, FMU_FILES))}")
-    packaged_name = FMU_FILES[fmi_version]
     if is_source_checkout():
         build = build_tool()
         checkout_fmu = build.CHECKOUT_FMUS[fmi_version]
         if build.fmu_is_stale(checkout_fmu):
             build.build_fmu(checkout_fmu, fmi_version=fmi_version)
         return checkout_fmu
-    packaged = resources.files(__name__) / "data" / packaged_name
+    return _packaged_file(FMU_FILES[fmi_version])
+
+
+def _packaged_file(name: str):
+    """The real file of data/NAME packaged with an installed package; MissingFile when it is not there."""
+    global _extracted
+    import atexit
+    import contextlib
+    from importlib import resources
+    from pathlib import Path
+
+    from ._errors import MissingFile
+
+    packaged = resources.files(__name__) / "data" / name
     if not packaged.is_file():
         raise MissingFile(
             f"pendulum_fmu {__version__} at {Path(__file__).parent} has neither its packaged "
-            f"data/{packaged_name} nor the FMU's sources beside it: reinstall it from its wheel or "
+            f"data/{name} nor the FMU's sources beside it: reinstall it from its wheel or "
             "sdist, or pass the FMU's path"
         )
     if _extracted is None:

@@ -22,9 +22,10 @@ from fmpy.container_fmu.config import Component, Configuration, Connection
 from fmpy.model_description import CoSimulation, DefaultExperiment, ModelDescription, ModelVariable
 from scipy.integrate import solve_ivp
 
+from . import default_fmu
 from ._atomic_files import replacing
-from ._checkout import ROOT, build_tool
-from ._errors import InvalidInput, MissingFile
+from ._checkout import ROOT, build_tool, is_source_checkout
+from ._errors import InvalidInput
 from ._parameters import total_inertia
 from ._simulate import resolve_parameters
 
@@ -36,21 +37,47 @@ WIRES = (
 )
 
 
-def controller_defaults() -> dict[str, float]:
-    """setpoint, kp, ki, kd as the controller's modelDescription.xml sets them.
+def controller_fmu() -> Path:
+    """The PID controller FMU that closes the loop around the pendulum.
+
+    In a source checkout: dist/PIDController.fmu, rebuilt first when any of its sources is newer.
+    In an installed package: the one packaged with it (the wheel builds it for the pendulum's
+    platforms).
+
+    Returns
+    -------
+    Path
 
     Raises
     ------
     MissingFile
-        In an installed package, which carries the pendulum's FMU but not the controller's sources.
+        An installed package without its packaged controller.
+    BuildError
+        A checkout whose controller is stale and cannot be rebuilt here.
+    """
+    from . import CONTROLLER_FMU_FILE, _packaged_file
+
+    if not is_source_checkout():
+        return _packaged_file(CONTROLLER_FMU_FILE)
+    build = build_tool()
+    if build.fmu_is_stale(build.CHECKOUT_CONTROLLER):
+        build.build_pid_controller(build.CHECKOUT_CONTROLLER)
+    return build.CHECKOUT_CONTROLLER
+
+
+def controller_defaults() -> dict[str, float]:
+    """setpoint, kp, ki, kd as the controller's modelDescription.xml sets them.
+
+    Read from its sources in a checkout, from its packaged FMU in an installed package.
+
+    Raises
+    ------
+    MissingFile
+        An installed package without its packaged controller.
     """
     description = ROOT / "fmu_src" / "pid_controller" / "modelDescription.xml"
-    if not description.is_file():
-        raise MissingFile(
-            f"the PID controller's sources ({description}) are not here: the closed loop (export-ssp, "
-            "scenarios --closed-loop, its reference) needs a clone of pendulum-fmu or its unpacked sdist"
-        )
-    variables = read_model_description(str(description)).modelVariables
+    source = description if description.is_file() else controller_fmu()
+    variables = read_model_description(str(source)).modelVariables
     return {v.name: float(v.start) for v in variables if v.causality == "parameter"}
 
 
@@ -85,9 +112,9 @@ def create_closed_loop_fmu(out_file: str | Path, *, step_size: float = 1e-3) -> 
     CannotWrite
         out_file cannot be written.
     MissingFile
-        In an installed package, which carries the pendulum's FMU but not the controller's sources.
+        An installed package without its packaged FMUs.
     BuildError
-        The pendulum or the controller cannot be built here.
+        A checkout whose FMUs are stale and cannot be rebuilt here.
 
     Examples
     --------
@@ -100,8 +127,8 @@ def create_closed_loop_fmu(out_file: str | Path, *, step_size: float = 1e-3) -> 
     ...     print(error)
     step size 0 must be a positive number of seconds
 
-    The build itself compiles both FMUs for every platform (about a minute), too long for a
-    doctest; tests/test_closed_loop.py runs it:
+    The FMUs are built when stale (about a minute for every platform), too long for a doctest;
+    tests/test_closed_loop.py runs it:
 
     >>> import tempfile
     >>> from pathlib import Path
@@ -115,11 +142,7 @@ def create_closed_loop_fmu(out_file: str | Path, *, step_size: float = 1e-3) -> 
     out_file = Path(out_file)
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
-        build = build_tool()
-        files = {
-            "pendulum": build.build_fmu(tmp / "Pendulum.fmu"),
-            "controller": build.build_pid_controller(tmp / "PIDController.fmu"),
-        }
+        files = {"pendulum": default_fmu(), "controller": controller_fmu()}
         components, variables = {}, {}
         for name, path in files.items():
             description = read_model_description(str(path))

@@ -13,15 +13,14 @@ from __future__ import annotations
 import math
 import numbers
 import os
-import tempfile
 import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 from xml.etree import ElementTree
 
+from . import default_fmu
 from ._atomic_files import replacing
-from ._checkout import build_tool
-from ._closed_loop import WIRES, controller_defaults
+from ._closed_loop import WIRES, controller_defaults, controller_fmu
 from ._errors import InvalidInput, MissingFile, PendulumFmuError
 from ._simulate import resolve_parameters
 
@@ -66,12 +65,16 @@ class SspSettings:
         The controller's parameter set (setpoint, kp, ki, kd).
     pendulum : dict
         The pendulum's parameter set.
+    call_record : str
+        The pendulum's callRecordFile in its set: where it writes the record of every FMI call
+        it receives (docs/calls.md); '' when the set has none.
     """
 
     stop_time: float
     step_size: float
     controller: dict
     pendulum: dict
+    call_record: str = ""
 
 
 def _positive(name: str, value) -> float:
@@ -88,8 +91,8 @@ def _element(parent, prefix: str, tag: str, **attributes) -> ElementTree.Element
     return ElementTree.SubElement(parent, _tag(prefix, tag), {k: str(v) for k, v in attributes.items()})
 
 
-def parameter_set_xml(name: str, values: dict[str, float]) -> bytes:
-    """An SSP 1.0 parameter set (.ssv) of real values.
+def parameter_set_xml(name: str, values: dict[str, float], strings: dict[str, str] | None = None) -> bytes:
+    """An SSP 1.0 parameter set (.ssv) of real values, and string ones.
 
     Parameters
     ----------
@@ -97,6 +100,9 @@ def parameter_set_xml(name: str, values: dict[str, float]) -> bytes:
         The set's name.
     values : dict
         Parameter name (relative to the component it is bound to) to value.
+    strings : dict, optional
+        String parameters, name to value, set before the real ones (the pendulum's
+        callRecordFile: a record opens when it is set, so what is set after it is in the record).
 
     Returns
     -------
@@ -110,6 +116,8 @@ def parameter_set_xml(name: str, values: dict[str, float]) -> bytes:
     """
     root = ElementTree.Element(_tag("ssv", "ParameterSet"), version="1.0", name=name)
     parameters = _element(root, "ssv", "Parameters")
+    for parameter, text in (strings or {}).items():
+        _element(_element(parameters, "ssv", "Parameter", name=parameter), "ssv", "String", value=text)
     for parameter, value in values.items():
         _element(_element(parameters, "ssv", "Parameter", name=parameter), "ssv", "Real", value=repr(float(value)))
     return ElementTree.tostring(root, encoding="UTF-8", xml_declaration=True)
@@ -189,6 +197,7 @@ def export_ssp(
     parameters: dict | None = None,
     stop_time: float = 3.0,
     step_size: float = 1e-3,
+    call_record: str | os.PathLike | None = None,
     overwrite: bool = False,
 ) -> Path:
     """Write ClosedLoop.ssp: the pendulum and the PID controller FMUs wired into one system.
@@ -204,6 +213,10 @@ def export_ssp(
         The pendulum's parameters over its defaults; the pendulum's parameter set.
     stop_time, step_size : float, optional
         The DefaultExperiment's stop time and the fixed communication step, in s.
+    call_record : str or PathLike, optional
+        The pendulum's callRecordFile in its parameter set: the file the pendulum appends the
+        record of every FMI call to, in any master that applies the set (a relative path is
+        the master's working folder's). `pendulum-fmu judge --calls FILE --ssp` reads it.
     overwrite : bool, optional
         Replace an existing out_file.
 
@@ -221,8 +234,10 @@ def export_ssp(
         a controller parameter the controller does not have, or pendulum parameters it refuses.
     CannotWrite
         out_file cannot be written.
+    MissingFile
+        An installed package without its packaged FMUs.
     BuildError
-        The FMUs cannot be built here.
+        A checkout whose FMUs are stale and cannot be rebuilt here.
 
     Examples
     --------
@@ -265,18 +280,70 @@ def export_ssp(
     pendulum = resolve_parameters(parameters)
     if out_file.exists() and not overwrite:
         raise SspExists(f"{out_file} exists: pass --overwrite to replace it, or name another file")
-    with tempfile.TemporaryDirectory(prefix="pendulum_fmu_ssp_") as tmp:
-        fmus = {
-            "pendulum": build_tool().build_fmu(Path(tmp) / "Pendulum.fmu"),
-            "controller": build_tool().build_pid_controller(Path(tmp) / "PIDController.fmu"),
-        }
-        with replacing(out_file, "wb") as file, zipfile.ZipFile(file, "w", zipfile.ZIP_DEFLATED) as archive:
-            archive.writestr("SystemStructure.ssd", system_structure_xml(stop_time, step_size))
-            for name, (source, _) in COMPONENTS.items():
-                archive.write(fmus[name], source)
-            archive.writestr("resources/controller.ssv", parameter_set_xml("controller", gains))
-            archive.writestr("resources/pendulum.ssv", parameter_set_xml("pendulum", pendulum))
+    fmus = {"pendulum": default_fmu(), "controller": controller_fmu()}
+    with replacing(out_file, "wb") as file, zipfile.ZipFile(file, "w", zipfile.ZIP_DEFLATED) as archive:
+        archive.writestr("SystemStructure.ssd", system_structure_xml(stop_time, step_size))
+        for name, (source, _) in COMPONENTS.items():
+            archive.write(fmus[name], source)
+        archive.writestr("resources/controller.ssv", parameter_set_xml("controller", gains))
+        record = {} if call_record is None else {"callRecordFile": os.fspath(call_record)}
+        archive.writestr("resources/pendulum.ssv", parameter_set_xml("pendulum", pendulum, record))
     return out_file
+
+
+def rebind_ssp(
+    ssp: str | os.PathLike,
+    out_file: str | os.PathLike,
+    *,
+    call_record: str | os.PathLike | None = None,
+    controller: dict[str, float] | None = None,
+) -> Path:
+    """A copy of the closed loop's SSP with the pendulum's callRecordFile or the controller's set replaced.
+
+    Parameters
+    ----------
+    ssp : str or PathLike
+        An SSP export_ssp wrote.
+    out_file : str or PathLike
+        The copy to write (replaced when it exists).
+    call_record : str or PathLike, optional
+        The pendulum's callRecordFile in the copy's pendulum set (as export_ssp's call_record).
+    controller : dict, optional
+        The copy's whole controller set, in place of the SSP's (a parameter left out is one the
+        controller takes its own default for).
+
+    Returns
+    -------
+    Path
+        out_file.
+
+    Raises
+    ------
+    MissingFile, SspFileError
+        As read_ssp.
+    CannotWrite
+        out_file cannot be written.
+
+    Examples
+    --------
+    >>> rebind_ssp("ClosedLoop.ssp", "Recorded.ssp", call_record="calls.log")  # doctest: +SKIP
+    PosixPath('Recorded.ssp')
+    """
+    settings = read_ssp(ssp)
+    replaced = {}
+    if call_record is not None:
+        record = {"callRecordFile": os.fspath(call_record)}
+        replaced["resources/pendulum.ssv"] = parameter_set_xml("pendulum", settings.pendulum, record)
+    if controller is not None:
+        replaced["resources/controller.ssv"] = parameter_set_xml("controller", controller)
+    with (
+        zipfile.ZipFile(ssp) as source,
+        replacing(out_file, "wb") as file,
+        zipfile.ZipFile(file, "w", zipfile.ZIP_DEFLATED) as copy,
+    ):
+        for name in source.namelist():
+            copy.writestr(name, replaced.get(name) or source.read(name))
+    return Path(out_file)
 
 
 def _attribute(element: ElementTree.Element, path: str, attribute: str) -> str:
@@ -288,12 +355,15 @@ def _attribute(element: ElementTree.Element, path: str, attribute: str) -> str:
     return value
 
 
-def _parameter_set(archive: zipfile.ZipFile, name: str) -> dict[str, float]:
+def _parameter_set(archive: zipfile.ZipFile, name: str, kind: str = "Real") -> dict:
+    """{name: value} of the set's parameters of one kind: Real (as float) or String."""
     root = ElementTree.fromstring(archive.read(name))
-    return {
-        _attribute(p, ".", "name"): float(_attribute(p, "ssv:Real", "value"))
+    values = {
+        _attribute(p, ".", "name"): _attribute(p, f"ssv:{kind}", "value")
         for p in root.iterfind("ssv:Parameters/ssv:Parameter", NAMESPACES)
+        if p.find(f"ssv:{kind}", NAMESPACES) is not None
     }
+    return {name: float(value) for name, value in values.items()} if kind == "Real" else values
 
 
 def read_ssp(path: str | os.PathLike) -> SspSettings:
@@ -336,6 +406,7 @@ def read_ssp(path: str | os.PathLike) -> SspSettings:
                 step_size=float(_attribute(ssd, ".//osp:FixedStepAlgorithm", "baseStepSize")),
                 controller=sets["controller"],
                 pendulum=sets["pendulum"],
+                call_record=_parameter_set(archive, bindings["pendulum"], "String").get("callRecordFile", ""),
             )
     except (zipfile.BadZipFile, KeyError, ValueError, ElementTree.ParseError) as error:
         raise SspFileError(

@@ -62,12 +62,11 @@ class SspVerdict:
 
 
 @lru_cache(maxsize=32)
-def _reference_theta(
-    stop_time: float, step_size: float, coupling: str, controller: tuple, pendulum: tuple
-) -> np.ndarray:
+def reference_run(stop_time: float, step_size: float, coupling: str, controller: tuple, pendulum: tuple) -> np.ndarray:
+    """sampled_loop_reference, kept for the next judgement; parameters as sorted (name, value) pairs."""
     return sampled_loop_reference(
         stop_time, step_size, controller=dict(controller), parameters=dict(pendulum), coupling=coupling
-    )["theta"]
+    )
 
 
 def judge_coupling(time, theta, settings: SspSettings, *, tolerance: float = MATCH_TOLERANCE) -> SspVerdict:
@@ -115,7 +114,7 @@ def judge_coupling(time, theta, settings: SspSettings, *, tolerance: float = MAT
     scores = {}
     for coupling in COUPLINGS:
         for applied, (controller, pendulum) in sets.items():
-            reference = _reference_theta(steps * step_size, step_size, coupling, controller, pendulum)
+            reference = reference_run(steps * step_size, step_size, coupling, controller, pendulum)["theta"]
             for shift in (0, 1):
                 scores[coupling, applied, shift] = float(np.max(np.abs(theta - reference[index + shift])))
     (coupling, applied, shift), error = min(scores.items(), key=lambda item: item[1])

@@ -11,7 +11,7 @@ adds to kit/:
 
 A master runs ClosedLoop.ssp and writes ClosedLoop_out.csv (time,theta); `pendulum-fmu judge
 ClosedLoop_out.csv --ssp ClosedLoop.ssp` names its coupling (_ssp_judge.py). The controller FMU is
-built from this project's sources, so the closed loop needs a source checkout.
+the one the package carries (built from the sources in a checkout).
 """
 
 from __future__ import annotations
@@ -50,8 +50,10 @@ def write_closed_loop_kit(output_dir: str | os.PathLike, *, overwrite: bool = Fa
         The folder holds one of CLOSED_LOOP_FILES and overwrite is False.
     CannotWrite
         The folder cannot be written.
+    MissingFile
+        An installed package without its packaged FMUs.
     BuildError
-        The FMUs cannot be built here (no source checkout).
+        A checkout whose FMUs are stale and cannot be rebuilt here.
 
     Examples
     --------

@@ -2,12 +2,17 @@
 
 Each runner takes the SSP as a user would hand it over and returns the pendulum's theta at the
 times the master reports, as the master labels them; ssp_judge then says what the master did.
+Where the SSP's pendulum set names a callRecordFile (export_ssp's call_record), each runner has
+the pendulum's record of its FMI calls written there, in the way that master allows, for
+_ssp_calls.py to judge: libcosim applies the set itself; fmpy.ssp is handed it as its parameter_set;
+fmucontainer ignores the set, so its container runs with logging on and its log is the record.
 OMSimulator is not among them: its PyPI sdist downloads binaries at install time (docs/ssp.md
 gives its command).
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
 import shutil
 import subprocess
@@ -17,8 +22,10 @@ from pathlib import Path
 
 import numpy as np
 
+from ._atomic_files import replacing
 from ._errors import MissingDependency
-from ._ssp import read_ssp
+from ._ssp import read_ssp, rebind_ssp
+from ._ssp_calls import judge_ssp_calls
 from ._ssp_judge import judge_coupling
 
 NANOSECONDS = 10**9  # libcosim counts time in ns
@@ -93,14 +100,46 @@ def run_fmpy_ssp(ssp: str | os.PathLike, *, parameter_set: bool = False) -> tupl
     from fmpy.ssp.ssd import Parameter, ParameterSet
 
     settings = read_ssp(ssp)
-    given = None
+    given = ParameterSet()
+    if settings.call_record:  # first, so that the record holds the parameters set after it
+        given.parameters.append(Parameter(name="pendulum.callRecordFile", type="String", value=settings.call_record))
     if parameter_set:
-        given = ParameterSet()
         for component, values in (("controller", settings.controller), ("pendulum", settings.pendulum)):
             for name, value in values.items():
                 given.parameters.append(Parameter(name=f"{component}.{name}", type="Real", value=value))
-    result = simulate_ssp(str(ssp), stop_time=settings.stop_time, step_size=settings.step_size, parameter_set=given)
+    with _fmpy_ssp_sets_strings():
+        result = simulate_ssp(
+            str(ssp),
+            stop_time=settings.stop_time,
+            step_size=settings.step_size,
+            parameter_set=given if given.parameters else None,
+        )
     return result["time"], result["pendulum.theta"]
+
+
+@contextlib.contextmanager
+def _fmpy_ssp_sets_strings():
+    """fmpy.ssp with String parameters in its parameter_set, for the pendulum's callRecordFile.
+
+    fmpy 0.3's fmpy.ssp.simulation.set_value refuses any type but Real, Integer and Boolean: while
+    this lasts, a String goes to the FMU's fmi2SetString and every other type to fmpy's own.
+    """
+    from fmpy.ssp import simulation
+
+    own = simulation.set_value
+
+    def set_value(component, name, value):
+        variable = component.variables[name]
+        if variable.type == "String":
+            component.fmu.setString([variable.valueReference], [str(value)])
+        else:
+            own(component, name, value)
+
+    simulation.set_value = set_value
+    try:
+        yield
+    finally:
+        simulation.set_value = own
 
 
 def run_fmucontainer(ssp: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
@@ -150,9 +189,16 @@ def run_fmucontainer(ssp: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
             check=True,
             capture_output=True,
         )
-        result = simulate_fmu(
-            str(copy.with_suffix(".fmu")), stop_time=settings.stop_time, output_interval=settings.step_size
-        )
+        container = str(copy.with_suffix(".fmu"))
+        if not settings.call_record:
+            result = simulate_fmu(container, stop_time=settings.stop_time, output_interval=settings.step_size)
+        else:
+            # The container passes no parameter set on, but forwards its FMUs' log messages: with
+            # logging on, its log (fmpy prints it) holds the pendulum's record.
+            with replacing(settings.call_record) as log, contextlib.redirect_stdout(log):
+                result = simulate_fmu(
+                    container, stop_time=settings.stop_time, output_interval=settings.step_size, debug_logging=True
+                )
     return result["time"], result["pendulum.theta"]
 
 
@@ -164,45 +210,59 @@ MASTERS = {
 }
 
 
-def masters_table(ssp: str | os.PathLike) -> str:
+def masters_table(ssp: str | os.PathLike, records: str | os.PathLike | None = None) -> str:
     """Run the SSP in every master here and tabulate what the judge says of each (Markdown).
 
     Parameters
     ----------
     ssp : str or PathLike
         The closed loop's SSP.
+    records : str or PathLike, optional
+        A folder: each master runs a copy of the SSP there whose pendulum writes its call record
+        beside it (MASTER_NUMBER.log), and the row adds what the judge reads from that record.
 
     Returns
     -------
     str
         One row per master: theta at the stop time, the coupling, whether the parameter set was
-        applied, the distance from that coupling's reference and the problems found; a master
-        that is not installed says so in its row.
+        applied, the distance from that coupling's reference and the problems found; with records,
+        the coupling, the controller parameters that did not arrive, the pendulum parameters set
+        and the problems the call record shows. A master that is not installed says so in its row.
 
     Examples
     --------
     >>> print(masters_table("ClosedLoop.ssp"))  # doctest: +SKIP
     """
     settings = read_ssp(ssp)
-    rows = [
-        "| master | theta at stop time | coupling | parameter set applied | from its reference | problems |",
-        "|---|---|---|---|---|---|",
-    ]
-    for name, run in MASTERS.items():
+    header = "| master | theta at stop time | coupling | parameter set applied | from its reference | problems |"
+    if records is not None:
+        header += " call record: coupling | controller parameters missing | pendulum parameters set | problems |"
+    columns = header.count("|") - 1
+    rows = [header, "|---" * columns + "|"]
+    for number, (name, run) in enumerate(MASTERS.items()):
+        record = None if records is None else Path(records, f"master_{number}.log")
+        ran = ssp if record is None else rebind_ssp(ssp, record.with_suffix(".ssp"), call_record=record)
         try:
-            time, theta = run(ssp)
+            time, theta = run(ran)
         except MissingDependency as missing:
-            rows.append(f"| {name} | not run: {missing} | | | | |")
+            rows.append(f"| {name} | not run: {missing} |" + " |" * (columns - 2))
             continue
         verdict = judge_coupling(time, theta, settings)
         # fmpy.ssp labels each value with its step's start: the value at the stop time is the one
         # labelled a step earlier.
         at_stop = np.interp(settings.stop_time - verdict.labelled_at_step_start * verdict.step_size, time, theta)
-        rows.append(
+        row = (
             f"| {name} | {float(at_stop)!r} | {verdict.coupling} | "
             f"{'yes' if verdict.parameter_set_applied else 'no'} | {verdict.max_error:.2g} rad | "
             f"{'; '.join(verdict.problems) or 'none'} |"
         )
+        if record is not None:
+            recorded = judge_ssp_calls(record, settings)
+            row += (
+                f" {recorded.coupling} | {', '.join(recorded.controller_missing) or 'none'} | "
+                f"{', '.join(recorded.pendulum_set) or 'none'} | {'; '.join(recorded.problems) or 'none'} |"
+            )
+        rows.append(row)
     return "\n".join(rows)
 
 
@@ -234,7 +294,7 @@ def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     with tempfile.TemporaryDirectory(prefix="pendulum_fmu_ssp_") as tmp:
         ssp = argv[0] if argv else export_ssp(Path(tmp) / "ClosedLoop.ssp")
-        print(masters_table(ssp))
+        print(masters_table(ssp, records=tmp))
     return 0
 
 

@@ -100,6 +100,10 @@ FILES = {
     "result_no_time.csv": "t,theta\n0,0\n0.001,0\n",
     "result_backwards.csv": "time,theta\n0,0\n0.002,0\n0.001,0\n",
     "result_t0.csv": "time,theta\n0,0\n",
+    # The controller's record alone: the pendulum's instance is not in it.
+    "controller_calls.log": '[pendulum-calls] instance="controller" fmi2SetReal(theta=0) time=0->0 status=OK\n'
+    '[pendulum-calls] instance="controller" fmi2DoStep(currentCommunicationPoint=0, communicationStepSize=0.001) '
+    "time=0->0.001 status=OK\n",
     # A folder with a study's entry that no sweep wrote.
     "not_a_study/study.json": "{}\n",
     # Folders holding a file of a scenario kit, and an output of a demo.
@@ -494,6 +498,18 @@ CASES = [
         "result.csv: time 0.001 is after the run's stop time 0.0005 s; give the run's --stop-time",
     ),
     _case("judge", "judge {files}", 2, "no scenario settings (NAME.json) in this folder"),
+    _case(
+        "judge",
+        "judge --calls {files}/controller_calls.log --ssp {files}/absent.ssp",
+        2,
+        "no instance of the pendulum stepped with a torque set",
+    ),
+    _case(
+        "judge",
+        "judge {files}/result.csv --calls {files}/controller_calls.log --ssp {files}/absent.ssp",
+        2,
+        "the master's result CSV or the pendulum's call record, one of them",
+    ),
     _case("judge", "judge {files} --torque 1", 2, "is a folder, judged as a scenario kit whose NAME.json files"),
     _case(
         "scenarios",

@@ -20,13 +20,16 @@ import tarfile
 import zipfile
 from pathlib import Path
 
+import fmpy
+import lxml.etree
 import numpy as np
 import pytest
 from fmpy import read_model_description
 from packaging.requirements import Requirement
 from readme_figures import measured_figures
 
-from pendulum_fmu import FMU_FILES, __version__
+from pendulum_fmu import CONTROLLER_FMU_FILE, FMU_FILES, __version__
+from pendulum_fmu._closed_loop import sampled_loop_reference
 from pendulum_fmu._reference import reference
 
 pytestmark = pytest.mark.packaging
@@ -109,6 +112,7 @@ def test_wheel_carries_the_fmu_for_every_platform_built(artefacts, tmp_path):
             version: zipfile.ZipFile(io.BytesIO(wheel.read(f"pendulum_fmu/data/{name}")))
             for version, name in FMU_FILES.items()
         }
+        controller = zipfile.ZipFile(io.BytesIO(wheel.read(f"pendulum_fmu/data/{CONTROLLER_FMU_FILE}")))
     with tarfile.open(artefacts["sdist"]) as sdist:
         [top] = {name.split("/")[0] for name in sdist.getnames()}
         assert sdist.extractfile(f"{top}/LICENSE").read() == (ROOT / "LICENSE").read_bytes()
@@ -118,6 +122,11 @@ def test_wheel_carries_the_fmu_for_every_platform_built(artefacts, tmp_path):
         "binaries/win64/Pendulum.dll",
         "binaries/aarch64-linux/Pendulum.so",
         "binaries/darwin64/Pendulum.dylib",
+    }
+    # The closed loop's controller for the same platforms (export-ssp from the wheel).
+    assert {name for name in controller.namelist() if name.startswith("binaries/")} == {
+        f"binaries/{folder}/PIDController.{suffix}"
+        for folder, suffix in (("linux64", "so"), ("win64", "dll"), ("aarch64-linux", "so"), ("darwin64", "dylib"))
     }
     assert {name for name in fmus[3].namelist() if name.startswith("binaries/")} == {
         f"binaries/{folder}/Pendulum.{suffix}"
@@ -198,10 +207,45 @@ def test_installed_package_runs_from_an_empty_folder(installed, tmp_path):
     )
     refused = _run([cli, "export"], cwd=tmp_path, check=False)
     assert refused.returncode == 2 and refused.stderr.startswith("pendulum-fmu export: error: Pendulum.fmu exists")
+    _closed_loop_ssp_from_the_installed_package(python, cli, tmp_path / "ssp")
+
     # Building is the repository's (python build_fmu.py): an installed package has no build command.
     assert "invalid choice: 'build'" in _run([cli, "build"], cwd=tmp_path, check=False).stderr
 
     assert _files_under(package) == before  # nothing written into site-packages
+
+
+SSP_SCHEMAS = Path(fmpy.__file__).parent / "ssp" / "schema"
+
+
+def _closed_loop_ssp_from_the_installed_package(python, cli, folder):
+    """export-ssp in an empty folder: an SSP that validates and that fmpy.ssp runs as its coupling's reference."""
+    folder.mkdir()
+    assert _run([cli, "export-ssp", "--stop-time", "2"], cwd=folder).stdout == "wrote ClosedLoop.ssp\n"
+    with zipfile.ZipFile(folder / "ClosedLoop.ssp") as archive:
+        for name, schema in (
+            ("SystemStructure.ssd", "SystemStructureDescription.xsd"),
+            ("resources/controller.ssv", "SystemStructureParameterValues.xsd"),
+            ("resources/pendulum.ssv", "SystemStructureParameterValues.xsd"),
+        ):
+            validator = lxml.etree.XMLSchema(file=str(SSP_SCHEMAS / schema))
+            assert validator.validate(lxml.etree.fromstring(archive.read(name))), (name, validator.error_log)
+    _run(
+        [
+            python,
+            "-c",
+            "from fmpy.ssp.simulation import simulate_ssp; from fmpy.util import write_csv; "
+            "write_csv('ssp.csv', simulate_ssp('ClosedLoop.ssp', stop_time=2.0, step_size=1e-3))",
+        ],
+        cwd=folder,
+    )
+    result = _csv_columns(folder / "ssp.csv")
+    # fmpy.ssp applies no bound set (the controller's own setpoint 0.5), holds torque 0 over the
+    # first step and labels each row with the start of the step whose end it holds; to 2 s its
+    # summed time takes one step more (tests/test_ssp.py).
+    expected = sampled_loop_reference(2.001, 1e-3, coupling="jacobi-first-exchange-missing")
+    assert len(result["time"]) == 2001
+    assert np.max(np.abs(result["pendulum.theta"] - expected["theta"][1:])) < 1e-12
 
 
 # The set-up's sizes the install page states (benchmarks.install's measured block) hold for

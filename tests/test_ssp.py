@@ -12,8 +12,10 @@ import lxml.etree
 import numpy as np
 import pytest
 
+from pendulum_fmu._calls import read_calls, reconstruct
 from pendulum_fmu._closed_loop import COUPLINGS, controller_defaults, sampled_loop_reference
-from pendulum_fmu._ssp import DEFAULT_SETPOINT, export_ssp, read_ssp
+from pendulum_fmu._ssp import DEFAULT_SETPOINT, export_ssp, read_ssp, rebind_ssp
+from pendulum_fmu._ssp_calls import judge_ssp_calls
 from pendulum_fmu._ssp_judge import judge_coupling
 from pendulum_fmu.cli import main
 
@@ -195,10 +197,150 @@ def test_the_kits_closed_loop_names_each_couplings_reference_as_that_coupling(tm
     assert "--overwrite" in capsys.readouterr().err
 
 
-def test_an_installed_package_without_the_controller_s_sources_is_one_line(tmp_path, monkeypatch, capsys):
-    # An installed package sits where no fmu_src/ is beside it (what the wheel installs).
+def test_an_installed_package_without_its_packaged_controller_is_one_line(tmp_path, monkeypatch, capsys):
+    # An installed package (no fmu_src/ beside it) whose data/ lacks the controller: reinstall.
     monkeypatch.setattr("pendulum_fmu._closed_loop.ROOT", tmp_path)
+    monkeypatch.setattr("pendulum_fmu._closed_loop.is_source_checkout", lambda: False)
+    monkeypatch.setattr("pendulum_fmu.CONTROLLER_FMU_FILE", "Absent.fmu")
     assert main(["export-ssp", str(tmp_path / "ClosedLoop.ssp")]) == 2
     [line] = capsys.readouterr().err.strip().splitlines()
-    assert line.startswith("pendulum-fmu export-ssp: error: the PID controller's sources")
-    assert "needs a clone of pendulum-fmu" in line and not (tmp_path / "ClosedLoop.ssp").exists()
+    assert line.startswith("pendulum-fmu export-ssp: error: pendulum_fmu ")
+    assert "has neither its packaged data/Absent.fmu" in line and "reinstall it" in line
+    assert not (tmp_path / "ClosedLoop.ssp").exists()
+
+
+def _recorded_torques(log):
+    """The torque held over each step of the pendulum's instance, read from its record."""
+    [pendulum] = [r for r in reconstruct(read_calls(log, {0: "torque"})).values() if any(s.torque for s in r.steps)]
+    return np.array([step.torque for step in pendulum.steps])
+
+
+def _libcosim_quiet():
+    pytest.importorskip("libcosimpy")
+    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+
+    log_output_level(CosimLogLevel.WARNING)
+
+
+# What each master here does with the SSP (docs/ssp.md's table): its coupling, whether the
+# controller's setpoint and the pendulum's set reach the FMUs, and whether it stops a step late.
+MASTERS_AS_KNOWN = {
+    "libcosim": ("jacobi", True, False),
+    "fmpy.ssp": ("jacobi-first-exchange-missing", False, True),
+    "fmpy.ssp parameter_set": ("jacobi-first-exchange-missing", True, True),
+    "fmucontainer": ("jacobi", False, False),
+}
+
+
+@pytest.mark.parametrize("master", MASTERS_AS_KNOWN)
+def test_the_pendulums_call_record_names_each_masters_coupling_and_sets(master, ssp, tmp_path):
+    from pendulum_fmu import _ssp_masters
+
+    if master == "libcosim":
+        _libcosim_quiet()
+    if master == "fmucontainer":
+        pytest.importorskip("fmu_manipulation_toolbox")
+    run = {
+        "libcosim": _ssp_masters.run_libcosim,
+        "fmpy.ssp": _ssp_masters.run_fmpy_ssp,
+        "fmpy.ssp parameter_set": lambda path: _ssp_masters.run_fmpy_ssp(path, parameter_set=True),
+        "fmucontainer": _ssp_masters.run_fmucontainer,
+    }[master]
+    coupling, applied, one_step_more = MASTERS_AS_KNOWN[master]
+    settings = read_ssp(ssp)
+    log = tmp_path / "calls.log"
+    time, theta = run(rebind_ssp(ssp, tmp_path / "ClosedLoop.ssp", call_record=log))
+    # The torques the record holds are the coupling's, by the reference alone.
+    torques = _recorded_torques(log)
+    steps = round(settings.stop_time / settings.step_size) + one_step_more
+    expected = sampled_loop_reference(
+        steps * settings.step_size,
+        settings.step_size,
+        controller=settings.controller if applied else None,
+        coupling=coupling,
+    )["torque"][:-1]
+    assert len(torques) == steps
+    assert np.max(np.abs(torques - expected)) < 1e-9
+    verdict = judge_ssp_calls(log, settings)
+    assert verdict.coupling == coupling == judge_coupling(time, theta, settings).coupling
+    assert verdict.controller_missing == (() if applied else ("setpoint",))
+    assert verdict.pendulum_set == (settings.pendulum if applied else {})
+    assert verdict.max_difference < 1e-9
+    expected_problems = [
+        *(
+            []
+            if applied
+            else [
+                "the controller's setpoint did not arrive: the torques are those of its default 0.5, "
+                "the SSP's set has 0.3",
+                "the pendulum's parameter set did not arrive: the record shows no mass, length, inertia, gravity, "
+                "damping set before initialization ended (the FMU ran on its start values)",
+            ]
+        ),
+        *(["ran to 2.001 s where the DefaultExperiment stops at 2 s"] if one_step_more else []),
+    ]
+    assert verdict.problems == expected_problems
+
+
+def _one_torque_a_step_late(log, step):
+    """The record with the torque set before step `step` moved after that step."""
+    lines = log.read_text().splitlines(keepends=True)
+    do_steps = [i for i, line in enumerate(lines) if "fmi2DoStep(" in line]
+    at = do_steps[step]
+    [set_torque] = [i for i in range(do_steps[step - 1], at) if "fmi2SetReal(torque=" in lines[i]]
+    lines.insert(at, lines.pop(set_torque))  # now after the step
+    log.write_text("".join(lines))
+
+
+def test_a_doctored_record_with_a_late_torque_and_no_setpoint_is_named(ssp, tmp_path, capsys):
+    _libcosim_quiet()
+    from pendulum_fmu._ssp_masters import run_libcosim
+
+    settings = read_ssp(ssp)
+    log = tmp_path / "calls.log"
+    # The master ran a set without the setpoint (the controller's own 0.5 in force) ...
+    without_setpoint = {name: value for name, value in settings.controller.items() if name != "setpoint"}
+    run_libcosim(rebind_ssp(ssp, tmp_path / "NoSetpoint.ssp", call_record=log, controller=without_setpoint))
+    # ... and set the torque of step 700 after that step.
+    _one_torque_a_step_late(log, 700)
+    torques = _recorded_torques(log)
+    reference = sampled_loop_reference(2.0, 1e-3, coupling="jacobi")["torque"]  # setpoint 0.5
+    assert abs(torques[700] - reference[699]) < 1e-9 < abs(reference[700] - reference[699])
+    assert main(["judge", "--calls", str(log), "--ssp", str(ssp)]) == 1
+    printed = capsys.readouterr().out.splitlines()
+    assert "coupling: jacobi (" in printed[1]
+    assert "controller's parameter set arrived: no: setpoint at the controller's default" in printed
+    [late] = [line for line in printed if line.startswith("problem: step")]
+    assert late.startswith(f"problem: step 700 (t = {0.7:.17g}) ")
+    assert late.endswith(f"holds {torques[700]:.17g} N.m, the torque jacobi gives step 699: set a step late")
+    assert (
+        "problem: the controller's setpoint did not arrive: the torques are those of its default 0.5, "
+        "the SSP's set has 0.3" in printed
+    )
+    assert printed[-1] == "FAIL"
+
+
+def test_fmpys_container_fmu_read_from_its_log_is_gauss_seidel_pendulum_first(ssp, tmp_path):
+    # fmpy's container (create_closed_loop_fmu) is the Gauss-Seidel master here: it takes no
+    # parameter set, and with logging on its log carries both FMUs' records.
+    import contextlib
+
+    from fmpy import simulate_fmu
+
+    from pendulum_fmu._closed_loop import create_closed_loop_fmu
+
+    container, log = create_closed_loop_fmu(tmp_path / "ClosedLoop.fmu"), tmp_path / "container.log"
+    with open(log, "w") as file, contextlib.redirect_stdout(file):
+        simulate_fmu(str(container), stop_time=2.0, output_interval=1e-3, debug_logging=True)
+    expected = sampled_loop_reference(2.0, 1e-3, coupling="gauss-seidel-pendulum-first")["torque"][:-1]
+    assert np.max(np.abs(_recorded_torques(log) - expected)) < 1e-9
+    verdict = judge_ssp_calls(log, read_ssp(ssp))
+    assert (verdict.instance, verdict.coupling, verdict.controller_missing) == (
+        "pendulum",
+        "gauss-seidel-pendulum-first",
+        ("setpoint",),
+    )
+    assert [problem.split(":")[0] for problem in verdict.problems] == [
+        "the controller's setpoint did not arrive",
+        "the pendulum's parameter set did not arrive",
+    ]

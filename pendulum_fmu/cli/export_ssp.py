@@ -48,6 +48,13 @@ def add_parser(commands) -> argparse.ArgumentParser:
     export.add_argument(
         "--step-size", type=float_number, default=1e-3, help="the fixed communication step in s (default: %(default)s)"
     )
+    export.add_argument(
+        "--call-record",
+        default=None,
+        metavar="FILE",
+        help="put the pendulum's callRecordFile in its parameter set: each master that applies the set "
+        "has the pendulum write the record of its FMI calls to FILE, for judge --calls FILE --ssp (docs/ssp.md)",
+    )
     export.add_argument("--overwrite", action="store_true", help="replace an existing output")
     export.set_defaults(run=run)
     return export
@@ -63,6 +70,7 @@ def run(args) -> int:
         parameters=parameters_of(args.assignments),
         stop_time=args.stop_time,
         step_size=args.step_size,
+        call_record=args.call_record,
         overwrite=args.overwrite,
     )
     print(f"wrote {written}")

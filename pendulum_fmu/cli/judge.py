@@ -86,8 +86,9 @@ def add_parser(commands) -> argparse.ArgumentParser:
         type=Path,
         default=None,
         metavar="ClosedLoop.ssp",
-        help="judge a closed-loop result (time, theta) of this SSP from any master: name its coupling, "
-        "whether the parameter sets arrived, its step and stop time (docs/ssp.md)",
+        help="judge a closed-loop result (time, theta) of this SSP from any master, or with --calls the "
+        "pendulum's call record of its run: name its coupling, whether the parameter sets arrived, its step "
+        "and stop time (with --calls: each torque wrong for the coupling) (docs/ssp.md)",
     )
     judge.set_defaults(run=run)
     return judge
@@ -99,16 +100,7 @@ def run(args) -> int:
     from .._plot import plot_judgement
 
     if args.ssp is not None:
-        from .._ssp_judge import format_ssp_verdict, judge_ssp_result
-
-        if args.result is None or args.calls is not None:
-            raise InvalidInput(
-                "judge --ssp reads the master's result CSV, not a call log: "
-                "pendulum-fmu judge RESULT.csv --ssp ClosedLoop.ssp [--map theta=COLUMN]"
-            )
-        verdict = judge_ssp_result(args.result, args.ssp, mapping=args.mapping)
-        print(format_ssp_verdict(verdict))
-        return 0 if verdict.passed else 1
+        return _judge_ssp(args)
 
     signal = torque_signal(args)
     if args.calls is not None:
@@ -159,6 +151,27 @@ def run(args) -> int:
     if args.json:
         print(f"wrote {write_json(verdicts, args.json)}")
     return 0 if all(judgement.passed for judgement in judged.values()) else 1
+
+
+def _judge_ssp(args) -> int:
+    """`judge RESULT --ssp` or `judge --calls LOG --ssp`: what a master did with ClosedLoop.ssp."""
+    if (args.result is None) == (args.calls is None):
+        raise InvalidInput(
+            "judge --ssp reads the master's result CSV or the pendulum's call record, one of them: "
+            "pendulum-fmu judge RESULT.csv --ssp ClosedLoop.ssp [--map theta=COLUMN], or "
+            "pendulum-fmu judge --calls LOG --ssp ClosedLoop.ssp"
+        )
+    if args.calls is not None:
+        from .._ssp_calls import format_ssp_calls_verdict, judge_ssp_calls
+
+        calls_verdict = judge_ssp_calls(args.calls, args.ssp)
+        print(format_ssp_calls_verdict(calls_verdict))
+        return 0 if calls_verdict.passed else 1
+    from .._ssp_judge import format_ssp_verdict, judge_ssp_result
+
+    verdict = judge_ssp_result(args.result, args.ssp, mapping=args.mapping)
+    print(format_ssp_verdict(verdict))
+    return 0 if verdict.passed else 1
 
 
 def _judge_calls(args, signal) -> int:

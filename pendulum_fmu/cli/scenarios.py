@@ -29,7 +29,7 @@ def add_parser(commands) -> argparse.ArgumentParser:
         "--closed-loop",
         action="store_true",
         help="also write the pendulum under the PID controller as ClosedLoop.ssp, with its settings "
-        "(ClosedLoop.json) and a reference per coupling (ClosedLoop_ref.csv); needs a source checkout",
+        "(ClosedLoop.json) and a reference per coupling (ClosedLoop_ref.csv)",
     )
     add_fmu_argument(scenarios)
     scenarios.set_defaults(run=run)
