@@ -26,7 +26,7 @@ import pyarrow.parquet as pq
 from fsspec.implementations.local import LocalFileSystem
 
 from pendulum_fmu import default_fmu
-from pendulum_fmu._torque_schedule import communication_points
+from pendulum_fmu._time_grid import communication_points
 from pendulum_fmu.sweep.store import Store
 from pendulum_fmu.sweep.study import OUTPUTS
 from pendulum_fmu.sweep.worker import Task, _runner, run_chunk

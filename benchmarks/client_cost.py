@@ -1,5 +1,6 @@
-"""What the sweep's client costs per case at scale, as one paragraph for docs/sweeps.md (its
-TEMPLATE; tests/readme_figures.py holds the page to it):
+"""What the sweep's client costs per case at scale, as one paragraph for docs/sweeps.md.
+
+Its wording is TEMPLATE, to which tests/readme_figures.py holds the page:
 
     .venv/bin/python -m benchmarks.client_cost
 

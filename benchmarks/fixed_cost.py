@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import importlib.util
 
-from pendulum_fmu._simulate import open_fmu, run_schedule, simulate
+from pendulum_fmu._instance import open_fmu
+from pendulum_fmu._simulate import run_schedule, simulate
 from pendulum_fmu._torque_schedule import schedule
 
 from .builds import BuiltFmu

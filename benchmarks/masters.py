@@ -256,7 +256,8 @@ def main() -> int:
     import tempfile
 
     from pendulum_fmu._judge import judge
-    from pendulum_fmu._scenarios import read_settings, write_scenarios
+    from pendulum_fmu._scenario_settings import read_settings
+    from pendulum_fmu._scenarios import write_scenarios
 
     # residual: of the diagnosis (for integration error without a variant, the difference
     # itself); others: the smallest residual of every other candidate; both as fractions of

@@ -18,18 +18,18 @@ __version__ = "0.1.0"
 _LAZY = {
     # running the FMU
     "simulate": "_simulate",
-    "open_fmu": "_simulate",
-    "FmuError": "_simulate",
+    "open_fmu": "_instance",
+    "FmuError": "_instance",
     "fmu_model": "_model",
     "FmuModel": "_model",
-    "FmuInstance": "_model",
+    "FmuInstance": "_instance",
     "FmuFileError": "_model",
     "total_inertia": "_parameters",
     # torque signals
     "schedule": "_torque_schedule",
     "TorqueSchedule": "_torque_schedule",
     "write_torque_csv": "_torque_schedule",
-    "TorqueFileError": "_torque_schedule",
+    "TorqueFileError": "_torque_csv",
     # references and comparisons
     "reference": "_reference",
     "reference_schedule": "_reference",
@@ -42,9 +42,9 @@ _LAZY = {
     "judge": "_judge",
     "judge_kit": "_judge",
     "Judgement": "_judge",
-    "ResultFileError": "_judge",
+    "ResultFileError": "_result_file",
     "write_scenarios": "_scenarios",
-    "read_settings": "_scenarios",
+    "read_settings": "_scenario_settings",
     # sweeps
     "run_sweep": "sweep",
     "sweep_grid": "sweep",

@@ -20,9 +20,10 @@ import numpy as np
 
 from . import __version__
 from ._atomic_files import check_writable, replacing, replacing_path
-from ._parameters import fmu_file, model_description, pendulum_variables
+from ._model import fmu_file
+from ._parameters import model_description, pendulum_variables
 from ._simulate import simulate
-from ._torque_schedule import TorqueTable
+from ._torque_csv import TorqueTable
 
 START_TIME, STOP_TIME, STEP_SIZE, RELATIVE_TOLERANCE = 0.0, 4.0, 1e-3, 1e-10
 # The torque in N.m from the start, then (time of a jump, torque after it).

@@ -6,12 +6,12 @@ that line (exit 2); anything else is a bug of ours, reported as an internal erro
 derives from the built-in exception a Python caller would expect (ValueError for a bad value,
 OSError for a file, ...). The kinds that belong to one module live there:
 
-    torque_schedule.TorqueFileError   a torque CSV that is not a signal
-    simulate.FmuError                 an FMI call failed or the FMU refused a value
+    torque_csv.TorqueFileError        a torque CSV that is not a signal
+    instance.FmuError                 an FMI call failed or the FMU refused a value
     model.FmuFileError                a file given as an FMU that is none this package can run
     compare_tools.ToolSpecError       a --tools list that names no runnable tool
     mapped_fmu.MapError               a --map, or an FMU that does not fit it
-    judge.ResultFileError             a result file, or a kit's folder, that cannot be judged
+    result_file.ResultFileError       a result file, or a kit's folder, that cannot be judged
     scenarios.KitExists               an output folder holding a scenario kit the run was not asked to replace
     ssp.SspExists                     an SSP the export was not asked to replace
     ssp.SspFileError                  a file given as the closed loop's SSP that is not one

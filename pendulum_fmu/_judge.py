@@ -29,7 +29,6 @@ explains the result leaves only rounding and solver noise (about 1e-11 rad). The
 
 from __future__ import annotations
 
-import csv
 import json
 import math
 from dataclasses import dataclass, field
@@ -37,65 +36,17 @@ from pathlib import Path
 
 import numpy as np
 
-from . import _results as results
 from ._atomic_files import replacing
+from ._diagnoses import AGREES, INPUT_TIMING, Run, candidate_variants, diagnose
 from ._errors import InvalidInput
-from ._mapped_fmu import as_map
-from ._parameters import variables
-from ._reference import equation_of_motion, reference, reference_schedule
+from ._model import FmuModel, fmu_model
+from ._reference import reference
 from ._regression_tools import format_verdicts, regression_verdicts
-from ._scenarios import JUDGE_TOLERANCE as DEFAULT_TOLERANCE, read_settings, settings_files
+from ._result_file import OPTIONAL, ResultFileError, read_result
+from ._scenario_settings import JUDGE_TOLERANCE as DEFAULT_TOLERANCE, read_settings, settings_files
 from ._simulate import resolve_parameters
-from ._torque_schedule import TorqueSchedule, TorqueTable, event_tolerance, read_torque_csv, schedule
-
-AGREES = "agrees"
-LATE, EARLY = "input one step late", "input one step early"
-INTERPOLATED, HELD = "input interpolated linearly", "input held"
-DRIFT, NOT_RESTORED = "time grid drift", "state not restored"
-INTEGRATION, UNEXPLAINED = "integration error", "unexplained"
-DIAGNOSES = (AGREES, LATE, EARLY, INTERPOLATED, HELD, DRIFT, NOT_RESTORED, INTEGRATION, UNEXPLAINED)
-# The mistakes in how the input reaches the FMU: a solver's error must be small beside them.
-INPUT_TIMING = (LATE, EARLY, INTERPOLATED, HELD, DRIFT)
-
-# A candidate explains a result when its variant removes nearly all of the difference: its
-# residual is at most EXPLAINS of the raw difference, or below the noise floor of the comparison
-# (NOISE of the tolerance; a correct run leaves 1e-11 rad against the reference). A variant that
-# removes only part of it merely resembles the mistake made: explicit Euler lags like an input half
-# a step late, and with gravity off semi-implicit Euler is close to an input ramped over each step.
-# Measured on the deliberately wrong masters of tests/test_judge.py: the mistake made leaves at most
-# 1.2e-8 of the raw difference; the closest other candidate 3.3e-4 of it (semi-implicit Euler
-# against a ramped input, gravity off), the others 0.37 or more. 1e-5 sits between 1.2e-8 and
-# 3.3e-4, and the smallest residual decides among candidates under it.
-EXPLAINS = 1e-5
-NOISE = 0.1
-# A difference no candidate explains is an integration error when it grows as a solver's does:
-# no larger than explicit Euler's at the communication step (the crudest solver a master would
-# use), and at most INTEGRATION_SMALL of the smallest difference any input-timing mistake makes in
-# this run, so that no such mistake hides in it. Measured: Heun's method at the communication step
-# (second order) is 3.2e-3 and 6.4e-3 of the input-timing effects; an input late at one jump only
-# (no candidate of its own) 0.38. 0.05 sits between, about a decade from either.
-INTEGRATION_SMALL = 0.05
-RESULT_QUANTITIES = ("time", "theta", "omega", "alpha")
-OPTIONAL = ("omega", "alpha")
-
-
-class ResultFileError(InvalidInput):
-    r"""A result file, or a kit's folder, that cannot be judged; the message names the file, the
-    line and the problem.
-
-    Examples
-    --------
-    >>> import tempfile
-    >>> from pathlib import Path
-    >>> from pendulum_fmu import ResultFileError, judge
-    >>> result = Path(tempfile.mkdtemp(), "result.csv")
-    >>> _ = result.write_text("time,theta\n0,0\n0.5,x\n")
-    >>> try:
-    ...     judge(result, 20.0, stop_time=1.0)
-    ... except ResultFileError as error:
-    ...     print(str(error).replace(str(result), "result.csv"))
-    result.csv:3: theta 'x' is not a number
-    """
+from ._time_grid import event_tolerance
+from ._torque_schedule import TorqueSchedule, schedule
 
 
 @dataclass
@@ -164,7 +115,7 @@ class Judgement:
         """What --json writes: plain numbers, rad and s."""
         worst = {}
         for name in OPTIONAL:
-            given = self.result[name] if name in self.result.dtype.names else np.nan
+            given = self.result[name] if name in (self.result.dtype.names or ()) else np.nan
             if np.all(np.isfinite(given)):
                 worst[f"max_abs_d{name}"] = float(np.max(np.abs(given - self.reference[name])))
         return {
@@ -191,80 +142,6 @@ class Judgement:
                 "smallest_input_effect": "rad",
             },
         }
-
-
-def read_result(path: str | Path, mapping: str | dict | None = None) -> np.ndarray:
-    """A result CSV as a result array (_results.py); omega and alpha are NaN where it has none.
-
-    Parameters
-    ----------
-    path : str or Path
-        A CSV with a header: a time column and theta, optionally omega and alpha.
-    mapping : str or dict, optional
-        Their names and unit factors, as --map gives them: "time=t,theta=phi*0.0174532925".
-
-    Returns
-    -------
-    numpy.ndarray
-        Fields time (s), torque (NaN: not judged), theta (rad), omega (rad/s), alpha (rad/s2).
-
-    Raises
-    ------
-    ResultFileError
-        One line naming the file, the line and the problem: no time column, a mapped column
-        missing, a cell that is not a finite number, times that go backwards, no rows.
-    """
-    path = Path(path)
-    mapped = as_map(mapping, RESULT_QUANTITIES)
-    try:
-        with open(path, newline="", encoding="utf-8-sig") as file:
-            rows = list(csv.reader(file))
-    except OSError as error:
-        raise ResultFileError(f"{path}: cannot read: {error.strerror}") from None
-    except UnicodeDecodeError:
-        raise ResultFileError(f"{path}: not UTF-8 text; save the result as a UTF-8 CSV") from None
-    numbered = [(number, row) for number, row in enumerate(rows, start=1) if any(c.strip() for c in row)]
-    if not numbered:
-        raise ResultFileError(f"{path}: the file is empty; expected a header such as time,theta")
-    header = [cell.strip() for cell in numbered[0][1]]
-    columns = {}
-    for quantity in RESULT_QUANTITIES:
-        given = mapped.get(quantity)
-        name = given.variable if given else quantity
-        if name in header:
-            columns[quantity] = (header.index(name), given.factor if given else 1.0)
-        elif given:
-            raise ResultFileError(
-                f"{path}:1: no column {name!r}, which --map names for {quantity} (header is {','.join(header)})"
-            )
-        elif quantity not in OPTIONAL:
-            raise ResultFileError(
-                f"{path}:1: no column {quantity!r} (header is {','.join(header)}); "
-                f"name the result's {quantity} column with --map {quantity}=NAME"
-            )
-    data = numbered[1:]
-    if not data:
-        raise ResultFileError(f"{path}: no data rows after the header")
-    out = results.empty(len(data))
-    out["torque"] = np.nan
-    for quantity in OPTIONAL:
-        out[quantity] = np.nan
-    for i, (number, row) in enumerate(data):
-        for quantity, (column, factor) in columns.items():
-            cell = row[column].strip() if column < len(row) else ""
-            try:
-                value = float(cell)
-            except ValueError:
-                raise ResultFileError(f"{path}:{number}: {quantity} {cell!r} is not a number") from None
-            if not math.isfinite(value):
-                raise ResultFileError(f"{path}:{number}: {quantity} is {cell}; values must be finite")
-            out[quantity][i] = value * factor
-        if i and out["time"][i] < out["time"][i - 1]:
-            raise ResultFileError(
-                f"{path}:{number}: time {out['time'][i]:.17g} goes backwards (previous "
-                f"row: {out['time'][i - 1]:.17g}); a result's times must not decrease"
-            )
-    return out
 
 
 def _check_span(result: np.ndarray, plan: TorqueSchedule, step_size: float, source: str) -> None:
@@ -300,190 +177,6 @@ def _check_span(result: np.ndarray, plan: TorqueSchedule, step_size: float, sour
         )
 
 
-def _plan_index(plan: TorqueSchedule, times: np.ndarray, step_size: float) -> np.ndarray | None:
-    """For each time, the index of the communication point it is; None when one is off them."""
-    index = np.clip(np.searchsorted(plan.time, times), 1, len(plan.time) - 1)
-    index = np.where(np.abs(plan.time[index] - times) < np.abs(plan.time[index - 1] - times), index, index - 1)
-    on_grid = np.abs(plan.time[index] - times) <= event_tolerance(times, step_size)
-    return index if np.all(on_grid) else None
-
-
-def _changed(plan: TorqueSchedule, torque: np.ndarray, rate: np.ndarray | None = None) -> TorqueSchedule:
-    return TorqueSchedule(time=plan.time, torque=torque, torque_rate=plan.torque_rate if rate is None else rate)
-
-
-def _late(plan: TorqueSchedule, start_torque: float) -> list[TorqueSchedule]:
-    """Step k holds what step k-1 should; the first step the signal's first value or the FMU's
-    start value (whatever the master set before it began).
-    """
-    variants = []
-    for first in dict.fromkeys((float(plan.torque[0]), start_torque)):
-        first_rate = plan.torque_rate[0] if first == plan.torque[0] else 0.0
-        variants.append(_changed(plan, np.r_[first, plan.torque[:-1]], np.r_[first_rate, plan.torque_rate[:-1]]))
-    return variants
-
-
-def _early(plan: TorqueSchedule) -> list[TorqueSchedule]:
-    return [_changed(plan, np.r_[plan.torque[1:], plan.torque[-1]], np.r_[plan.torque_rate[1:], 0.0])]
-
-
-def _interpolated(plan: TorqueSchedule) -> list[TorqueSchedule]:
-    """Each step ramps from its value to the next step's; the last one holds."""
-    return [_changed(plan, plan.torque, np.r_[np.diff(plan.torque) / plan.step_size[:-1], 0.0])]
-
-
-def _signal_values(torque, times: np.ndarray, side: str) -> np.ndarray | None:
-    """The signal just after (side "after") or before each time, sampled as a master would,
-    without the definition's snapping of events onto communication points; None for a per-step
-    array, which has no value between its steps.
-    """
-    if isinstance(torque, (str, Path)):
-        torque = read_torque_csv(torque)
-    if isinstance(torque, TorqueTable):
-        return torque.value_after(times) if side == "after" else torque.value_before(times)
-    if callable(torque):
-        return np.array([float(torque(t)) for t in times.tolist()])
-    if isinstance(torque, (list, tuple, np.ndarray)):
-        return None
-    return np.full(len(times), float(torque))
-
-
-def _drifted(torque, times: np.ndarray, ramp: bool) -> list[TorqueSchedule]:
-    """The master's steps are the result's own times; each samples the signal at its start."""
-    points = np.unique(times)
-    start = _signal_values(torque, points[:-1], "after")
-    if start is None or len(points) < 2:
-        return []
-    rate = (_signal_values(torque, points[1:], "before") - start) / np.diff(points) if ramp else np.zeros(len(start))
-    return [TorqueSchedule(time=points, torque=start, torque_rate=rate)]
-
-
-def _euler(plan: TorqueSchedule, acceleration, theta0: float, omega0: float, semi_implicit: bool) -> np.ndarray:
-    """The equation of motion stepped once per communication step, holding each step's start
-    torque: explicit Euler, or semi-implicit (the new omega moves theta).
-    """
-    out = results.empty(len(plan.time))
-    out["time"] = plan.time
-    theta, omega = theta0, omega0
-    for k, (h, u) in enumerate(zip(plan.step_size.tolist(), plan.torque.tolist(), strict=False)):
-        out["theta"][k], out["omega"][k] = theta, omega
-        alpha = acceleration(theta, omega, u)
-        if semi_implicit:
-            omega += h * alpha
-            theta += h * omega
-        else:
-            theta, omega = theta + h * omega, omega + h * alpha
-    out["theta"][-1], out["omega"][-1] = theta, omega
-    out["torque"][:-1], out["torque"][-1] = plan.torque, plan.torque[-1]
-    return out
-
-
-@dataclass
-class _Run:
-    """What every variant of one run needs."""
-
-    plan: TorqueSchedule
-    times: np.ndarray
-    step_size: float
-    parameters: dict
-    theta0: float
-    omega0: float
-    fmu_path: str | Path | None
-
-    def integrate(self, plan: TorqueSchedule, at: np.ndarray | None = None) -> np.ndarray:
-        """The schedule from the run's initial state, exactly, at the result's times (or at)."""
-        return reference_schedule(
-            plan,
-            parameters=self.parameters,
-            theta0=self.theta0,
-            omega0=self.omega0,
-            at=self.times if at is None else at,
-            fmu_path=self.fmu_path,
-        )
-
-
-def _not_restored(run: _Run, correct: np.ndarray, first_wrong: int) -> list[np.ndarray]:
-    """Up to a point the reference; from there the run restarts from its initial state, as a
-    resumed run that did not restore its saved FMU state. The restart is where the first row that
-    disagrees is (it shows the initial state), or the row before it (it shows the old instance's
-    state, the next row the new one's).
-    """
-    variants = []
-    for restart_row in (first_wrong, first_wrong - 1):
-        if restart_row < 1:  # a restart at the very start is no restart
-            continue
-        restart = run.times[restart_row]
-        k = int(np.argmin(np.abs(run.plan.time - restart)))
-        off = abs(run.plan.time[k] - restart) > event_tolerance(restart, run.step_size)
-        if off or k + 1 >= len(run.plan.time):
-            continue
-        tail = TorqueSchedule(time=run.plan.time[k:], torque=run.plan.torque[k:], torque_rate=run.plan.torque_rate[k:])
-        variant = correct.copy()
-        variant[first_wrong:] = run.integrate(tail, at=run.times[first_wrong:])
-        variants.append(variant)
-    return variants
-
-
-def _integration(run: _Run) -> list[np.ndarray]:
-    index = _plan_index(run.plan, run.times, run.step_size)
-    if index is None:
-        return []
-    acceleration = equation_of_motion(run.parameters)
-    return [_euler(run.plan, acceleration, run.theta0, run.omega0, semi)[index] for semi in (False, True)]
-
-
-def _candidates(
-    run: _Run,
-    torque,
-    held: TorqueSchedule | None,
-    correct: np.ndarray,
-    result: np.ndarray,
-    tolerance: float,
-    start_torque: float,
-) -> dict[str, list[np.ndarray]]:
-    """{candidate: its variants at the result's times}; an empty list where it does not apply.
-    held: for a ramp run, the same signal held over each step (schedule without ramp).
-    """
-    plan, ramp = run.plan, held is not None
-    off_grid = _plan_index(plan, run.times, run.step_size) is None
-    wrong = np.flatnonzero(np.abs(result["theta"] - correct["theta"]) > tolerance)
-    return {
-        LATE: [run.integrate(p) for p in _late(plan, start_torque)],
-        EARLY: [run.integrate(p) for p in _early(plan)],
-        INTERPOLATED: [] if ramp else [run.integrate(p) for p in _interpolated(plan)],
-        HELD: [run.integrate(held)] if ramp else [],
-        DRIFT: [run.integrate(p) for p in _drifted(torque, run.times, ramp)] if off_grid else [],
-        NOT_RESTORED: _not_restored(run, correct, int(wrong[0])) if len(wrong) else [],
-        INTEGRATION: _integration(run),
-    }
-
-
-def _diagnose(
-    raw: float, tolerance: float, scores: dict[str, dict | None], smallest_input_effect: float | None
-) -> tuple[str, float]:
-    """The candidate that explains the difference, or integration error, or unexplained."""
-    applicable = {name: score for name, score in scores.items() if score is not None}
-    best = min(applicable, key=lambda name: applicable[name]["residual"], default=None)
-    if best is not None and applicable[best]["residual"] <= max(EXPLAINS * raw, NOISE * tolerance):
-        # Variants the same to the noise are the same run: from rest at an equilibrium, a first step
-        # without torque and a restart from the initial state after it cannot be told apart. The
-        # earlier in DIAGNOSES, the commoner mistake, names it.
-        tied = [
-            name
-            for name in DIAGNOSES
-            if name in applicable and applicable[name]["residual"] <= applicable[best]["residual"] + NOISE * tolerance
-        ]
-        return tied[0], applicable[tied[0]]["residual"]
-    euler = applicable.get(INTEGRATION)
-    if (
-        euler is not None
-        and raw <= euler["effect"]
-        and (smallest_input_effect is None or raw <= INTEGRATION_SMALL * smallest_input_effect)
-    ):
-        return INTEGRATION, raw
-    return UNEXPLAINED, applicable[best]["residual"] if best is not None else raw
-
-
 def judge(
     result,
     torque,
@@ -497,7 +190,7 @@ def judge(
     omega0: float = 0.0,
     tolerance: float | None = None,
     mapping: str | dict | None = None,
-    fmu_path: str | Path | None = None,
+    fmu_path: str | Path | FmuModel | None = None,
     max_steps: int | None = None,
 ) -> Judgement:
     """Judge a result from any tool against the independent reference, and diagnose a failure.
@@ -510,7 +203,8 @@ def judge(
         The run's signal, as simulate() takes it: a constant (N.m), a callable of time or a
         time,torque CSV (docs/signals.md).
     start_time, stop_time, step_size, ramp, parameters, theta0, omega0, max_steps, fmu_path
-        The run's definition, as simulate() takes it.
+        The run's definition, as simulate() takes it; fmu_path may also be the FMU's model
+        (fmu_model), looked up once here and passed to everything the judgement runs.
     tolerance : float, optional
         The largest ``|dtheta|`` (rad) that passes (default: DEFAULT_TOLERANCE, 1e-9 rad).
     mapping : str or dict, optional
@@ -554,7 +248,8 @@ def judge(
             "a map renames and scales a result file's columns: an array result is "
             "judged as it is, in the fields time and theta (rad); leave out mapping"
         )
-    parameters = resolve_parameters(parameters, fmu_path)
+    model = fmu_model(fmu_path)
+    parameters = resolve_parameters(parameters, model)
     plan = schedule(
         torque, start_time=start_time, stop_time=stop_time, step_size=step_size, ramp=ramp, max_steps=max_steps
     )
@@ -570,16 +265,18 @@ def judge(
         theta0=theta0,
         omega0=omega0,
         at=times,
-        fmu_path=fmu_path,
+        fmu_path=model,
     )
     difference = np.abs(result["theta"] - correct["theta"])
     raw = float(np.max(difference))
     worst_time = float(times[int(np.argmax(difference))])
-    run = _Run(plan, times, step_size, parameters, theta0, omega0, fmu_path)
-    start_torque = float(variables(fmu_path)["torque"].start or 0.0)
+    run = Run(plan, times, step_size, parameters, theta0, omega0, model)
+    start_torque = float(model.variables["torque"].start or 0.0)
     held = schedule(torque, start_time=start_time, stop_time=stop_time, step_size=step_size) if ramp else None
-    variants = _candidates(run, torque, held, correct, result, tolerance, start_torque)
-    scores, best_variant, timing_effects = {}, {}, []
+    variants = candidate_variants(run, torque, held, correct, result, tolerance, start_torque)
+    scores: dict[str, dict | None] = {}
+    best_variant: dict[str, np.ndarray] = {}
+    timing_effects: list[float] = []
     for name, made in variants.items():
         if not made:
             scores[name] = None
@@ -595,7 +292,7 @@ def judge(
     if raw <= tolerance:
         diagnosis, residual = AGREES, raw
     else:
-        diagnosis, residual = _diagnose(raw, tolerance, scores, smallest_input_effect)
+        diagnosis, residual = diagnose(raw, tolerance, scores, smallest_input_effect)
     return Judgement(
         verdict="pass" if raw <= tolerance else "fail",
         diagnosis=diagnosis,
@@ -681,7 +378,7 @@ def judge_kit(
     *,
     tolerance: float | None = None,
     mapping: str | None = None,
-    fmu_path: str | Path | None = None,
+    fmu_path: str | Path | FmuModel | None = None,
 ) -> dict[str, Judgement | None]:
     """Judge every NAME_out.csv beside the settings NAME.json of a scenario kit (_scenarios.py).
 
@@ -725,7 +422,8 @@ def judge_kit(
             f"{folder}: no scenario settings (NAME.json) in this folder; write a kit "
             "with pendulum-fmu scenarios --output-dir FOLDER"
         )
-    verdicts = {}
+    model = None  # the FMU's model, looked up once, for the first result there is
+    verdicts: dict[str, Judgement | None] = {}
     for name, settings_path in found.items():
         settings = read_settings(settings_path)
         output = folder / settings.pop("output")
@@ -734,7 +432,8 @@ def judge_kit(
             continue
         if tolerance is not None:
             settings["tolerance"] = tolerance
-        verdicts[name] = judge(output, mapping=mapping, fmu_path=fmu_path, **settings)
+        model = model or fmu_model(fmu_path)
+        verdicts[name] = judge(output, mapping=mapping, fmu_path=model, **settings)
     if all(v is None for v in verdicts.values()):
         raise ResultFileError(
             f"{folder}: no result to judge: run each scenario and write NAME_out.csv "
@@ -770,14 +469,4 @@ def write_json(verdicts: dict[str, Judgement | None] | Judgement, path: str | Pa
     return Path(path)
 
 
-__all__ = [
-    "DIAGNOSES",
-    "Judgement",
-    "ResultFileError",
-    "format_judgement",
-    "format_kit",
-    "judge",
-    "judge_kit",
-    "read_result",
-    "write_json",
-]
+__all__ = ["Judgement", "format_judgement", "format_kit", "judge", "judge_kit", "write_json"]

@@ -31,9 +31,10 @@ from fmpy.fmi2 import FMU2Slave
 from fmpy.fmi3 import FMU3Slave
 
 from ._errors import InvalidInput, WrongType
-from ._model import fmu_model
-from ._parameters import START_VALUES, FmuFileError, default_parameters
-from ._simulate import FmuError, MessageLog, fmi2_library, instantiate, resolve_parameters
+from ._instance import FmuError, MessageLog, fmi2_library, instantiate
+from ._model import START_VALUES, FmuFileError, fmu_model
+from ._parameters import default_parameters
+from ._simulate import resolve_parameters
 from ._torque_schedule import TorqueSchedule
 from .engines import check_held, check_mode, held_results
 

@@ -167,11 +167,18 @@ class FmuModel:
         """
         return tuple(name for name, v in self.variables.items() if v.causality in ("input", "output"))
 
+    @cached_property
+    def value_references(self) -> dict[str, int]:
+        """{name: value reference} of every variable of a pendulum FMU, made once per model so a
+        run looks each one up in a dict; raises as pendulum_variables.
+        """
+        return {name: v.valueReference for name, v in self.pendulum_variables.items()}
+
     def value_reference(self, name: str) -> int:
         """The value reference of a pendulum variable; raises as pendulum_variables, KeyError
         for a name it does not have.
         """
-        return self.pendulum_variables[name].valueReference
+        return self.value_references[name]
 
     def unit(self, name: str) -> str:
         """The declared unit of a variable, parameter or start value (theta0: theta's), '' where
@@ -255,59 +262,3 @@ def fmu_model(fmu: str | os.PathLike | FmuModel | None = None) -> FmuModel:
     path = fmu_file(fmu)
     version = file_version(path)
     return _read(str(path.resolve()), version, str(path))
-
-
-class FmuInstance:
-    """One FMI instance of a model: fmpy's FMU2Slave or FMU3Slave, the log of what the FMU says,
-    and the model whose value references and parameters apply.
-
-    fmpy's calls (doStep, getReal, setFloat64, terminate, freeInstance, dll, component, ...) pass
-    through to the slave, so an instance is used as the slave would be.
-
-    Made by open_fmu(), which instantiates and initializes it.
-
-    Parameters
-    ----------
-    slave : fmpy.fmi2.FMU2Slave or fmpy.fmi3.FMU3Slave
-        Instantiated with messages as its logger.
-    messages : pendulum_fmu._simulate.MessageLog
-        Keeps what the FMU logs (and its logger callback alive as long as the instance).
-    model : FmuModel
-        The FMU the slave was made from.
-
-    Attributes
-    ----------
-    slave : fmpy.fmi2.FMU2Slave or fmpy.fmi3.FMU3Slave
-        fmpy's instance, which the calls pass through to.
-    messages : pendulum_fmu._simulate.MessageLog
-        What the FMU logged.
-    model : FmuModel
-        The FMU's model object: value references, parameters, outputs.
-    fmi_version : {2, 3}
-        The FMI standard of the FMU.
-    dll, component
-        fmpy's loaded library and the FMI component, as the native loop binds them.
-
-    Examples
-    --------
-    >>> from pendulum_fmu import open_fmu
-    >>> instance = open_fmu()
-    >>> type(instance).__name__, instance.fmi_version, instance.model.outputs
-    ('FmuInstance', 2, ('theta', 'omega', 'alpha'))
-    >>> instance.getReal([instance.model.value_reference("theta")])
-    [0.0]
-    >>> status = instance.terminate(); instance.freeInstance()
-    """
-
-    def __init__(self, slave, messages, model: FmuModel):
-        self.slave, self.messages, self.model = slave, messages, model
-        self.fmi_version = model.fmi_version  # 2 or 3
-        # Read on every run (the loops bind the FMI functions): plain attributes, not a pass-through.
-        self.dll, self.component = slave.dll, slave.component
-
-    def __getattr__(self, name: str):
-        # Only what the instance itself lacks: fmpy's calls and attributes (never the slave itself,
-        # which an instance not yet initialized, as when copied, lacks).
-        if name == "slave":
-            raise AttributeError(name)
-        return getattr(self.slave, name)

@@ -2,7 +2,7 @@
 
 It drives any FMI 2.0 co-simulation instance that fmpy instantiated, through the FMU's own
 exported FMI functions, for a whole case in one call: optionally a restart (fmi2Reset and
-initialization with new start values, as simulate.initialize does), then every step of a
+initialization with new start values, as _instance.initialize does), then every step of a
 schedule (fmi2SetReal, fmi2SetRealInputDerivatives, fmi2GetReal, fmi2DoStep), writing into the
 caller's numpy buffers; or a chunk of restarted cases in one call (Stepper.run_cases). `pip install` (or
 `pip install -e .` in a checkout) compiles it; without it `available()` is
@@ -159,7 +159,7 @@ class Stepper:
         time[0] with these start values and the relative tolerance, None for the FMU's own), or
         None when it is initialized already. A failing call raises the slave's MessageLog error,
         with the FMU's messages and the time of the failing step, or FmuError("initialization
-        failed: ...") as simulate.initialize does.
+        failed: ...") as _instance.initialize does.
         """
         steps = len(time) - 1
         if inputs is None and self.inputs:
@@ -254,7 +254,7 @@ class Stepper:
     def _error(self, status: int, time: np.ndarray) -> Exception:
         """The error of a run that failed with status: the slave's MessageLog error with the FMU's
         messages, the failing call and the time of its step, or FmuError("initialization failed:
-        ...") for a restart's call, as simulate.initialize raises.
+        ...") for a restart's call, as _instance.initialize raises.
         """
         call = self._failed_call.value
         if call >= _RESTART:

@@ -13,18 +13,7 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from ._errors import InvalidInput, WrongType
-
-# The names that lived here before the model object: re-exported, so that their imports still work.
-from ._model import (
-    FMI_VERSIONS as FMI_VERSIONS,
-    PENDULUM_VARIABLES as PENDULUM_VARIABLES,
-    START_VALUES as START_VALUES,
-    FmuFileError as FmuFileError,
-    FmuModel,
-    file_version as file_version,
-    fmu_file as fmu_file,
-    fmu_model,
-)
+from ._model import FmuModel, fmu_model
 
 Fmu = str | Path | FmuModel | None
 

@@ -422,7 +422,7 @@ def plot_calls(judged: dict, path: str | Path, title: str) -> Path:
     Parameters
     ----------
     judged : dict
-        As pendulum_fmu._calls.judge_calls returns it.
+        As pendulum_fmu._call_judge.judge_calls returns it.
     path : str or Path
         The figure's file.
     title : str

@@ -31,7 +31,9 @@ from . import _results as results
 from ._errors import InvalidInput, WrongType
 from ._parameters import Fmu, start_value, total_inertia
 from ._simulate import resolve_parameters
-from ._torque_schedule import TorqueSchedule, read_torque_csv, step_count
+from ._time_grid import step_count
+from ._torque_csv import read_torque_csv
+from ._torque_schedule import TorqueSchedule
 
 # docs/signals.md: an event within max(1e-9 step, 64 ulp of its time) of a communication point
 # is that point. Written again here on purpose: the oracle must not borrow the schedule's code.

@@ -35,22 +35,20 @@ documentation/fmi-ls-ref.txt, as the standard recommends. Where it departs:
 from __future__ import annotations
 
 import json
-import math
 import os
 import shutil
 import uuid
 import zipfile
-from dataclasses import dataclass, field
 from pathlib import Path
 from xml.etree import ElementTree
-
-import numpy as np
 
 from . import __version__, _results as results
 from ._atomic_files import check_writable, make_folder, replacing, replacing_path
 from ._errors import InvalidInput, PendulumFmuError
-from ._parameters import START_VALUES, fmu_file, model_description
+from ._model import START_VALUES, FmuModel, fmu_model
 from ._reference import reference
+from ._scenario_list import SCENARIOS, Scenario
+from ._scenario_settings import KIT_FMU, RELATIVE_TOLERANCE, scenario_settings
 from ._simulate import resolve_parameters
 from ._stop_signals import signals_deferred
 
@@ -61,306 +59,10 @@ LS_REF_DOCUMENTATION = "documentation/fmi-ls-ref.txt"
 EXPERIMENTS_FILE = "scenarios.exp"
 EXPERIMENTS_TYPE = "application/x-ma-hs-experiments"
 SSV_NAMESPACE = "http://ssp-standard.org/SSP1/SystemStructureParameterValues"
-# The tolerance the kit's FMU is run at (its own default); the judge's, in rad.
-RELATIVE_TOLERANCE, JUDGE_TOLERANCE = 1e-10, 1e-9
-KIT_FMU = "Pendulum.fmu"
-
-
-@dataclass(frozen=True)
-class Scenario:
-    """One run of the kit: its torque rows (s, N.m) and the rest of its definition."""
-
-    name: str
-    description: str
-    rows: tuple[tuple[float, float], ...]
-    stop_time: float
-    step_size: float
-    parameters: dict = field(default_factory=dict)  # overrides of the FMU's defaults
-    theta0: float = 0.0
-    omega0: float = 0.0
-    ramp: bool = False
-    resume_time: float | None = None
-    start_time: float = 0.0
-
-
-def _random_steps(seed: int, stop_time: float, amplitude: float) -> tuple[tuple[float, float], ...]:
-    """Levels in -amplitude..amplitude N.m (to the mN.m), jumping at random times on the ms grid
-    50 to 400 ms apart.
-    """
-    rng = np.random.default_rng(seed)
-    jumps_ms = np.cumsum(rng.integers(50, 400, size=int(stop_time * 20) + 1))
-    jumps = [int(ms) / 1000 for ms in jumps_ms if ms < stop_time * 1000]
-    levels = [round(float(level), 3) for level in rng.uniform(-amplitude, amplitude, len(jumps) + 1)]
-    rows = [(0.0, levels[0])]
-    for t, before, after in zip(jumps, levels, levels[1:], strict=False):
-        rows += [(t, before), (t, after)]
-    return tuple([*rows, (stop_time, levels[-1])])
-
-
-SCENARIOS = (
-    Scenario(
-        "constant_torque",
-        "The OpenSim tutorial's case: 20 N.m from rest, gravity on, 3 s in 1 ms steps.",
-        ((0.0, 20.0), (3.0, 20.0)),
-        stop_time=3.0,
-        step_size=1e-3,
-    ),
-    Scenario(
-        "steps_on_grid",
-        "Jumps on communication points (0, 40 N.m from 0.5 s, -40 from 1.5 s, 10 "
-        "from 2.5 s), gravity off so theta is a parabola between jumps, from theta = 0.2 rad and "
-        "omega = -0.5 rad/s; 1 ms steps. At a jump, the step that starts there holds the value "
-        "after it.",
-        ((0.0, 0.0), (0.5, 0.0), (0.5, 40.0), (1.5, 40.0), (1.5, -40.0), (2.5, -40.0), (2.5, 10.0), (3.0, 10.0)),
-        stop_time=3.0,
-        step_size=1e-3,
-        parameters={"gravity": 0.0},
-        theta0=0.2,
-        omega0=-0.5,
-    ),
-    Scenario(
-        "random_steps",
-        "A random level in -40..40 N.m, jumping every 50 to 400 ms on the ms grid, "
-        "4 s in 1 ms steps, with damping 0.5 N.m.s/rad, from theta = 0.3 rad and omega = -0.5 "
-        "rad/s.",
-        _random_steps(25, 4.0, 40.0),
-        stop_time=4.0,
-        step_size=1e-3,
-        parameters={"damping": 0.5},
-        theta0=0.3,
-        omega0=-0.5,
-    ),
-    Scenario(
-        "decimal_steps",
-        "9 ms steps with jumps at 0.027, 0.333 and 0.45 s: decimals that are no "
-        "binary fractions (3 x 0.009 is 0.026999999999999996 in binary), so a master that "
-        "compares times for equality or sums its steps misses them; 0.9 s.",
-        (
-            (0.0, 10.0),
-            (0.027, 10.0),
-            (0.027, -20.0),
-            (0.333, -20.0),
-            (0.333, 30.0),
-            (0.45, 30.0),
-            (0.45, 5.0),
-            (0.9, 5.0),
-        ),
-        stop_time=0.9,
-        step_size=0.009,
-    ),
-    Scenario(
-        "ramp",
-        "The torque is the CSV's own line, kinks on communication points: each 10 ms step "
-        "ramps, so a master sends the slope with fmi2SetRealInputDerivatives (order 1) before "
-        "each fmi2DoStep; 3 s.",
-        ((0.0, 0.0), (0.5, 40.0), (1.5, -40.0), (2.5, 20.0), (3.0, 20.0)),
-        stop_time=3.0,
-        step_size=0.01,
-        ramp=True,
-    ),
-    Scenario(
-        "resume",
-        "Stopped at 1.5 s and resumed through a saved FMU state: take the state there "
-        "(fmi2GetFMUstate, and fmi2SerializeFMUstate to keep it), free the instance, restore the "
-        "state into a new one (fmi2DeSerializeFMUstate, fmi2SetFMUstate) and go on to 3 s, setting "
-        "the torque again: it jumps from 20 to -20 N.m at 1.5 s. From theta = -0.2 rad and omega = 1 "
-        "rad/s, 1 ms steps. The result equals an uninterrupted run.",
-        ((0.0, 20.0), (1.5, 20.0), (1.5, -20.0), (3.0, -20.0)),
-        stop_time=3.0,
-        step_size=1e-3,
-        theta0=-0.2,
-        omega0=1.0,
-        resume_time=1.5,
-    ),
-)
 
 
 def _csv_text(header: tuple[str, ...], rows) -> str:
     return ",".join(header) + "\n" + "".join(",".join(repr(float(v)) for v in row) + "\n" for row in rows)
-
-
-def _settings(scenario: Scenario, parameters: dict) -> dict:
-    name = scenario.name
-    return {
-        "name": name,
-        "description": scenario.description,
-        "fmu": KIT_FMU,
-        "input": f"{name}_in.csv",
-        "reference": f"{name}_ref.csv",
-        "output": f"{name}_out.csv",
-        "start_time": scenario.start_time,
-        "stop_time": scenario.stop_time,
-        "step_size": scenario.step_size,
-        "ramp": scenario.ramp,
-        "resume_time": scenario.resume_time,
-        "parameters": parameters,
-        "theta0": scenario.theta0,
-        "omega0": scenario.omega0,
-        "relative_tolerance": RELATIVE_TOLERANCE,
-        "tolerance": JUDGE_TOLERANCE,
-        "units": {**results.UNITS, "step_size": "s", "tolerance": "rad"},
-    }
-
-
-def read_settings(path: str | Path) -> dict:
-    """A scenario's settings as judge()'s keyword arguments.
-
-    Parameters
-    ----------
-    path : str or Path
-        The scenario's NAME.json.
-
-    Returns
-    -------
-    dict
-        torque (the input's path), start_time, stop_time, step_size, ramp, parameters, theta0,
-        omega0, tolerance; and output, the name of the result file a master writes.
-
-    Raises
-    ------
-    InvalidInput
-        One line naming the file and what is wrong with it: not JSON, not an object, a field
-        missing, or a field of the wrong type or out of its range (a time that is not a finite
-        number, a step size or tolerance that is not positive, stop_time not after start_time).
-
-    Examples
-    --------
-    A kit's first scenario; ``judge(result, **settings)`` (without output) judges a master's
-    result of it:
-
-    >>> import tempfile
-    >>> from pendulum_fmu import read_settings, write_scenarios
-    >>> kit = write_scenarios(tempfile.mkdtemp())
-    >>> settings = read_settings(next(path for path in kit if path.name == "constant_torque.json"))
-    >>> settings["torque"].name, settings["output"], settings["stop_time"], settings["step_size"]
-    ('constant_torque_in.csv', 'constant_torque_out.csv', 3.0, 0.001)
-    """
-    path = Path(path)
-    try:
-        settings = json.loads(path.read_text(encoding="utf-8"))
-    except (json.JSONDecodeError, UnicodeDecodeError) as error:
-        raise InvalidInput(f"{path}: not a scenario's settings: {error}") from None
-    except OSError as error:
-        raise InvalidInput(f"{path}: cannot read: {error.strerror}") from None
-    if not isinstance(settings, dict):
-        raise InvalidInput(
-            f"{path}: not a scenario's settings: it holds a JSON {_json_kind(settings)}, not an object; {_AGAIN}"
-        )
-    missing = [key for key in SETTINGS_READ if key not in settings]
-    if missing:
-        raise InvalidInput(f"{path}: not a scenario's settings: no {', '.join(map(repr, missing))}; {_AGAIN}")
-    field = _FieldChecker(path, settings)
-    start_time = field.number("start_time", "s")
-    stop_time = field.number("stop_time", "s")
-    if not stop_time > start_time:
-        raise InvalidInput(
-            f"{path}: stop_time {stop_time!r} is not after start_time {start_time!r}; correct it, or {_AGAIN}"
-        )
-    return {
-        "torque": path.parent / field.file_name("input"),
-        "output": field.file_name("output"),
-        "start_time": start_time,
-        "stop_time": stop_time,
-        "step_size": field.number("step_size", "s", positive=True),
-        "ramp": field.boolean("ramp"),
-        "parameters": field.parameters("parameters"),
-        "theta0": field.number("theta0", "rad"),
-        "omega0": field.number("omega0", "rad/s"),
-        "tolerance": field.number("tolerance", "rad", positive=True),
-    }
-
-
-# The fields read_settings takes from NAME.json.
-SETTINGS_READ = (
-    "input",
-    "output",
-    "start_time",
-    "stop_time",
-    "step_size",
-    "ramp",
-    "parameters",
-    "theta0",
-    "omega0",
-    "tolerance",
-)
-_AGAIN = "write the kit again with pendulum-fmu scenarios --output-dir FOLDER --overwrite"
-
-
-def _json_kind(value) -> str:
-    """What a value is called in JSON, for messages about a hand-edited file."""
-    if value is None:
-        return "null"
-    if isinstance(value, bool):
-        return "boolean"
-    if isinstance(value, (int, float)):
-        return "number"
-    return {str: "string", list: "array", dict: "object"}.get(type(value), type(value).__name__)
-
-
-@dataclass(frozen=True)
-class _FieldChecker:
-    """The checks of NAME.json's fields: a hand-edited value of the wrong type or out of range is
-    refused naming the file and the field, before it can reach the judge's arithmetic.
-    """
-
-    path: Path
-    settings: dict
-
-    def _refuse(self, key: str, what: str):
-        value = json.dumps(self.settings[key])
-        raise InvalidInput(f"{self.path}: {key} is {value}; it must be {what}: correct it, or {_AGAIN}")
-
-    def number(self, key: str, unit: str, positive: bool = False) -> float:
-        value = self.settings[key]
-        # bool is an int in Python, but true is no time or angle.
-        if (
-            isinstance(value, bool)
-            or not isinstance(value, (int, float))
-            or not math.isfinite(value)
-            or (positive and value <= 0)
-        ):
-            self._refuse(key, f"{'a positive' if positive else 'a'} finite number ({unit})")
-        return float(value)
-
-    def boolean(self, key: str) -> bool:
-        if not isinstance(self.settings[key], bool):
-            self._refuse(key, "true or false")
-        return self.settings[key]
-
-    def file_name(self, key: str) -> str:
-        value = self.settings[key]
-        if not (isinstance(value, str) and value.strip()):
-            self._refuse(key, "a file name (a JSON string)")
-        return value
-
-    def parameters(self, key: str) -> dict[str, float]:
-        value = self.settings[key]
-        if not isinstance(value, dict):
-            self._refuse(key, "an object {name: value}")
-        for name, number in value.items():
-            if isinstance(number, bool) or not isinstance(number, (int, float)) or not math.isfinite(number):
-                raise InvalidInput(
-                    f"{self.path}: parameters: {name} is {json.dumps(number)}; it must be "
-                    f"a finite number: correct it, or {_AGAIN}"
-                )
-        return {name: float(number) for name, number in value.items()}
-
-
-def settings_files(folder: str | Path) -> dict[str, Path]:
-    """The scenarios in a folder: each NAME.json with a NAME_in.csv beside it.
-
-    Parameters
-    ----------
-    folder : str or Path
-        A kit's folder.
-
-    Returns
-    -------
-    dict
-        {scenario: its NAME.json}, by name.
-    """
-    folder = Path(folder)
-    return {path.stem: path for path in sorted(folder.glob("*.json")) if (folder / f"{path.stem}_in.csv").is_file()}
 
 
 def _ssv(scenario: Scenario, parameters: dict) -> bytes:
@@ -368,7 +70,10 @@ def _ssv(scenario: Scenario, parameters: dict) -> bytes:
     FMU's own variables, so the set applies as-is.
     """
     ElementTree.register_namespace("ssv", SSV_NAMESPACE)
-    tag = lambda name: f"{{{SSV_NAMESPACE}}}{name}"
+
+    def tag(name: str) -> str:
+        return f"{{{SSV_NAMESPACE}}}{name}"
+
     root = ElementTree.Element(tag("ParameterSet"), {"version": "1.0", "name": scenario.name})
     listed = ElementTree.SubElement(root, tag("Parameters"))
     values = {**parameters, START_VALUES["theta0"]: scenario.theta0, START_VALUES["omega0"]: scenario.omega0}
@@ -571,7 +276,9 @@ def _check_replaceable(folder: Path, overwrite: bool) -> None:
         )
 
 
-def write_scenarios(output_dir: str | Path, fmu_path: str | Path | None = None, overwrite: bool = False) -> list[Path]:
+def write_scenarios(
+    output_dir: str | Path, fmu_path: str | Path | FmuModel | None = None, overwrite: bool = False
+) -> list[Path]:
     """Write the scenario kit (see the module's docstring).
 
     The kit is written into a hidden folder inside output_dir and moved into place once whole, so
@@ -581,8 +288,9 @@ def write_scenarios(output_dir: str | Path, fmu_path: str | Path | None = None, 
     ----------
     output_dir : str or Path
         The kit's folder; results a user put there (NAME_out.csv) are left alone.
-    fmu_path : str or Path, optional
-        The FMI 2.0 FMU to carry and whose parameters apply (default: pendulum_fmu.default_fmu()).
+    fmu_path : str, Path or FmuModel, optional
+        The FMI 2.0 FMU to carry and whose parameters apply, or its model (default:
+        pendulum_fmu.default_fmu()).
     overwrite : bool, optional
         Replace the files of a kit the folder already holds (kit_files()); without it such a
         folder is refused. Other files in it are kept either way.
@@ -609,11 +317,11 @@ def write_scenarios(output_dir: str | Path, fmu_path: str | Path | None = None, 
     >>> sorted(path.name for path in written if path.name.startswith("ramp"))
     ['ramp.json', 'ramp_in.csv', 'ramp_ref.csv']
     """
-    fmu = fmu_file(fmu_path)
-    version = model_description(fmu).fmiVersion
+    model = fmu_model(fmu_path)
+    version = model.description.fmiVersion
     if version != "2.0":
         raise InvalidInput(
-            f"{fmu} is FMI {version}: the kit is for the FMI 2.0 FMU (its ramp scenario needs input derivatives)"
+            f"{model.path} is FMI {version}: the kit is for the FMI 2.0 FMU (its ramp scenario needs input derivatives)"
         )
     folder = Path(output_dir)
     _check_replaceable(folder, overwrite)
@@ -622,7 +330,7 @@ def write_scenarios(output_dir: str | Path, fmu_path: str | Path | None = None, 
     make_folder(folder, folder, "output directory")
     staging = folder / f".scenarios.{uuid.uuid4().hex}.partial"
     try:
-        names = _write_kit(staging, fmu)
+        names = _write_kit(staging, model)
         with signals_deferred():
             for name in names:
                 os.replace(staging / name, folder / name)
@@ -631,12 +339,14 @@ def write_scenarios(output_dir: str | Path, fmu_path: str | Path | None = None, 
     return [folder / name for name in names]
 
 
-def _write_kit(folder: Path, fmu: Path) -> list[str]:
+def _write_kit(folder: Path, model: FmuModel) -> list[str]:
     """Write the kit into folder; returns the names written, the FMU first."""
     written, carried, steps = [], {}, {}
+    # Read once: each read of these looks the default FMU up again.
+    fields, units = results.FIELDS, results.UNITS
     for scenario in SCENARIOS:
         name = scenario.name
-        parameters = resolve_parameters(scenario.parameters, fmu)
+        parameters = resolve_parameters(scenario.parameters, model)
         signal = folder / f"{name}_in.csv"
         files = {signal.name: _csv_text(("time", "torque"), scenario.rows)}
         _write(signal, files[signal.name])
@@ -650,11 +360,11 @@ def _write_kit(folder: Path, fmu: Path) -> list[str]:
             parameters=parameters,
             theta0=scenario.theta0,
             omega0=scenario.omega0,
-            fmu_path=fmu,
+            fmu_path=model,
         )
         steps[name] = len(solution) - 1
-        files[f"{name}_ref.csv"] = _csv_text(results.FIELDS, (tuple(row) for row in solution.tolist()))
-        files[f"{name}.json"] = json.dumps(_settings(scenario, parameters), indent=2) + "\n"
+        files[f"{name}_ref.csv"] = _csv_text(fields, (tuple(row) for row in solution.tolist()))
+        files[f"{name}.json"] = json.dumps(scenario_settings(scenario, parameters, units), indent=2) + "\n"
         for file_name, text in files.items():
             if file_name != signal.name:
                 _write(folder / file_name, text)
@@ -671,7 +381,7 @@ def _write_kit(folder: Path, fmu: Path) -> list[str]:
     )
     _write(folder / "ReadMe.md", readme)
     written.append("ReadMe.md")
-    with zipfile.ZipFile(fmu) as original, replacing_path(folder / KIT_FMU) as partial:
+    with zipfile.ZipFile(model.path) as original, replacing_path(folder / KIT_FMU) as partial:
         with zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as archive:
             for item in original.infolist():
                 # A kit FMU given as the source: its old kit files give way to the new ones.

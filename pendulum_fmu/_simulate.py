@@ -9,34 +9,21 @@ from __future__ import annotations
 
 import array
 import ctypes
-import itertools
 import os
 import threading
-import weakref
 from collections import OrderedDict
 from functools import lru_cache
 from pathlib import Path
+from typing import Any
 
-import fmpy
 import numpy as np
-from fmpy.fmi1 import printLogMessage
-from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
-from fmpy.fmi3 import FMU3Slave
 
 from . import _native_loop as cs_loop, _results as results, default_fmu
-from ._errors import InvalidInput, PendulumFmuError
-from ._model import FmuInstance, FmuModel, fmu_model
-from ._parameters import (
-    default_parameters,
-    file_version,
-    fmu_file,
-    merged_parameters,
-    merged_with,
-    start_value,
-)
+from ._errors import InvalidInput
+from ._instance import FmuError, FmuInstance, initialize, instantiated, open_fmu
+from ._model import FmuModel, file_version, fmu_file, fmu_model
+from ._parameters import merged_with, start_value
 from ._torque_schedule import TorqueSchedule, TorqueSignal, schedule
-
-_STATUS = ["OK", "WARNING", "DISCARD", "ERROR", "FATAL", "PENDING"]
 
 
 def __getattr__(name: str):
@@ -45,249 +32,6 @@ def __getattr__(name: str):
     if name == "RECORDED":
         return fmu_model().recorded
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-class FmuError(PendulumFmuError, RuntimeError):
-    """An FMI call failed, or the FMU refused a value; the message carries what the FMU logged.
-
-    Examples
-    --------
-    A relative tolerance the FMU refuses when it is set up:
-
-    >>> from pendulum_fmu import FmuError, simulate
-    >>> try:
-    ...     simulate(20.0, tolerance=2.0)
-    ... except FmuError as error:
-    ...     print(error)
-    initialization failed: [ERROR] fmi2SetupExperiment: tolerance 2 must be in (0, 1)
-    """
-
-
-def _log_to_instance(environment, instance_name, status, category, message):
-    log = _logs.get(environment)
-    if log is not None:
-        log.log_fmi3(environment, status, category, message)
-    elif environment is None:
-        # An instance fmpy made with its default callbacks (the user's own FMU2Slave): fmpy's
-        # proxy now calls this logger for it too, so print its messages as fmpy's would.
-        printLogMessage(environment, instance_name, status, category, message)
-
-
-# One FMI 2.0 logger for every instance, never freed, which hands each message to its instance's
-# log by the componentEnvironment the instance was given: fmpy's formatting proxy keeps the last
-# logger it was given in one global, so a logger per instance would be called for another
-# instance's messages, or after it was freed (a crash when instances live in several threads).
-_LOGGER = fmi2CallbackLoggerTYPE(_log_to_instance)
-_logs: weakref.WeakValueDictionary[int, MessageLog] = weakref.WeakValueDictionary()
-_log_keys = itertools.count(1)
-
-
-class MessageLog:
-    """FMI callbacks whose logger keeps what the FMU says, so a failure can say why.
-
-    FMI 2.0: `callbacks` for fmi2Instantiate. FMI 3.0: `log_fmi3` is the logMessage callback (it
-    has no instance name), and fmpy's FMI 2.0 proxy is left alone.
-    """
-
-    def __init__(self, fmi_version: int = 2):
-        self.lines: list[str] = []
-        if fmi_version == 3:
-            return
-        self.callbacks = fmi2CallbackFunctions()
-        self.callbacks.logger = _LOGGER
-        key = next(_log_keys)
-        self.callbacks.componentEnvironment = key
-        _logs[key] = self
-        try:
-            # fmpy's C proxy formats printf-style arguments before they reach Python.
-            from fmpy.logging import addLoggerProxy
-
-            addLoggerProxy(ctypes.byref(self.callbacks))
-        except Exception:
-            pass
-
-    def log_fmi3(self, environment, status, category, message):
-        self.lines.append(f"[{_STATUS[status] if 0 <= status < 6 else status}] {message.decode('utf-8', 'replace')}")
-
-    def error(self, status: int, call: str) -> FmuError:
-        detail = "; ".join(self.lines[-3:]) or "no message"
-        return FmuError(f"{call} returned {_STATUS[status]}: {detail}")
-
-    def initialization_error(self, reason: str) -> FmuError:
-        return FmuError(f"initialization failed: {'; '.join(self.lines) or reason}")
-
-    def instantiation_error(self, fmu_path) -> FmuError:
-        """An FMU that returned no instance (fmpy raises a bare Exception), with what it logged."""
-        return FmuError(f"{fmu_path}: the FMU refused to instantiate: {'; '.join(self.lines) or 'no message'}")
-
-
-def instantiate(slave: FMU2Slave | FMU3Slave, messages: MessageLog, fmu_path) -> None:
-    """slave.instantiate with messages as its logger; FmuError naming fmu_path and what the FMU
-    logged when it returns no instance.
-    """
-    try:
-        if isinstance(slave, FMU3Slave):
-            slave.instantiate(logMessage=messages.log_fmi3)
-        else:
-            slave.instantiate(callbacks=messages.callbacks)
-    except Exception:  # fmpy's own, for a NULL instance
-        raise messages.instantiation_error(fmu_path) from None
-
-
-def _unzipped(fmu_path):
-    """(folder, model description) of an FMU file, extracted once per model (model.FmuModel)."""
-    model = fmu_model(fmu_path)  # refuses what is no FMU before it is unzipped
-    return model.folder, model.description
-
-
-def fmi2_library(folder: str, model_identifier: str) -> str | None:
-    """The FMI 2.0 binary for fmpy to load (FMU2Slave's libraryPath), or None to let fmpy choose.
-
-    fmpy 0.3 looks in binaries/linux64 on ARM64 Linux too, where an FMU (this one, the Reference
-    FMUs) keeps its binary in binaries/aarch64-linux: that one, when the FMU has it.
-
-    Parameters
-    ----------
-    folder : str
-        The extracted FMU.
-    model_identifier : str
-        The Co-Simulation model identifier, the binary's file name.
-
-    Returns
-    -------
-    str or None
-        The binary's path on ARM64 Linux when the FMU has binaries/aarch64-linux, else None.
-    """
-    if fmpy.system == "linux" and fmpy.architecture == "aarch64":
-        library = Path(folder, "binaries", "aarch64-linux", f"{model_identifier}.so")
-        if library.is_file():
-            return str(library)
-    return None
-
-
-def open_fmu(
-    fmu_path: str | Path | None = None,
-    *,
-    parameters: dict | None = None,
-    theta0: float = 0.0,
-    omega0: float = 0.0,
-    tolerance: float | None = None,
-    start_time: float = 0.0,
-    instance_name: str = "pendulum",
-):
-    """An FMU instance, initialized and in step mode, to drive call by call with fmpy's calls.
-
-    The FMI version is read from the FMU's model description (instance.fmi_version says which);
-    fmpy's calls (doStep, getReal, setReal, setFloat64, ...) pass through to its FMU2Slave or
-    FMU3Slave. The caller frees it with ``instance.terminate(); instance.freeInstance()``.
-
-    Parameters
-    ----------
-    fmu_path : str, Path, FmuModel or None, optional
-        The FMU; None: pendulum_fmu.default_fmu(). Its parameters and value references apply.
-    parameters : dict, optional
-        The FMU's parameters over its defaults (mass, length, inertia, gravity, damping).
-    theta0, omega0 : float, optional
-        Start angle (rad) and rate (rad/s).
-    tolerance : float, optional
-        The relative tolerance handed to the FMU (None: the FMU's own).
-    start_time : float, optional
-        The time of the first communication point, in s.
-    instance_name : str, optional
-        The FMI instance name, which the FMU's log messages carry.
-
-    Returns
-    -------
-    FmuInstance
-        With its message log as instance.messages and its model as instance.model.
-
-    Raises
-    ------
-    MissingFile, FmuFileError
-        No file at fmu_path, or none that is a pendulum FMU this machine can run (checked before
-        anything is unzipped or loaded).
-    InvalidInput
-        A parameter or start value that is no finite number, or one the FMU refuses.
-    FmuError
-        The FMU refused the tolerance or the start time; the message carries what it logged.
-
-    Examples
-    --------
-    One 0.1 s step with 20 N.m from theta = 0.1 rad:
-
-    >>> from pendulum_fmu import open_fmu
-    >>> instance = open_fmu(theta0=0.1)
-    >>> theta, omega, torque = (instance.model.value_reference(name) for name in ("theta", "omega", "torque"))
-    >>> instance.fmi_version, instance.getReal([theta, omega])
-    (2, [0.1, 0.0])
-    >>> instance.setReal([torque], [20.0])
-    >>> instance.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.1)
-    >>> [round(value, 6) for value in instance.getReal([theta, omega])]
-    [0.100068, 0.001361]
-    >>> instance.terminate()  # fmpy returns the FMI status: 0, OK
-    0
-    >>> instance.freeInstance()
-    """
-    slave = _instantiated(fmu_model(fmu_path), instance_name)
-    try:
-        initialize(
-            slave, parameters=parameters, theta0=theta0, omega0=omega0, tolerance=tolerance, start_time=start_time
-        )
-    except BaseException:
-        slave.freeInstance()
-        raise
-    return slave
-
-
-def _instantiated(model, instance_name: str) -> FmuInstance:
-    """An instantiated FmuInstance of a model, not yet initialized (see open_fmu)."""
-    model.pendulum_variables  # FmuFileError when it is no pendulum FMU this machine runs
-    folder, description, fmi_version = model.folder, model.description, model.fmi_version
-    messages = MessageLog(fmi_version)
-    arguments = dict(
-        guid=description.guid,
-        unzipDirectory=folder,
-        instanceName=instance_name,
-        modelIdentifier=description.coSimulation.modelIdentifier,
-    )
-    if fmi_version == 3:
-        slave = FMU3Slave(**arguments)
-    else:
-        slave = FMU2Slave(**arguments, libraryPath=fmi2_library(folder, arguments["modelIdentifier"]))
-    instantiate(slave, messages, model.path)
-    return FmuInstance(slave, messages, model)
-
-
-def initialize(
-    slave: FmuInstance,
-    *,
-    parameters: dict | None = None,
-    theta0: float = 0.0,
-    omega0: float = 0.0,
-    tolerance: float | None = None,
-    start_time: float = 0.0,
-) -> None:
-    """Set the parameters and start values of an instantiated (or reset) slave from open_fmu and
-    leave it in step mode; FmuError says why the FMU refused.
-    """
-    # The FMU checks the parameters itself, here as everywhere (resolve_parameters).
-    start = {
-        **merged_with(slave.model.default_parameters, parameters),
-        "theta": start_value("theta0", theta0, "rad"),
-        "omega": start_value("omega0", omega0, "rad/s"),
-    }
-    references = [slave.model.value_reference(n) for n in start]
-    try:
-        if slave.fmi_version == 3:
-            slave.enterInitializationMode(tolerance=tolerance, startTime=start_time)
-            slave.setFloat64(references, list(start.values()))
-        else:
-            slave.setupExperiment(tolerance=tolerance, startTime=start_time)
-            slave.enterInitializationMode()
-            slave.setReal(references, list(start.values()))
-        slave.exitInitializationMode()
-    except Exception as error:
-        raise slave.messages.initialization_error(str(error)) from None
 
 
 def run_schedule(slave: FmuInstance, plan: TorqueSchedule) -> np.ndarray:
@@ -306,9 +50,10 @@ def _stepper(slave, start_names: tuple[str, ...] = ()) -> cs_loop.Stepper:
     """The native loop bound to an instance: the torque in, its model's recorded variables out,
     a restart setting start_names.
     """
+    value_references = slave.model.value_references
 
     def references(names):
-        return np.array([slave.model.value_reference(name) for name in names], np.uint32)
+        return np.array([value_references[name] for name in names], np.uint32)
 
     return cs_loop.Stepper(slave, references(["torque"]), references(slave.model.recorded), references(start_names))
 
@@ -352,12 +97,15 @@ def run_schedule_python(slave: FmuInstance, plan: TorqueSchedule) -> np.ndarray:
         if fmi3
         else ("fmi2SetReal", "fmi2GetReal", "fmi2SetRealInputDerivatives", "fmi2DoStep")
     )
-    set_real, get_real, set_rate, do_step = (dll[name] if name else None for name in names)
+    # ctypes functions of the library (FMI 3.0 has no input derivatives: no set_rate, never called).
+    set_real, get_real, do_step = dll[names[0]], dll[names[1]], dll[names[3]]
+    set_rate: Any = dll[names[2]] if names[2] else None
     component = ctypes.c_void_p(slave.component)
     recorded_names = slave.model.recorded
     count = len(recorded_names)
-    torque_vr = (ctypes.c_uint * 1)(slave.model.value_reference("torque"))
-    recorded_vr = (ctypes.c_uint * count)(*(slave.model.value_reference(n) for n in recorded_names))
+    value_references = slave.model.value_references
+    torque_vr = (ctypes.c_uint * 1)(value_references["torque"])
+    recorded_vr = (ctypes.c_uint * count)(*(value_references[n] for n in recorded_names))
     one, recorded_count = ctypes.c_size_t(1), ctypes.c_size_t(count)
     first_order = (ctypes.c_int * 1)(1)
     no_rollback = ctypes.c_int(1)
@@ -452,7 +200,7 @@ def simulate(
     fmu_path : str or Path, optional
         The FMU to run (default: pendulum_fmu.default_fmu()); its own parameters apply.
     max_steps : int, optional
-        The longest run accepted (default torque_schedule.DEFAULT_MAX_STEPS); a longer one, or
+        The longest run accepted (default _time_grid.DEFAULT_MAX_STEPS); a longer one, or
         one that would not fit in memory, is refused before anything is allocated.
 
     Returns
@@ -512,25 +260,29 @@ def simulate_plan(
 def resolve_parameters(
     overrides: dict[str, float] | None = None, fmu_path: str | Path | FmuModel | None = None
 ) -> dict[str, float]:
-    """parameters.merged_parameters, and a set the FMU accepts.
+    """The FMU's parameters with overrides applied (parameters.merged_with), and a set it accepts.
+
+    fmu_path is the FMU: a path, its model (fmu_model), or None for the default FMU.
 
     The physical checks (mass > 0, an inertia about the pivot > 0, ...) live in one place, the
     FMU's model.c, and every tool goes through them here: the FMU, the scipy reference, OpenSim,
     the engines. Each refuses a bad set with the FMU's own message, word for word.
     """
-    parameters = merged_parameters(overrides, fmu_path)
-    path = fmu_file(fmu_path)
-    refusal = _refusal(str(path.resolve()), file_version(path), tuple(parameters.items()))
+    model = fmu_model(fmu_path)
+    parameters = merged_with(model.default_parameters, overrides)
+    refusal = _refusal(model, tuple(parameters.items()))
     if refusal:
         raise InvalidInput(refusal)
     return parameters
 
 
 @lru_cache(maxsize=256)
-def _refusal(fmu: str, version: tuple, items: tuple) -> str | None:
-    """What the FMU says when it refuses these parameters at initialization, or None."""
+def _refusal(model: FmuModel, items: tuple) -> str | None:
+    """What the FMU says when it refuses these parameters at initialization, or None; asked once
+    per model (a file rebuilt or replaced is another model) and set of parameters.
+    """
     try:
-        slave = open_fmu(fmu, parameters=dict(items))
+        slave = open_fmu(model, parameters=dict(items))
     except FmuError as error:
         # "initialization failed: [ERROR] fmi2ExitInitializationMode: mass must be > 0"
         return f"the FMU refuses the parameters: {str(error).rsplit(': ', 1)[-1]}"
@@ -553,8 +305,8 @@ class Simulator:
 
     def __init__(self, fmu_path: Path, version: tuple):
         self.fmu_path, self.version = fmu_path, version
-        self.slave = _instantiated(fmu_model(fmu_path), "pendulum")
-        self.defaults = default_parameters(self.slave.model)
+        self.slave = instantiated(fmu_model(fmu_path), "pendulum")
+        self.defaults = dict(self.slave.model.default_parameters)
         self.stepper = (
             _stepper(self.slave, (*self.defaults, *self.START_STATES)) if cs_loop.drives(self.slave) else None
         )
@@ -603,14 +355,14 @@ def _default_fmu() -> Path:
     return default_fmu()
 
 
-def simulator(fmu_path: str | Path | None = None) -> Simulator:
-    """This thread's Simulator of an FMU file, made on first use and again whenever the file is
-    rebuilt or replaced (its file_version changes).
+def simulator(fmu_path: str | Path | FmuModel | None = None) -> Simulator:
+    """The Simulator of an FMU file kept by the calling thread, made on first use and again
+    whenever the file is rebuilt or replaced (its file_version changes).
 
     Parameters
     ----------
     fmu_path
-        The FMU file; None: pendulum_fmu.default_fmu(), looked up once per process.
+        The FMU file or its model; None: pendulum_fmu.default_fmu(), looked up once per process.
 
     Returns
     -------

@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ._calls import Call, InstanceCalls, read_calls, reconstruct
+from ._call_record import Call, InstanceCalls, read_calls, reconstruct
 from ._closed_loop import COUPLINGS, controller_defaults
 from ._errors import InvalidInput
 from ._parameters import default_parameters, variables

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ._closed_loop import COUPLINGS, sampled_loop_reference
-from ._judge import ResultFileError, read_result
+from ._result_file import ResultFileError, read_result
 from ._ssp import SspSettings, read_ssp
 
 # The masters here match their coupling's reference to 1e-15 rad; the couplings differ from one

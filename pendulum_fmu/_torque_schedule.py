@@ -1,5 +1,7 @@
 """Torque signals and the step-wise schedule a master feeds the FMU.
 
+(A CSV is read by _torque_csv.py; the communication points come from _time_grid.py.)
+
 A signal is one of:
 - a constant (N.m);
 - a callable of time, sampled at each step's start;
@@ -28,126 +30,24 @@ FMU's linear ramp over each step is the CSV's own piecewise-linear signal, exact
 
 from __future__ import annotations
 
-import csv
 import inspect
-import math
 import numbers
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from fractions import Fraction
 from functools import cached_property
 from pathlib import Path
 from typing import Union
 
 import numpy as np
-import psutil
 
 from ._errors import InvalidInput
+from ._time_grid import communication_points, event_tolerance, nearest
+from ._torque_csv import TorqueTable, read_torque_csv
 
 TorqueSignal = Union[float, int, Callable[[float], float], str, Path, Sequence[float], np.ndarray, "TorqueTable"]
 
-# Events closer than this to a communication point are that point: a billionth of a step, or 64
-# ulp of the time where times are so large that a grid point's own rounding is bigger.
-EVENT_TOLERANCE_STEPS = 1e-9
-EVENT_TOLERANCE_ULPS = 64
 # stop_time without a CSV to take it from.
 DEFAULT_STOP_TIME = 3.0
-# A run longer than this is refused unless asked for (max_steps, --max-steps): at 1 ms it is
-# close to 3 hours of simulated time, and a typo in a time (epoch seconds, 1e-8 s steps) is
-# likelier than a run that long.
-DEFAULT_MAX_STEPS = 10_000_000
-# A study larger than this is refused unless asked for (run_sweep's max_cases, --max-cases): at a
-# millisecond a case it is a quarter of an hour on 1,000 cores, and a grid multiplied out by a
-# stray value list is likelier than a study that large. Here beside the other size limit, so that
-# the command line's help reads it without loading the sweep.
-DEFAULT_MAX_CASES = 1_000_000
-# Runs needing less memory than this are not checked against what the machine has left: reading
-# it (/proc/meminfo) costs more than such a run, which no machine that runs Python lacks.
-MEMORY_CHECKED_FROM = 2**26  # bytes (64 MiB: about 700,000 steps)
-# Memory one step takes in simulate(): the schedule's three doubles, the result's five and the
-# four recorded outputs.
-BYTES_PER_STEP = 8 * (3 + 5 + 4)
-
-
-def event_tolerance(time, step_size: float):
-    """How close an event must be to a communication point to be that point (s)."""
-    if isinstance(time, float):  # math.ulp is np.spacing for a scalar, without numpy's overhead
-        return max(EVENT_TOLERANCE_STEPS * step_size, EVENT_TOLERANCE_ULPS * math.ulp(abs(time)))
-    return np.maximum(
-        EVENT_TOLERANCE_STEPS * step_size, EVENT_TOLERANCE_ULPS * np.spacing(np.abs(np.asarray(time, dtype=float)))
-    )
-
-
-def _nearest(points: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """The point of the sorted `points` (two or more) nearest to each t."""
-    i = np.clip(np.searchsorted(points, t), 1, len(points) - 1)
-    return np.where(np.abs(points[i] - t) < np.abs(points[i - 1] - t), points[i], points[i - 1])
-
-
-class TorqueFileError(InvalidInput):
-    r"""A torque CSV that cannot be read; the message names the file, line and problem.
-
-    Examples
-    --------
-    >>> import tempfile
-    >>> from pathlib import Path
-    >>> from pendulum_fmu import TorqueFileError, schedule
-    >>> table = Path(tempfile.mkdtemp(), "torque.csv")
-    >>> _ = table.write_text("time,torque\n0,1\n1,x\n")
-    >>> try:
-    ...     schedule(table)
-    ... except TorqueFileError as error:
-    ...     print(str(error).replace(str(table), "torque.csv"))
-    torque.csv:3: torque 'x' is not a number
-    """
-
-
-@dataclass(frozen=True)
-class TorqueTable:
-    """Rows of a torque CSV: piecewise linear, with a jump where a time repeats."""
-
-    time: np.ndarray
-    torque: np.ndarray
-
-    def value_after(self, t: np.ndarray) -> np.ndarray:
-        """The torque just after each t: at a jump, the value after it."""
-        return self._values(np.asarray(t, dtype=float), "right")
-
-    def value_before(self, t: np.ndarray) -> np.ndarray:
-        """The torque just before each t: at a jump, the value before it."""
-        return self._values(np.asarray(t, dtype=float), "left")
-
-    def _values(self, t: np.ndarray, side: str) -> np.ndarray:
-        # np.interp takes the last of equal times, so look the segment up ourselves. Just after
-        # t (side "right") the segment is time[i-1] <= t < time[i]; just before it,
-        # time[i-1] < t <= time[i]: either way a segment of positive length, never the jump.
-        time, torque = self.time, self.torque
-        if len(time) == 1:
-            return np.full(t.shape, torque[0])
-        i = np.clip(np.searchsorted(time, t, side=side), 1, len(time) - 1)
-        t0, t1, u0, u1 = time[i - 1], time[i], torque[i - 1], torque[i]
-        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-            inside = u0 + (u1 - u0) * (t - t0) / (t1 - t0)
-            # Rows of opposite sign near the largest double (1e308, then -1e308) differ by inf;
-            # weighting each row's value instead stays finite (only there: elsewhere it would
-            # round differently from the form above, which docs/signals.md states).
-            overflowed = ~np.isfinite(inside)
-            if overflowed.any():
-                share = (t - t0) / (t1 - t0)
-                inside = np.where(overflowed, u0 * (1 - share) + u1 * share, inside)
-        if side == "right":
-            return np.where(t < time[0], torque[0], np.where(t >= time[-1], torque[-1], inside))
-        return np.where(t <= time[0], torque[0], np.where(t > time[-1], torque[-1], inside))
-
-    def jumps(self) -> np.ndarray:
-        """Times where the torque jumps (a repeated time)."""
-        return self.time[1:][np.diff(self.time) == 0]
-
-    def snapped(self, points: np.ndarray, step_size: float) -> TorqueTable:
-        """The same table with every row time within event_tolerance of a point moved onto it."""
-        nearest = _nearest(points, self.time)
-        close = np.abs(nearest - self.time) <= event_tolerance(self.time, step_size)
-        return TorqueTable(np.where(close, nearest, self.time), self.torque)
 
 
 @dataclass(frozen=True)
@@ -185,130 +85,6 @@ class TorqueSchedule:
     def step_size(self) -> np.ndarray:
         """The length of each step, in s."""
         return np.diff(self.time)
-
-
-def _decode(path: Path, raw: bytes) -> str:
-    try:
-        return raw.decode("utf-8")
-    except UnicodeDecodeError as error:
-        line = raw[: error.start].count(b"\n") + 1
-        raise TorqueFileError(
-            f"{path}:{line}: byte 0x{raw[error.start]:02x} is not UTF-8; save the "
-            "file as UTF-8 (with or without a byte-order mark)"
-        ) from None
-
-
-def _first_bad_row(path: Path, lines: list[str], columns: tuple[int, int]) -> TorqueFileError | None:
-    """The one-line error for the first row that is not two finite numbers, or has more
-    columns than the header, or None.
-    """
-    header = len(next(csv.reader([lines[0]])))
-    for number, line in enumerate(lines[1:], start=2):
-        if not line.strip():
-            continue
-        cells = next(csv.reader([line]))  # as pyarrow reads it: "1,5" is one quoted cell
-        for column, name in zip(columns, ("time", "torque"), strict=False):
-            cell = cells[column].strip() if column < len(cells) else ""
-            try:
-                # Python's float takes 1_0 and fullwidth digits, which pyarrow refuses.
-                value = float(cell) if cell.isascii() and "_" not in cell else float("")
-            except ValueError:
-                return TorqueFileError(f"{path}:{number}: {name} {cell!r} is not a number")
-            if not math.isfinite(value):
-                return TorqueFileError(f"{path}:{number}: {name} is {cell}; values must be finite")
-        if len(cells) > header:
-            return TorqueFileError(
-                f"{path}:{number}: {len(cells)} columns, but the header names {header}; quote a cell holding a comma"
-            )
-    return None
-
-
-def _line_of_row(lines: list[str], row: int) -> int:
-    """The file line (1-based) of data row `row` (0-based), skipping blank lines."""
-    seen = -1
-    for number, line in enumerate(lines[1:], start=2):
-        if line.strip():
-            seen += 1
-            if seen == row:
-                return number
-    return len(lines)
-
-
-def _parse_numbers(raw: bytes, names: list[str], columns: tuple[int, int]) -> tuple[np.ndarray, np.ndarray] | None:
-    """The time and torque columns as float arrays, parsed by pyarrow's multi-threaded C
-    reader; None when a cell is not a number (the caller then finds the line).
-    """
-    import pyarrow as pa
-    import pyarrow.csv as pa_csv
-
-    # Positional names, so a header with spaces or repeated names still reads.
-    positional = [f"c{i}" for i in range(len(names))]
-    wanted = [positional[i] for i in columns]
-    try:
-        table = pa_csv.read_csv(
-            pa.py_buffer(raw),
-            read_options=pa_csv.ReadOptions(skip_rows=1, column_names=positional),
-            convert_options=pa_csv.ConvertOptions(
-                include_columns=wanted, column_types={name: pa.float64() for name in wanted}
-            ),
-        )
-    except pa.ArrowInvalid:
-        return None
-    return tuple(table.column(name).to_numpy() for name in wanted)
-
-
-def read_torque_csv(path: str | Path) -> TorqueTable:
-    """Read a ``time,torque`` CSV (UTF-8, with or without a byte-order mark; other columns are
-    ignored). A bad file raises TorqueFileError naming the file, line and problem. The numbers
-    are parsed in C in one pass, with no Python object per row.
-    """
-    path = Path(path)
-    try:
-        raw = path.read_bytes()
-    except OSError as error:
-        raise TorqueFileError(f"{path}: cannot read: {error.strerror}") from None
-    raw = raw[3:] if raw.startswith(b"\xef\xbb\xbf") else raw  # spreadsheets write a byte-order mark
-    _decode(path, raw)  # only to refuse another encoding here, with its line
-    header_line = raw[: raw.find(b"\n") if b"\n" in raw else len(raw)].decode("utf-8")
-    if not header_line.strip():
-        if raw.strip():
-            raise TorqueFileError(
-                f"{path}:1: the line is blank; the header, e.g. time,torque, must be "
-                "the first line: remove the blank lines before it"
-            )
-        raise TorqueFileError(f"{path}: the file is empty; expected a header 'time,torque'")
-    header = [name.strip() for name in header_line.split(",")]
-    for column in ("time", "torque"):
-        if column not in header:
-            raise TorqueFileError(
-                f"{path}:1: missing column {column!r} (header is {','.join(header)}); "
-                "the first line must name the columns, e.g. time,torque"
-            )
-    columns = (header.index("time"), header.index("torque"))
-    data = _parse_numbers(raw, header, columns)
-    if data is None or not all(np.all(np.isfinite(column)) for column in data):
-        lines = _decode(path, raw).splitlines()
-        error = _first_bad_row(path, lines, columns)
-        raise error or TorqueFileError(f"{path}: rows must have as many columns as the header ({len(header)})")
-    times, torques = data
-    if len(times) == 0:
-        raise TorqueFileError(f"{path}: no data rows after the header")
-    backwards = np.flatnonzero(np.diff(times) < 0)
-    triple = np.flatnonzero((times[2:] == times[1:-1]) & (times[1:-1] == times[:-2]))
-    if len(backwards) or len(triple):
-        lines = _decode(path, raw).splitlines()
-        if len(backwards) and (not len(triple) or backwards[0] < triple[0] + 1):
-            row = backwards[0] + 1
-            raise TorqueFileError(
-                f"{path}:{_line_of_row(lines, row)}: time {times[row]:g} goes backwards "
-                f"(previous row: {times[row - 1]:g}); sort the rows by time"
-            )
-        row = triple[0] + 2
-        raise TorqueFileError(
-            f"{path}:{_line_of_row(lines, row)}: time {times[row]:g} appears three "
-            "times; a jump is two rows with the same time"
-        )
-    return TorqueTable(np.ascontiguousarray(times), np.ascontiguousarray(torques))
 
 
 def write_torque_csv(path: str | Path, plan: TorqueSchedule) -> Path:
@@ -356,7 +132,7 @@ def write_torque_csv(path: str | Path, plan: TorqueSchedule) -> Path:
     from ._atomic_files import replacing
 
     end = plan.torque + plan.torque_rate * plan.step_size
-    points = []
+    points: list[tuple[float, float]] = []
     for t0, t1, u0, u1 in zip(
         plan.time[:-1].tolist(), plan.time[1:].tolist(), plan.torque.tolist(), end.tolist(), strict=False
     ):
@@ -373,99 +149,13 @@ def write_torque_csv(path: str | Path, plan: TorqueSchedule) -> Path:
     return Path(path)
 
 
-def _check_times(start_time: float, stop_time: float, step_size: float) -> None:
-    for name, value in (("start time", start_time), ("stop time", stop_time), ("step size", step_size)):
-        if not isinstance(value, numbers.Real):
-            raise InvalidInput(f"{name} {value!r} must be a finite number of seconds")
-        if not math.isfinite(value):
-            raise InvalidInput(f"{name} {value} must be a finite number of seconds")
-    if not step_size > 0:
-        raise InvalidInput(f"step size {step_size} must be positive")
-    if not stop_time > start_time:
-        raise InvalidInput(f"stop time {stop_time} must be after start time {start_time}")
-
-
-def _available_memory() -> int:
-    """Bytes the machine can still give: MemAvailable on Linux, psutil's counterpart elsewhere."""
-    return psutil.virtual_memory().available
-
-
-def step_count(start_time: float, stop_time: float, step_size: float, max_steps: int | None = None) -> int:
-    """The number of grid steps from start to stop (the last one shorter when stop is off the
-    grid). A run over max_steps (default DEFAULT_MAX_STEPS), or one whose arrays would not fit in
-    the memory the machine has left, is refused here, before anything is allocated.
-    """
-    _check_times(start_time, stop_time, step_size)
-    span = stop_time - start_time
-    ratio = span / step_size
-    if math.isfinite(ratio):
-        steps = math.floor(ratio)
-        # stop within the event tolerance past a grid point is that point, not a sliver of a step.
-        if span - steps * step_size > event_tolerance(stop_time, step_size):
-            steps += 1
-    else:
-        # The span or the count is past the largest double (1e308 s, a 1e-320 s step): count
-        # exactly, so the run is refused below in the same words as any run too long.
-        steps = math.ceil((Fraction(stop_time) - Fraction(start_time)) / Fraction(step_size))
-    steps = max(steps, 1)
-    limit = DEFAULT_MAX_STEPS if max_steps is None else max_steps
-    if not (isinstance(limit, numbers.Integral) and limit >= 1):
-        raise InvalidInput(f"max steps {limit!r} must be a whole number of steps, at least 1")
-    what = f"{start_time:g} to {stop_time:g} s in steps of {step_size:g} s is {_count(steps)} steps"
-    if steps > limit:
-        raise InvalidInput(
-            f"{what}, over the limit of {limit:,}: use a coarser step size or a shorter "
-            "stop time, or raise the limit (--max-steps) if the run is meant to be that long"
-        )
-    needed = steps * BYTES_PER_STEP
-    if needed > MEMORY_CHECKED_FROM:
-        available = _available_memory()
-        if needed > available:
-            raise InvalidInput(
-                f"{what}, which needs {_gib(needed)} and the machine has "
-                f"{available / 2**30:.1f} GiB free: use a coarser step size or a "
-                "shorter stop time"
-            )
-    return steps
-
-
-def _count(steps: int) -> str:
-    """A step count as a line can hold it: every digit up to 2**53, then 'about 1.23e+628'. Past
-    2**53 the count came from a float quotient, whose trailing digits are rounding, and past 1e308
-    no float holds it, so it is rounded here in integers.
-    """
-    if steps <= 2**53:
-        return f"{steps:,}"
-    exponent = len(str(steps)) - 1
-    mantissa = round(Fraction(steps, 10 ** (exponent - 2)))  # three digits, 100 to 1000
-    if mantissa == 1000:
-        mantissa, exponent = 100, exponent + 1
-    return f"about {mantissa / 100:g}e+{exponent}"
-
-
-def _gib(size: int) -> str:
-    return f"{size / 2**30:.1f} GiB" if size < 2**1000 else f"{_count(size >> 30)} GiB"
-
-
-def communication_points(
-    start_time: float, stop_time: float, step_size: float, *, max_steps: int | None = None
-) -> np.ndarray:
-    """start, start + h, ... up to stop. A grid point is start + k*h, never a running sum, so no
-    rounding accumulates over a long run. max_steps: see step_count.
-    """
-    steps = step_count(start_time, stop_time, step_size, max_steps)
-    grid = start_time + step_size * np.arange(steps + 1, dtype=float)
-    grid[-1] = stop_time if abs(grid[-1] - stop_time) > event_tolerance(stop_time, step_size) else grid[-1]
-    return grid
-
-
 def _with_events(grid: np.ndarray, events: np.ndarray | None, step_size: float) -> np.ndarray:
     """The grid plus the events inside it that are not within event_tolerance of a grid point."""
     if events is None or not len(events):
         return grid
     events = np.unique(events[(events > grid[0]) & (events < grid[-1])])
     if len(events):
-        distance = np.abs(_nearest(grid, events) - events)
+        distance = np.abs(nearest(grid, events) - events)
         events = events[distance > event_tolerance(events, step_size)]
     return np.union1d(grid, events)
 
@@ -604,7 +294,8 @@ def schedule(
             samples = np.array([_sample(torque, t) for t in _takes_time(torque, time.tolist())])
         else:
             try:
-                samples = np.full(len(time), float(torque))
+                # Whatever else it is is tried as a number: float() refuses what is none.
+                samples = np.full(len(time), float(torque))  # type: ignore[arg-type]
             except (TypeError, ValueError):
                 raise InvalidInput(
                     f"a torque is a number, a callable of time, a per-step array or a CSV "

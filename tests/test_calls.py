@@ -18,7 +18,7 @@ import pytest
 from fmpy import extract, read_model_description, simulate_fmu
 from fmpy.fmi2 import FMU2Slave
 
-from pendulum_fmu._calls import IntendedRun, judge_calls
+from pendulum_fmu._call_judge import IntendedRun, judge_calls
 from pendulum_fmu.cli import main
 
 STEP = 1e-3

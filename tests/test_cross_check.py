@@ -12,7 +12,7 @@ from fmpy.util import read_ref_opt_file
 
 from pendulum_fmu import __version__
 from pendulum_fmu._reference import reference
-from pendulum_fmu._torque_schedule import read_torque_csv
+from pendulum_fmu._torque_csv import read_torque_csv
 from pendulum_fmu.cli import main
 
 

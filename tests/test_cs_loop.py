@@ -8,9 +8,11 @@ import numpy as np
 import pytest
 
 from pendulum_fmu import _native_loop as cs_loop
+from pendulum_fmu._instance import FmuError, open_fmu
 from pendulum_fmu._parameters import value_reference
 from pendulum_fmu._reference import reference_schedule
-from pendulum_fmu._torque_schedule import TorqueTable, schedule
+from pendulum_fmu._torque_csv import TorqueTable
+from pendulum_fmu._torque_schedule import schedule
 from pendulum_fmu.sweep import OUTPUTS
 
 # The module; the package's attribute of that name is its function.
@@ -29,7 +31,7 @@ def test_native_loop_matches_the_python_loop_bit_for_bit(fmu, ramp):
     assert len(set(np.round(np.diff(plan.time), 12))) > 1
     runs = []
     for loop in (simulate.run_schedule, simulate.run_schedule_python):
-        slave = simulate.open_fmu(fmu, parameters={"damping": 1.5}, theta0=0.2)
+        slave = open_fmu(fmu, parameters={"damping": 1.5}, theta0=0.2)
         try:
             runs.append(loop(slave, plan))
         finally:
@@ -44,11 +46,11 @@ def test_native_loop_matches_the_python_loop_bit_for_bit(fmu, ramp):
 
 
 def test_native_loop_reports_the_failing_step(fmu):
-    slave = simulate.open_fmu(fmu)
+    slave = open_fmu(fmu)
     try:
         plan = schedule(1.0, stop_time=0.01, step_size=1e-3)
         wrong = plan.time + 0.5  # fmi2DoStep refuses a step from where the instance is not
-        with pytest.raises(simulate.FmuError, match=r"fmi2DoStep at t = 0.5 returned ERROR: .*not where"):
+        with pytest.raises(FmuError, match=r"fmi2DoStep at t = 0.5 returned ERROR: .*not where"):
             stepper = cs_loop.Stepper(slave, np.array([0], np.uint32), np.array([1, 2, 3], np.uint32))
             stepper.run(wrong, plan.torque[:, None].copy(), None, np.empty((len(wrong), 3)))
     finally:
@@ -63,20 +65,20 @@ def test_native_restart_matches_a_fresh_instance_bit_for_bit(fmu):
     names = ("mass", "damping", "theta", "torque")
     references = np.array([value_reference(n, fmu) for n in names], np.uint32)
     outputs = np.array([value_reference(n, fmu) for n in OUTPUTS], np.uint32)
-    slave = simulate.open_fmu(fmu)  # initialized with the defaults, then restarted twice
+    slave = open_fmu(fmu)  # initialized with the defaults, then restarted twice
     try:
         stepper = cs_loop.Stepper(slave, np.empty(0, np.uint32), outputs, references)
         for mass in (30.0, 55.0):
             restarted = np.empty((len(plan.time), 3))
             stepper.run(plan.time, None, None, restarted, start_values=np.array([mass, 2.0, 0.4, 12.0]))
-            fresh = simulate.open_fmu(fmu, parameters={"mass": mass, "damping": 2.0}, theta0=0.4)
+            fresh = open_fmu(fmu, parameters={"mass": mass, "damping": 2.0}, theta0=0.4)
             try:
                 expected = simulate.run_schedule_python(fresh, plan)
             finally:
                 fresh.freeInstance()
             for column, name in enumerate(OUTPUTS):
                 assert np.array_equal(restarted[:, column], expected[name]), (mass, name)
-        with pytest.raises(simulate.FmuError, match=r"initialization failed: .*mass must be > 0"):
+        with pytest.raises(FmuError, match=r"initialization failed: .*mass must be > 0"):
             stepper.run(plan.time, None, None, restarted, start_values=np.array([-1.0, 0.0, 0.0, 0.0]))
     finally:
         slave.freeInstance()
@@ -93,7 +95,7 @@ def test_a_chunk_in_one_call_matches_case_by_case_and_the_physics_bit_for_bit(fm
     references = np.array([value_reference(n, fmu) for n in names], np.uint32)
     outputs = np.array([value_reference(n, fmu) for n in OUTPUTS], np.uint32)
     points = schedule(0.0, stop_time=0.2, step_size=1e-3).time
-    slave = simulate.open_fmu(fmu)
+    slave = open_fmu(fmu)
     try:
         stepper = cs_loop.Stepper(slave, np.empty(0, np.uint32), outputs, references)
         chunk = np.empty((3, len(cases), len(points)))
@@ -102,7 +104,7 @@ def test_a_chunk_in_one_call_matches_case_by_case_and_the_physics_bit_for_bit(fm
         assert messages[0] == messages[2] == messages[3] == ""
         assert messages[1].startswith("initialization failed: ") and "mass must be > 0" in messages[1]
         assert np.isnan(chunk[1]).all()
-        with pytest.raises(simulate.FmuError) as refused:
+        with pytest.raises(FmuError) as refused:
             stepper.run(points, None, None, np.empty((len(points), 3)), start_values=cases[1])
         assert messages[1] == str(refused.value)
         for case in (0, 2, 3):
@@ -112,7 +114,7 @@ def test_a_chunk_in_one_call_matches_case_by_case_and_the_physics_bit_for_bit(fm
             mass, damping, theta0, torque = cases[case]
             parameters = {"mass": mass, "damping": damping}
             plan = schedule(torque, stop_time=0.2, step_size=1e-3)
-            fresh = simulate.open_fmu(fmu, parameters=parameters, theta0=theta0)
+            fresh = open_fmu(fmu, parameters=parameters, theta0=theta0)
             try:
                 expected = simulate.run_schedule_python(fresh, plan)
             finally:

@@ -222,7 +222,7 @@ def test_pybullet_velocity_limit_is_raised():
 
 def off_grid_plan():
     """A CSV jump off the 1 ms grid and a short last step: communication steps of three sizes."""
-    from pendulum_fmu._torque_schedule import TorqueTable
+    from pendulum_fmu._torque_csv import TorqueTable
 
     table = TorqueTable(np.array([0.0, 0.0305, 0.0305, 0.1003]), np.array([40.0, 40.0, -60.0, -60.0]))
     plan = schedule(table, step_size=1e-3)

@@ -34,8 +34,8 @@ def test_every_exception_class_of_the_package_is_a_user_error():
             ):
                 defined[f"{value.__module__}.{name}"] = value
     assert {
-        "pendulum_fmu._torque_schedule.TorqueFileError",
-        "pendulum_fmu._simulate.FmuError",
+        "pendulum_fmu._torque_csv.TorqueFileError",
+        "pendulum_fmu._instance.FmuError",
         "pendulum_fmu._model.FmuFileError",
         "pendulum_fmu._errors.BuildError",
         "pendulum_fmu.sweep.store.InUse",

@@ -16,9 +16,10 @@ from fmpy.fmi3 import FMU3Model
 from fmpy.validation import validate_fmu
 
 from fmu_build import MODEL_DESCRIPTION
+from pendulum_fmu._instance import open_fmu
 from pendulum_fmu._parameters import default_parameters, total_inertia
 from pendulum_fmu._reference import reference, reference_schedule
-from pendulum_fmu._simulate import open_fmu, run_schedule, simulate
+from pendulum_fmu._simulate import run_schedule, simulate
 from pendulum_fmu._torque_schedule import TorqueSchedule, schedule
 from pendulum_fmu.cli import main
 

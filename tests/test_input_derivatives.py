@@ -13,8 +13,8 @@ from scipy.integrate import solve_ivp
 
 from fmu_build import build_pid_controller
 from pendulum_fmu._closed_loop import controller_defaults, sampled_loop_reference
+from pendulum_fmu._instance import MessageLog, _unzipped, open_fmu
 from pendulum_fmu._parameters import default_parameters, total_inertia
-from pendulum_fmu._simulate import MessageLog, _unzipped, open_fmu
 
 TORQUE, THETA, OMEGA = 0, 1, 2
 I_TOTAL = total_inertia(default_parameters())

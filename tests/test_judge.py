@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from benchmarks.masters import WRONG_MASTERS, run
-from pendulum_fmu._judge import (
+from pendulum_fmu._diagnoses import (
     AGREES,
     DRIFT,
     EARLY,
@@ -22,13 +22,13 @@ from pendulum_fmu._judge import (
     LATE,
     NOT_RESTORED,
     UNEXPLAINED,
-    ResultFileError,
-    judge,
-    read_result,
 )
+from pendulum_fmu._judge import judge
 from pendulum_fmu._parameters import total_inertia
 from pendulum_fmu._plot import _log_difference
-from pendulum_fmu._scenarios import KIT_FMU, read_settings, write_scenarios
+from pendulum_fmu._result_file import ResultFileError, read_result
+from pendulum_fmu._scenario_settings import KIT_FMU, read_settings
+from pendulum_fmu._scenarios import write_scenarios
 from pendulum_fmu.cli import main
 
 

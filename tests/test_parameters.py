@@ -14,7 +14,8 @@ from bad_inputs import write_files
 
 from pendulum_fmu._compare_tools import KINDS, parse_tools
 from pendulum_fmu._cross_check import write_cross_check
-from pendulum_fmu._parameters import FmuFileError, default_parameters, model_description
+from pendulum_fmu._model import FmuFileError
+from pendulum_fmu._parameters import default_parameters, model_description
 from pendulum_fmu._reference import reference
 from pendulum_fmu._simulate import simulate
 from pendulum_fmu._torque_schedule import schedule

@@ -18,20 +18,15 @@ from fmpy.validation import validate_fmu
 
 from benchmarks.masters import run
 from pendulum_fmu import _native_loop as cs_loop
+from pendulum_fmu._diagnoses import AGREES
 from pendulum_fmu._errors import InvalidInput
-from pendulum_fmu._judge import AGREES, judge, judge_kit
+from pendulum_fmu._instance import open_fmu
+from pendulum_fmu._judge import judge, judge_kit
 from pendulum_fmu._parameters import default_parameters, total_inertia
-from pendulum_fmu._scenarios import (
-    KIT_FMU,
-    LS_REF_FOLDER,
-    LS_REF_VERSION,
-    SCENARIOS,
-    KitExists,
-    kit_files,
-    read_settings,
-    write_scenarios,
-)
-from pendulum_fmu._simulate import open_fmu, run_schedule
+from pendulum_fmu._scenario_list import SCENARIOS
+from pendulum_fmu._scenario_settings import KIT_FMU, read_settings
+from pendulum_fmu._scenarios import LS_REF_FOLDER, LS_REF_VERSION, KitExists, kit_files, write_scenarios
+from pendulum_fmu._simulate import run_schedule
 from pendulum_fmu._torque_schedule import TorqueSchedule, schedule
 from pendulum_fmu.cli import main
 

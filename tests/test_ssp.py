@@ -12,7 +12,7 @@ import lxml.etree
 import numpy as np
 import pytest
 
-from pendulum_fmu._calls import read_calls, reconstruct
+from pendulum_fmu._call_record import read_calls, reconstruct
 from pendulum_fmu._closed_loop import COUPLINGS, controller_defaults, sampled_loop_reference
 from pendulum_fmu._ssp import DEFAULT_SETPOINT, export_ssp, read_ssp, rebind_ssp
 from pendulum_fmu._ssp_calls import judge_ssp_calls

@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from .._errors import InvalidInput
-from .._torque_schedule import DEFAULT_MAX_STEPS
+from .._time_grid import DEFAULT_MAX_STEPS
 
 
 def assignment(text: str) -> tuple[str, str]:

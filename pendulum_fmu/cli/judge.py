@@ -175,8 +175,10 @@ def _judge_ssp(args) -> int:
 
 
 def _judge_calls(args, signal) -> int:
-    """`judge --calls LOG`: the master's calls against the intended run (pendulum_fmu._calls)."""
-    from .._calls import IntendedRun, format_calls, judge_calls, write_calls_json
+    """`judge --calls LOG`: the master's calls (read by _call_record) against the intended run
+    (_call_judge).
+    """
+    from .._call_judge import IntendedRun, format_calls, judge_calls, write_calls_json
     from .._parameters import variables
 
     if args.result is not None:

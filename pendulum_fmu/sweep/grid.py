@@ -13,7 +13,8 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from .._errors import InvalidInput, WrongType
-from .._parameters import START_VALUES, default_parameters
+from .._model import START_VALUES
+from .._parameters import default_parameters
 
 
 def sweepable(fmu_path=None) -> list[str]:

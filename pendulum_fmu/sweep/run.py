@@ -13,8 +13,9 @@ from pathlib import Path
 import numpy as np
 
 from .._errors import InvalidInput, MissingDependency, WrongType
-from .._parameters import fmu_file, pendulum_variables
-from .._torque_schedule import DEFAULT_MAX_CASES
+from .._model import fmu_file
+from .._parameters import pendulum_variables
+from .._time_grid import DEFAULT_MAX_CASES
 from .client import SchedulerLost, dask_client, progress_bar, run_chunks
 from .figure import draw
 from .grid import columns

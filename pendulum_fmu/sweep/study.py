@@ -13,7 +13,7 @@ import numpy as np
 
 from .. import _results as results
 from .._errors import InvalidInput, WrongType
-from .._torque_schedule import communication_points
+from .._time_grid import communication_points
 from .grid import Grid, check_cases, columns
 
 OUTPUTS = results.FIELDS[2:]  # theta, omega, alpha: what a case records besides time and torque

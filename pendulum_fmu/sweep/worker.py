@@ -16,9 +16,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _native_loop as cs_loop
-from .._parameters import START_VALUES, value_reference
-from .._simulate import FmuError, initialize, run_schedule_python, simulator
-from .._torque_schedule import TorqueSchedule, communication_points
+from .._instance import FmuError, initialize
+from .._model import START_VALUES
+from .._parameters import value_reference
+from .._simulate import run_schedule_python, simulator
+from .._time_grid import communication_points
+from .._torque_schedule import TorqueSchedule
 from .store import SUMMARIES, Store
 from .study import OUTPUTS
 
@@ -50,7 +53,7 @@ class Runner:
     """
 
     def __init__(self, fmu_simulator):
-        self.simulator, fmu = fmu_simulator, fmu_simulator.fmu_path
+        self.simulator, fmu = fmu_simulator, fmu_simulator.slave.model
         self.defaults = {**fmu_simulator.defaults, "theta": 0.0, "omega": 0.0, "torque": 0.0}
         start_references = np.array([value_reference(n, fmu) for n in self.defaults], np.uint32)
         outputs = np.array([value_reference(name, fmu) for name in OUTPUTS], np.uint32)
