@@ -150,7 +150,30 @@ def robustness() -> str:
     )
 
 
-GENERATED = {"sweeps": sweeps, "robustness": robustness}
+def quickstart() -> str:
+    """What the README's quick start prints last: its commands, run as written in an empty folder."""
+    import tempfile
+
+    from test_readme_commands import commands_in
+
+    text = README.read_text(encoding="utf-8")
+    section = text[text.index("## Quick start") : text.index("From Python:")]
+    # .venv/bin/ is the environment this interpreter runs in, wherever it is.
+    programs = f"{Path(sys.executable).parent}/"
+    with tempfile.TemporaryDirectory() as folder:
+        for command in commands_in(section):
+            done = subprocess.run(
+                ["bash", "-c", command.replace(".venv/bin/", programs)],
+                cwd=folder,
+                capture_output=True,
+                text=True,
+                check=True,
+                timeout=600,
+            )
+    return "```text\n" + done.stdout.rstrip("\n") + "\n```"
+
+
+GENERATED = {"sweeps": sweeps, "robustness": robustness, "quickstart": quickstart}
 
 
 # --- running the commands, checking, updating ----------------------------------------------

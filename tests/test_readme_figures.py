@@ -29,6 +29,7 @@ def test_the_moved_blocks_are_on_the_docs_pages():
         INSTALL,
         ".venv/bin/python tests/readme_figures.py sweeps",
         ".venv/bin/python tests/readme_figures.py robustness",
+        ".venv/bin/python tests/readme_figures.py quickstart",
     } <= commands
 
 
