@@ -5,10 +5,10 @@
 Every run_sweep ends by drawing sweep.png from the cases table (pendulum_fmu/sweep/figure.py's
 draw): a serial tail on the client after the workers are done. Two studies of short cases
 (10 ms, no trajectories) are run once on one local worker, with the pendulum FMU built from this
-checkout; then draw is timed on each study's cases table, CPU (time.process_time) and wall, the
-least of REPEATS, after a first draw that imports matplotlib (printed apart: a fresh client pays
-it once). The comparison figure of a 3-s run, which _plot.py finishes the same way, is timed
-alike. The machine's load average is printed before and after.
+checkout (their runs import matplotlib, which a client pays once); then draw is timed on each
+study's cases table, CPU (time.process_time) and wall, the least of REPEATS. The comparison
+figure of a 3-s run, which _plot.py finishes the same way, is timed alike. The machine's load
+average is printed before and after: run the benchmark of two checkouts in turn to compare them.
 """
 
 from __future__ import annotations
@@ -82,8 +82,6 @@ def main() -> None:
             for torques, gravities in STUDIES
         }
         print(f"{cpu_model()}, {os.cpu_count()} cores; load average {os.getloadavg()[0]:.2f} before")
-        first = cpu_and_wall(next(iter(figures.values())))
-        print(f"first draw in the process (imports matplotlib): CPU {first[0]:.3f} s, wall {first[1]:.3f} s")
         figures["comparison figure, 3-s run"] = comparison_figure(scratch, fmu)
         print(f"{'figure':32} {'CPU s':>7} {'wall s':>7}   (least of {REPEATS})")
         for name, draw in figures.items():

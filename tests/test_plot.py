@@ -4,6 +4,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from matplotlib import rcParams
 
 from pendulum_fmu import _plot as plot, _results as results
 from pendulum_fmu._reference import reference
@@ -67,6 +68,35 @@ def test_several_cases_per_value_draw_the_median_and_two_bands(drawn, tmp_path):
     assert np.allclose(median.get_ydata(), [np.median(y[:20]), np.median(y[20:])], rtol=0, atol=1e-15)
     assert _legend(ax) == ["5%-95% of cases", "25%-75% of cases", "median"]
     assert ax.get_xlabel() == "gravity in m/s2"
+
+
+def test_figures_lie_where_tight_layout_puts_them_inside_the_page_at_120_dpi(drawn, tmp_path):
+    # _finish lays out in one measuring pass, on the renderer the file is drawn with: the axes
+    # must land where matplotlib's own fig.tight_layout() puts them, everything drawn must lie
+    # inside the page, and the PNG must have 120 dots per inch.
+    rng = np.random.default_rng(11)
+    torque, gravity = np.repeat(np.linspace(0.0, 40.0, 8), 30), np.tile(np.linspace(0.0, 20.0, 30), 8)
+    summaries = {
+        "max |theta| in rad": 1e-5 * torque * rng.uniform(0.5, 1.5, 240),
+        "final theta in rad": 1e4 * rng.normal(size=240),
+    }
+    plot.plot_case_bands({"torque": torque, "gravity": gravity}, summaries, tmp_path / "bands.png", "bands")
+    base = _run(np.linspace(0.0, 1.0, 50))
+    plot.plot_comparison({"reference": base, "fmu": _run(base["theta"] + 1e-9)}, tmp_path / "compared.png", "compared")
+    for (fig, axes, _), name in zip(drawn, ("bands.png", "compared.png"), strict=True):
+        inked = fig.get_tightbbox(fig.canvas.get_renderer())  # inches
+        assert 0 <= inked.x0 and inked.x1 <= fig.get_figwidth() and 0 <= inked.y0 and inked.y1 <= fig.get_figheight()
+        laid_out = [ax.get_position().bounds for ax in axes]
+        fig.subplots_adjust(**{name: rcParams[f"figure.subplot.{name}"] for name in fig.subplotpars.__dict__})
+        fig.tight_layout()  # from where _finish started: tight_layout moves a figure laid out already
+        assert np.allclose([ax.get_position().bounds for ax in axes], laid_out, rtol=0, atol=1e-12)
+        header = (tmp_path / name).read_bytes()[16:24]  # the PNG's IHDR: width, height
+        width, height = int.from_bytes(header[:4], "big"), int.from_bytes(header[4:], "big")
+        assert (width, height) == (round(120 * fig.get_figwidth()), round(120 * fig.get_figheight()))
+    # A column's panels share its x values: only the bottom one writes them.
+    _, (top_left, _, bottom_left, _), _ = drawn[0]
+    assert not any(label.get_visible() for label in top_left.get_xticklabels())
+    assert {"0", "40"} <= {label.get_text() for label in bottom_left.get_xticklabels() if label.get_visible()}
 
 
 def _run(theta, omega=None):
