@@ -109,7 +109,9 @@ def dask_process_handles(
                 process.wait(timeout=30)
 
 
-def measure_client(address: str, cases: int, stop_time: float, fmu: str, output_dir: str) -> None:
+def measure_client(
+    address: str, cases: int, stop_time: float, fmu: str, output_dir: str, outputs: Sequence[str] | None = None
+) -> None:
     """Run in the client process: the sweep; prints its figures as JSON."""
     import resource
 
@@ -133,8 +135,12 @@ def measure_client(address: str, cases: int, stop_time: float, fmu: str, output_
         progress=False,
     )
     before = cpu()
+    chosen = {} if outputs is None else {"outputs": outputs}
     result = sweep.run_sweep(
-        sweep.Study(grid, stop_time=stop_time, fmu_path=fmu), output_dir=output_dir, scheduler=address, progress=False
+        sweep.Study(grid, stop_time=stop_time, fmu_path=fmu, **chosen),
+        output_dir=output_dir,
+        scheduler=address,
+        progress=False,
     )
     client_cpu = cpu() - before
     print(
@@ -179,11 +185,14 @@ def _control_speedup(fmu: BuiltFmu, processes: int, cases: int = 200) -> float:
     return processes * seconds[1] / seconds[processes]
 
 
-def _study(address: str, cases: int, stop_time: float, fmu: BuiltFmu) -> dict:
+def _study(address: str, cases: int, stop_time: float, fmu: BuiltFmu, outputs: Sequence[str] | None = None) -> dict:
+    """measure_client's figures of a study run from a client process of its own; outputs: the
+    study's (None: the default, every output).
+    """
     with tempfile.TemporaryDirectory(prefix="pendulum-scale-") as out:
         code = (
             f"from benchmarks.scale import measure_client; measure_client({address!r}, {cases}, "
-            f"{stop_time}, {str(fmu.path)!r}, {out!r})"
+            f"{stop_time}, {str(fmu.path)!r}, {out!r}, {None if outputs is None else list(outputs)!r})"
         )
         done = subprocess.run([sys.executable, "-c", code], cwd=REPOSITORY, capture_output=True, text=True, check=True)
         result = json.loads(done.stdout.strip().splitlines()[-1])
@@ -209,6 +218,14 @@ def _cpu_seconds(process: subprocess.Popen) -> float:
 
     times = psutil.Process(process.pid).cpu_times()
     return times.user + times.system
+
+
+def _cpu_seconds_with_children(process: subprocess.Popen) -> float:
+    """CPU of a process and of its children (a worker's nanny and the worker it runs)."""
+    import psutil
+
+    parent = psutil.Process(process.pid)
+    return sum(sum(member.cpu_times()[:2]) for member in (parent, *parent.children(recursive=True)))
 
 
 def scale_rows(fmu: BuiltFmu, quick: bool, cases: int | None = None) -> list[Row]:
