@@ -28,7 +28,7 @@ import numpy as np
 from .builds import BuiltFmu, build_pendulum_fmu
 from .chunk_cost import native_loop_cpu
 from .report import Row, as_text, main_table
-from .scale import _cpu_seconds, _cpu_seconds_with_children, _study, dask_process_handles
+from .scale import _study, dask_process_handles
 
 PART = "scale"
 STOP_TIME = 3.0
@@ -50,17 +50,12 @@ class StudyCost:
 
 
 def _measured(address: str, processes, cases: int, fmu: BuiltFmu, outputs) -> StudyCost:
-    scheduler, workers = processes[0], processes[1:]
-    before = _cpu_seconds(scheduler), sum(map(_cpu_seconds_with_children, workers))
-    result = _study(address, cases, STOP_TIME, fmu, outputs)
-    return StudyCost(
-        result["seconds"],
-        {
-            "workers": sum(map(_cpu_seconds_with_children, workers)) - before[1],
-            "client": result["cpu"],
-            "scheduler": _cpu_seconds(scheduler) - before[0],
-        },
-    )
+    """A study's cost, each process's CPU over the study alone (the client process's start and
+    its warm-up study left out).
+    """
+    result = _study(address, cases, STOP_TIME, fmu, outputs, [process.pid for process in processes])
+    scheduler, *workers = result["others_cpu"]
+    return StudyCost(result["seconds"], {"workers": sum(workers), "client": result["cpu"], "scheduler": scheduler})
 
 
 def measure(fmu: BuiltFmu, small: int, rounds: int) -> dict:
