@@ -277,6 +277,57 @@ def test_finished_chunks_are_gathered_together_and_none_awaited_once_all_are_in(
     assert finished.empty()
 
 
+def test_the_chunks_that_ran_are_committed_before_one_that_failed_with_them_raises():
+    """A chunk that fails (a full disk) in a batch of chunks that finished together: the others
+    of the batch are committed first, so --resume keeps them.
+    """
+    from pendulum_fmu.sweep import client
+
+    class Finished:
+        def __init__(self, index, error=None):
+            self.index, self.error = index, error
+            self.status = "error" if error else "finished"
+
+        def add_done_callback(self, callback):
+            callback(self)  # already done
+
+        def result(self):
+            raise self.error
+
+        def release(self):
+            pass
+
+    class Cluster:
+        def map(self, function, indices, firsts, values, tasks, pure):
+            return [Finished(i, OSError("No space left on device") if i == 1 else None) for i in indices]
+
+        def gather(self, futures):
+            assert all(future.status == "finished" for future in futures)
+            return [(future.index, 1, 0, 10, 0.0, 0.0) for future in futures]
+
+    committed = []
+
+    class Store:
+        def commit(self, index, run, tables):
+            committed.append(index)
+
+    task = Task("fmu", Store(), 1.0, 0.1, (), 1, "run")
+    with pytest.raises(OSError, match="No space"):
+        client.run_chunks(Cluster(), task, [(i, i, {}) for i in range(3)], _Bar())
+    assert committed == [0, 2]
+
+
+class _Bar:
+    def set_postfix_str(self, text, refresh):
+        pass
+
+    def update(self, count):
+        pass
+
+    def refresh(self):
+        pass
+
+
 def test_a_run_commits_only_the_parts_staged_under_its_own_token(tmp_path):
     store = Store(LocalFileSystem(), str(tmp_path), "parquet")
     store.write_table("cases", 0, {"case": np.arange(3)}, "other-run")
