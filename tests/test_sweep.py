@@ -174,6 +174,13 @@ def test_a_study_on_an_fmu_with_other_outputs_chooses_and_records_by_its_own(tmp
         assert table["max_abs_theta"][number] == np.max(np.abs(trajectories["theta"][rows]))
         # Not an output of this FMU: not computed, so NaN, never zeros.
         assert np.isnan(table["final_alpha"][number]) and table["status"][number] == "ok"
+    # The command without --outputs keeps them all, as Study does: the same table.
+    command = ["sweep", "--torque", "5", "20", "--gravity", "0", "9.81", "--stop-time", str(STOP_TIME)]
+    command += ["--output-dir", str(tmp_path / "command"), "--scheduler", threads_scheduler, "--fmu", str(fmu)]
+    assert main(command) == 0
+    assert {name: column.tolist() for name, column in _table(tmp_path / "command" / "trajectories").items()} == {
+        name: column.tolist() for name, column in trajectories.items()
+    }
 
 
 def test_a_case_the_fmu_refuses_is_recorded_and_the_rest_go_on(tmp_path, threads_scheduler):

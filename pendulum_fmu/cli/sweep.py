@@ -23,7 +23,10 @@ def _sweep_values(assignments) -> dict[str, list[float]]:
     return values
 
 
-def _sweep_outputs(text: str) -> tuple[str, ...]:
+def _sweep_outputs(text: str | None) -> tuple[str, ...] | None:
+    """--outputs as Study takes it: None (not given) keeps all the FMU's outputs."""
+    if text is None:
+        return None
     return () if text.strip() == "none" else tuple(name.strip() for name in text.split(","))
 
 
@@ -62,8 +65,8 @@ def add_parser(commands) -> argparse.ArgumentParser:
     )
     sweep.add_argument(
         "--outputs",
-        default="theta,omega,alpha",
-        help="outputs the trajectories keep, comma-separated, or none for only the cases table (default: %(default)s)",
+        help="outputs of the FMU the trajectories keep, comma-separated, or none for only the cases table "
+        "(default: all of them; the default FMU's are theta,omega,alpha)",
     )
     sweep.add_argument(
         "--output-interval",
