@@ -23,10 +23,7 @@ def _sweep_values(assignments) -> dict[str, list[float]]:
     return values
 
 
-def _sweep_outputs(text: str | None) -> tuple[str, ...] | None:
-    """--outputs as Study takes it: None (not given) keeps all the FMU's outputs."""
-    if text is None:
-        return None
+def _sweep_outputs(text: str) -> tuple[str, ...]:
     return () if text.strip() == "none" else tuple(name.strip() for name in text.split(","))
 
 
@@ -113,11 +110,13 @@ def run(args) -> int:
     """Run `pendulum-fmu sweep` with the parsed arguments; returns the exit status."""
     from ..sweep import Study, run_sweep, sweep_grid
 
+    # Without --outputs, Study's default: all of its FMU's outputs.
+    chosen = {} if args.outputs is None else {"outputs": _sweep_outputs(args.outputs)}
     study = Study(
         sweep_grid(args.torque, args.gravity, _sweep_values(args.assignments)),
         stop_time=args.stop_time,
         step_size=args.step_size,
-        outputs=_sweep_outputs(args.outputs),
+        **chosen,
         output_interval=args.output_interval,
         format=args.format,
         fmu_path=args.fmu,

@@ -17,6 +17,16 @@ from .._time_grid import communication_points
 from .grid import Grid, check_cases, columns
 
 FORMATS = ("parquet", "csv")
+
+
+class _AllOutputs(tuple):
+    """The default of Study's outputs: all of its FMU's, known only once the FMU is read."""
+
+    def __repr__(self) -> str:
+        return "<all of the FMU's outputs>"
+
+
+ALL_OUTPUTS: tuple[str, ...] = _AllOutputs()
 # A study is cut into about this many chunks, so that up to 16 workers each get several (the
 # load evens out and progress shows), but no chunk holds more than MAX_CHUNK_CASES cases, so a
 # lost worker loses little; more only where its cases are short, up to MAX_CHUNK_STEPS steps in
@@ -78,7 +88,7 @@ class Study:
     cases: Grid | Sequence[dict]
     stop_time: float = 3.0
     step_size: float = 1e-3
-    outputs: Sequence[str] | None = None
+    outputs: Sequence[str] = ALL_OUTPUTS
     output_interval: float | None = None
     format: str = "parquet"
     fmu_path: str | Path | None = None
@@ -99,7 +109,7 @@ class Study:
         derived["points"] = len(communication_points(0.0, self.stop_time, self.step_size))
         if isinstance(self.outputs, str):
             raise WrongType(f"outputs is a list of names, e.g. ['theta'], not the string {self.outputs!r}")
-        derived["outputs"] = outputs = model.outputs if self.outputs is None else tuple(self.outputs)
+        derived["outputs"] = outputs = model.outputs if self.outputs is ALL_OUTPUTS else tuple(self.outputs)
         for name in outputs:
             if name not in model.outputs or outputs.count(name) > 1:
                 raise InvalidInput(
