@@ -13,6 +13,7 @@ from pathlib import Path
 
 from .accuracy_cost import accuracy_cost_rows
 from .builds import build_null_fmu, build_pendulum_fmu, build_step_master
+from .case_cost import case_cost_rows
 from .fixed_cost import fixed_cost_rows
 from .floor import floor_rows
 from .own_cost import own_cost_rows
@@ -93,7 +94,7 @@ def main(argv=None) -> int:
             elif part == "pythonfmu":
                 rows += pythonfmu_rows(pendulum, scratch, repetitions)
             elif part == "scale":
-                rows += scale_rows(pendulum, args.quick)
+                rows += scale_rows(pendulum, args.quick) + case_cost_rows(pendulum, args.quick)
     tables = [main_table(rows)] + ([grid] if grid else [])
     print("\n\n".join(as_text(table) for table in tables))
     if args.markdown:

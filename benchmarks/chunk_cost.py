@@ -63,11 +63,14 @@ def chunk_cpu(outputs: tuple[str, ...]) -> tuple[float, float, float]:
     return min(rounds)
 
 
-def native_loop_cpu() -> float:
-    """CPU per case of the same cases through Stepper.run, a restart per call, nothing written."""
-    runner = _runner(str(default_fmu()))
+def native_loop_cpu(fmu: str | None = None, values: dict[str, np.ndarray] | None = None) -> float:
+    """CPU per case of the same cases (or those of values, {name: column}) through Stepper.run,
+    a restart per call, nothing written, over CHUNKS times the cases.
+    """
+    runner = _runner(fmu or str(default_fmu()))
     points = communication_points(0.0, STOP_TIME, STEP_SIZE)
-    start_values = runner.start_values(_values(), CASES)
+    values = _values() if values is None else values
+    start_values = runner.start_values(values, len(next(iter(values.values()))))
     outputs = np.empty((len(points), len(OUTPUTS)))
     rounds = []
     for _ in range(ROUNDS):
@@ -75,7 +78,7 @@ def native_loop_cpu() -> float:
         for _ in range(CHUNKS):
             for case in start_values:
                 runner.stepper.run(points, None, None, outputs, start_values=case)
-        rounds.append((time.thread_time() - started) / (CHUNKS * CASES))
+        rounds.append((time.thread_time() - started) / (CHUNKS * len(start_values)))
     return min(rounds)
 
 

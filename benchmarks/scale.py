@@ -109,8 +109,18 @@ def dask_process_handles(
                 process.wait(timeout=30)
 
 
-def measure_client(address: str, cases: int, stop_time: float, fmu: str, output_dir: str) -> None:
-    """Run in the client process: the sweep; prints its figures as JSON."""
+def measure_client(
+    address: str,
+    cases: int,
+    stop_time: float,
+    fmu: str,
+    output_dir: str,
+    outputs: Sequence[str] | None = None,
+    others: Sequence[int] = (),
+) -> None:
+    """Run in the client process: the sweep; prints its figures as JSON. others: the process ids
+    whose CPU (with their children's) over the study itself is reported too ("others_cpu").
+    """
     import resource
 
     import numpy as np
@@ -132,11 +142,17 @@ def measure_client(address: str, cases: int, stop_time: float, fmu: str, output_
         scheduler=address,
         progress=False,
     )
+    others_before = [_pid_cpu_seconds(pid) for pid in others]
     before = cpu()
+    chosen = {} if outputs is None else {"outputs": outputs}
     result = sweep.run_sweep(
-        sweep.Study(grid, stop_time=stop_time, fmu_path=fmu), output_dir=output_dir, scheduler=address, progress=False
+        sweep.Study(grid, stop_time=stop_time, fmu_path=fmu, **chosen),
+        output_dir=output_dir,
+        scheduler=address,
+        progress=False,
     )
     client_cpu = cpu() - before
+    others_cpu = [_pid_cpu_seconds(pid) - seconds for pid, seconds in zip(others, others_before, strict=True)]
     print(
         json.dumps(
             {
@@ -149,6 +165,7 @@ def measure_client(address: str, cases: int, stop_time: float, fmu: str, output_
                 "worker_cpu": result.worker_cpu_seconds,
                 "worker_stepping": result.worker_stepping_seconds,
                 "peak_rss": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024,
+                "others_cpu": others_cpu,
             }
         )
     )
@@ -179,11 +196,22 @@ def _control_speedup(fmu: BuiltFmu, processes: int, cases: int = 200) -> float:
     return processes * seconds[1] / seconds[processes]
 
 
-def _study(address: str, cases: int, stop_time: float, fmu: BuiltFmu) -> dict:
+def _study(
+    address: str,
+    cases: int,
+    stop_time: float,
+    fmu: BuiltFmu,
+    outputs: Sequence[str] | None = None,
+    others: Sequence[int] = (),
+) -> dict:
+    """measure_client's figures of a study run from a client process of its own; outputs: the
+    study's (None: the default, every output); others: as measure_client's.
+    """
     with tempfile.TemporaryDirectory(prefix="pendulum-scale-") as out:
         code = (
             f"from benchmarks.scale import measure_client; measure_client({address!r}, {cases}, "
-            f"{stop_time}, {str(fmu.path)!r}, {out!r})"
+            f"{stop_time}, {str(fmu.path)!r}, {out!r}, {None if outputs is None else list(outputs)!r}, "
+            f"{list(others)!r})"
         )
         done = subprocess.run([sys.executable, "-c", code], cwd=REPOSITORY, capture_output=True, text=True, check=True)
         result = json.loads(done.stdout.strip().splitlines()[-1])
@@ -209,6 +237,14 @@ def _cpu_seconds(process: subprocess.Popen) -> float:
 
     times = psutil.Process(process.pid).cpu_times()
     return times.user + times.system
+
+
+def _pid_cpu_seconds(pid: int) -> float:
+    """CPU of a process and of its children (a worker's nanny and the worker it runs)."""
+    import psutil
+
+    parent = psutil.Process(pid)
+    return sum(sum(member.cpu_times()[:2]) for member in (parent, *parent.children(recursive=True)))
 
 
 def scale_rows(fmu: BuiltFmu, quick: bool, cases: int | None = None) -> list[Row]:

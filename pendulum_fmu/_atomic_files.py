@@ -75,25 +75,36 @@ def _temporary_beside(path: Path, suffix: str) -> tuple[int, str]:
     open() would give (mkstemp's are 0600, which would hide an FMU or a table from the other users
     of a shared folder).
     """
-    for folder in (path.parent, *path.parent.parents):
-        if folder.exists() and not folder.is_dir():
-            raise CannotWrite(f"cannot write {path}: {folder} is a file, not a folder; choose another output path")
-    make_folder(path.parent, path)
     try:
-        descriptor, temporary = tempfile.mkstemp(
-            prefix=f".{path.name[:_NAME_IN_TEMPORARY]}.", suffix=suffix[:_NAME_IN_TEMPORARY], dir=path.parent
-        )
-    except OSError as error:
-        raise CannotWrite(
-            f"cannot write {path}: no file can be created in {path.parent} "
-            f"({error.strerror}); choose another output path"
-        ) from None
+        descriptor, temporary = _new_file_beside(path, suffix)
+    except OSError:
+        # Only now the folders on the way, which cost a few system calls each: a sweep's worker
+        # writes two files per chunk into a folder that exists.
+        for folder in (path.parent, *path.parent.parents):
+            if folder.exists() and not folder.is_dir():
+                raise CannotWrite(
+                    f"cannot write {path}: {folder} is a file, not a folder; choose another output path"
+                ) from None
+        make_folder(path.parent, path)
+        try:
+            descriptor, temporary = _new_file_beside(path, suffix)
+        except OSError as error:
+            raise CannotWrite(
+                f"cannot write {path}: no file can be created in {path.parent} "
+                f"({error.strerror}); choose another output path"
+            ) from None
     try:
         permissions = stat.S_IMODE(path.stat().st_mode)
     except OSError:
         permissions = 0o666 & ~_UMASK
     os.chmod(temporary, permissions)
     return descriptor, temporary
+
+
+def _new_file_beside(path: Path, suffix: str) -> tuple[int, str]:
+    return tempfile.mkstemp(
+        prefix=f".{path.name[:_NAME_IN_TEMPORARY]}.", suffix=suffix[:_NAME_IN_TEMPORARY], dir=path.parent
+    )
 
 
 def make_folder(folder: Path, target, choice: str = "output path") -> None:

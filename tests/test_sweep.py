@@ -301,6 +301,30 @@ def test_a_stale_workers_part_never_enters_the_study_that_replaced_its_own(tmp_p
     assert not list(tmp_path.glob("*/_part-*"))  # and the stale parts are gone
 
 
+def test_finished_chunks_are_gathered_together_and_none_awaited_once_all_are_in(monkeypatch):
+    """The client asks for the results of the chunks that finished together in one request,
+    waiting a moment for more, but not once every chunk it waits for is in.
+    """
+    import queue
+
+    from pendulum_fmu.sweep import client
+
+    finished = queue.SimpleQueue()
+    for future in ("a", "b", "c"):
+        finished.put(future)
+    # All three it waits for are in: it returns them without waiting out the window.
+    monkeypatch.setattr(client, "GATHER_SECONDS", 30.0)
+    started = time.monotonic()
+    assert client._finished_together(finished, 3) == ["a", "b", "c"]
+    assert time.monotonic() - started < 30.0
+    # More to come than are in: it waits out the window, then returns those that came.
+    for future in ("d", "e"):
+        finished.put(future)
+    monkeypatch.setattr(client, "GATHER_SECONDS", 0.05)
+    assert client._finished_together(finished, 4) == ["d", "e"]
+    assert finished.empty()
+
+
 def test_a_run_commits_only_the_parts_staged_under_its_own_token(tmp_path):
     store = Store(LocalFileSystem(), str(tmp_path), "parquet")
     store.write_table("cases", 0, {"case": np.arange(3)}, "other-run")

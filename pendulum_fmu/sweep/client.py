@@ -13,6 +13,7 @@ import queue
 import signal
 import sys
 import threading
+import time
 from collections.abc import Iterable
 from dataclasses import dataclass
 
@@ -229,23 +230,50 @@ def run_chunks(client, task: Task, chunks: Iterable[tuple[int, int, dict]], bar)
     finishes.
     """
     totals = Totals()
-    futures = [client.submit(run_chunk, index, first, values, task, pure=False) for index, first, values in chunks]
+    chunks = list(chunks)
+    indices, firsts, values = ([chunk[part] for chunk in chunks] for part in range(3))
+    # One request for all the chunks, and one for the results of those that finished together:
+    # each request costs the scheduler and this client about a millisecond, as much as a chunk's
+    # bookkeeping on its worker (python -m benchmarks.client_cost).
+    futures = client.map(run_chunk, indices, firsts, values, [task] * len(chunks), pure=False)
     # Done callbacks rather than as_completed: on Ctrl-C no waiting coroutine is left to fail,
     # with a traceback, when the cluster closes.
     finished: queue.SimpleQueue = queue.SimpleQueue()
     for future in futures:
         future.add_done_callback(finished.put)
-    for _ in futures:
-        future = finished.get()
-        index, count, failed, written, cpu, stepping = future.result()
-        task.store.commit(index, task.run, task.tables())
-        totals.failed += failed
-        totals.bytes += written
-        totals.worker_cpu_seconds += cpu
-        totals.worker_stepping_seconds += stepping
-        future.release()
-        bar.set_postfix_str(f"{totals.failed} failed", refresh=False)
-        bar.update(count)
+    waiting = len(futures)
+    while waiting:
+        batch = _finished_together(finished, waiting)
+        waiting -= len(batch)
+        for index, count, failed, written, cpu, stepping in client.gather(batch):
+            task.store.commit(index, task.run, task.tables())
+            totals.failed += failed
+            totals.bytes += written
+            totals.worker_cpu_seconds += cpu
+            totals.worker_stepping_seconds += stepping
+            bar.set_postfix_str(f"{totals.failed} failed", refresh=False)
+            bar.update(count)
+        for future in batch:
+            future.release()
     if futures:
         bar.refresh()  # the last count, which a log would otherwise miss
     return totals
+
+
+# How long the client lets finished chunks gather before it asks for their results: as long as
+# the progress line waits between redraws on a terminal.
+GATHER_SECONDS = 0.2
+
+
+def _finished_together(finished: queue.SimpleQueue, waiting: int) -> list:
+    """The next finished futures: the first to come, and those that finish within GATHER_SECONDS
+    of it (none more once all `waiting` are in).
+    """
+    batch = [finished.get()]
+    deadline = time.monotonic() + GATHER_SECONDS
+    while len(batch) < waiting:
+        try:
+            batch.append(finished.get(timeout=max(0.0, deadline - time.monotonic())))
+        except queue.Empty:
+            break
+    return batch

@@ -89,9 +89,12 @@ class Store:
         """Where a worker of run writes a chunk's part, for the run's client to commit."""
         return f"{self.root}/{table}/_part-{index:06d}.{run}.staged"
 
-    def write_table(self, name: str, index: int, columns: dict, run: str, split: tuple = ()) -> int:
+    def write_table(
+        self, name: str, index: int, columns: dict, run: str, split: tuple = (), unsummarized: tuple = ()
+    ) -> int:
         """Write one part of a table, staged for run (see commit); returns its size in bytes.
-        split: float columns stored byte-stream-split, as smooth series compress best.
+        split: float columns stored byte-stream-split, as smooth series compress best;
+        unsummarized: columns written without min/max statistics in Parquet.
         """
         import pyarrow as pa
 
@@ -108,13 +111,17 @@ class Store:
                 # Measured on trajectories (python -m benchmarks.chunk_cost, docs/sweep_performance.md):
                 # LZ4 after byte-stream-split is within 2 % of zstd's size (57 kB for a 3-s case)
                 # for about two thirds of its CPU, and 23 % smaller than LZ4 alone; dictionaries
-                # only where values repeat within a column (case numbers, status).
+                # only where values repeat within a column (case numbers, status). Min/max
+                # statistics let readers skip a part by its case numbers or times; on a series
+                # that spans its whole range in every case they would skip nothing, for about 5 %
+                # of a case's CPU.
                 pq.write_table(
                     table,
                     file,
                     compression="lz4",
                     use_dictionary=[c for c in table.column_names if c not in split],
                     column_encoding={c: "BYTE_STREAM_SPLIT" for c in split},
+                    write_statistics=[c for c in table.column_names if c not in unsummarized],
                 )
             else:
                 import pyarrow.csv

@@ -116,7 +116,8 @@ def _runner(fmu: str) -> Runner:
 
 def kept_points(points: int, stride: int) -> np.ndarray:
     """Indices of the communication points written: every stride-th, and the last."""
-    return np.unique(np.append(np.arange(0, points, stride), points - 1))
+    every = np.arange(0, points, stride)
+    return every if every[-1] == points - 1 else np.append(every, points - 1)
 
 
 def run_chunk(index: int, first: int, values: dict[str, np.ndarray], task: Task) -> tuple:
@@ -154,6 +155,7 @@ def run_chunk(index: int, first: int, values: dict[str, np.ndarray], task: Task)
             },
             task.run,
             split=("time", *task.outputs),
+            unsummarized=task.outputs,
         )
     # The summaries by name; NaN (never zeros) for a variable the FMU does not output.
     not_output = np.full((count, 1), np.nan)

@@ -1,0 +1,144 @@
+"""A sweep's CPU per case over all its processes, against the C loop's: issue 32's targets.
+
+    .venv/bin/python -m benchmarks.case_cost           # also part of --only scale
+    .venv/bin/python -m benchmarks.case_cost --quick
+
+A `dask scheduler` and 1 or 2 `dask worker`s (each under its nanny, one thread) on localhost run
+studies of 3-s cases at 1 ms steps from a client process of their own (scale.py's
+measure_client, warmed by a small study), with every output written and with none (--outputs
+none), of SMALL and 4 x SMALL cases. A study's CPU is summed over every process: the workers with
+their nannies, the client, the scheduler. Reported per case, as a multiple of the C loop's (the
+same cases through the native loop in one process, a restart per case, nothing written):
+- at 4 x SMALL cases, everything included (starting, the figure);
+- marginal: what the larger study cost beyond the smaller, per added case, by process: what a
+  case costs in a study so large that its fixed costs no longer count.
+And the speed-up of 2 workers over 1, end to end, at each size. Each figure is the least of the
+rounds (other work on a shared machine only adds); the machine's load is printed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import os
+from dataclasses import dataclass
+
+import numpy as np
+
+from .builds import BuiltFmu, build_pendulum_fmu
+from .chunk_cost import native_loop_cpu
+from .report import Row, as_text, main_table
+from .scale import _study, dask_process_handles
+
+PART = "scale"
+STOP_TIME = 3.0
+ALL_OUTPUTS_TARGET = 1.6  # x the C loop's CPU per case (issue 32)
+NO_OUTPUTS_TARGET = 1.15
+SPEED_UP_TARGET = 1.7  # 2 workers over 1, end to end, on a quiet machine
+PROCESSES = ("workers", "client", "scheduler")
+
+
+@dataclass(frozen=True)
+class StudyCost:
+    """A study's wall time and each process's CPU seconds."""
+
+    seconds: float
+    cpu: dict[str, float]
+
+    def total(self) -> float:
+        return sum(self.cpu.values())
+
+
+def _measured(address: str, processes, cases: int, fmu: BuiltFmu, outputs) -> StudyCost:
+    """A study's cost, each process's CPU over the study alone (the client process's start and
+    its warm-up study left out).
+    """
+    result = _study(address, cases, STOP_TIME, fmu, outputs, [process.pid for process in processes])
+    scheduler, *workers = result["others_cpu"]
+    return StudyCost(result["seconds"], {"workers": sum(workers), "client": result["cpu"], "scheduler": scheduler})
+
+
+def measure(fmu: BuiltFmu, small: int, rounds: int) -> dict:
+    """{(workers, outputs label, cases): the round of least CPU (and, apart, of least wall time)}."""
+    kinds = {"all outputs": None, "--outputs none": ()}
+    sizes = (small, 4 * small)
+    costs: dict[tuple, list[StudyCost]] = {}
+    with contextlib.ExitStack() as clusters:
+        handles = {workers: clusters.enter_context(dask_process_handles(workers)) for workers in (1, 2)}
+        # Rounds alternate between every setting, so that a change in the machine's speed falls
+        # on all alike.
+        for _ in range(rounds):
+            for workers, (address, processes) in handles.items():
+                for label, outputs in kinds.items():
+                    for cases in sizes:
+                        cost = _measured(address, processes, cases, fmu, outputs)
+                        costs.setdefault((workers, label, cases), []).append(cost)
+    return {key: (min(runs, key=StudyCost.total), min(run.seconds for run in runs)) for key, runs in costs.items()}
+
+
+def case_cost_rows(fmu: BuiltFmu, quick: bool) -> list[Row]:
+    """The part's rows: CPU per case against the C loop's, at a size and marginal; the speed-up."""
+    small, rounds = (1024, 1) if quick else (4096, 2)
+    load = os.getloadavg()[0]
+    # The studies' own cases (scale.py's grid: torques from 5 to 40 N.m, gravity 0 and 9.81).
+    c_loop = native_loop_cpu(
+        str(fmu.path), {"torque": np.tile(np.linspace(5.0, 40.0, 32), 2), "gravity": np.repeat([0.0, 9.81], 32)}
+    )
+    measured = measure(fmu, small, rounds)
+    large = 4 * small
+    rows = [
+        Row(PART, "case cost: load average before", f"{load:.1f} (2-core figures need a quiet machine)"),
+        Row(PART, "case cost: C loop CPU per 3-s case (native loop, a restart per case)", f"{c_loop * 1e3:.3f} ms"),
+    ]
+    for label, target in (("all outputs", ALL_OUTPUTS_TARGET), ("--outputs none", NO_OUTPUTS_TARGET)):
+        for workers in (1, 2):
+            (big, _), (little, _) = measured[(workers, label, large)], measured[(workers, label, small)]
+            at_size = big.total() / large / c_loop
+            marginal = {name: (big.cpu[name] - little.cpu[name]) / (large - small) for name in PROCESSES}
+            ratio = sum(marginal.values()) / c_loop
+            breakdown = ", ".join(f"{name} {marginal[name] * 1e3:.3f}" for name in PROCESSES)
+            fixed = ", ".join(f"{name} {little.cpu[name] - marginal[name] * small:.2f}" for name in PROCESSES)
+            rows += [
+                Row(
+                    PART,
+                    f"case cost, {label}, {workers} worker(s): CPU per case, all processes, {large} cases",
+                    f"{at_size:.2f} x the C loop ({big.total() / large * 1e3:.3f} ms)",
+                    f"<= {target:g} x",
+                    at_size <= target,
+                ),
+                Row(
+                    PART,
+                    f"case cost, {label}, {workers} worker(s): marginal CPU per case ({small} -> {large} cases)",
+                    f"{ratio:.2f} x the C loop ({breakdown} ms)",
+                    f"<= {target:g} x",
+                    ratio <= target,
+                ),
+                Row(PART, f"case cost, {label}, {workers} worker(s): fixed CPU per study", f"{fixed} s"),
+            ]
+    for cases in (small, large):
+        (_, one), (_, two) = measured[(1, "all outputs", cases)], measured[(2, "all outputs", cases)]
+        rows.append(
+            Row(
+                PART,
+                f"case cost: 2 workers over 1, end to end, {cases} cases, all outputs",
+                f"{one / two:.2f} ({one:.2f} s / {two:.2f} s)",
+                f">= {SPEED_UP_TARGET:g}",
+                one / two >= SPEED_UP_TARGET,
+            )
+        )
+    return rows
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="1,024 and 4,096 cases, one round")
+    args = parser.parse_args()
+    import tempfile
+    from pathlib import Path
+
+    with tempfile.TemporaryDirectory(prefix="pendulum-case-cost-") as scratch:
+        print(as_text(main_table(case_cost_rows(build_pendulum_fmu(Path(scratch)), args.quick))))
+
+
+if __name__ == "__main__":
+    main()
