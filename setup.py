@@ -40,6 +40,7 @@ class BuildPyWithFmu(build_py):
         # An editable install runs from the checkout, which builds dist/Pendulum.fmu on demand.
         if getattr(self, "editable_mode", False):
             return
+        _remove_stale_modules(Path(self.build_lib, "pendulum_fmu"))
         from fmu_build import build_fmu, build_pid_controller
         from pendulum_fmu import CONTROLLER_FMU_FILE, FMU_FILES, __version__
         from pendulum_fmu._errors import PlatformSkipped
@@ -62,6 +63,17 @@ class BuildPyWithFmu(build_py):
             for warning in skipped:
                 print(f"pendulum_fmu {__version__}: {what} without {warning.message}", file=sys.stderr)
             print(f"pendulum_fmu {__version__}: built {fmu} ({', '.join(fmu_platforms(fmu))})")
+
+
+def _remove_stale_modules(built: Path) -> None:
+    """Remove from the build folder the modules this tree no longer has: build_py copies into a
+    build/lib that an earlier build of the same checkout left, and never removes what was renamed
+    or deleted since, which the wheel would then carry.
+    """
+    source = Path(__file__).resolve().parent / "pendulum_fmu"
+    for module in built.rglob("*.py"):
+        if not (source / module.relative_to(built)).exists():
+            module.unlink()
 
 
 class BuildNativeLoop(build_ext):

@@ -27,8 +27,8 @@ from fsspec.implementations.local import LocalFileSystem
 
 from pendulum_fmu import default_fmu
 from pendulum_fmu._time_grid import communication_points
+from pendulum_fmu.sweep import OUTPUTS
 from pendulum_fmu.sweep.store import Store
-from pendulum_fmu.sweep.study import OUTPUTS
 from pendulum_fmu.sweep.worker import Task, _runner, run_chunk
 
 CHUNKS, CASES, STOP_TIME, STEP_SIZE = 10, 64, 3.0, 1e-3

@@ -20,8 +20,8 @@ import pyarrow as pa
 from fsspec.implementations.local import LocalFileSystem
 
 from pendulum_fmu import default_fmu
+from pendulum_fmu.sweep import OUTPUTS
 from pendulum_fmu.sweep.store import Store
-from pendulum_fmu.sweep.study import OUTPUTS
 from pendulum_fmu.sweep.worker import Task, run_chunk
 
 CHUNKS, CASES = 20, 64

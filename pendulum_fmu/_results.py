@@ -18,11 +18,15 @@ import warnings
 from collections.abc import Sequence
 from functools import lru_cache
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ._atomic_files import replacing
 from ._errors import NotComputed, WrongType
+
+if TYPE_CHECKING:
+    from ._model import FmuModel
 
 
 @lru_cache(maxsize=1)
@@ -41,7 +45,7 @@ def __getattr__(name: str):
     if name == "UNITS":
         from ._model import fmu_model
 
-        return {"time": "s", **{field: fmu_model().unit(field) for field in _default_recorded()}}
+        return units(("time", *_default_recorded()), fmu_model())
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
@@ -63,6 +67,29 @@ def dtype(recorded: Sequence[str]) -> np.dtype:
     ('time', 'torque', 'theta')
     """
     return np.dtype([(name, "f8") for name in ("time", *recorded)])
+
+
+def units(fields: Sequence[str], model: FmuModel) -> dict[str, str]:
+    """{field: unit} of a result's fields: time in s, each variable in the unit its FMU declares.
+
+    Parameters
+    ----------
+    fields : sequence of str
+        The result's fields (fields(run)), time first.
+    model : FmuModel
+        The FMU that made the result, or whose variables it holds.
+
+    Returns
+    -------
+    dict
+
+    Examples
+    --------
+    >>> from pendulum_fmu._model import fmu_model
+    >>> units(("time", "torque", "theta"), fmu_model())
+    {'time': 's', 'torque': 'N.m', 'theta': 'rad'}
+    """
+    return {name: "s" if name == "time" else model.unit(name) for name in fields}
 
 
 def empty(n_points: int, recorded: Sequence[str] | None = None) -> np.ndarray:

@@ -22,7 +22,7 @@ KIT_FMU = "Pendulum.fmu"
 
 def scenario_settings(scenario: Scenario, parameters: dict, units: dict[str, str]) -> dict:
     """What NAME.json holds for a scenario run with these parameters (every one of the FMU's);
-    units: the result's (_results.UNITS).
+    units: the reference's (_results.units).
     """
     name = scenario.name
     return {

@@ -342,8 +342,6 @@ def write_scenarios(
 def _write_kit(folder: Path, model: FmuModel) -> list[str]:
     """Write the kit into folder; returns the names written, the FMU first."""
     written, carried, steps = [], {}, {}
-    # Read once: each read of these looks the default FMU up again.
-    fields, units = results.FIELDS, results.UNITS
     for scenario in SCENARIOS:
         name = scenario.name
         parameters = resolve_parameters(scenario.parameters, model)
@@ -363,8 +361,11 @@ def _write_kit(folder: Path, model: FmuModel) -> list[str]:
             fmu_path=model,
         )
         steps[name] = len(solution) - 1
+        # The reference's own fields, in the kit's FMU's units.
+        fields = results.fields(solution)
         files[f"{name}_ref.csv"] = _csv_text(fields, (tuple(row) for row in solution.tolist()))
-        files[f"{name}.json"] = json.dumps(scenario_settings(scenario, parameters, units), indent=2) + "\n"
+        settings = scenario_settings(scenario, parameters, results.units(fields, model))
+        files[f"{name}.json"] = json.dumps(settings, indent=2) + "\n"
         for file_name, text in files.items():
             if file_name != signal.name:
                 _write(folder / file_name, text)

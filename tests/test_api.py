@@ -39,6 +39,26 @@ def test_import_pendulum_fmu_loads_no_numerics_nor_plotting():
     assert loaded["ours"] == ["pendulum_fmu"]
 
 
+def test_importing_the_sweep_looks_no_fmu_up():
+    """No import-time lookup: a study takes its own FMU's outputs when it is made."""
+    # Every FMU the package reads is parsed by _model._read, and the default one is found by
+    # pendulum_fmu.default_fmu: both refuse, so a lookup at import fails the import.
+    loaded = _loaded_after(
+        "import pendulum_fmu, pendulum_fmu._model as model\n"
+        "def refuse(*args, **kwargs):\n"
+        "    raise AssertionError('an FMU was looked up')\n"
+        "pendulum_fmu.default_fmu = model._read = refuse\n"
+        "import pendulum_fmu.sweep\n"
+        "try:\n"
+        "    pendulum_fmu.sweep.OUTPUTS\n"
+        "except AssertionError as error:\n"
+        "    print(error)"
+    )
+    assert {"pendulum_fmu.sweep.study", "pendulum_fmu.sweep.worker"} <= set(loaded["ours"])
+    # The refusals were in force: the default FMU's outputs, asked for, were looked up then.
+    assert loaded["printed"] == ["an FMU was looked up"]
+
+
 def test_the_command_lines_simulate_loads_neither_the_sweep_nor_matplotlib():
     loaded = _loaded_after("from pendulum_fmu.cli import main\nmain(['simulate', '--torque', '20'])")
     assert "matplotlib" not in loaded["top"] and "dask" not in loaded["top"]

@@ -22,6 +22,7 @@ import psutil
 import pyarrow.csv
 import pyarrow.dataset as ds
 import pytest
+from bad_inputs import _edited_fmu
 from dask.distributed import Client, LocalCluster
 from fsspec.implementations.local import LocalFileSystem
 
@@ -133,6 +134,53 @@ def test_csv_with_chosen_outputs_and_interval(tmp_path, threads_scheduler):
         )
         assert abs(expected["theta"][-1] - oracle["theta"][-1]) < 1e-10
     assert _table(result.cases_table, "csv")["damping"].tolist() == [0.0, 4.0]
+
+
+def _alpha_not_an_output(xml: str) -> str:
+    """The pendulum's model description with alpha a local variable: outputs theta and omega."""
+    edited = xml.replace(
+        'name="alpha" valueReference="3" causality="output"', 'name="alpha" valueReference="3" causality="local"'
+    )
+    edited = re.sub(r'\s*<Unknown index="4" [^>]*/>(\s*</Outputs>)', r"\1", edited, count=1)
+    assert edited.count('causality="output"') == 2 and "<Outputs>" in edited
+    return edited
+
+
+def test_a_study_on_an_fmu_with_other_outputs_chooses_and_records_by_its_own(tmp_path, threads_scheduler):
+    """The pendulum with alpha no output: a study of it keeps theta and omega, and refuses alpha."""
+    fmu = tmp_path / "NoAlphaOutput.fmu"
+    fmu.write_bytes(_edited_fmu(_alpha_not_an_output))
+    with pytest.raises(InvalidInput, match=r"outputs alpha: choose each at most once among theta, omega$"):
+        Study([{"torque": 1.0}], outputs=["alpha"], fmu_path=fmu)
+    cases = sweep_grid([5.0, 20.0], [0.0, 9.81])
+    study = Study(cases, stop_time=STOP_TIME, step_size=STEP_SIZE, fmu_path=fmu)
+    assert study.outputs == ("theta", "omega")
+    result = run_sweep(study, output_dir=tmp_path / "study", scheduler=threads_scheduler, progress=False)
+    trajectories, table = _table(result.trajectories), _table(result.cases_table)
+    assert set(trajectories) == {"case", "time", "theta", "omega"} and len(trajectories["case"]) == 4 * POINTS
+    for number, case in enumerate(cases):
+        rows = trajectories["case"] == number
+        oracle = reference(
+            case["torque"], stop_time=STOP_TIME, step_size=STEP_SIZE, parameters={"gravity": case["gravity"]}
+        )
+        for name in ("time", "theta", "omega"):
+            assert np.max(np.abs(trajectories[name][rows] - oracle[name])) < 1e-9, (number, name)
+        if case["gravity"] == 0.0:  # theta = tau t^2 / (2 I), omega = tau t / I
+            seconds = trajectories["time"][rows]
+            assert np.max(np.abs(trajectories["theta"][rows] - 0.5 * case["torque"] / I_TOTAL * seconds**2)) < 1e-12
+            assert np.max(np.abs(trajectories["omega"][rows] - case["torque"] / I_TOTAL * seconds)) < 1e-12
+        assert table["final_theta"][number] == trajectories["theta"][rows][-1]
+        assert table["final_omega"][number] == trajectories["omega"][rows][-1]
+        assert table["max_abs_theta"][number] == np.max(np.abs(trajectories["theta"][rows]))
+        # Not an output of this FMU: not computed, so NaN, never zeros.
+        assert np.isnan(table["final_alpha"][number]) and table["status"][number] == "ok"
+    # The command without --outputs keeps them all, as Study does: the same table.
+    command = ["sweep", "--torque", "5", "20", "--gravity", "0", "9.81", "--stop-time", str(STOP_TIME)]
+    command += ["--output-dir", str(tmp_path / "command"), "--scheduler", threads_scheduler, "--fmu", str(fmu)]
+    assert main(command) == 0
+    assert {name: column.tolist() for name, column in _table(tmp_path / "command" / "trajectories").items()} == {
+        name: column.tolist() for name, column in trajectories.items()
+    }
 
 
 def test_a_case_the_fmu_refuses_is_recorded_and_the_rest_go_on(tmp_path, threads_scheduler):
@@ -275,6 +323,57 @@ def test_finished_chunks_are_gathered_together_and_none_awaited_once_all_are_in(
     monkeypatch.setattr(client, "GATHER_SECONDS", 0.05)
     assert client._finished_together(finished, 4) == ["d", "e"]
     assert finished.empty()
+
+
+def test_the_chunks_that_ran_are_committed_before_one_that_failed_with_them_raises():
+    """A chunk that fails (a full disk) in a batch of chunks that finished together: the others
+    of the batch are committed first, so --resume keeps them.
+    """
+    from pendulum_fmu.sweep import client
+
+    class Finished:
+        def __init__(self, index, error=None):
+            self.index, self.error = index, error
+            self.status = "error" if error else "finished"
+
+        def add_done_callback(self, callback):
+            callback(self)  # already done
+
+        def result(self):
+            raise self.error
+
+        def release(self):
+            pass
+
+    class Cluster:
+        def map(self, function, indices, firsts, values, tasks, pure):
+            return [Finished(i, OSError("No space left on device") if i == 1 else None) for i in indices]
+
+        def gather(self, futures):
+            assert all(future.status == "finished" for future in futures)
+            return [(future.index, 1, 0, 10, 0.0, 0.0) for future in futures]
+
+    committed = []
+
+    class Store:
+        def commit(self, index, run, tables):
+            committed.append(index)
+
+    task = Task("fmu", Store(), 1.0, 0.1, (), 1, "run")
+    with pytest.raises(OSError, match="No space"):
+        client.run_chunks(Cluster(), task, [(i, i, {}) for i in range(3)], _Bar())
+    assert committed == [0, 2]
+
+
+class _Bar:
+    def set_postfix_str(self, text, refresh):
+        pass
+
+    def update(self, count):
+        pass
+
+    def refresh(self):
+        pass
 
 
 def test_a_run_commits_only_the_parts_staged_under_its_own_token(tmp_path):

@@ -43,6 +43,7 @@ def add_parser(commands) -> argparse.ArgumentParser:
 def run(args) -> int:
     """Run `pendulum-fmu simulate` with the parsed arguments; returns the exit status."""
     from .. import _results as results
+    from .._model import fmu_model
     from .._simulate import simulate
 
     check_outputs(
@@ -57,7 +58,9 @@ def run(args) -> int:
     )
     if args.output:
         results.write_csv(run, args.output)
-        print(f"wrote {args.output} ({','.join(results.FIELDS)}; units {', '.join(results.UNITS.values())})")
+        # The fields and units of the FMU that ran, --fmu's or the default one.
+        units = results.units(results.fields(run), fmu_model(args.fmu))
+        print(f"wrote {args.output} ({','.join(units)}; units {', '.join(units.values())})")
     if args.plot:
         from .._plot import case_title, plot_overlay
 

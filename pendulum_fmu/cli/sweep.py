@@ -62,8 +62,8 @@ def add_parser(commands) -> argparse.ArgumentParser:
     )
     sweep.add_argument(
         "--outputs",
-        default="theta,omega,alpha",
-        help="outputs the trajectories keep, comma-separated, or none for only the cases table (default: %(default)s)",
+        help="outputs of the FMU the trajectories keep, comma-separated, or none for only the cases table "
+        "(default: all of them; the default FMU's are theta,omega,alpha)",
     )
     sweep.add_argument(
         "--output-interval",
@@ -110,11 +110,13 @@ def run(args) -> int:
     """Run `pendulum-fmu sweep` with the parsed arguments; returns the exit status."""
     from ..sweep import Study, run_sweep, sweep_grid
 
+    # Without --outputs, Study's default: all of its FMU's outputs.
+    chosen = {} if args.outputs is None else {"outputs": _sweep_outputs(args.outputs)}
     study = Study(
         sweep_grid(args.torque, args.gravity, _sweep_values(args.assignments)),
         stop_time=args.stop_time,
         step_size=args.step_size,
-        outputs=_sweep_outputs(args.outputs),
+        **chosen,
         output_interval=args.output_interval,
         format=args.format,
         fmu_path=args.fmu,

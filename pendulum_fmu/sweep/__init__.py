@@ -40,6 +40,17 @@ The package, in the order a run goes through it:
 
 from .grid import Grid, sweep_grid
 from .run import DEFAULT_MAX_CASES, run_sweep
-from .study import FORMATS, OUTPUTS, Study, SweepResult
+from .study import FORMATS, Study, SweepResult
+
+
+def __getattr__(name: str):
+    # OUTPUTS: the default FMU's outputs (a Study's default outputs on it), read from its model
+    # description on first use, not at import; a Study on another FMU takes that FMU's.
+    if name == "OUTPUTS":
+        from .._model import fmu_model
+
+        return fmu_model().outputs
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 __all__ = ["DEFAULT_MAX_CASES", "FORMATS", "OUTPUTS", "Grid", "Study", "SweepResult", "run_sweep", "sweep_grid"]

@@ -11,13 +11,22 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import _results as results
 from .._errors import InvalidInput, WrongType
+from .._model import fmu_model
 from .._time_grid import communication_points
 from .grid import Grid, check_cases, columns
 
-OUTPUTS = results.FIELDS[2:]  # theta, omega, alpha: what a case records besides time and torque
 FORMATS = ("parquet", "csv")
+
+
+class _AllOutputs(tuple):
+    """The default of Study's outputs: all of its FMU's, known only once the FMU is read."""
+
+    def __repr__(self) -> str:
+        return "<all of the FMU's outputs>"
+
+
+ALL_OUTPUTS: tuple[str, ...] = _AllOutputs()
 # A study is cut into about this many chunks, so that up to 16 workers each get several (the
 # load evens out and progress shows), but no chunk holds more than MAX_CHUNK_CASES cases, so a
 # lost worker loses little; more only where its cases are short, up to MAX_CHUNK_STEPS steps in
@@ -49,7 +58,8 @@ class Study:
     step_size : float, optional
         Communication step in s.
     outputs : sequence of str, optional
-        Which of theta, omega, alpha the trajectories keep; none: only the cases table.
+        Which of the FMU's outputs (the default FMU's: theta, omega, alpha) the trajectories
+        keep (default: all of them); none: only the cases table.
     output_interval : float, optional
         Keep a point every so many s, a whole number of steps (default: every step).
     format : {"parquet", "csv"}, optional
@@ -78,7 +88,7 @@ class Study:
     cases: Grid | Sequence[dict]
     stop_time: float = 3.0
     step_size: float = 1e-3
-    outputs: Sequence[str] = OUTPUTS
+    outputs: Sequence[str] = ALL_OUTPUTS
     output_interval: float | None = None
     format: str = "parquet"
     fmu_path: str | Path | None = None
@@ -87,17 +97,24 @@ class Study:
     names: list[str] = field(init=False, compare=False)  # the cases' keys: the cases table's value columns
     points: int = field(init=False, compare=False)  # communication points of a case, its start included
     stride: int = field(init=False, compare=False)  # keep every stride-th point (and the last)
+    # The FMU's outputs, in modelDescription.xml's order: what a worker records of every case,
+    # and what outputs chooses among.
+    fmu_outputs: tuple[str, ...] = field(init=False, compare=False)
 
     def __post_init__(self):
-        derived: dict[str, object] = {"names": check_cases(self.cases, self.fmu_path)}
+        # The study's own FMU, read once here (check_cases reads it too: the same object).
+        model = fmu_model(self.fmu_path)
+        derived: dict[str, object] = {"names": check_cases(self.cases, model), "fmu_outputs": model.outputs}
         # Refuses a bad stop time or step size with simulate()'s words.
         derived["points"] = len(communication_points(0.0, self.stop_time, self.step_size))
         if isinstance(self.outputs, str):
             raise WrongType(f"outputs is a list of names, e.g. ['theta'], not the string {self.outputs!r}")
-        derived["outputs"] = outputs = tuple(self.outputs)
+        derived["outputs"] = outputs = model.outputs if self.outputs is ALL_OUTPUTS else tuple(self.outputs)
         for name in outputs:
-            if name not in OUTPUTS or outputs.count(name) > 1:
-                raise InvalidInput(f"outputs {', '.join(outputs)}: choose each at most once among {', '.join(OUTPUTS)}")
+            if name not in model.outputs or outputs.count(name) > 1:
+                raise InvalidInput(
+                    f"outputs {', '.join(outputs)}: choose each at most once among {', '.join(model.outputs)}"
+                )
         derived["stride"] = _stride(self.output_interval, self.step_size)
         if self.format not in FORMATS:
             raise InvalidInput(f"format {self.format!r}: choose {' or '.join(FORMATS)}")
@@ -106,7 +123,7 @@ class Study:
 
     def chunk_cases(self) -> int:
         """The cases of a chunk, each chunk written as one part of each table."""
-        fitting = MAX_CHUNK_BYTES // (self.points * len(OUTPUTS) * 8)
+        fitting = MAX_CHUNK_BYTES // (self.points * max(1, len(self.fmu_outputs)) * 8)
         most = max(MAX_CHUNK_CASES, MAX_CHUNK_STEPS // max(1, self.points - 1))
         return max(1, min(most, fitting, math.ceil(len(self.cases) / TARGET_CHUNKS)))
 

@@ -23,7 +23,6 @@ from .._simulate import run_schedule_python, simulator
 from .._time_grid import communication_points
 from .._torque_schedule import TorqueSchedule
 from .store import SUMMARIES, Store
-from .study import OUTPUTS
 
 
 @dataclass(frozen=True)
@@ -54,9 +53,11 @@ class Runner:
 
     def __init__(self, fmu_simulator):
         self.simulator, fmu = fmu_simulator, fmu_simulator.slave.model
+        # What it records of every case: the FMU's outputs, which a Study of it chooses among.
+        self.outputs = fmu.outputs
         self.defaults = {**fmu_simulator.defaults, "theta": 0.0, "omega": 0.0, "torque": 0.0}
         start_references = np.array([value_reference(n, fmu) for n in self.defaults], np.uint32)
-        outputs = np.array([value_reference(name, fmu) for name in OUTPUTS], np.uint32)
+        outputs = np.array([value_reference(name, fmu) for name in self.outputs], np.uint32)
         self.stepper = (
             cs_loop.Stepper(fmu_simulator.slave, np.empty(0, np.uint32), outputs, start_references)
             if fmu_simulator.stepper is not None
@@ -71,10 +72,10 @@ class Runner:
         ).astype(float)
 
     def run_cases(self, start_values: np.ndarray, points: np.ndarray, outputs: np.ndarray) -> list[str]:
-        """theta, omega and alpha of each case (a row of start_values) at every communication
-        point into outputs (3 x cases x points). Returns per case "" or why the FMU refused it
-        (its values then NaN); the next case's restart starts from fmi2Reset, whatever state the
-        refusal left.
+        """The FMU's outputs (self.outputs) of each case (a row of start_values) at every
+        communication point into outputs (outputs x cases x points). Returns per case "" or why
+        the FMU refused it (its values then NaN); the next case's restart starts from fmi2Reset,
+        whatever state the refusal left.
         """
         if self.stepper is not None:
             return self.stepper.run_cases(points, start_values, outputs)
@@ -98,7 +99,7 @@ class Runner:
             time=points, torque=np.full(len(points) - 1, torque), torque_rate=np.zeros(len(points) - 1)
         )
         run = run_schedule_python(slave, plan)
-        outputs[:] = [run[name] for name in OUTPUTS]
+        outputs[:] = [run[name] for name in self.outputs]
 
 
 _runners = threading.local()
@@ -129,8 +130,8 @@ def run_chunk(index: int, first: int, values: dict[str, np.ndarray], task: Task)
     cpu = time.thread_time()
     points = communication_points(0.0, task.stop_time, task.step_size)
     count = len(next(iter(values.values())))
-    recorded = np.empty((len(OUTPUTS), count, len(points)))
     runner = _runner(task.fmu)
+    recorded = np.empty((len(runner.outputs), count, len(points)))
     start_values = runner.start_values(values, count)
     stepping = time.thread_time()
     messages = runner.run_cases(start_values, points, recorded)
@@ -150,16 +151,21 @@ def run_chunk(index: int, first: int, values: dict[str, np.ndarray], task: Task)
             {
                 "case": np.repeat(numbers[ok], len(keep)),
                 "time": _tiled(points[keep], int(ok.sum())),
-                **{name: kept[OUTPUTS.index(name)].reshape(-1) for name in task.outputs},
+                **{name: kept[runner.outputs.index(name)].reshape(-1) for name in task.outputs},
             },
             task.run,
             split=("time", *task.outputs),
             unsummarized=task.outputs,
         )
-    theta = recorded[OUTPUTS.index("theta")]
+    # The summaries by name; NaN (never zeros) for a variable the FMU does not output.
+    not_output = np.full((count, 1), np.nan)
+    theta, omega, alpha = (
+        recorded[runner.outputs.index(name)] if name in runner.outputs else not_output
+        for name in ("theta", "omega", "alpha")
+    )
     # max |theta| as |max(max, -min)|: two passes and no temporary the size of the chunk (the
     # outer abs only for theta all -0.0, where abs first gives 0.0).
-    summaries = [*recorded[:, :, -1], np.abs(np.maximum(theta.max(axis=1), -theta.min(axis=1)))]
+    summaries = [theta[:, -1], omega[:, -1], alpha[:, -1], np.abs(np.maximum(theta.max(axis=1), -theta.min(axis=1)))]
     written += task.store.write_table(
         "cases",
         index,
