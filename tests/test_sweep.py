@@ -331,38 +331,72 @@ def test_the_chunks_that_ran_are_committed_before_one_that_failed_with_them_rais
     """
     from pendulum_fmu.sweep import client
 
-    class Finished:
-        def __init__(self, index, error=None):
-            self.index, self.error = index, error
-            self.status = "error" if error else "finished"
-
-        def add_done_callback(self, callback):
-            callback(self)  # already done
-
-        def result(self):
-            raise self.error
-
-        def release(self):
-            pass
-
-    class Cluster:
-        def map(self, function, indices, firsts, values, tasks, pure):
-            return [Finished(i, OSError("No space left on device") if i == 1 else None) for i in indices]
-
-        def gather(self, futures):
-            assert all(future.status == "finished" for future in futures)
-            return [(future.index, 1, 0, 10, 0.0, 0.0) for future in futures]
-
-    committed = []
-
-    class Store:
-        def commit(self, index, run, tables):
-            committed.append(index)
-
-    task = Task("fmu", Store(), 1.0, 0.1, (), 1, "run")
+    store = _Commits()
     with pytest.raises(OSError, match="No space"):
-        client.run_chunks(Cluster(), task, [(i, i, {}) for i in range(3)], _Bar())
-    assert committed == [0, 2]
+        client.run_chunks(_Cluster(failing=1), Task("fmu", store, 1.0, 0.1, (), 1, "run"), _chunks(3), _Bar())
+    assert store.committed == [0, 2]
+
+
+def test_chunks_whose_results_the_lost_scheduler_cannot_give_are_kept_and_the_loss_reported():
+    """The scheduler lost between chunks finishing and the request for their results: the chunks
+    are committed (their parts are staged whole) and run_sweep hears of a lost scheduler.
+    """
+    from concurrent.futures import CancelledError
+
+    from pendulum_fmu.sweep import client
+
+    store = _Commits()
+    with pytest.raises(CancelledError) as lost:
+        client.run_chunks(_Cluster(unreachable=True), Task("fmu", store, 1.0, 0.1, (), 1, "run"), _chunks(3), _Bar())
+    assert lost.value.reason == "scheduler-connection-lost"
+    assert store.committed == [0, 1, 2]
+
+
+def _chunks(count):
+    return [(index, index, {}) for index in range(count)]
+
+
+class _Finished:
+    """A dask future already done: finished, or failed with error."""
+
+    def __init__(self, index, error=None):
+        self.index, self.error, self.key = index, error, f"run_chunk-{index}"
+        self.status = "error" if error else "finished"
+
+    def add_done_callback(self, callback):
+        callback(self)
+
+    def result(self):
+        raise self.error
+
+    def release(self):
+        pass
+
+
+class _Cluster:
+    """A dask client whose chunks are done at once: `failing` fails with a full disk; unreachable:
+    the scheduler cannot be reached for the results.
+    """
+
+    def __init__(self, failing=None, unreachable=False):
+        self.failing, self.unreachable = failing, unreachable
+
+    def map(self, function, indices, firsts, values, tasks, pure):
+        return [_Finished(i, OSError("No space left on device") if i == self.failing else None) for i in indices]
+
+    def gather(self, futures):
+        if self.unreachable:
+            raise OSError("Timed out trying to connect to tcp://127.0.0.1:1 after 10 s")
+        assert all(future.status == "finished" for future in futures)
+        return [(future.index, 1, 0, 10, 0.0, 0.0) for future in futures]
+
+
+class _Commits:
+    def __init__(self):
+        self.committed = []
+
+    def commit(self, index, run, tables):
+        self.committed.append(index)
 
 
 class _Bar:
