@@ -63,9 +63,11 @@ def chunk_cpu(outputs: tuple[str, ...]) -> tuple[float, float, float]:
     return min(rounds)
 
 
-def native_loop_cpu(fmu: str | None = None, values: dict[str, np.ndarray] | None = None) -> float:
+def native_loop_cpu(
+    fmu: str | None = None, values: dict[str, np.ndarray] | None = None, repeats: int = CHUNKS
+) -> float:
     """CPU per case of the same cases (or those of values, {name: column}) through Stepper.run,
-    a restart per call, nothing written, over CHUNKS times the cases.
+    a restart per call, nothing written, over repeats times the cases.
     """
     runner = _runner(fmu or str(default_fmu()))
     points = communication_points(0.0, STOP_TIME, STEP_SIZE)
@@ -75,10 +77,10 @@ def native_loop_cpu(fmu: str | None = None, values: dict[str, np.ndarray] | None
     rounds = []
     for _ in range(ROUNDS):
         started = time.thread_time()
-        for _ in range(CHUNKS):
+        for _ in range(repeats):
             for case in start_values:
                 runner.stepper.run(points, None, None, outputs, start_values=case)
-        rounds.append((time.thread_time() - started) / (CHUNKS * len(start_values)))
+        rounds.append((time.thread_time() - started) / (repeats * len(start_values)))
     return min(rounds)
 
 
