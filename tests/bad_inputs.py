@@ -908,6 +908,16 @@ def _edited_fmu(edit) -> bytes:
     return buffer.getvalue()
 
 
+def alpha_not_an_output(xml: str) -> str:
+    """The pendulum's model description with alpha a local variable: outputs theta and omega."""
+    edited = xml.replace(
+        'name="alpha" valueReference="3" causality="output"', 'name="alpha" valueReference="3" causality="local"'
+    )
+    edited = re.sub(r'\s*<Unknown index="4" [^>]*/>(\s*</Outputs>)', r"\1", edited, count=1)
+    assert edited.count('causality="output"') == 2 and "<Outputs>" in edited
+    return edited
+
+
 def write_files(folder: Path) -> None:
     files = {**FILES, **{name: _edited_fmu(edit) for name, edit in EDITED_FMUS.items()}}
     for name, content in files.items():

@@ -68,6 +68,24 @@ def test_simulate_writes_csv_and_plot(tmp_path, capsys):
     assert "theta = 3.1" in capsys.readouterr().out
 
 
+def test_simulate_reports_the_outputs_of_the_fmu_that_ran(tmp_path, capsys):
+    """An FMU whose outputs are theta and omega (alpha a local variable): the summary line and the
+    file name its outputs, and the values are the analytic ones (gravity 0: theta = tau t^2 / 2I).
+    """
+    from bad_inputs import _edited_fmu, alpha_not_an_output
+
+    fmu, out = tmp_path / "NoAlphaOutput.fmu", tmp_path / "out.csv"
+    fmu.write_bytes(_edited_fmu(alpha_not_an_output))
+    arguments = ["simulate", "--torque", "20", "--set", "gravity=0", "--stop-time", "1", "--fmu", str(fmu)]
+    assert main([*arguments, "--output", str(out)]) == 0
+    line, wrote = capsys.readouterr().out.splitlines()
+    theta, omega = 20 / (2 * I_TOTAL), 20 / I_TOTAL
+    assert line.startswith("1000 steps to t = 1 s: theta = ") and "alpha" not in line, line
+    assert abs(float(line.split("theta = ")[1].split(" rad,")[0]) - theta) < 1e-9, line
+    assert abs(float(line.split("omega = ")[1].split(" rad/s;")[0]) - omega) < 1e-9, line
+    assert wrote == f"wrote {out} (time,torque,theta,omega; units s, N.m, rad, rad/s)"
+
+
 def test_simulate_torque_file(tmp_path):
     csv = tmp_path / "t.csv"
     csv.write_text("time,torque\n0,5\n1,5\n1,-5\n2,-5\n")

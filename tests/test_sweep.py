@@ -22,7 +22,7 @@ import psutil
 import pyarrow.csv
 import pyarrow.dataset as ds
 import pytest
-from bad_inputs import _edited_fmu
+from bad_inputs import _edited_fmu, alpha_not_an_output
 from dask.distributed import Client, LocalCluster
 from fsspec.implementations.local import LocalFileSystem
 
@@ -136,20 +136,10 @@ def test_csv_with_chosen_outputs_and_interval(tmp_path, threads_scheduler):
     assert _table(result.cases_table, "csv")["damping"].tolist() == [0.0, 4.0]
 
 
-def _alpha_not_an_output(xml: str) -> str:
-    """The pendulum's model description with alpha a local variable: outputs theta and omega."""
-    edited = xml.replace(
-        'name="alpha" valueReference="3" causality="output"', 'name="alpha" valueReference="3" causality="local"'
-    )
-    edited = re.sub(r'\s*<Unknown index="4" [^>]*/>(\s*</Outputs>)', r"\1", edited, count=1)
-    assert edited.count('causality="output"') == 2 and "<Outputs>" in edited
-    return edited
-
-
 def test_a_study_on_an_fmu_with_other_outputs_chooses_and_records_by_its_own(tmp_path, threads_scheduler):
     """The pendulum with alpha no output: a study of it keeps theta and omega, and refuses alpha."""
     fmu = tmp_path / "NoAlphaOutput.fmu"
-    fmu.write_bytes(_edited_fmu(_alpha_not_an_output))
+    fmu.write_bytes(_edited_fmu(alpha_not_an_output))
     with pytest.raises(InvalidInput, match=r"outputs alpha: choose each at most once among theta, omega$"):
         Study([{"torque": 1.0}], outputs=["alpha"], fmu_path=fmu)
     cases = sweep_grid([5.0, 20.0], [0.0, 9.81])

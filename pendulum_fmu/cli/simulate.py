@@ -51,15 +51,16 @@ def run(args) -> int:
     )
     run = simulate(torque_signal(args), tolerance=args.tolerance, **signal_options(args))
     last = run[-1]
+    # The fields and units of the FMU that ran, --fmu's or the default one: its outputs, as many
+    # as it has, after time and torque.
+    units = results.units(results.fields(run), fmu_model(args.fmu))
+    outputs = ", ".join(f"{name} = {last[name]:.12g} {units[name]}" for name in list(units)[2:])
     print(
-        f"{len(run) - 1} steps to t = {last['time']:g} s: theta = {last['theta']:.12g} rad, "
-        f"omega = {last['omega']:.12g} rad/s, alpha = {last['alpha']:.12g} rad/s2; "
+        f"{len(run) - 1} steps to t = {last['time']:g} s: {outputs}; "
         f"max |theta| = {np.max(np.abs(run['theta'])):.6g} rad"
     )
     if args.output:
         results.write_csv(run, args.output)
-        # The fields and units of the FMU that ran, --fmu's or the default one.
-        units = results.units(results.fields(run), fmu_model(args.fmu))
         print(f"wrote {args.output} ({','.join(units)}; units {', '.join(units.values())})")
     if args.plot:
         from .._plot import case_title, plot_overlay
