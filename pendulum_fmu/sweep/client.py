@@ -32,14 +32,6 @@ class SchedulerLost(PendulumFmuError, ConnectionError):
     """
 
 
-class _ResultsUnasked(CancelledError):
-    """The scheduler went away before the results of chunks that finished could be asked of it:
-    to run_sweep, a study's work cancelled by a lost scheduler, as dask's own cancellation.
-    """
-
-    reason = "scheduler-connection-lost"  # the reason dask's cancellation gives
-
-
 @contextlib.contextmanager
 def dask_client(scheduler: str | None, workers: int | None, connect_timeout: float):
     """A dask client: on a local cluster of `workers` processes started (and closed) here, or on
@@ -273,7 +265,7 @@ def run_chunks(client, task: Task, chunks: Iterable[tuple[int, int, dict]], bar)
             # reported as when it comes first.
             for future in ran:
                 task.store.commit(chunk_of[future.key], task.run, task.tables())
-            raise _ResultsUnasked("the scheduler did not answer for the chunks' results") from None
+            raise CancelledError("scheduler-connection-lost") from None  # as dask's cancellation says it
         for index, count, failed, written, cpu, stepping in results:
             task.store.commit(index, task.run, task.tables())
             totals.failed += failed

@@ -199,7 +199,8 @@ def run_sweep(
 def _lost(scheduler: str | None, error: CancelledError, url: str, overwrite: bool) -> SchedulerLost:
     """The one line for a scheduler lost mid-study: what the folder keeps, and how to go on."""
     which = f"the dask scheduler at {scheduler}" if scheduler else "the local dask cluster's scheduler"
-    reason = getattr(error, "reason", None) or "its work was cancelled"
+    # dask's cancellation gives its reason apart; run_chunks' (the results unreachable) as its text.
+    reason = getattr(error, "reason", None) or str(error) or "its work was cancelled"
     if overwrite:
         kept = (
             f"{url} holds what it held before (the new study was not finished and is not "
