@@ -780,29 +780,17 @@ def test_a_worker_stopped_mid_study_and_continued_after_an_overwrite_changes_not
     options = dict(stop_time=600.0, outputs=["theta"], output_interval=1.0)
     old = Study(sweep_grid(torques, [9.81], {"damping": [0.0, 0.5]}), **options)
     new = Study(sweep_grid(torques, [9.81], {"damping": [0.0, 0.25]}), **options)
-    with benchmarks.scale.dask_process_handles(2, nanny=False) as (address, processes):
-        stopped = psutil.Process(processes[1].pid)
-        results = []
-        first = threading.Thread(
-            target=lambda: results.append(run_sweep(old, output_dir=tmp_path, scheduler=address, progress=False))
-        )
-        first.start()
-        deadline = time.monotonic() + 120
-        while not (list(tmp_path.glob("cases/part-*")) and stopped.cpu_percent(0.1) > 30):
-            assert first.is_alive() and time.monotonic() < deadline
-        stopped.suspend()  # mid-chunk: it was computing
-        first.join(timeout=300)
-        assert results[0].cases == 256 and results[0].failed == 0
-        stale_run = _stale_task(tmp_path).run
-        run_sweep(new, output_dir=tmp_path, overwrite=True, scheduler=address, progress=False)
-        parts = {p: p.read_bytes() for p in tmp_path.glob("*/part-*")}
-        stopped.resume()
-        deadline = time.monotonic() + 60
-        while not list(tmp_path.glob(f"cases/_part-*.{stale_run}.staged")):
-            assert time.monotonic() < deadline, list(tmp_path.glob("*/_*"))
-            time.sleep(0.05)
-    assert {p: p.read_bytes() for p in tmp_path.glob("*/part-*")} == parts
-    table, trajectories = _table(tmp_path / "cases"), _table(tmp_path / "trajectories")
+    # The worker is stopped wherever it is when seen computing: stopped outside a chunk (between
+    # two, or after its chunk's write), it has no stale chunk to write when continued (seen once,
+    # in a CI run on the loaded 2-core VM), and the scenario runs once more, in a folder of its own.
+    for attempt in range(2):
+        folder = tmp_path / f"try-{attempt}"
+        parts, stale = _stop_replace_and_continue(folder, old, new)
+        assert {p: p.read_bytes() for p in folder.glob("*/part-*")} == parts
+        if stale:
+            break
+    assert stale, "in two tries the worker continued wrote no part of the study it was stopped in"
+    table, trajectories = _table(folder / "cases"), _table(folder / "trajectories")
     assert table["case"].tolist() == list(range(256)) and set(table["damping"]) == {0.0, 0.25}
     assert len(trajectories["case"]) == 256 * 601
     # The new study's cases are its own: their damping's trajectory, to the bit (every part is
@@ -810,9 +798,40 @@ def test_a_worker_stopped_mid_study_and_continued_after_an_overwrite_changes_not
     for number in range(1, 256, 16):
         expected = simulate.simulate(torques[number // 2], parameters={"damping": 0.25}, stop_time=600.0)
         assert np.array_equal(trajectories["theta"][trajectories["case"] == number], expected["theta"][::1000]), number
-    again = run_sweep(new, output_dir=tmp_path, resume=True, workers=1, progress=False)
-    assert again.chunks_run == 0 and {p: p.read_bytes() for p in tmp_path.glob("*/part-*")} == parts
-    assert not list(tmp_path.glob("*/_part-*"))
+    again = run_sweep(new, output_dir=folder, resume=True, workers=1, progress=False)
+    assert again.chunks_run == 0 and {p: p.read_bytes() for p in folder.glob("*/part-*")} == parts
+    assert not list(folder.glob("*/_part-*"))
+
+
+def _stop_replace_and_continue(folder, old: Study, new: Study) -> tuple[dict, bool]:
+    """On a cluster of 2 workers without nannies: old run into folder, one worker stopped while it
+    computes, old finished without it, new run into folder with overwrite, the worker continued.
+    Returns the new study's parts (path: bytes) as new left them, and whether the continued
+    worker wrote its stale chunk (staged under old's run) within 60 s.
+    """
+    with benchmarks.scale.dask_process_handles(2, nanny=False) as (address, processes):
+        stopped = psutil.Process(processes[1].pid)
+        results = []
+        first = threading.Thread(
+            target=lambda: results.append(run_sweep(old, output_dir=folder, scheduler=address, progress=False))
+        )
+        first.start()
+        deadline = time.monotonic() + 120
+        while not (list(folder.glob("cases/part-*")) and stopped.cpu_percent(0.1) > 30):
+            assert first.is_alive() and time.monotonic() < deadline
+        stopped.suspend()  # mid-chunk, as a rule: it was computing
+        first.join(timeout=300)
+        assert results[0].cases == 256 and results[0].failed == 0
+        stale_run = _stale_task(folder).run
+        run_sweep(new, output_dir=folder, overwrite=True, scheduler=address, progress=False)
+        parts = {p: p.read_bytes() for p in folder.glob("*/part-*")}
+        stopped.resume()
+        deadline = time.monotonic() + 60
+        while not list(folder.glob(f"cases/_part-*.{stale_run}.staged")):
+            if time.monotonic() > deadline:
+                return parts, False
+            time.sleep(0.05)
+    return parts, True
 
 
 def _assert_every_case_once(folder, torques, stop_time: float, stride: int = 1, sample: int = 4) -> None:
