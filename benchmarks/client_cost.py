@@ -37,9 +37,9 @@ def measure(fmu) -> dict:
     """The figures of TEMPLATE."""
     load = os.getloadavg()[0]
     with dask_process_handles(WORKERS) as (address, processes):
-        scheduler_cpu = _cpu_seconds(processes[0])
+        scheduler_cpu = _cpu_seconds(processes[0].pid)
         result = _study(address, CASES, 0.01, fmu)
-        scheduler_cpu = _cpu_seconds(processes[0]) - scheduler_cpu
+        scheduler_cpu = _cpu_seconds(processes[0].pid) - scheduler_cpu
     return {
         "date": datetime.date.today().isoformat(),
         "machine": f"{cpu_model()}, {os.cpu_count()} cores",

@@ -142,7 +142,7 @@ def measure_client(
         scheduler=address,
         progress=False,
     )
-    others_before = [_pid_cpu_seconds(pid) for pid in others]
+    others_before = [_cpu_seconds(pid) for pid in others]
     before = cpu()
     chosen = {} if outputs is None else {"outputs": outputs}
     result = sweep.run_sweep(
@@ -152,7 +152,7 @@ def measure_client(
         progress=False,
     )
     client_cpu = cpu() - before
-    others_cpu = [_pid_cpu_seconds(pid) - seconds for pid, seconds in zip(others, others_before, strict=True)]
+    others_cpu = [_cpu_seconds(pid) - seconds for pid, seconds in zip(others, others_before, strict=True)]
     print(
         json.dumps(
             {
@@ -232,14 +232,7 @@ def _median_study(results: list[dict]) -> dict:
     return {key: median([result[key] for result in results]) for key in results[0]}
 
 
-def _cpu_seconds(process: subprocess.Popen) -> float:
-    import psutil
-
-    times = psutil.Process(process.pid).cpu_times()
-    return times.user + times.system
-
-
-def _pid_cpu_seconds(pid: int) -> float:
+def _cpu_seconds(pid: int) -> float:
     """CPU of a process and of its children (a worker's nanny and the worker it runs)."""
     import psutil
 
@@ -262,9 +255,9 @@ def scale_rows(fmu: BuiltFmu, quick: bool, cases: int | None = None) -> list[Row
         runs = {workers: [] for workers in worker_counts}
         for _ in range(rounds):
             for workers, (address, processes) in handles.items():
-                scheduler_cpu = _cpu_seconds(processes[0])
+                scheduler_cpu = _cpu_seconds(processes[0].pid)
                 runs[workers].append(_study(address, cases, 3.0, fmu))
-                runs[workers][-1]["scheduler_cpu"] = _cpu_seconds(processes[0]) - scheduler_cpu
+                runs[workers][-1]["scheduler_cpu"] = _cpu_seconds(processes[0].pid) - scheduler_cpu
     results = {workers: _median_study(runs[workers]) for workers in worker_counts}
     rates = {workers: cases / result["seconds"] for workers, result in results.items()}
     # The figure is a fixed cost of a study (about a second), whatever its size or workers.

@@ -254,20 +254,17 @@ def run_chunks(client, task: Task, chunks: Iterable[tuple[int, int, dict]], bar)
     while waiting:
         batch = _finished_together(finished, waiting)
         waiting -= len(batch)
-        # The chunks that ran committed before the first that failed raises (a full disk, a lost
-        # scheduler), so that every whole chunk is kept for --resume.
+        # A chunk whose run finished has its parts staged whole: committed at once, before a
+        # failed one raises (a full disk) and whether or not its result can still be asked of the
+        # scheduler, so that every whole chunk is kept for --resume.
         ran = [future for future in batch if future.status == "finished"]
+        for future in ran:
+            task.store.commit(chunk_of[future.key], task.run, task.tables())
         try:
             results = client.gather(ran)
-        except OSError:
-            # The scheduler went away after these chunks finished, before their results could be
-            # asked of it: their parts are staged whole, so they are kept, and the loss is
-            # reported as when it comes first.
-            for future in ran:
-                task.store.commit(chunk_of[future.key], task.run, task.tables())
+        except OSError:  # the scheduler went away since: reported as when that comes first
             raise CancelledError("scheduler-connection-lost") from None  # as dask's cancellation says it
-        for index, count, failed, written, cpu, stepping in results:
-            task.store.commit(index, task.run, task.tables())
+        for _, count, failed, written, cpu, stepping in results:
             totals.failed += failed
             totals.bytes += written
             totals.worker_cpu_seconds += cpu
