@@ -3,7 +3,8 @@
     .venv/bin/python -m benchmarks.case_cost           # also part of --only scale
     .venv/bin/python -m benchmarks.case_cost --quick
 
-A `dask scheduler` and 1 or 2 `dask worker`s (each under its nanny, one thread) on localhost run
+A `dask scheduler` and 1 or 2 `dask worker`s (each under its nanny, one thread; QUIET_DASK's
+settings) on localhost run
 studies of 3-s cases at 1 ms steps from a client process of their own (scale.py's
 measure_client, warmed by a small study), with every output written and with none (--outputs
 none), of SMALL and 4 x SMALL cases. A study's CPU is summed over every process: the workers with
@@ -12,7 +13,9 @@ same cases through the native loop in one process, a restart per case, nothing w
 - at 4 x SMALL cases, everything included (starting, the figure);
 - marginal: what the larger study cost beyond the smaller, per added case, by process: what a
   case costs in a study so large that its fixed costs no longer count.
-And the speed-up of 2 workers over 1, end to end, at each size. Each figure is the least of the
+And the speed-up of 2 workers over 1, end to end, at each size; and what dask's periodic work
+costs an idle cluster of 2 workers, at dask's defaults and at the sweep's settings (QUIET_DASK,
+which these clusters run with). Each figure is the least of the
 rounds (other work on a shared machine only adds); the machine's load is printed.
 """
 
@@ -25,10 +28,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from pendulum_fmu.sweep.client import QUIET_DASK
+
 from .builds import BuiltFmu, build_pendulum_fmu
 from .chunk_cost import native_loop_cpu
 from .report import Row, as_text, main_table
-from .scale import _study, dask_process_handles
+from .scale import _cpu_seconds, _study, dask_process_handles
 
 PART = "scale"
 STOP_TIME = 3.0
@@ -36,6 +41,25 @@ ALL_OUTPUTS_TARGET = 1.6  # x the C loop's CPU per case (issue 32)
 NO_OUTPUTS_TARGET = 1.15
 SPEED_UP_TARGET = 1.7  # 2 workers over 1, end to end, on a quiet machine
 PROCESSES = ("workers", "client", "scheduler")
+IDLE_SECONDS = 10.0
+
+
+def idle_cpu(config: dict) -> tuple[float, float]:
+    """(the scheduler's, the 2 workers' with their nannies) CPU per second, in % of a core, of a
+    cluster that runs nothing, started with these dask settings in its environment: dask's
+    periodic work, which a study pays for as long as it runs.
+    """
+    import time
+
+    with dask_process_handles(2, config=config) as (_, processes):
+        time.sleep(2.0)  # past the start
+        before = [_cpu_seconds(process.pid) for process in processes]
+        time.sleep(IDLE_SECONDS)
+        used = [
+            (_cpu_seconds(process.pid) - cpu) / IDLE_SECONDS * 100
+            for process, cpu in zip(processes, before, strict=True)
+        ]
+    return used[0], sum(used[1:])
 
 
 @dataclass(frozen=True)
@@ -118,6 +142,15 @@ def case_cost_rows(fmu: BuiltFmu, quick: bool) -> list[Row]:
                 ),
                 Row(PART, f"case cost, {label}, {workers} worker(s): fixed CPU per study", f"{fixed} s"),
             ]
+    for label, config in (("dask's defaults", {}), ("the sweep's settings (QUIET_DASK)", QUIET_DASK)):
+        scheduler, workers = idle_cpu(config)
+        rows.append(
+            Row(
+                PART,
+                f"case cost: an idle cluster of 2 workers, {label}: CPU, % of a core",
+                f"scheduler {scheduler:.1f}, workers with their nannies {workers:.1f}",
+            )
+        )
     for cases in (small, large):
         (_, one), (_, two) = measured[(1, "all outputs", cases)], measured[(2, "all outputs", cases)]
         rows.append(

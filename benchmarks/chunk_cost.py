@@ -6,10 +6,9 @@ Runs chunks of 64 3-s cases at 1 ms steps through sweep.worker.run_chunk (what a
 runs per chunk: stepping, building and writing the parts) with every output and with none, and
 the same cases through the native loop alone, a restart per call (the C loop plus a few
 microseconds of ctypes: the floor a case can cost). Then the chunk's trajectories table written
-with each compression (none, lz4, zstd) with and without byte-stream-split on its float columns:
-size and CPU per case, the figures the store's choice (sweep/store.py) rests on (the case
-numbers dictionary-encoded in each, the floats plain or split). CPU is this
-thread's (time.thread_time), the least of 5 rounds; the machine's load is printed, as it slows
+with the store's Parquet options (sweep/store.py parquet_options) and with each alternative
+(VARIANTS, one option changed at a time): size and CPU per case, the figures the store's choice
+rests on. CPU is this thread's (time.thread_time), the least of 5 rounds; the machine's load is printed, as it slows
 every figure.
 """
 
@@ -28,12 +27,11 @@ from fsspec.implementations.local import LocalFileSystem
 from pendulum_fmu import default_fmu
 from pendulum_fmu._time_grid import communication_points
 from pendulum_fmu.sweep import OUTPUTS
-from pendulum_fmu.sweep.store import Store
+from pendulum_fmu.sweep.store import Store, parquet_options
 from pendulum_fmu.sweep.worker import Task, _runner, run_chunk
 
 CHUNKS, CASES, STOP_TIME, STEP_SIZE = 10, 64, 3.0, 1e-3
 ROUNDS = 5  # each figure the least of this many: other work on a shared machine only adds
-COMPRESSIONS = ("none", "lz4", "zstd")
 
 
 def _values() -> dict[str, np.ndarray]:
@@ -84,10 +82,23 @@ def native_loop_cpu(
     return min(rounds)
 
 
-def encodings() -> list[tuple[str, bool, float, float]]:
-    """(compression, byte-stream-split, bytes per case, write CPU per case) of a chunk's
-    trajectories table (case, time, theta, omega, alpha), written as sweep/store.py writes it
-    but for these two choices.
+# The store's Parquet options (sweep/store.py parquet_options), and each alternative measured
+# against them: one option changed at a time.
+VARIANTS = {
+    "the store's: LZ4, byte-stream-split series": {},
+    "zstd instead of LZ4": {"compression": "zstd"},
+    "no compression": {"compression": "none"},
+    "series plain, not byte-stream-split": {"column_encoding": None},
+    "no compression, series plain": {"compression": "none", "column_encoding": None},
+    "case numbers plain, not a dictionary": {"use_dictionary": False},
+    "statistics on every column": {"write_statistics": True},
+    "batches of 1,024 values (pyarrow's)": {"write_batch_size": 1024},
+}
+
+
+def encodings() -> list[tuple[str, float, float]]:
+    """(variant, bytes per case, write CPU per case) of a chunk's trajectories table (case, time,
+    theta, omega, alpha) written with the store's options and with each of VARIANTS'.
     """
     runner = _runner(str(default_fmu()))
     points = communication_points(0.0, STOP_TIME, STEP_SIZE)
@@ -100,22 +111,15 @@ def encodings() -> list[tuple[str, bool, float, float]]:
             **{name: recorded[j].reshape(-1) for j, name in enumerate(OUTPUTS)},
         }
     )
-    floats = ["time", *OUTPUTS]
+    stored = parquet_options(table.column_names, ("time", *OUTPUTS))
     rows = []
-    for compression in COMPRESSIONS:
-        for split in (False, True):
-            cpu = float("inf")
-            for _ in range(ROUNDS):
-                sink, started = io.BytesIO(), time.thread_time()
-                pq.write_table(
-                    table,
-                    sink,
-                    compression=compression,
-                    use_dictionary=["case"],
-                    column_encoding={c: "BYTE_STREAM_SPLIT" for c in floats} if split else None,
-                )
-                cpu = min(cpu, (time.thread_time() - started) / CASES)
-            rows.append((compression, split, sink.tell() / CASES, cpu))
+    for variant, change in VARIANTS.items():
+        cpu = float("inf")
+        for _ in range(ROUNDS):
+            sink, started = io.BytesIO(), time.thread_time()
+            pq.write_table(table, sink, **{**stored, **change})
+            cpu = min(cpu, (time.thread_time() - started) / CASES)
+        rows.append((variant, sink.tell() / CASES, cpu))
     return rows
 
 
@@ -132,9 +136,9 @@ def main() -> None:
             f"run_chunk, {label}: {cpu * 1e3:.3f} ms ({stepping * 1e3:.3f} ms stepping), "
             f"{cpu / floor:.2f} x the native loop, {written / 1e3:.1f} kB written"
         )
-    print("trajectories part: compression, byte-stream-split, kB per case, write CPU per case")
-    for compression, split, size, cpu in encodings():
-        print(f"  {compression:5} {'on ' if split else 'off'} {size / 1e3:7.1f} kB {cpu * 1e3:7.3f} ms")
+    print("trajectories part: kB per case, write CPU per case")
+    for variant, size, cpu in encodings():
+        print(f"  {variant:42} {size / 1e3:6.1f} kB {cpu * 1e3:7.3f} ms")
 
 
 if __name__ == "__main__":

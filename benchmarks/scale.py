@@ -23,6 +23,8 @@ import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 
+from pendulum_fmu.sweep.client import QUIET_DASK, dask_environment
+
 from .builds import BuiltFmu
 from .report import Row
 from .timing import median
@@ -45,7 +47,8 @@ def free_port() -> int:
 @contextlib.contextmanager
 def dask_processes(workers: int):
     """The address of a `dask scheduler` with `workers` single-threaded `dask worker`s, each its
-    own process on localhost, started as a user starts them on a cluster; stopped on exit.
+    own process on localhost, started as a user starts them on a cluster (docs/sweeps.md);
+    stopped on exit.
     """
     with dask_process_handles(workers) as (address, _):
         yield address
@@ -53,19 +56,25 @@ def dask_processes(workers: int):
 
 @contextlib.contextmanager
 def dask_process_handles(
-    workers: int, nanny: bool = True, host: str = "127.0.0.1", places: Sequence[tuple[Sequence[str], str]] = ()
+    workers: int,
+    nanny: bool = True,
+    host: str = "127.0.0.1",
+    places: Sequence[tuple[Sequence[str], str]] = (),
+    config: dict = QUIET_DASK,
 ):
     """(address, [the scheduler's process, each worker's]) of a cluster as dask_processes
     starts it; nanny=False: each worker is the process that runs its tasks (no nanny restarts
     it), for the fault tests to stop or kill. host: the scheduler's (and by default each
     worker's) address; places: each worker's (command prefix, host) instead, e.g. a worker in
-    another network namespace, for the fault tests to cut its link.
+    another network namespace, for the fault tests to cut its link. config: the dask settings
+    every process gets in its environment (docs/sweeps.md has a user give them; {} for dask's
+    defaults).
     """
     from dask.distributed import Client
 
     port = free_port()
     address = f"tcp://{host}:{port}"
-    quiet = dict(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    quiet = dict(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env={**os.environ, **dask_environment(config)})
     processes = [
         subprocess.Popen(
             [sys.executable, "-m", "dask", "scheduler", "--host", host, "--port", str(port), "--no-dashboard"],

@@ -114,6 +114,48 @@ def test_grid_on_a_local_cluster_matches_simulate_bit_for_bit(tmp_path, capsys):
     assert figure[:8] == b"\x89PNG\r\n\x1a\n" and len(figure) > 10_000
 
 
+def test_the_local_cluster_and_the_documented_environment_run_dask_s_periodic_work_less_often():
+    """QUIET_DASK reaches the local cluster's scheduler and workers, and the environment variables
+    docs/sweeps.md gives for workers started by hand are what dask itself reads as those settings.
+    """
+    import dask
+
+    from pendulum_fmu.sweep.client import QUIET_DASK, dask_client, dask_environment
+
+    environment = dask_environment(QUIET_DASK)
+    docs = (benchmarks.scale.REPOSITORY / "docs" / "sweeps.md").read_text()
+    assert all(f"export {name}={value}\n" in docs for name, value in environment.items())
+    code = f"import dask, distributed, json; print(json.dumps([dask.config.get(k) for k in {list(QUIET_DASK)!r}]))"
+    read = subprocess.run(
+        [sys.executable, "-c", code], env={**os.environ, **environment}, capture_output=True, text=True, check=True
+    )
+    assert json.loads(read.stdout) == list(QUIET_DASK.values())
+    assert dask.config.get("distributed.admin.tick.interval") == "20ms"  # dask's own, unchanged here
+    with dask_client(None, 1, 30.0) as client:
+        assert client.run_on_scheduler(lambda dask_scheduler: dask_scheduler._tick_interval) == 0.2
+        seen = client.run(lambda dask_worker: (dask_worker._tick_interval, "profile" in dask_worker.periodic_callbacks))
+        assert list(seen.values()) == [(0.2, False)]
+
+
+def test_a_trajectories_part_is_stored_as_measured(tmp_path):
+    """LZ4; the series (time and the outputs) byte-stream-split without min/max statistics, the case
+    numbers a dictionary with them, as pyarrow's reader sees the part's metadata.
+    """
+    import pyarrow.parquet as pq
+
+    task = Task(str(default_fmu()), Store(LocalFileSystem(), str(tmp_path), "parquet"), 0.05, 1e-3, OUTPUTS, 1, "run")
+    run_chunk(0, 7, {"torque": np.array([1.0, 2.0, 3.0])}, task)
+    metadata = pq.ParquetFile(task.store.staged("trajectories", 0, "run")).metadata
+    columns = {metadata.schema.column(j).name: metadata.row_group(0).column(j) for j in range(metadata.num_columns)}
+    assert list(columns) == ["case", "time", *OUTPUTS] and metadata.num_rows == 3 * 51
+    assert {column.compression for column in columns.values()} == {"LZ4"}
+    assert "RLE_DICTIONARY" in columns["case"].encodings
+    assert (columns["case"].statistics.min, columns["case"].statistics.max) == (7, 9)
+    for name in ("time", *OUTPUTS):
+        assert "BYTE_STREAM_SPLIT" in columns[name].encodings and "RLE_DICTIONARY" not in columns[name].encodings
+        assert not columns[name].is_stats_set, name
+
+
 def test_csv_with_chosen_outputs_and_interval(tmp_path, threads_scheduler):
     cases = [{"torque": 10.0, "damping": 0.0, "theta0": 0.3}, {"torque": 10.0, "damping": 4.0, "theta0": 0.3}]
     study = Study(

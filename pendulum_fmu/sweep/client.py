@@ -21,6 +21,24 @@ from dataclasses import dataclass
 from .._errors import PendulumFmuError
 from .worker import Task, run_chunk
 
+# dask's periodic work, for a local cluster: at dask's defaults its scheduler, nannies and
+# workers wake every 10 to 100 ms (an event-loop watchdog, the dashboard's profile and system
+# plots, memory checks), about 8 % of a core for two idle workers, 2 % at these
+# (docs/sweep_performance.md). Nothing a sweep uses changes: the dashboard's profile page stays
+# empty, its plots are coarser, a worker over its memory limit is stopped within 1 s instead of
+# 0.1 s. docs/sweeps.md gives them to workers started by hand (dask_environment).
+QUIET_DASK = {
+    "distributed.admin.tick.interval": "200ms",
+    "distributed.admin.system-monitor.interval": "2s",
+    "distributed.worker.profile.enabled": False,
+    "distributed.worker.memory.monitor-interval": "1s",
+}
+
+
+def dask_environment(config: dict) -> dict[str, str]:
+    """The environment variables that give a dask process these settings."""
+    return {f"DASK_{key.upper().replace('.', '__').replace('-', '_')}": str(value) for key, value in config.items()}
+
 
 class SchedulerUnreachable(PendulumFmuError, ConnectionError):
     """The dask scheduler did not answer; the message names the address."""
@@ -37,11 +55,14 @@ def dask_client(scheduler: str | None, workers: int | None, connect_timeout: flo
     """A dask client: on a local cluster of `workers` processes started (and closed) here, or on
     the scheduler at an address, refused within connect_timeout when it does not answer.
     """
+    import dask
     from dask.distributed import Client, LocalCluster
 
     if scheduler is None:
         with contextlib.ExitStack() as stack:
-            with _ctrl_c_held():
+            # The scheduler and nannies read the settings as they start; each nanny hands them on
+            # to its worker.
+            with _ctrl_c_held(), dask.config.set(QUIET_DASK):
                 # Port 0 for the scheduler's HTTP server: another cluster may hold dask's usual 8787.
                 cluster = stack.enter_context(
                     LocalCluster(

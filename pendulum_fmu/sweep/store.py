@@ -44,6 +44,27 @@ LOCK_FILE = ".sweep.lock"
 STAGED_GLOB = "_part-*.staged"
 
 
+def parquet_options(columns: list[str], series: tuple = ()) -> dict:
+    """pyarrow.parquet.write_table's options for a part with these columns, of which series are
+    float series over the time grid (see Store.write_table).
+
+    Measured on trajectories (python -m benchmarks.chunk_cost, docs/sweep_performance.md): LZ4
+    after byte-stream-split is within 2 % of zstd's size (57 kB for a 3-s case) for little more
+    than half its CPU, and 23 % smaller than LZ4 alone. A series spans its whole range in every
+    part, so its min/max statistics would let no reader skip a part: only the other columns
+    (case numbers, a case's values) have them. Dictionaries on the other columns, whose values
+    repeat (case numbers, status). Batches of 65,536 values rather than pyarrow's 1,024: fewer
+    passes through the writer per page.
+    """
+    return {
+        "compression": "lz4",
+        "use_dictionary": [column for column in columns if column not in series],
+        "column_encoding": {column: "BYTE_STREAM_SPLIT" for column in series} or None,
+        "write_statistics": [column for column in columns if column not in series],
+        "write_batch_size": 65536,
+    }
+
+
 class InUse(PendulumFmuError, OSError):
     """Another run holds the output folder; the message says which folder and what to do."""
 
@@ -89,12 +110,10 @@ class Store:
         """Where a worker of run writes a chunk's part, for the run's client to commit."""
         return f"{self.root}/{table}/_part-{index:06d}.{run}.staged"
 
-    def write_table(
-        self, name: str, index: int, columns: dict, run: str, split: tuple = (), unsummarized: tuple = ()
-    ) -> int:
+    def write_table(self, name: str, index: int, columns: dict, run: str, series: tuple = ()) -> int:
         """Write one part of a table, staged for run (see commit); returns its size in bytes.
-        split: float columns stored byte-stream-split, as smooth series compress best;
-        unsummarized: columns written without min/max statistics in Parquet.
+        series: the columns that are float series over the time grid (a trajectories part's time
+        and outputs), stored as parquet_options says.
         """
         import pyarrow as pa
 
@@ -108,21 +127,7 @@ class Store:
             if self.format == "parquet":
                 import pyarrow.parquet as pq
 
-                # Measured on trajectories (python -m benchmarks.chunk_cost, docs/sweep_performance.md):
-                # LZ4 after byte-stream-split is within 2 % of zstd's size (57 kB for a 3-s case)
-                # for about two thirds of its CPU, and 23 % smaller than LZ4 alone; dictionaries
-                # only where values repeat within a column (case numbers, status). Min/max
-                # statistics let readers skip a part by its case numbers or times; on a series
-                # that spans its whole range in every case they would skip nothing, for about 5 %
-                # of a case's CPU.
-                pq.write_table(
-                    table,
-                    file,
-                    compression="lz4",
-                    use_dictionary=[c for c in table.column_names if c not in split],
-                    column_encoding={c: "BYTE_STREAM_SPLIT" for c in split},
-                    write_statistics=[c for c in table.column_names if c not in unsummarized],
-                )
+                pq.write_table(table, file, **parquet_options(table.column_names, series))
             else:
                 import pyarrow.csv
 

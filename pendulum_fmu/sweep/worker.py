@@ -154,8 +154,7 @@ def run_chunk(index: int, first: int, values: dict[str, np.ndarray], task: Task)
                 **{name: kept[runner.outputs.index(name)].reshape(-1) for name in task.outputs},
             },
             task.run,
-            split=("time", *task.outputs),
-            unsummarized=task.outputs,
+            series=("time", *task.outputs),
         )
     # The summaries by name; NaN (never zeros) for a variable the FMU does not output.
     not_output = np.full((count, 1), np.nan)
