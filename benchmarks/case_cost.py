@@ -12,7 +12,10 @@ their nannies, the client, the scheduler. Reported per case, as a multiple of th
 same cases through the native loop in one process, a restart per case, nothing written):
 - at 4 x SMALL cases, everything included (starting, the figure);
 - marginal: what the larger study cost beyond the smaller, per added case, by process: what a
-  case costs in a study so large that its fixed costs no longer count.
+  case costs in a study so large that its fixed costs no longer count (both studies have 64
+  chunks, so a chunk's cost is not in it);
+- what a chunk costs each process (two studies of one-step cases, 22 and 64 chunks), and from
+  all three the CPU per case of a study of a million 3-s cases, in chunks of the size it gets.
 And the speed-up of 2 workers over 1, end to end, at each size; and what dask's periodic work
 costs an idle cluster of 2 workers, at dask's defaults and at the sweep's settings (QUIET_DASK,
 which these clusters run with). Each figure is the least of the
@@ -26,14 +29,12 @@ import contextlib
 import os
 from dataclasses import dataclass
 
-import numpy as np
-
 from pendulum_fmu.sweep.client import QUIET_DASK
 
 from .builds import BuiltFmu, build_pendulum_fmu
 from .chunk_cost import native_loop_cpu
 from .report import Row, as_text, main_table
-from .scale import _cpu_seconds, _study, dask_process_handles
+from .scale import _cpu_seconds, _study, dask_process_handles, study_grid
 
 PART = "scale"
 STOP_TIME = 3.0
@@ -42,6 +43,20 @@ NO_OUTPUTS_TARGET = 1.15
 SPEED_UP_TARGET = 1.7  # 2 workers over 1, end to end, on a quiet machine
 PROCESSES = ("workers", "client", "scheduler")
 IDLE_SECONDS = 10.0
+# Two studies of one-step cases, a case per chunk in the smaller, whose difference is what a
+# chunk costs each process (a case of one step costs next to nothing; both over 20 cases, so
+# that both figures draw bands): the marginal figures leave it out, as both of their studies
+# have 64 chunks.
+CHUNK_STUDIES, ONE_STEP = (22, 128), 1e-3
+LARGE_STUDY = 1_000_000
+
+
+def chunks(cases: int, stop_time: float) -> tuple[int, int]:
+    """(chunks, cases per chunk) of a benchmark study of this many cases."""
+    from pendulum_fmu.sweep import Study
+
+    per_chunk = Study(study_grid(cases), stop_time=stop_time).chunk_cases()
+    return -(-cases // per_chunk), per_chunk
 
 
 def idle_cpu(config: dict) -> tuple[float, float]:
@@ -73,11 +88,11 @@ class StudyCost:
         return sum(self.cpu.values())
 
 
-def _measured(address: str, processes, cases: int, fmu: BuiltFmu, outputs) -> StudyCost:
+def _measured(address: str, processes, cases: int, fmu: BuiltFmu, outputs, stop_time: float = STOP_TIME) -> StudyCost:
     """A study's cost, each process's CPU over the study alone (the client process's start and
     its warm-up study left out).
     """
-    result = _study(address, cases, STOP_TIME, fmu, outputs, [process.pid for process in processes])
+    result = _study(address, cases, stop_time, fmu, outputs, [process.pid for process in processes])
     scheduler, *workers = result["others_cpu"]
     return StudyCost(result["seconds"], {"workers": sum(workers), "client": result["cpu"], "scheduler": scheduler})
 
@@ -97,6 +112,10 @@ def measure(fmu: BuiltFmu, small: int, rounds: int) -> dict:
                     for cases in sizes:
                         cost = _measured(address, processes, cases, fmu, outputs)
                         costs.setdefault((workers, label, cases), []).append(cost)
+                if workers == 1:
+                    for cases in CHUNK_STUDIES:
+                        cost = _measured(address, processes, cases, fmu, None, ONE_STEP)
+                        costs.setdefault((workers, "one-step cases", cases), []).append(cost)
     return {key: (min(runs, key=StudyCost.total), min(run.seconds for run in runs)) for key, runs in costs.items()}
 
 
@@ -104,13 +123,9 @@ def case_cost_rows(fmu: BuiltFmu, quick: bool) -> list[Row]:
     """The part's rows: CPU per case against the C loop's, at a size and marginal; the speed-up."""
     small, rounds = (1024, 1) if quick else (4096, 2)
     load = os.getloadavg()[0]
-    # The smaller study's own cases (scale.py's grid: torques evenly from 5 to 40 N.m, gravity 0
-    # and 9.81; the larger's are spread alike): a case's cost depends on its torque, up to a
-    # fifth more at the strongest than at the weakest.
-    torques = np.linspace(5.0, 40.0, small // 2)
-    c_loop = native_loop_cpu(
-        str(fmu.path), {"torque": np.tile(torques, 2), "gravity": np.repeat([0.0, 9.81], len(torques))}, repeats=1
-    )
+    # The smaller study's own cases (the larger's are spread alike): a case's cost depends on its
+    # torque, up to a fifth more at the strongest than at the weakest.
+    c_loop = native_loop_cpu(str(fmu.path), study_grid(small).columns(0, small), repeats=1)
     measured = measure(fmu, small, rounds)
     large = 4 * small
     rows = [
@@ -142,6 +157,36 @@ def case_cost_rows(fmu: BuiltFmu, quick: bool) -> list[Row]:
                 ),
                 Row(PART, f"case cost, {label}, {workers} worker(s): fixed CPU per study", f"{fixed} s"),
             ]
+    (few, _), (many, _) = (measured[(1, "one-step cases", cases)] for cases in CHUNK_STUDIES)
+    added_chunks = chunks(CHUNK_STUDIES[1], ONE_STEP)[0] - chunks(CHUNK_STUDIES[0], ONE_STEP)[0]
+    per_chunk = {name: (many.cpu[name] - few.cpu[name]) / added_chunks for name in PROCESSES}
+    rows.append(
+        Row(
+            PART,
+            f"case cost: CPU per chunk, 1 worker (studies of {CHUNK_STUDIES[0]} and {CHUNK_STUDIES[1]} one-step cases)",
+            ", ".join(f"{name} {per_chunk[name] * 1e3:.2f}" for name in PROCESSES) + " ms",
+        )
+    )
+    # A study of LARGE_STUDY 3-s cases: the marginal CPU per case, each chunk's, and the study's
+    # fixed cost (the smaller study's, less its chunks').
+    (big, _), (little, _) = measured[(1, "all outputs", large)], measured[(1, "all outputs", small)]
+    large_chunks, chunk_cases = chunks(LARGE_STUDY, STOP_TIME)
+    small_chunks = chunks(small, STOP_TIME)[0]
+    marginal = sum(big.cpu.values()) - sum(little.cpu.values())
+    marginal /= large - small
+    fixed = little.total() - marginal * small - small_chunks * sum(per_chunk.values())
+    at_scale = (marginal * LARGE_STUDY + sum(per_chunk.values()) * large_chunks + fixed) / LARGE_STUDY
+    rows.append(
+        Row(
+            PART,
+            f"case cost, all outputs, 1 worker: CPU per case in a study of {LARGE_STUDY:,} 3-s cases "
+            f"({large_chunks:,} chunks of {chunk_cases}), estimated",
+            f"{at_scale / c_loop:.2f} x the C loop ({at_scale * 1e3:.3f} ms: marginal {marginal * 1e3:.3f}, "
+            f"chunks {sum(per_chunk.values()) / chunk_cases * 1e3:.3f})",
+            f"<= {ALL_OUTPUTS_TARGET:g} x",
+            at_scale / c_loop <= ALL_OUTPUTS_TARGET,
+        )
+    )
     for label, config in (("dask's defaults", {}), ("the sweep's settings (QUIET_DASK)", QUIET_DASK)):
         scheduler, workers = idle_cpu(config)
         rows.append(

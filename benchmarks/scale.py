@@ -118,6 +118,15 @@ def dask_process_handles(
                 process.wait(timeout=30)
 
 
+def study_grid(cases: int):
+    """The cases of a benchmark study: torques evenly from 5 to 40 N.m, gravity 0 and 9.81."""
+    import numpy as np
+
+    from pendulum_fmu import sweep
+
+    return sweep.sweep_grid(list(np.linspace(5.0, 40.0, cases // 2)), [0.0, 9.81])
+
+
 def measure_client(
     address: str,
     cases: int,
@@ -132,11 +141,9 @@ def measure_client(
     """
     import resource
 
-    import numpy as np
-
     from pendulum_fmu import sweep
 
-    grid = sweep.sweep_grid(list(np.linspace(5.0, 40.0, cases // 2)), [0.0, 9.81])
+    grid = study_grid(cases)
     output_dir = f"{output_dir}/study"
 
     def cpu() -> float:

@@ -38,8 +38,9 @@ def test_a_grid_is_the_product_of_its_axes():
     [
         (100_000, 0.01, 1_563),  # short cases: about 64 chunks, as their steps allow
         (4_096, 3.0, 64),  # about 64 chunks
-        (1_000_000, 3.0, 256),  # at most 256 3-s cases (768,000 steps) in a chunk
-        (256, 600.0, 4),  # long cases: still about 64 chunks, never fewer cases than 256 allow
+        (1_000_000, 3.0, 888),  # 888 3-s cases: their 3 x 3,001 doubles each within 64 MB
+        (1_000_000, 1.0, 2_664),  # shorter cases: more, as many as 64 MB of recordings hold
+        (256, 600.0, 4),  # long cases: still about 64 chunks
         (100, 2_000.0, 1),  # a chunk's recordings within 64 MB: a 2,000-s case's 3 x 2,000,001 doubles are 48 MB
     ],
 )

@@ -30,11 +30,13 @@ ALL_OUTPUTS: tuple[str, ...] = _AllOutputs()
 # A study is cut into about this many chunks, so that up to 16 workers each get several (the
 # load evens out and progress shows), but no chunk holds more than MAX_CHUNK_CASES cases, so a
 # lost worker loses little; more only where its cases are short, up to MAX_CHUNK_STEPS steps in
-# all (as many as 256 3-s cases at 1 ms steps): the client's work per chunk (submitting it,
-# committing its parts) is then spread over more cases (python -m benchmarks --only scale:
-# 100,000 10-ms cases in 64 chunks instead of 391).
+# all (as many as 1,024 3-s cases at 1 ms steps). A chunk costs its worker, the client and the
+# scheduler about 5 ms in all whatever its size (python -m benchmarks.case_cost), 0.02 ms per
+# case in chunks of 256 3-s cases: a large study's chunks are as large as MAX_CHUNK_BYTES allows
+# (888 3-s cases, the whole study 10 % less CPU per case), and 100,000 10-ms cases go in 64
+# chunks instead of 391 (python -m benchmarks --only scale).
 TARGET_CHUNKS = 64
-MAX_CHUNK_CASES = 256
+MAX_CHUNK_CASES = 1024
 MAX_CHUNK_STEPS = MAX_CHUNK_CASES * 3000
 # And a chunk's recordings (every point of every case, before thinning) stay this small, so a
 # chunk's files stay tens of megabytes.
