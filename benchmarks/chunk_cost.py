@@ -90,7 +90,7 @@ VARIANTS = {
     "no compression": {"compression": "none"},
     "series plain, not byte-stream-split": {"column_encoding": None},
     "no compression, series plain": {"compression": "none", "column_encoding": None},
-    "case numbers plain, not a dictionary": {"use_dictionary": False},
+    "case numbers a dictionary, not plain": {"use_dictionary": ["case"]},
     "statistics on every column": {"write_statistics": True},
     "batches of 1,024 values (pyarrow's)": {"write_batch_size": 1024},
 }

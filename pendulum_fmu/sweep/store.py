@@ -52,13 +52,15 @@ def parquet_options(columns: list[str], series: tuple = ()) -> dict:
     after byte-stream-split is within 2 % of zstd's size (57 kB for a 3-s case) for little more
     than half its CPU, and 23 % smaller than LZ4 alone. A series spans its whole range in every
     part, so its min/max statistics would let no reader skip a part: only the other columns
-    (case numbers, a case's values) have them. Dictionaries on the other columns, whose values
-    repeat (case numbers, status). Batches of 65,536 values rather than pyarrow's 1,024: fewer
-    passes through the writer per page.
+    (case numbers, a case's values) have them. Dictionaries in the cases table, whose values
+    repeat (status, the swept values); a trajectories part's case numbers, runs of one value,
+    cost less plain under LZ4 (10 % fewer instructions for the part, 0.006 ms per 3-s case, 0.2 %
+    larger). Batches of 65,536 values rather than pyarrow's 1,024: fewer passes through the
+    writer per page.
     """
     return {
         "compression": "lz4",
-        "use_dictionary": [column for column in columns if column not in series],
+        "use_dictionary": not series,
         "column_encoding": {column: "BYTE_STREAM_SPLIT" for column in series} or None,
         "write_statistics": [column for column in columns if column not in series],
         "write_batch_size": 65536,
