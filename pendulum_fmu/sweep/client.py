@@ -24,9 +24,10 @@ from .worker import Task, run_chunk
 # dask's periodic work, for a local cluster: at dask's defaults its scheduler, nannies and
 # workers wake every 10 to 100 ms (an event-loop watchdog, the dashboard's profile and system
 # plots, memory checks), 10 to 12 % of a core for an idle cluster of two workers, 1.5 to 2.4 %
-# at these (python -m benchmarks.case_cost). Nothing a sweep uses changes: the dashboard's profile page stays
-# empty, its plots are coarser, a worker over its memory limit is stopped within 1 s instead of
-# 0.1 s. docs/sweeps.md gives them to workers started by hand (dask_environment).
+# at these (python -m benchmarks.case_cost). Nothing a sweep uses changes: the dashboard's
+# profile page stays empty, its plots are coarser, a worker over its memory limit is stopped
+# within 1 s instead of 0.1 s. docs/sweeps.md gives them to workers started by hand
+# (dask_environment).
 QUIET_DASK = {
     "distributed.admin.tick.interval": "200ms",
     "distributed.admin.system-monitor.interval": "2s",
