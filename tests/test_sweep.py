@@ -1130,7 +1130,23 @@ def _sweep_command(output_dir, *arguments):
     "signal_number, code, word", [(signal.SIGINT, 130, "interrupted"), (signal.SIGTERM, 143, "terminated")]
 )
 def test_a_signal_stops_a_sweep_cleanly(tmp_path, signal_number, code, word):
-    command = _sweep_command(tmp_path, "--torque", *map(str, range(1, 300)), "--gravity", "0", "9.81", "--workers", "2")
+    # Cases of 600 s kept at every second: a chunk of 10 steps for a few tenths of a second, so
+    # the study is still running when its first part appears (cases of 3 s all finished in the
+    # time the signal took to arrive once, on a loaded machine).
+    command = _sweep_command(
+        tmp_path,
+        "--torque",
+        *map(str, range(1, 300)),
+        "--gravity",
+        "0",
+        "9.81",
+        "--stop-time",
+        "600",
+        "--output-interval",
+        "1",
+        "--workers",
+        "2",
+    )
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 120
     while not glob.glob(str(tmp_path / "cases" / "part-*")):
@@ -1146,10 +1162,15 @@ def test_a_signal_stops_a_sweep_cleanly(tmp_path, signal_number, code, word):
     assert not list(tmp_path.glob("**/.*"))  # no temporaries
     written = sorted(p.name for p in tmp_path.glob("cases/part-*"))
     assert written and written == sorted(p.name for p in tmp_path.glob("trajectories/part-*"))
-    # And what was written is whole: every part reads, with the cases it should hold (598 cases
-    # in chunks of 10).
-    chunks = [int(name[5:11]) for name in written]
-    assert len(_table(tmp_path / "cases")["case"]) == sum(min(10, 598 - 10 * i) for i in chunks)
+    # And what was written is whole: every part reads, a chunk's cases are consecutive, no case
+    # twice, and each case's trajectory has its 601 points (0 to 600 s, one a second).
+    parts = [_table(tmp_path / "cases" / name)["case"] for name in written]
+    assert all(np.array_equal(case, np.arange(case[0], case[0] + len(case))) for case in parts)
+    cases = np.concatenate(parts)
+    assert 0 < len(cases) < 598 and len(np.unique(cases)) == len(cases)
+    trajectories = _table(tmp_path / "trajectories")
+    assert np.array_equal(trajectories["case"], np.repeat(np.sort(cases), 601))
+    assert np.array_equal(trajectories["time"], np.tile(np.arange(601.0), len(cases)))
 
 
 @pytest.mark.parametrize("delay", [0.3, 0.6, 1.0, 1.5, 2.0, 2.5, 3.0, 4.0])
