@@ -738,12 +738,14 @@ def test_a_study_on_a_scheduler_and_workers_started_as_processes(tmp_path, dask_
 
 
 def test_a_chunk_whose_worker_dies_is_run_again(tmp_path, dask_processes):
-    cases = sweep_grid(list(np.linspace(1.0, 40.0, 256)), [9.81])  # 64 chunks of 4 cases
+    # 64 chunks of 4 cases of 60 s: a chunk takes several times what finding and killing the
+    # worker does, so chunks are still queued when it dies.
+    cases = sweep_grid(list(np.linspace(1.0, 40.0, 256)), [9.81])
     results = []
     study = threading.Thread(
         target=lambda: results.append(
             run_sweep(
-                Study(cases, stop_time=10.0, outputs=[]), output_dir=tmp_path, scheduler=dask_processes, progress=False
+                Study(cases, stop_time=60.0, outputs=[]), output_dir=tmp_path, scheduler=dask_processes, progress=False
             )
         )
     )
@@ -763,7 +765,7 @@ def test_a_chunk_whose_worker_dies_is_run_again(tmp_path, dask_processes):
     assert results[0].cases == 256 and results[0].failed == 0
     table = _table(tmp_path / "cases")
     assert table["case"].tolist() == list(range(256)) and set(table["status"]) == {"ok"}
-    assert table["final_theta"][255] == simulate.simulate(40.0, stop_time=10.0)["theta"][-1]
+    assert table["final_theta"][255] == simulate.simulate(40.0, stop_time=60.0)["theta"][-1]
     assert not list(tmp_path.glob("**/.*"))
 
 
