@@ -16,6 +16,9 @@ same cases through the native loop in one process, a restart per case, nothing w
   chunks, so a chunk's cost is not in it);
 - what a chunk costs each process (two studies of one-step cases, 22 and 64 chunks), and from
   all three the CPU per case of a study of a million 3-s cases, in chunks of the size it gets.
+The marginal rows also say how much of the workers' CPU was the kernel's (mostly copying the
+parts into the page cache), and a row gives what that copy costs this machine now (kernel CPU
+per MB written to new files): on a VM it can move by several times from one minute to the next.
 And the speed-up of 2 workers over 1, end to end, at each size; and what dask's periodic work
 costs an idle cluster of 2 workers, at dask's defaults and at the sweep's settings (QUIET_DASK,
 which these clusters run with). Each figure is the least of the
@@ -27,7 +30,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from pendulum_fmu.sweep.client import QUIET_DASK
 
@@ -77,12 +80,34 @@ def idle_cpu(config: dict) -> tuple[float, float]:
     return used[0], sum(used[1:])
 
 
+def kernel_write_cpu(megabytes: int = 256) -> float:
+    """Kernel CPU seconds per MB written to new files in the temporary folder (the copy into the
+    page cache; the disk is written later, by the kernel's own threads). A sweep's workers pay it
+    for every byte of their parts. On a virtual machine whose free memory goes back to its host,
+    fresh page-cache pages cost the host's faults too, more or less from one moment to the next.
+    """
+    import resource
+    import tempfile
+
+    block = os.urandom(1 << 20)
+    with tempfile.TemporaryDirectory(prefix="pendulum-kernel-write-") as folder:
+        before = resource.getrusage(resource.RUSAGE_SELF).ru_stime
+        for file in range(megabytes // 4):
+            with open(os.path.join(folder, f"{file}"), "wb") as out:
+                for _ in range(4):
+                    out.write(block)
+        return (resource.getrusage(resource.RUSAGE_SELF).ru_stime - before) / megabytes
+
+
 @dataclass(frozen=True)
 class StudyCost:
-    """A study's wall time and each process's CPU seconds."""
+    """A study's wall time and each process's CPU seconds (kernel: of it in the kernel, the
+    workers' only).
+    """
 
     seconds: float
     cpu: dict[str, float]
+    kernel: dict[str, float] = field(default_factory=dict)
 
     def total(self) -> float:
         return sum(self.cpu.values())
@@ -94,7 +119,12 @@ def _measured(address: str, processes, cases: int, fmu: BuiltFmu, outputs, stop_
     """
     result = _study(address, cases, stop_time, fmu, outputs, [process.pid for process in processes])
     scheduler, *workers = result["others_cpu"]
-    return StudyCost(result["seconds"], {"workers": sum(workers), "client": result["cpu"], "scheduler": scheduler})
+    workers_kernel = sum(result["others_kernel_cpu"][1:])
+    return StudyCost(
+        result["seconds"],
+        {"workers": sum(workers), "client": result["cpu"], "scheduler": scheduler},
+        {"workers": workers_kernel},
+    )
 
 
 def measure(fmu: BuiltFmu, small: int, rounds: int) -> dict:
@@ -139,11 +169,17 @@ def case_cost_rows(fmu: BuiltFmu, quick: bool) -> list[Row]:
     # The smaller study's own cases (the larger's are spread alike): a case's cost depends on its
     # torque, up to a fifth more at the strongest than at the weakest.
     c_loop = native_loop_cpu(str(fmu.path), study_grid(small).columns(0, small), repeats=1)
+    kernel_write = kernel_write_cpu()
     measured = measure(fmu, small, rounds)
     large = 4 * small
     rows = [
         Row(PART, "case cost: load average before", f"{load:.1f} (2-core figures need a quiet machine)"),
         Row(PART, "case cost: C loop CPU per 3-s case (native loop, a restart per case)", f"{c_loop * 1e3:.3f} ms"),
+        Row(
+            PART,
+            "case cost: kernel CPU per MB written to new files, before the studies (this machine, now)",
+            f"{kernel_write * 1e3:.2f} ms",
+        ),
     ]
     for label, target in (("all outputs", ALL_OUTPUTS_TARGET), ("--outputs none", NO_OUTPUTS_TARGET)):
         for workers in (1, 2):
@@ -151,7 +187,9 @@ def case_cost_rows(fmu: BuiltFmu, quick: bool) -> list[Row]:
             at_size = big.total() / large / c_loop
             marginal = {name: (big.cpu[name] - little.cpu[name]) / (large - small) for name in PROCESSES}
             ratio = sum(marginal.values()) / c_loop
+            kernel = (big.kernel["workers"] - little.kernel["workers"]) / (large - small)
             breakdown = ", ".join(f"{name} {marginal[name] * 1e3:.3f}" for name in PROCESSES)
+            breakdown += f"; of the workers', in the kernel {kernel * 1e3:.3f}"
             fixed = ", ".join(f"{name} {little.cpu[name] - marginal[name] * small:.2f}" for name in PROCESSES)
             rows += [
                 Row(

@@ -137,7 +137,8 @@ def measure_client(
     others: Sequence[int] = (),
 ) -> None:
     """Run in the client process: the sweep; prints its figures as JSON. others: the process ids
-    whose CPU (with their children's) over the study itself is reported too ("others_cpu").
+    whose CPU (with their children's) over the study itself is reported too ("others_cpu"; of
+    it in the kernel, "others_kernel_cpu").
     """
     import resource
 
@@ -158,7 +159,7 @@ def measure_client(
         scheduler=address,
         progress=False,
     )
-    others_before = [_cpu_seconds(pid) for pid in others]
+    others_before = [_cpu_times(pid) for pid in others]
     before = cpu()
     chosen = {} if outputs is None else {"outputs": outputs}
     result = sweep.run_sweep(
@@ -168,7 +169,10 @@ def measure_client(
         progress=False,
     )
     client_cpu = cpu() - before
-    others_cpu = [_cpu_seconds(pid) - seconds for pid, seconds in zip(others, others_before, strict=True)]
+    others_used = [
+        (after[0] - before[0], after[1] - before[1])
+        for before, after in zip(others_before, [_cpu_times(pid) for pid in others], strict=True)
+    ]
     print(
         json.dumps(
             {
@@ -181,7 +185,8 @@ def measure_client(
                 "worker_cpu": result.worker_cpu_seconds,
                 "worker_stepping": result.worker_stepping_seconds,
                 "peak_rss": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024,
-                "others_cpu": others_cpu,
+                "others_cpu": [sum(used) for used in others_used],
+                "others_kernel_cpu": [kernel for _, kernel in others_used],
             }
         )
     )
@@ -248,12 +253,20 @@ def _median_study(results: list[dict]) -> dict:
     return {key: median([result[key] for result in results]) for key in results[0]}
 
 
-def _cpu_seconds(pid: int) -> float:
-    """CPU of a process and of its children (a worker's nanny and the worker it runs)."""
+def _cpu_times(pid: int) -> tuple[float, float]:
+    """(user, kernel) CPU seconds of a process and of its children (a worker's nanny and the
+    worker it runs).
+    """
     import psutil
 
     parent = psutil.Process(pid)
-    return sum(sum(member.cpu_times()[:2]) for member in (parent, *parent.children(recursive=True)))
+    times = [member.cpu_times() for member in (parent, *parent.children(recursive=True))]
+    return sum(t.user for t in times), sum(t.system for t in times)
+
+
+def _cpu_seconds(pid: int) -> float:
+    """CPU of a process and of its children, user and kernel."""
+    return sum(_cpu_times(pid))
 
 
 def scale_rows(fmu: BuiltFmu, quick: bool, cases: int | None = None) -> list[Row]:
