@@ -30,7 +30,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import os
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from pendulum_fmu.sweep.client import QUIET_DASK
 
@@ -92,8 +92,8 @@ def kernel_write_cpu(megabytes: int = 256) -> float:
     block = os.urandom(1 << 20)
     with tempfile.TemporaryDirectory(prefix="pendulum-kernel-write-") as folder:
         before = resource.getrusage(resource.RUSAGE_SELF).ru_stime
-        for file in range(megabytes // 4):
-            with open(os.path.join(folder, f"{file}"), "wb") as out:
+        for index in range(megabytes // 4):
+            with open(os.path.join(folder, str(index)), "wb") as out:
                 for _ in range(4):
                     out.write(block)
         return (resource.getrusage(resource.RUSAGE_SELF).ru_stime - before) / megabytes
@@ -101,13 +101,11 @@ def kernel_write_cpu(megabytes: int = 256) -> float:
 
 @dataclass(frozen=True)
 class StudyCost:
-    """A study's wall time and each process's CPU seconds (kernel: of it in the kernel, the
-    workers' only).
-    """
+    """A study's wall time, each process's CPU seconds, and of the workers' those in the kernel."""
 
     seconds: float
     cpu: dict[str, float]
-    kernel: dict[str, float] = field(default_factory=dict)
+    workers_kernel: float = 0.0
 
     def total(self) -> float:
         return sum(self.cpu.values())
@@ -119,11 +117,10 @@ def _measured(address: str, processes, cases: int, fmu: BuiltFmu, outputs, stop_
     """
     result = _study(address, cases, stop_time, fmu, outputs, [process.pid for process in processes])
     scheduler, *workers = result["others_cpu"]
-    workers_kernel = sum(result["others_kernel_cpu"][1:])
     return StudyCost(
         result["seconds"],
         {"workers": sum(workers), "client": result["cpu"], "scheduler": scheduler},
-        {"workers": workers_kernel},
+        sum(result["others_kernel_cpu"][1:]),
     )
 
 
@@ -187,7 +184,7 @@ def case_cost_rows(fmu: BuiltFmu, quick: bool) -> list[Row]:
             at_size = big.total() / large / c_loop
             marginal = {name: (big.cpu[name] - little.cpu[name]) / (large - small) for name in PROCESSES}
             ratio = sum(marginal.values()) / c_loop
-            kernel = (big.kernel["workers"] - little.kernel["workers"]) / (large - small)
+            kernel = (big.workers_kernel - little.workers_kernel) / (large - small)
             breakdown = ", ".join(f"{name} {marginal[name] * 1e3:.3f}" for name in PROCESSES)
             breakdown += f"; of the workers', in the kernel {kernel * 1e3:.3f}"
             fixed = ", ".join(f"{name} {little.cpu[name] - marginal[name] * small:.2f}" for name in PROCESSES)
