@@ -1132,9 +1132,9 @@ def _sweep_command(output_dir, *arguments):
     "signal_number, code, word", [(signal.SIGINT, 130, "interrupted"), (signal.SIGTERM, 143, "terminated")]
 )
 def test_a_signal_stops_a_sweep_cleanly(tmp_path, signal_number, code, word):
-    # Cases of 600 s kept every second: a chunk of 10 of them steps for a few tenths of a second,
-    # so the study is still running when its first part appears (cases of 3 s had all finished
-    # once, on a loaded machine, before the signal arrived).
+    # Cases of 600 s kept every second: a chunk (4 of them, as its recordings hold every step)
+    # steps for a tenth of a second or more, so the study is still running when its first part
+    # appears (cases of 3 s had all finished once, on a loaded machine, before the signal came).
     settings = "--gravity 0 9.81 --stop-time 600 --output-interval 1 --workers 2"
     command = _sweep_command(tmp_path, "--torque", *map(str, range(1, 300)), *settings.split())
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
