@@ -83,8 +83,8 @@ def idle_cpu(config: dict) -> tuple[float, float]:
 def kernel_write_cpu(megabytes: int = 256) -> float:
     """Kernel CPU seconds per MB written to new files in the temporary folder (the copy into the
     page cache; the disk is written later, by the kernel's own threads). A sweep's workers pay it
-    for every byte of their parts. On a virtual machine whose free memory goes back to its host,
-    fresh page-cache pages cost the host's faults too, more or less from one moment to the next.
+    for every byte of their parts. On this project's VM it moved by ten times within an hour
+    (likely the host's work for fresh guest pages; not verified).
     """
     import resource
     import tempfile
