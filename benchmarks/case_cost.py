@@ -37,7 +37,7 @@ from pendulum_fmu.sweep.client import QUIET_DASK
 from .builds import BuiltFmu, build_pendulum_fmu
 from .chunk_cost import native_loop_cpu
 from .report import Row, as_text, main_table
-from .scale import _cpu_seconds, _study, dask_process_handles, study_grid
+from .scale import _cpu_seconds, _cpu_times, _study, dask_process_handles, study_grid
 
 PART = "scale"
 STOP_TIME = 3.0
@@ -86,17 +86,16 @@ def kernel_write_cpu(megabytes: int = 256) -> float:
     for every byte of their parts. On this project's VM it moved by ten times within an hour
     (likely the host's work for fresh guest pages; not verified).
     """
-    import resource
     import tempfile
 
     block = os.urandom(1 << 20)
     with tempfile.TemporaryDirectory(prefix="pendulum-kernel-write-") as folder:
-        before = resource.getrusage(resource.RUSAGE_SELF).ru_stime
+        _, before = _cpu_times(os.getpid())
         for index in range(megabytes // 4):
             with open(os.path.join(folder, str(index)), "wb") as out:
                 for _ in range(4):
                     out.write(block)
-        return (resource.getrusage(resource.RUSAGE_SELF).ru_stime - before) / megabytes
+        return (_cpu_times(os.getpid())[1] - before) / megabytes
 
 
 @dataclass(frozen=True)
