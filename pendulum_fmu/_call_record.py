@@ -38,10 +38,61 @@ INPUT = "torque"
 TIME_TOLERANCE = 1e-9
 
 
+# The FMU escapes every string a master gave it (instance="...", file="...") as C does, \xHH for
+# each byte outside printable ASCII and for '%', so that no line of a record starts with anything
+# but the marker (fmu_src/src/record_file.c): a quoted field is a run of anything but a quote or
+# a backslash, and of escapes.
+_QUOTED = r'"(?:[^"\\]|\\.)*"'
+
+
 _RECORD = re.compile(
-    r'\[pendulum-calls\] instance="(?P<instance>[^"]*)" (?P<function>fmi[23]\w+)'
+    rf"\[pendulum-calls\] instance=(?P<instance>{_QUOTED}) (?P<function>fmi[23]\w+)"
     r"\((?P<arguments>.*)\) time=(?P<before>\S+)->(?P<after>\S+) status=(?P<status>\w+)"
 )
+
+
+_ESCAPE = re.compile(rb"\\(x[0-9a-fA-F]{2}|.)", re.DOTALL)
+
+
+_ESCAPED_CHARACTERS = {b"n": b"\n", b"r": b"\r", b"t": b"\t"}
+
+
+def unescape(quoted: str) -> str:
+    r"""The string a master gave the FMU, from its escaped, quoted form in a record line.
+
+    Parameters
+    ----------
+    quoted : str
+        A quoted field of a record line, quotes included: ``"x\n\x25s"``.
+
+    Returns
+    -------
+    str
+        The string itself, its bytes read as UTF-8 (a byte that is not becomes U+FFFD).
+
+    Examples
+    --------
+    >>> unescape(r'"pend\"ulum\n\xc3\xa9"')
+    'pend"ulum\né'
+    """
+
+    def byte(match: re.Match) -> bytes:
+        code = match[1]
+        return bytes([int(code[1:], 16)]) if code[:1] == b"x" else _ESCAPED_CHARACTERS.get(code, code)
+
+    return _ESCAPE.sub(byte, quoted[1:-1].encode("ascii", "backslashreplace")).decode("utf-8", "replace")
+
+
+def printable(text: str) -> str:
+    r"""Text as a terminal may show it: as it is when every character is printable, else with
+    Python's escapes, so that a name from a record cannot start a line or steer a terminal.
+
+    Examples
+    --------
+    >>> printable("x\ncurl")
+    "'x\\ncurl'"
+    """
+    return text if text.isprintable() else repr(text)
 
 
 _MASTER = re.compile(r"(?P<function>fmi[23][A-Z]\w+)\((?P<arguments>.*)\)(?:\s*->\s*(?P<result>\S+))?\s*$")
@@ -163,9 +214,9 @@ def _record_call(match: re.Match, variables: frozenset) -> Call:
         if name in variables or name.startswith(("der(", "x[")):
             values[name] = float(value)
         else:
-            arguments[name] = value
+            arguments[name] = unescape(value) if value.startswith('"') else value
     return Call(
-        match["instance"],
+        unescape(match["instance"]),
         match["function"],
         values,
         arguments,
@@ -176,16 +227,17 @@ def _record_call(match: re.Match, variables: frozenset) -> Call:
 
 
 def _split_arguments(text: str) -> list[str]:
-    """Split at ', ' outside parentheses (der(torque,1)=5 holds a comma)."""
+    """Split at ', ' outside parentheses (der(torque,1)=5 holds a comma) and quoted strings."""
     parts, depth, start = [], 0, 0
-    for position, character in enumerate(text):
+    for piece in re.finditer(rf"{_QUOTED}|[(),]", text):
+        character = piece[0]
         if character == "(":
             depth += 1
         elif character == ")":
             depth -= 1
         elif character == "," and depth == 0:
-            parts.append(text[start:position])
-            start = position + 1
+            parts.append(text[start : piece.start()])
+            start = piece.end()
     parts.append(text[start:])
     return parts
 
@@ -377,7 +429,7 @@ def timeline(record: InstanceCalls) -> list[str]:
     >>> timeline(InstanceCalls("p"))
     ['instance p ()', '  0 steps']
     """
-    lines = [f"instance {record.instance} ({record.interface})"]
+    lines = [f"instance {printable(record.instance)} ({record.interface})"]
     if record.set_before_start:
         lines.append(
             "  set before initialization ended: "

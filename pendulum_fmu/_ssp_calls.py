@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ._call_record import Call, InstanceCalls, read_calls, reconstruct
+from ._call_record import Call, InstanceCalls, printable, read_calls, reconstruct
 from ._closed_loop import COUPLINGS, controller_defaults
 from ._errors import InvalidInput
 from ._parameters import default_parameters, variables
@@ -242,7 +242,8 @@ def format_ssp_calls_verdict(verdict: SspCallsVerdict) -> str:
     )
     shown = ", ".join(f"{name}={value!r}" for name, value in verdict.pendulum_set.items()) or "none"
     lines = [
-        f"instance {verdict.instance}: {verdict.steps} steps of {verdict.step_size:.9g} s, to {verdict.end_time:.9g} s",
+        f"instance {printable(verdict.instance)}: {verdict.steps} steps of {verdict.step_size:.9g} s, "
+        f"to {verdict.end_time:.9g} s",
         f"coupling: {verdict.coupling} ({COUPLINGS[verdict.coupling]})",
         f"controller's parameter set arrived: {arrived}",
         f"pendulum's parameters set before initialization ended: {shown}",

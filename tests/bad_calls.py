@@ -1088,6 +1088,14 @@ CASES = [
         "cannot be opened for appending",
         _instantiated_then("fmi2SetString", refs(CALL_RECORD_FILE), 1, lambda: strings(b"/no/such/folder/record.log")),
     ),
+    Case(
+        "record file",
+        "callRecordFile a symbolic link (/proc/self/exe, a link on every Linux)",
+        "fmi2SetString",
+        WARNING,
+        "is a symbolic link: the FMU writes no record file",
+        _instantiated_then("fmi2SetString", refs(CALL_RECORD_FILE), 1, lambda: strings(b"/proc/self/exe")),
+    ),
     *_foreign_state_cases(Harness),
 ]
 
@@ -1260,6 +1268,14 @@ CASES_FMI3 = [
         ERROR,
         "callRecordFile is 1024 bytes long: at most 1023",
         _instantiated_then("fmi3SetString", refs(CALL_RECORD_FILE), 1, lambda: strings(b"x" * 1024), 1),
+    ),
+    Case(
+        "record file",
+        "callRecordFile a symbolic link (/proc/self/exe, a link on every Linux)",
+        "fmi3SetString",
+        WARNING,
+        "is a symbolic link: the FMU writes no record file",
+        _instantiated_then("fmi3SetString", refs(CALL_RECORD_FILE), 1, lambda: strings(b"/proc/self/exe"), 1),
     ),
     Case(
         "counts",

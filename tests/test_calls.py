@@ -291,8 +291,8 @@ def test_a_record_file_that_cannot_be_opened_is_one_warning_and_the_run_complete
     )
     warnings = [line for line in capsys.readouterr().out.splitlines() if "callRecordFile" in line]
     assert warnings == [
-        f"[WARNING] fmi2SetString: callRecordFile {missing} cannot be opened for appending "
-        "(No such file or directory): the FMU writes no record file"
+        f'[WARNING] fmi2SetString: callRecordFile "{missing}" cannot be opened for appending '
+        "(No such file or directory): the FMU writes no record file (name a new file, or one of its records)"
     ]
     assert not missing.parent.exists()
     assert result["time"].tolist() == pytest.approx([k * STEP for k in range(N_STEPS + 1)], abs=1e-15)

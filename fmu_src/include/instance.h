@@ -11,6 +11,7 @@
 #include <stdint.h>
 
 #include "model.h"
+#include "record_file.h"
 
 /* Same order and values as fmi2Status and fmi3Status, so an adapter converts by a cast. */
 typedef enum {
@@ -93,6 +94,11 @@ typedef enum {
 #define RECORD_BITS (LOG_CALLS | RECORD_TO_FILE)
 /* The longest callRecordFile, with its terminating zero. */
 #define MAX_RECORD_FILE_NAME 1024
+/* A record line's arguments: the longest is fmi*SetString's, the record file's name escaped; a
+   call that sets every variable at round-trip precision fits too. */
+#define RECORD_ARGUMENTS_SIZE (ESCAPED_SIZE(MAX_RECORD_FILE_NAME) + 16)
+/* A record line: its arguments, the instance name escaped, the function, times and status. */
+#define RECORD_LINE_SIZE (RECORD_ARGUMENTS_SIZE + ESCAPED_SIZE(MAX_INSTANCE_NAME) + 256)
 
 typedef struct {
     InstanceData data;
@@ -174,8 +180,8 @@ void instance_record_call(const Instance *instance, const char *function, double
 /* The arguments are values by variable name (vr given: "torque=20"), input derivatives by name
    and order (order given too: "der(torque,1)=5"), or a state vector (vr NULL: "x[0]=0.1"). */
 /* The String parameters (callRecordFile): set by value reference, each value a file name that
-   is opened for appending at once (a file that cannot be opened: a warning, and no record file);
-   get returns the name as set. */
+   is opened for appending at once where record_file_open allows (else a warning, and no record
+   file); get returns the name as set. */
 Status instance_set_string(Instance *instance, const char *function, const unsigned int vr[], size_t n,
                            const char *const value[]);
 Status instance_get_string(Instance *instance, const char *function, const unsigned int vr[], size_t n,

@@ -257,7 +257,8 @@ fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
     REQUIRE_ARRAY(vr, nvr)
     REQUIRE_ARRAY(value, nvr)
     const Status status = instance_set_string(instance, function, vr, nvr, value);
-    RECORD(status, "file=\"%s\"", instance->record_file_name)
+    char file[ESCAPED_SIZE(MAX_RECORD_FILE_NAME)];
+    RECORD(status, "file=\"%s\"", escape_text(file, sizeof(file), instance->record_file_name))
     return STATUS(status);
 }
 

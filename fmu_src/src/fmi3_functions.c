@@ -373,7 +373,8 @@ fmi3Status fmi3SetString(fmi3Instance c, const fmi3ValueReference valueReference
     REQUIRE_ARRAY(values, nValues)
     REQUIRE_COUNT(nValues, nValueReferences)
     const Status status = instance_set_string(instance, function, valueReferences, nValueReferences, values);
-    RECORD(status, "file=\"%s\"", instance->record_file_name)
+    char file[ESCAPED_SIZE(MAX_RECORD_FILE_NAME)];
+    RECORD(status, "file=\"%s\"", escape_text(file, sizeof(file), instance->record_file_name))
     return STATUS(status);
 }
 

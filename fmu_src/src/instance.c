@@ -1,4 +1,3 @@
-#include <errno.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -17,8 +16,8 @@ static const char *const category_names[] = {"logStatusWarning", "logStatusDisca
 
 void instance_log(const Instance *instance, Status status, LogCategory category,
                   const char *format, ...) {
-    /* Room for a call record that sets every variable at round-trip precision. */
-    char message[1024];
+    /* Room for a whole record line. */
+    char message[RECORD_LINE_SIZE];
     va_list args;
     if (category >= LOG_ALL && !(instance->log_categories & category)) return;
     va_start(args, format);
@@ -28,9 +27,13 @@ void instance_log(const Instance *instance, Status status, LogCategory category,
     size_t index = 0;
     while ((1u << index) != (unsigned)category) index++;
     /* Passed as the format itself, because some masters (fmpy among them) print the format and
-       drop the arguments; so no '%' from a master's strings may reach a master that formats it. */
-    for (char *c = message; *c; c++)
+       drop the arguments; so no '%' may reach a master that formats it. A master's strings come
+       escaped (escape_text); this catches any that would not, and any control character, which
+       could start a line of its own in the master's log. */
+    for (char *c = message; *c; c++) {
         if (*c == '%') *c = '#';
+        if ((unsigned char)*c < 0x20) *c = '?';
+    }
     instance->logger.forward(instance->logger.master_logger, instance->logger.environment,
                              instance->name, status, category_names[index], message);
 }
@@ -49,19 +52,16 @@ static const char *const status_names[] = {"OK", "Warning", "Discard", "Error", 
 
 void instance_record_call(const Instance *instance, const char *function, double time_before,
                           Status status, const char *format, ...) {
-    char arguments[896];
+    char arguments[RECORD_ARGUMENTS_SIZE];
     va_list args;
     va_start(args, format);
     vsnprintf(arguments, sizeof(arguments), format, args);
     va_end(args);
-    /* The name sits between double quotes, so a reader finds where it ends: any in it become ' */
-    char name[MAX_INSTANCE_NAME];
-    for (size_t i = 0; i < sizeof(name); i++) {
-        name[i] = instance->name[i] == '"' ? '\'' : instance->name[i];
-        if (!name[i]) break;
-    }
-    /* Room for the arguments, the name and the rest; the logger's copy is cut at its own size. */
-    char line[sizeof(arguments) + MAX_INSTANCE_NAME + 256];
+    /* Escaped, so that no name a master gives can end the quotes or the line: every line of a
+       record starts with the marker (docs/calls.md says how the judge reads it back). */
+    char name[ESCAPED_SIZE(MAX_INSTANCE_NAME)];
+    escape_text(name, sizeof(name), instance->name);
+    char line[RECORD_LINE_SIZE];
     snprintf(line, sizeof(line), CALL_RECORD_MARKER " instance=\"%s\" %s(%s) time=%.17g->%.17g status=%s",
              name, function, arguments, time_before, instance->data.time, status_names[status]);
     if (instance->record_file) {
@@ -80,11 +80,13 @@ static Status record_to_file(Instance *instance, const char *function, const cha
     instance->log_categories &= ~RECORD_TO_FILE;
     strcpy(instance->record_file_name, name);
     if (!name[0]) return STATUS_OK;
-    instance->record_file = fopen(name, "a");
+    char why[128];
+    instance->record_file = record_file_open(name, CALL_RECORD_MARKER, why, sizeof(why));
     if (!instance->record_file) {
+        char escaped[ESCAPED_SIZE(MAX_RECORD_FILE_NAME)];
         instance_log(instance, STATUS_WARNING, LOG_STATUS_WARNING,
-                     "%s: callRecordFile %s cannot be opened for appending (%s): the FMU writes no "
-                     "record file", function, name, strerror(errno));
+                     "%s: callRecordFile \"%s\" %s: the FMU writes no record file (name a new file, "
+                     "or one of its records)", function, escape_text(escaped, sizeof(escaped), name), why);
         return STATUS_WARNING;
     }
     instance->log_categories |= RECORD_TO_FILE;
@@ -137,7 +139,7 @@ Status instance_get_string(Instance *instance, const char *function, const unsig
 void instance_record_values(const Instance *instance, const char *function, double time_before,
                             Status status, const unsigned int vr[], const int order[], size_t n,
                             const double value[]) {
-    char arguments[896];
+    char arguments[RECORD_ARGUMENTS_SIZE];
     size_t used = 0;
     arguments[0] = '\0';
     for (size_t i = 0; i < n && used < sizeof(arguments); i++) {
@@ -223,11 +225,13 @@ Instance *instance_create(const char *function, const char *name, const char *to
     if (!logger || !logger->master_logger) return NULL;
     if (!name || !name[0])
         return instance_refuse(function, name, logger, "instanceName must be a non-empty string");
-    if (!token || strcmp(token, MODEL_GUID) != 0)
+    if (!token || strcmp(token, MODEL_GUID) != 0) {
+        char escaped[96];
         return instance_refuse(function, name, logger,
                                "%s %s does not match this FMU's %s (was the model description "
-                               "taken from another FMU?)", token_argument, token ? token : "NULL",
-                               MODEL_GUID);
+                               "taken from another FMU?)", token_argument,
+                               token ? escape_text(escaped, sizeof(escaped), token) : "NULL", MODEL_GUID);
+    }
 
     Instance *instance = calloc(1, sizeof(Instance));
     if (!instance)
