@@ -45,6 +45,7 @@ CROSS = [
     for platform in ("win64", "aarch64-linux")
 ]
 POW_VERSIONS = Path(__file__).parent / "c/pow_versions.c"
+RECORD_MASTER = Path(__file__).parent / "c/record_master.c"
 EACH_FMI_VERSION = pytest.mark.parametrize("fmi_version", FMI_VERSIONS, ids=lambda version: f"fmi{version}")
 # The value references benchmarks/bare_master.h hard-codes (VR_TORQUE, VR_THETA).
 MASTER_VALUE_REFERENCES = {"torque": 0, "theta": 1}
@@ -112,6 +113,11 @@ def _exports(platform, library):
     return _exports_of_so(library, "aarch64-linux-gnu-nm" if platform == "aarch64-linux" else "nm")
 
 
+def _wine_environment(build):
+    # One wine prefix for both FMI versions: making one takes wine seconds.
+    return {**os.environ, "WINEPREFIX": str(build.work.parent / "wineprefix"), "WINEDEBUG": "-all"}
+
+
 def _theta_by_step_master(build, platform, master=None):
     """Theta at every communication point, from the C master of build's FMI version built for and
     run on platform (or master, built before).
@@ -119,8 +125,6 @@ def _theta_by_step_master(build, platform, master=None):
     assert {name: build.value_references[name] for name in MASTER_VALUE_REFERENCES} == MASTER_VALUE_REFERENCES
     master = master or build_step_master(build.work, platform, build.fmi_version)
     trajectory = build.work / f"theta_{platform}.txt"
-    # One wine prefix for both FMI versions: making one takes wine seconds.
-    environment = {**os.environ, "WINEPREFIX": str(build.work.parent / "wineprefix"), "WINEDEBUG": "-all"}
     subprocess.run(
         [
             *RUNNERS[platform],
@@ -134,7 +138,7 @@ def _theta_by_step_master(build, platform, master=None):
         ],
         check=True,
         capture_output=True,
-        env=environment,
+        env=_wine_environment(build),
         timeout=300,
     )
     return np.loadtxt(trajectory)
@@ -147,6 +151,43 @@ def test_binary_exports_exactly_the_functions_of_the_linux_binary(every_platform
     exports = _exports(platform, build.library(platform))
     assert exports == _exports_of_so(build.library("linux64"))
     assert all(name.startswith(f"fmi{fmi_version}") for name in exports) and f"fmi{fmi_version}DoStep" in exports
+
+
+@pytest.mark.parametrize("platform", ["linux64", *CROSS])
+def test_each_platforms_binary_writes_its_record_only_into_a_record_of_its_own(every_platform, platform, tmp_path):
+    """The record file's rules (tests/test_record_file.py) where each binary's own C library opens the
+    file: a user's file refused, a new record made and appended to, the instance name escaped.
+    """
+    build = every_platform[2]
+    master = build_bare_master(build.work, RECORD_MASTER, platform)
+
+    def run(record, name='x\\y"%s'):
+        command = [*RUNNERS[platform], str(master), str(build.library(platform)), build.token, name, record]
+        done = subprocess.run(
+            command, cwd=tmp_path, capture_output=True, text=True, env=_wine_environment(build), timeout=300
+        )
+        assert done.returncode == 0, done.stderr
+        return done.stdout
+
+    (tmp_path / "bashrc").write_text("export PATH=$HOME/bin:$PATH\n")
+    assert "is not a call record" in run("bashrc")
+    assert (tmp_path / "bashrc").read_text() == "export PATH=$HOME/bin:$PATH\n"
+    for _ in range(2):
+        assert "WARNING" not in run("calls.log")
+    assert (tmp_path / "calls.log").read_text().splitlines() == [
+        '[pendulum-calls] instance="x\\\\y\\"\\x25s" fmi2SetString(file="calls.log") time=0->0 status=OK',
+        '[pendulum-calls] instance="x\\\\y\\"\\x25s" fmi2FreeInstance() time=0->0 status=OK',
+    ] * 2
+    if platform == "win64":
+        # wine shows Windows a host's symbolic link as the file it points to, no reparse point, so
+        # the link is opened as its target (a real Windows link is opened as itself and refused, by
+        # FILE_FLAG_OPEN_REPARSE_POINT: inspected, not run). A link to the user's file is refused
+        # as what that file is.
+        (tmp_path / "link.log").symlink_to(tmp_path / "bashrc")
+        assert "is not a call record" in run("link.log")
+    else:
+        (tmp_path / "link.log").symlink_to(tmp_path / "calls.log")
+        assert "is a symbolic link" in run("link.log")
 
 
 # linux64 too: there the master of each FMI version checks the other's, and scipy, with no cross tools.

@@ -9,6 +9,7 @@ and in the master's log. What the judge reads back is checked against the string
 
 import os
 import stat
+import subprocess
 from pathlib import Path
 
 import pytest
@@ -18,6 +19,7 @@ from fmpy.fmi3 import FMU3Model, FMU3Slave
 
 from pendulum_fmu._call_record import MARKER, read_calls
 
+ROOT = Path(__file__).resolve().parent.parent
 VARIABLE_NAMES = {0: "torque"}
 # An SSP component name or fmpy instanceName that, unescaped, puts a command on a line of its own
 # in the file it lands in, ends the quotes the name sits in, and asks a master's printf-style
@@ -147,3 +149,51 @@ def test_a_hard_link_to_a_record_is_refused(unzipped, tmp_path, capsys):
     run_instance(unzipped, 2, FMU2Slave, Path(tmp_path / "other.log"))
     assert record.read_bytes() == before
     assert "has other hard links" in warnings_about_the_record(capsys.readouterr().out)[0]
+
+
+def _escaped_pieces(text: bytes) -> list[str]:
+    """The escapes of text's bytes, one per byte, as docs/calls.md defines them."""
+    named = {ord("\\"): "\\\\", ord('"'): '\\"', ord("\t"): "\\t", ord("\n"): "\\n", ord("\r"): "\\r"}
+    return [
+        named[byte] if byte in named else f"\\x{byte:02x}" if byte < 0x20 or byte > 0x7E or byte == 0x25 else chr(byte)
+        for byte in text
+    ]
+
+
+def _expected_escape(text: bytes, size: int) -> str:
+    pieces = _escaped_pieces(text)
+    if size == 0:
+        return ""
+    if len("".join(pieces)) < size:
+        return "".join(pieces)
+    kept, room = "", max(size - 4, 0)
+    for piece in pieces:
+        if len(kept) + len(piece) > room:
+            break
+        kept += piece
+    return kept + ("..." if size > 4 else "")
+
+
+def test_escape_text_writes_whole_escapes_and_marks_a_cut(tmp_path):
+    # escape_text alone, built from its source: every buffer size from none to room to spare.
+    program = tmp_path / "escape_text_check"
+    subprocess.run(
+        [
+            "gcc",
+            "-std=c99",
+            "-Wall",
+            "-Wextra",
+            "-Werror",
+            f"-I{ROOT / 'fmu_src/include'}",
+            str(ROOT / "tests/c/escape_text_check.c"),
+            str(ROOT / "fmu_src/src/record_file.c"),
+            "-o",
+            str(program),
+        ],
+        check=True,
+    )
+    texts = [b"", b"Pendulum", HOSTILE_NAME.encode(), bytes(range(1, 256)), b"\\" * 9, b'%"%"', "é€".encode()]
+    cases = [(text, size) for text in texts for size in range(4 * len(text) + 3)]
+    stdin = "".join(f"{size} {text.hex() or '-'}\n" for text, size in cases)
+    written = subprocess.run([str(program)], input=stdin, capture_output=True, text=True, check=True).stdout
+    assert written.split("\n")[:-1] == [_expected_escape(text, size) for text, size in cases]
