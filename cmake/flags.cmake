@@ -35,9 +35,13 @@ function(export_only target prefix)
     if(APPLE)
         set_target_properties(${target} PROPERTIES NO_SONAME ON)
         target_link_options(${target} PRIVATE "LINKER:-install_name,$<TARGET_FILE_NAME:${target}>")
+        # Without the debug map (stabs naming each object file and source by its absolute path,
+        # which differ from build folder to build folder), so one commit gives the same bytes.
+        target_link_options(${target} PRIVATE -s)
     elseif(MINGW)
-        # No dependency on the mingw runtime DLLs: the binary loads on any Windows.
-        target_link_options(${target} PRIVATE -static-libgcc -s)
+        # No dependency on the mingw runtime DLLs: the binary loads on any Windows. No link time
+        # in the PE header, so one commit gives the same bytes.
+        target_link_options(${target} PRIVATE -static-libgcc -s "LINKER:--no-insert-timestamp")
     elseif(UNIX AND NOT APPLE)
         set(script "${CMAKE_CURRENT_BINARY_DIR}/${target}.exports.map")
         file(WRITE "${script}" "{ global: ${prefix}*; local: *; };\n")
