@@ -99,6 +99,41 @@ def differences(record: InstanceCalls, intended: IntendedRun) -> list[str]:
     >>> differences(record, IntendedRun(torque=20.0))  # doctest: +SKIP
     ['input applied 1 step late from step 0 (t = 0): ...']
     """
+    found = [*_settings_differences(record, intended), *_restore_differences(record)]
+    steps = record.steps
+    if record.interface == "ModelExchange" or (not steps and record.model_exchange_times):
+        return [*found, *_model_exchange(record)]
+    if not steps:
+        return [*found, "no communication step taken"]
+    sizes = np.array([step.size for step in steps])
+    times = np.array([step.time for step in steps])
+    size = float(sizes[0])
+    if not np.allclose(sizes, size, rtol=TIME_TOLERANCE, atol=0):
+        k = int(np.flatnonzero(~np.isclose(sizes, size, rtol=TIME_TOLERANCE, atol=0))[0])
+        return [
+            *found,
+            f"variable step sizes: {sizes.min():.17g} to {sizes.max():.17g} s (step {k} "
+            f"at t = {times[k]:.17g} is {sizes[k]:.17g} s, step 0 {size:.17g} s)",
+        ]
+    grid = intended.start_time + size * np.arange(len(steps))
+    drift = np.abs(times - grid)
+    if drift.max() > TIME_TOLERANCE * max(1.0, abs(grid[-1])):
+        k = int(np.argmax(drift > TIME_TOLERANCE * max(1.0, abs(grid[-1]))))
+        found.append(
+            f"communication points drift: step {k} starts at t = {times[k]:.17g}, not "
+            f"{grid[k]:.17g} (up to {drift.max():.3g} s off by step {int(np.argmax(drift))})"
+        )
+    plan = _plan(record, intended)
+    n = min(len(steps), len(plan.torque))
+    found.extend(_torque_differences(np.array([step.torque for step in steps[:n]]), plan.torque[:n], times))
+    found.extend(_ramp_differences(np.array([step.torque_rate for step in steps[:n]]), plan.torque_rate[:n], times))
+    if len(steps) != len(plan.torque):
+        found.append(f"{len(steps)} steps taken, {len(plan.torque)} intended")
+    return found
+
+
+def _settings_differences(record: InstanceCalls, intended: IntendedRun) -> list[str]:
+    """The intended parameters and start values the master did not set, or set otherwise."""
     found = []
     for name, value in intended.parameters.items():
         if name not in record.set_before_start:
@@ -113,62 +148,49 @@ def differences(record: InstanceCalls, intended: IntendedRun) -> list[str]:
             found.append(
                 f"start value {variable} set to {record.set_before_start[variable]:.17g}, intended {value:.17g}"
             )
-    for number, before, after in record.restores:
-        if before is not None and after is not None and not math.isclose(before, after, abs_tol=TIME_TOLERANCE):
-            found.append(f"call {number}: an FMU state restored to t = {after:.17g} at t = {before:.17g}")
+    return found
+
+
+def _restore_differences(record: InstanceCalls) -> list[str]:
+    """The FMU states restored to another time, and the rewinds no restore explains."""
+    found = [
+        f"call {number}: an FMU state restored to t = {after:.17g} at t = {before:.17g}"
+        for number, before, after in record.restores
+        if before is not None and after is not None and not math.isclose(before, after, abs_tol=TIME_TOLERANCE)
+    ]
     if not any(before is not None for _, before, _ in record.restores):
         found.extend(
             f"call {number}: the master went back from t = {reached:.17g} to t = "
             f"{time:.17g} (an FMU state restored to another time)"
             for number, reached, time in record.rewinds
         )
-    steps = record.steps
-    if record.interface == "ModelExchange" or (not steps and record.model_exchange_times):
-        found.extend(_model_exchange(record))
-        return found
-    if not steps:
-        return [*found, "no communication step taken"]
-    sizes = np.array([step.size for step in steps])
-    times = np.array([step.time for step in steps])
-    size = float(sizes[0])
-    if not np.allclose(sizes, size, rtol=TIME_TOLERANCE, atol=0):
-        k = int(np.flatnonzero(~np.isclose(sizes, size, rtol=TIME_TOLERANCE, atol=0))[0])
-        found.append(
-            f"variable step sizes: {sizes.min():.17g} to {sizes.max():.17g} s (step {k} "
-            f"at t = {times[k]:.17g} is {sizes[k]:.17g} s, step 0 {size:.17g} s)"
-        )
-        return found
-    grid = intended.start_time + size * np.arange(len(steps))
-    drift = np.abs(times - grid)
-    if drift.max() > TIME_TOLERANCE * max(1.0, abs(grid[-1])):
-        k = int(np.argmax(drift > TIME_TOLERANCE * max(1.0, abs(grid[-1]))))
-        found.append(
-            f"communication points drift: step {k} starts at t = {times[k]:.17g}, not "
-            f"{grid[k]:.17g} (up to {drift.max():.3g} s off by step {int(np.argmax(drift))})"
-        )
-    plan = _plan(record, intended)
-    n = min(len(steps), len(plan.torque))
-    applied = np.array([step.torque for step in steps[:n]])
-    rate = np.array([step.torque_rate for step in steps[:n]])
-    first = _first_mismatch(applied, plan.torque[:n])
-    if first is not None:
-        shift = _shift(applied, plan.torque[:n], first)
-        at = f"from step {first} (t = {times[first]:.17g})"
-        if shift is not None and shift > 0:
-            found.append(
-                f"input applied {shift} step{'s' * (shift > 1)} late {at}: step n holds the torque "
-                f"meant for step n-{shift} (set after the step it was meant for)"
-            )
-        elif shift is not None:
-            found.append(
-                f"input applied {-shift} step{'s' * (shift < -1)} early {at}: step n holds the torque "
-                f"meant for step n+{-shift}"
-            )
-        else:
-            found.append(
-                f"torque differs {at}: {applied[first]:.17g} N.m applied, {plan.torque[first]:.17g} N.m intended"
-            )
-    ramps, should_ramp = rate != 0, plan.torque_rate[:n] != 0
+    return found
+
+
+def _torque_differences(applied: np.ndarray, intended: np.ndarray, times: np.ndarray) -> list[str]:
+    """The first step whose torque is not the intended one: a shift (late, early) or another value."""
+    first = _first_mismatch(applied, intended)
+    if first is None:
+        return []
+    shift = _shift(applied, intended, first)
+    at = f"from step {first} (t = {times[first]:.17g})"
+    if shift is not None and shift > 0:
+        return [
+            f"input applied {shift} step{'s' * (shift > 1)} late {at}: step n holds the torque "
+            f"meant for step n-{shift} (set after the step it was meant for)"
+        ]
+    if shift is not None:
+        return [
+            f"input applied {-shift} step{'s' * (shift < -1)} early {at}: step n holds the torque "
+            f"meant for step n+{-shift}"
+        ]
+    return [f"torque differs {at}: {applied[first]:.17g} N.m applied, {intended[first]:.17g} N.m intended"]
+
+
+def _ramp_differences(rate: np.ndarray, intended_rate: np.ndarray, times: np.ndarray) -> list[str]:
+    """Steps that ramp where they should hold, hold where they should ramp, or ramp at another rate."""
+    found = []
+    ramps, should_ramp = rate != 0, intended_rate != 0
     if (ramps & ~should_ramp).any():
         k = int(np.flatnonzero(ramps & ~should_ramp)[0])
         found.append(
@@ -178,18 +200,16 @@ def differences(record: InstanceCalls, intended: IntendedRun) -> list[str]:
         k = int(np.flatnonzero(~ramps & should_ramp)[0])
         found.append(
             f"held where it should ramp from step {k} (t = {times[k]:.17g}): intended "
-            f"der(torque) = {plan.torque_rate[k]:.17g} N.m/s"
+            f"der(torque) = {intended_rate[k]:.17g} N.m/s"
         )
     elif (ramps & should_ramp).any():
-        wrong = np.flatnonzero(ramps & should_ramp & ~np.isclose(rate, plan.torque_rate[:n], rtol=1e-9))
+        wrong = np.flatnonzero(ramps & should_ramp & ~np.isclose(rate, intended_rate, rtol=1e-9))
         if len(wrong):
             k = int(wrong[0])
             found.append(
                 f"ramp rate differs from step {k} (t = {times[k]:.17g}): {rate[k]:.17g} "
-                f"N.m/s applied, {plan.torque_rate[k]:.17g} intended"
+                f"N.m/s applied, {intended_rate[k]:.17g} intended"
             )
-    if len(steps) != len(plan.torque):
-        found.append(f"{len(steps)} steps taken, {len(plan.torque)} intended")
     return found
 
 

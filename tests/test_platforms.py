@@ -405,7 +405,7 @@ def _without_compiler(monkeypatch, platform):
     )
     if targets:
         monkeypatch.setitem(fmu_build.PLATFORMS, platform, dataclasses.replace(PLATFORMS[platform], targets=targets))
-    monkeypatch.setattr(fmu_build, "find_zig", lambda: None)
+    monkeypatch.setattr(fmu_build.platforms, "find_zig", lambda: None)  # where the compilers look for it
     monkeypatch.setenv(
         "PATH",
         os.pathsep.join(

@@ -1,0 +1,157 @@
+"""An FMU file: a model's binaries for each platform, its sources and its documentation, zipped.
+
+Everything is compiled in a private temporary folder and the zip is renamed into place whole, so
+builds into the same path at the same time all succeed. The FMI 3.0 FMU is built from the same
+sources, its model description generated from the FMI 2.0 one (fmi3.py).
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import tempfile
+import zipfile
+from pathlib import Path
+
+from fmpy import read_model_description
+
+from pendulum_fmu import __version__
+from pendulum_fmu._atomic_files import check_writable, replacing_path
+from pendulum_fmu._errors import BuildError
+
+from . import fmi3
+from .binaries import cmake_build, merged_binary
+from .documentation import documentation_html
+from .platforms import PLATFORMS, available_platforms, check_platforms, check_toolchain
+from .sources import (
+    CHECKOUT_CONTROLLER,
+    DEFAULT_FMU,
+    FMI_VERSIONS,
+    MODEL_DESCRIPTION,
+    MODELS,
+    PENDULUM_DIR,
+    check_source_files,
+    check_sources_present,
+    copy_sources,
+    write_variables,
+)
+
+
+def _stamped_model_description(xml: Path, fmi_version: int = 2) -> str:
+    """The model description as the FMU carries it (for FMI 3.0 generated from the FMI 2.0 one):
+    generationTool names this package's version.
+    """
+    text = xml.read_text(encoding="utf-8") if fmi_version == 2 else fmi3.model_description(xml)
+    text, count = re.subn(r'generationTool="[^"]*"', f'generationTool="pendulum_fmu {__version__}"', text, count=1)
+    if count != 1:
+        raise BuildError(f"{xml}: no generationTool attribute to stamp the version into")
+    return text
+
+
+def build_fmu(
+    out_file: str | os.PathLike = DEFAULT_FMU,
+    *,
+    model_dir: Path = PENDULUM_DIR,
+    model_description_file: Path = MODEL_DESCRIPTION,
+    platforms: tuple[str, ...] | None = None,
+    fmi_version: int = 2,
+    linux_glibc: str | None = None,
+) -> Path:
+    """Build an FMU (binaries/, sources/, documentation/) of a model over the FMI plumbing.
+
+    Everything is compiled in a private temporary folder and the zip is renamed into place
+    whole, so builds into the same path at the same time all succeed.
+
+    Parameters
+    ----------
+    out_file : str or os.PathLike
+        Where to write the FMU.
+    model_dir : Path
+        The model's folder (config.h, model.c); see MODELS.
+    model_description_file : Path
+        The model's FMI 2.0 modelDescription.xml, the source of its variables.
+    platforms : tuple of str, optional
+        FMI 2.0 platform folder names (keys of PLATFORMS). None builds every platform whose
+        tools are present and warns (PlatformSkipped) about each other one; a platform named
+        here must build.
+    fmi_version : int
+        2, or 3 for the FMI 3.0 FMU from the same sources: its model description and
+        sources/buildDescription.xml are generated from the FMI 2.0 one (fmi3.py), its binaries
+        go into the FMI 3.0 platform folders (darwin64's two slices into x86_64-darwin and
+        aarch64-darwin) and export only fmi3* functions.
+    linux_glibc : str, optional
+        The oldest glibc the Linux binaries are to load on, such as "2.17" (manylinux2014's):
+        zig's C compiler builds them against that glibc's symbol versions (cmake/linux.cmake).
+        None: gcc (or $CC) and the cross gcc, against the build machine's glibc and the cross
+        libc.
+
+    Returns
+    -------
+    Path
+        out_file.
+
+    Raises
+    ------
+    BuildError
+        When the sources are not beside the package, a platform or FMI version is unknown, a
+        named platform's tools are missing, linux_glibc is not a glibc version, or a compiler
+        fails.
+    CannotWrite
+        out_file cannot be written.
+    """
+    check_sources_present()
+    if fmi_version not in FMI_VERSIONS:
+        raise BuildError(f"FMI version {fmi_version}: choose among {', '.join(map(str, FMI_VERSIONS))}")
+    if platforms is None:
+        platforms = available_platforms(fmi_version, linux_glibc)
+    check_platforms(platforms)
+    check_writable(out_file)  # before the compilers run
+    for name in platforms:
+        check_toolchain(PLATFORMS[name], fmi_version, linux_glibc)
+    model_dir = Path(model_dir)
+    model_description = read_model_description(str(model_description_file))
+    identifier = model_description.coSimulation.modelIdentifier
+    with tempfile.TemporaryDirectory(prefix="pendulum_fmu_build_") as tmp:
+        tmp = Path(tmp)
+        sources = tmp / "sources"
+        sources.mkdir()
+        copy_sources(model_dir, sources, fmi_version)
+        write_variables(model_description_file, sources)  # as CMake generates them for the binaries
+        check_source_files(model_description, model_description_file, sources, fmi_version)
+        if fmi_version == 3:
+            (sources / "buildDescription.xml").write_text(fmi3.build_description(model_description_file))
+        definitions = {
+            "MODEL_DIR": model_dir.resolve(),
+            "MODEL_DESCRIPTION": Path(model_description_file).resolve(),
+            "FMI_VERSION": fmi_version,
+        }
+        binaries = {}
+        for name in platforms:
+            platform = PLATFORMS[name]
+            slices = {
+                target.name: cmake_build(target, tmp / name / target.name, "fmu", definitions, linux_glibc=linux_glibc)
+                for target in platform.targets
+            }
+            if fmi_version == 3:
+                binaries.update({f"binaries/{folder}/{binary.name}": binary for folder, binary in slices.items()})
+            else:
+                binary = merged_binary(list(slices.values()), tmp / name / f"{identifier}{platform.suffix}")
+                binaries[f"binaries/{name}/{binary.name}"] = binary
+        with replacing_path(out_file) as partial, zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as fmu:
+            fmu.writestr("modelDescription.xml", _stamped_model_description(Path(model_description_file), fmi_version))
+            for name, binary in binaries.items():
+                fmu.write(binary, name)
+            for source in sorted(sources.iterdir()):
+                fmu.write(source, f"sources/{source.name}")
+            fmu.writestr("documentation/index.html", documentation_html(model_description, fmi_version))
+    return Path(out_file)
+
+
+def build_pid_controller(out_file: str | os.PathLike = CHECKOUT_CONTROLLER, **options) -> Path:
+    """The PID controller FMU that closes the loop around the pendulum in co-simulation.
+
+    options are build_fmu's platforms and linux_glibc: the wheel builds it as it builds the
+    pendulum's FMI 2.0 FMU, for the same platforms.
+    """
+    model = MODELS["pid_controller"]
+    return build_fmu(out_file, model_dir=model.folder, model_description_file=model.description, **options)
