@@ -78,6 +78,8 @@ def cmake_build(
         build,
         f"-DFMI_HEADERS={FMI_HEADERS}",
         f"-DPython3_EXECUTABLE={sys.executable}",
+        # The commands, for the FMU's build record (build_record.py).
+        "-DCMAKE_EXPORT_COMPILE_COMMANDS=ON",
         *(f"-D{name}={value}" for name, value in (definitions or {}).items()),
     ]
     cross = not target.native or target.built_by_zig(linux_glibc)

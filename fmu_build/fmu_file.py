@@ -10,17 +10,18 @@ from __future__ import annotations
 import os
 import re
 import tempfile
-import zipfile
 from pathlib import Path
 
 from fmpy import read_model_description
 
 from pendulum_fmu import __version__
 from pendulum_fmu._atomic_files import check_writable, replacing_path
+from pendulum_fmu._build_record import RECORD_FORMAT, with_record, write_archive
 from pendulum_fmu._errors import BuildError
 
 from . import fmi3
 from .binaries import cmake_build, merged_binary
+from .build_record import source_commit, source_date_epoch, toolchain
 from .documentation import documentation_html
 from .platforms import PLATFORMS, available_platforms, check_platforms, check_toolchain
 from .sources import (
@@ -125,25 +126,42 @@ def build_fmu(
             "MODEL_DESCRIPTION": Path(model_description_file).resolve(),
             "FMI_VERSION": fmi_version,
         }
-        binaries = {}
+        binaries, toolchains = {}, {}
         for name in platforms:
             platform = PLATFORMS[name]
             slices = {
                 target.name: cmake_build(target, tmp / name / target.name, "fmu", definitions, linux_glibc=linux_glibc)
                 for target in platform.targets
             }
+            made = {
+                folder: {"target": folder, **toolchain(binary.parent.parent / "build", "fmu")}
+                for folder, binary in slices.items()
+            }
             if fmi_version == 3:
-                binaries.update({f"binaries/{folder}/{binary.name}": binary for folder, binary in slices.items()})
+                for folder, binary in slices.items():
+                    binaries[f"binaries/{folder}/{binary.name}"] = binary
+                    toolchains[f"binaries/{folder}/{binary.name}"] = [made[folder]]
             else:
                 binary = merged_binary(list(slices.values()), tmp / name / f"{identifier}{platform.suffix}")
                 binaries[f"binaries/{name}/{binary.name}"] = binary
-        with replacing_path(out_file) as partial, zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as fmu:
-            fmu.writestr("modelDescription.xml", _stamped_model_description(Path(model_description_file), fmi_version))
-            for name, binary in binaries.items():
-                fmu.write(binary, name)
-            for source in sorted(sources.iterdir()):
-                fmu.write(source, f"sources/{source.name}")
-            fmu.writestr("documentation/index.html", documentation_html(model_description, fmi_version))
+                toolchains[f"binaries/{name}/{binary.name}"] = list(made.values())
+        entries = {
+            "modelDescription.xml": _stamped_model_description(Path(model_description_file), fmi_version).encode(),
+            **{name: binary.read_bytes() for name, binary in binaries.items()},
+            **{f"sources/{source.name}": source.read_bytes() for source in sorted(sources.iterdir())},
+            "documentation/index.html": documentation_html(model_description, fmi_version).encode(),
+        }
+        epoch = source_date_epoch()
+        record = {
+            "format": RECORD_FORMAT,
+            "generator": f"pendulum_fmu {__version__}",
+            **source_commit(),
+            "source_date_epoch": epoch,
+            "fmi_version": fmi_version,
+            "binaries": toolchains,
+        }
+        with replacing_path(out_file) as partial:
+            write_archive(partial, with_record(entries, record).items(), epoch)
     return Path(out_file)
 
 

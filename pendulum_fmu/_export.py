@@ -15,7 +15,9 @@ from pathlib import Path
 
 from . import FMU_FILES, default_fmu
 from ._atomic_files import check_writable, replacing_path
+from ._build_record import RECORD_FILE, SIGNATURE_FILE, read_entries, recorded_epoch, write_archive
 from ._errors import PendulumFmuError
+from ._signing import load_private_key
 
 
 class FmuExists(PendulumFmuError, FileExistsError):
@@ -68,7 +70,11 @@ def fmu_platforms(fmu: str | os.PathLike) -> tuple[str, ...]:
 
 
 def export_fmu(
-    output: str | os.PathLike | None = None, *, fmi_version: int = 2, overwrite: bool = False
+    output: str | os.PathLike | None = None,
+    *,
+    fmi_version: int = 2,
+    overwrite: bool = False,
+    sign: str | os.PathLike | None = None,
 ) -> ExportedFmu:
     """Write the pendulum's FMU to output, whole or not at all.
 
@@ -80,6 +86,10 @@ def export_fmu(
         The FMI standard of the FMU.
     overwrite : bool, optional
         Replace a file already at output; False refuses it.
+    sign : str or os.PathLike, optional
+        An Ed25519 private key (PEM): the FMU then carries a signature of its build record
+        (extra/org.pendulum-fmu.build/build.json.sig), which `pendulum-fmu verify --public-key`
+        checks.
 
     Returns
     -------
@@ -110,7 +120,13 @@ def export_fmu(
     output = Path(FMU_FILES[fmi_version] if output is None else output)
     if not overwrite and output.exists():
         raise FmuExists(f"{output} exists: pass --overwrite (overwrite=True) to replace it, or another --output")
+    key = load_private_key(sign) if sign is not None else None  # before anything is written
     check_writable(output)
     with replacing_path(output) as partial:
-        shutil.copyfile(source, partial)
+        if key is None:
+            shutil.copyfile(source, partial)
+        else:
+            entries = read_entries(source)
+            entries[SIGNATURE_FILE] = key.sign(entries[RECORD_FILE])
+            write_archive(partial, entries.items(), recorded_epoch(entries))
     return ExportedFmu(output, fmu_platforms(output))

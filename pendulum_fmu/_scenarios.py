@@ -38,12 +38,12 @@ import json
 import os
 import shutil
 import uuid
-import zipfile
 from pathlib import Path
 from xml.etree import ElementTree
 
 from . import __version__, _results as results
 from ._atomic_files import check_writable, make_folder, replacing, replacing_path
+from ._build_record import read_entries, rewrite_fmu
 from ._errors import InvalidInput, PendulumFmuError
 from ._model import START_VALUES, FmuModel, fmu_model
 from ._reference import reference
@@ -382,12 +382,13 @@ def _write_kit(folder: Path, model: FmuModel) -> list[str]:
     )
     _write(folder / "ReadMe.md", readme)
     written.append("ReadMe.md")
-    with zipfile.ZipFile(model.path) as original, replacing_path(folder / KIT_FMU) as partial:
-        with zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as archive:
-            for item in original.infolist():
-                # A kit FMU given as the source: its old kit files give way to the new ones.
-                if not (item.filename.startswith(LS_REF_FOLDER) or item.filename == LS_REF_DOCUMENTATION):
-                    archive.writestr(item, original.read(item))
-            for name, content in carried.items():
-                archive.writestr(name, content)
+    # A kit FMU given as the source: its old kit files give way to the new ones.
+    entries = {
+        name: data
+        for name, data in read_entries(model.path).items()
+        if not (name.startswith(LS_REF_FOLDER) or name == LS_REF_DOCUMENTATION)
+    }
+    with replacing_path(folder / KIT_FMU) as partial:
+        # The record names the kit's files too, so that `verify` finds them its own.
+        rewrite_fmu(partial, {**entries, **carried}, {"kit": f"pendulum_fmu {__version__} scenarios"})
     return [KIT_FMU, *written]

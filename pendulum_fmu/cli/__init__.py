@@ -19,14 +19,14 @@ from .. import __version__
 from .._checkout import is_source_checkout
 from .._errors import NotComputed, PendulumFmuError, PlatformSkipped, Skipped
 from .._stop_signals import STOPPING_SIGNALS, Stopped, restore_signals, stop_on_signals
-from . import build, compare, cross_check, demo, export, export_ssp, judge, scenarios, simulate, sweep
+from . import build, compare, cross_check, demo, export, export_ssp, judge, scenarios, simulate, sweep, verify
 from ._stdout import UntilTheReaderIsGone
 
 __all__ = ["build_parser", "main"]
 
 # In the order `pendulum-fmu --help` lists them. build is the developer's (python build_fmu.py),
 # listed only in a checkout, whose build tool it runs; users take the FMU with export.
-COMMANDS = (build, export, cross_check, simulate, compare, sweep, demo, judge, scenarios, export_ssp)
+COMMANDS = (build, export, cross_check, simulate, compare, sweep, demo, judge, scenarios, export_ssp, verify)
 
 
 def build_parser() -> argparse.ArgumentParser:

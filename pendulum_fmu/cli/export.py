@@ -32,6 +32,13 @@ def add_parser(commands) -> argparse.ArgumentParser:
     export.add_argument(
         "--overwrite", action="store_true", help="replace a file already at the output path (default: refuse)"
     )
+    export.add_argument(
+        "--sign",
+        metavar="KEY",
+        default=None,
+        help="sign the FMU's build record with this Ed25519 private key (PEM, as `openssl genpkey -algorithm "
+        "ed25519` writes it); `pendulum-fmu verify --public-key` checks it",
+    )
     export.set_defaults(run=run)
     return export
 
@@ -40,6 +47,7 @@ def run(args) -> int:
     """Run `pendulum-fmu export` with the parsed arguments; returns the exit status."""
     from .._export import export_fmu
 
-    exported = export_fmu(args.output, fmi_version=args.fmi_version, overwrite=args.overwrite)
-    print(f"wrote {exported.path} (binaries for {', '.join(exported.platforms)})")
+    exported = export_fmu(args.output, fmi_version=args.fmi_version, overwrite=args.overwrite, sign=args.sign)
+    signed = ", its build record signed" if args.sign else ""
+    print(f"wrote {exported.path} (binaries for {', '.join(exported.platforms)}{signed})")
     return 0
