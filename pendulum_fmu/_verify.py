@@ -25,12 +25,17 @@ import tempfile
 import zipfile
 from dataclasses import asdict, dataclass
 from pathlib import Path
+from xml.etree import ElementTree
 
 from ._build_record import OBJECTS, RECORD_FILE, SIGNATURE_FILE, read_entries, sha256
 from ._errors import InvalidInput, MissingFile
 
 PASS, FAIL, SKIP = "pass", "fail", "not checked"
 LS_REF_MANIFEST = "extra/org.fmi-standard.fmi-ls-ref/fmi-ls-manifest.xml"
+# How far fmpy's run of an FMU's default experiment may lie from a result it carries, as a share
+# of each column's range (at least 1): a replay on the result's own grid differs by rounding only
+# (a Modelica Reference FMU: 5e-13), a changed model by far more.
+RESULT_TOLERANCE = 1e-6
 # This machine's binary folders, FMI 2.0's and FMI 3.0's.
 HOST_FOLDERS = {
     ("linux", "x86_64"): ("linux64", "x86_64-linux"),
@@ -198,7 +203,7 @@ def _references(fmu: Path, entries: dict[str, bytes]) -> Check:
         if name.startswith(LS_REF_FOLDER) and name.endswith(".json")
     }
     if not settings:
-        return Check("references", SKIP, "FMI-LS-REF references without a scenario kit's settings: not replayed")
+        return _replay_results(fmu, entries)
     from ._judge import judge_kit
     from ._scenario_settings import KIT_FMU
 
@@ -218,6 +223,42 @@ def _references(fmu: Path, entries: dict[str, bytes]) -> Check:
     detail = f"{len(held) - len(failed)} of {len(held)} scenarios replayed in fmpy pass the judge"
     detail += f" ({', '.join(left)} need input derivatives or an FMU state: not replayed)" if left else ""
     return Check("references", FAIL if failed else PASS, detail + (f"; failing: {', '.join(failed)}" if failed else ""))
+
+
+def _replay_results(fmu: Path, entries: dict[str, bytes]) -> Check:
+    """Each result (role "result", a CSV) of any FMU's FMI-LS-REF manifest against fmpy's run of
+    the FMU's default experiment on the result's own time grid, column by column.
+    """
+    import io
+
+    import numpy as np
+    from fmpy import simulate_fmu
+
+    folder = LS_REF_MANIFEST.rsplit("/", 1)[0] + "/"
+    manifest = ElementTree.fromstring(entries[LS_REF_MANIFEST])
+    results = [e.get("source", "") for e in manifest.iter() if e.tag.endswith("Related") and e.get("role") == "result"]
+    results = [source for source in results if source.endswith(".csv") and folder + source in entries]
+    if not results:
+        return Check("references", SKIP, "FMI-LS-REF references, none a CSV result: not replayed")
+    worst = []
+    for source in results:
+        reference = np.genfromtxt(io.BytesIO(entries[folder + source]), delimiter=",", names=True, deletechars="")
+        times, columns = reference["time"], reference.dtype.names or ()
+        run = simulate_fmu(
+            str(fmu), start_time=times[0], stop_time=times[-1], output_interval=float(np.median(np.diff(times)))
+        )
+        for column in columns[1:]:
+            if column in run.dtype.names:
+                difference = np.max(np.abs(np.interp(times, run["time"], run[column]) - reference[column]))
+                worst.append((difference / max(1.0, float(np.ptp(reference[column]))), source, column, difference))
+    if not worst:
+        return Check("references", SKIP, f"{', '.join(results)}: no column fmpy's run has")
+    scaled, source, column, difference = max(worst)
+    detail = (
+        f"{len(results)} result(s) replayed in fmpy (the default experiment): largest difference "
+        f"{difference:.3g} ({source}, {column}), tolerance {RESULT_TOLERANCE:g} of each column's range"
+    )
+    return Check("references", PASS if scaled <= RESULT_TOLERANCE else FAIL, detail)
 
 
 def _replay(kit: Path, settings: dict) -> None:

@@ -8,6 +8,7 @@ against the binary the build put into the FMU.
 
 import hashlib
 import json
+import shutil
 import subprocess
 import sys
 import time
@@ -172,3 +173,36 @@ def test_the_kit_fmu_is_written_with_the_time_its_record_gives(tmp_path, capsys)
         times = {item.date_time for item in archive.infolist()}
     *day, seconds = time.gmtime(max(record["source_date_epoch"], 315532800))[:6]
     assert times == {(*day, seconds // 2 * 2)}  # a zip entry's time counts seconds in twos
+
+
+def _with_result(fmu, out, rows):
+    """A copy of fmu with an FMI-LS-REF manifest naming one result CSV of the default experiment, as the
+    Modelica Reference FMUs carry theirs (BouncingBall: BouncingBall_out.csv, role "result").
+    """
+    folder = "extra/org.fmi-standard.fmi-ls-ref/"
+    manifest = (
+        '<fmiReferences xmlns:fmi-ls="http://fmi-standard.org/fmi-ls-manifest" fmi-ls:fmi-ls-name='
+        '"org.fmi-standard.fmi-ls-ref" fmi-ls:fmi-ls-version="1.0.0-alpha.1"><Related type="text/csv" '
+        'source="Pendulum_out.csv" role="result" description="Output of the default experiment"/></fmiReferences>'
+    )
+    csv = "time,theta\n" + "".join(f"{t!r},{theta!r}\n" for t, theta in rows)
+    shutil.copyfile(fmu, out)
+    with zipfile.ZipFile(out, "a") as archive:
+        archive.writestr(folder + "fmi-ls-manifest.xml", manifest)
+        archive.writestr(folder + "Pendulum_out.csv", csv)
+    return out
+
+
+def test_a_result_an_fmu_carries_is_replayed_from_its_default_experiment(fmu, tmp_path, capsys):
+    # The default experiment (3 s, no torque, at rest) keeps theta at 0: the analytic solution.
+    grid = [k * 0.01 for k in range(301)]
+    carried = _with_result(fmu, tmp_path / "carried.fmu", [(t, 0.0) for t in grid])
+    checks = _verified(capsys, carried, "--no-rebuild")[1]
+    assert checks["references"]["status"] == "pass"
+    assert checks["references"]["detail"].startswith("1 result(s) replayed in fmpy (the default experiment)")
+    # Added after the build, so the checksums name them: the record is the builder's word.
+    assert "not in the record (added after the build)" in checks["checksums"]["detail"]
+    wrong = _with_result(fmu, tmp_path / "wrong.fmu", [(t, 0.5 if t == 1.0 else 0.0) for t in grid])
+    checks = _verified(capsys, wrong, "--no-rebuild")[1]
+    assert checks["references"]["status"] == "fail"
+    assert "largest difference 0.5 (Pendulum_out.csv, theta)" in checks["references"]["detail"]
