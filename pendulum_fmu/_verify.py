@@ -344,7 +344,7 @@ def format_checks(fmu: str | os.PathLike, checks: list[Check]) -> str:
       checksums    pass          22 entries match
     """
     counts = {status: sum(check.status == status for check in checks) for status in (PASS, FAIL, SKIP)}
-    verdict = "FAILED" if counts[FAIL] else "verified"
+    verdict = "FAILED" if counts[FAIL] else "verified" if counts[PASS] else "nothing could be checked"
     lines = [f"{fmu}: {verdict} ({counts[PASS]} passed, {counts[FAIL]} failed, {counts[SKIP]} not checked)"]
     lines += [f"  {check.name:<12} {check.status:<13} {check.detail}" for check in checks]
     return "\n".join(lines)
