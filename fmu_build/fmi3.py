@@ -69,6 +69,63 @@ def _interface(fmi2_root: ET.Element, tag: str) -> dict[str, str] | None:
     return attributes
 
 
+def _add_variables(root: ET.Element, variables: list, references: dict, time_reference: str, fmi2_xml) -> None:
+    """ModelVariables: `time`, then each FMI 2.0 variable as Float64 or String."""
+    model_variables = ET.SubElement(root, "ModelVariables")
+    ET.SubElement(
+        model_variables,
+        "Float64",
+        {
+            "name": "time",
+            "valueReference": time_reference,
+            "causality": "independent",
+            "variability": "continuous",
+            "description": "Simulation time",
+            "unit": "s",
+        },
+    )
+    for variable in variables:
+        attributes = {
+            key: variable.get(key)
+            for key in ("name", "valueReference", "causality", "variability", "initial", "description")
+            if variable.get(key) is not None
+        }
+        string = variable.find("String")
+        if string is not None:
+            # FMI 3.0 gives a String's start value as an element.
+            start = string.get("start")
+            element = ET.SubElement(model_variables, "String", attributes)
+            if start is not None:
+                ET.SubElement(element, "Start", {"value": start})
+            continue
+        real = variable.find("Real")
+        if real is None:
+            raise ValueError(f"{fmi2_xml}: variable {variable.get('name')!r} is neither Real nor String")
+        attributes.update(real.attrib)
+        if "derivative" in attributes:
+            attributes["derivative"] = references[attributes["derivative"]]
+        ET.SubElement(model_variables, "Float64", attributes)
+
+
+def _add_structure(root: ET.Element, fmi2_structure: ET.Element, references: dict) -> None:
+    """ModelStructure: FMI 2.0's unknowns by index become FMI 3.0's by value reference."""
+    structure = ET.SubElement(root, "ModelStructure")
+    for fmi2_tag, fmi3_tag in (
+        ("Outputs", "Output"),
+        ("Derivatives", "ContinuousStateDerivative"),
+        ("InitialUnknowns", "InitialUnknown"),
+    ):
+        for unknown in fmi2_structure.findall(f"{fmi2_tag}/Unknown"):
+            attributes = {"valueReference": references[unknown.get("index")]}
+            if unknown.get("dependencies") is not None:
+                attributes["dependencies"] = " ".join(
+                    references[index] for index in unknown.get("dependencies").split()
+                )
+            if unknown.get("dependenciesKind") is not None:
+                attributes["dependenciesKind"] = unknown.get("dependenciesKind")
+            ET.SubElement(structure, fmi3_tag, attributes)
+
+
 def model_description(fmi2_xml: str | Path) -> str:
     """The FMI 3.0 modelDescription.xml for the FMU that fmi2_xml describes."""
     fmi2 = ET.parse(fmi2_xml).getroot()
@@ -106,57 +163,8 @@ def model_description(fmi2_xml: str | Path) -> str:
         if element is not None:
             root.append(element)
 
-    model_variables = ET.SubElement(root, "ModelVariables")
-    ET.SubElement(
-        model_variables,
-        "Float64",
-        {
-            "name": "time",
-            "valueReference": time_reference,
-            "causality": "independent",
-            "variability": "continuous",
-            "description": "Simulation time",
-            "unit": "s",
-        },
-    )
-    for variable in variables:
-        attributes = {
-            key: variable.get(key)
-            for key in ("name", "valueReference", "causality", "variability", "initial", "description")
-            if variable.get(key) is not None
-        }
-        string = variable.find("String")
-        if string is not None:
-            # FMI 3.0 gives a String's start value as an element.
-            start = string.get("start")
-            element = ET.SubElement(model_variables, "String", attributes)
-            if start is not None:
-                ET.SubElement(element, "Start", {"value": start})
-            continue
-        real = variable.find("Real")
-        if real is None:
-            raise ValueError(f"{fmi2_xml}: variable {variable.get('name')!r} is neither Real nor String")
-        attributes.update(real.attrib)
-        if "derivative" in attributes:
-            attributes["derivative"] = references[attributes["derivative"]]
-        ET.SubElement(model_variables, "Float64", attributes)
-
-    structure = ET.SubElement(root, "ModelStructure")
-    fmi2_structure = fmi2.find("ModelStructure")
-    for fmi2_tag, fmi3_tag in (
-        ("Outputs", "Output"),
-        ("Derivatives", "ContinuousStateDerivative"),
-        ("InitialUnknowns", "InitialUnknown"),
-    ):
-        for unknown in fmi2_structure.findall(f"{fmi2_tag}/Unknown"):
-            attributes = {"valueReference": references[unknown.get("index")]}
-            if unknown.get("dependencies") is not None:
-                attributes["dependencies"] = " ".join(
-                    references[index] for index in unknown.get("dependencies").split()
-                )
-            if unknown.get("dependenciesKind") is not None:
-                attributes["dependenciesKind"] = unknown.get("dependenciesKind")
-            ET.SubElement(structure, fmi3_tag, attributes)
+    _add_variables(root, variables, references, time_reference, fmi2_xml)
+    _add_structure(root, fmi2.find("ModelStructure"), references)
 
     ET.indent(root)
     return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
