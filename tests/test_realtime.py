@@ -142,22 +142,24 @@ def test_the_record_writes_once_per_call(harness, tmp_path):
 
 
 # Per 1 ms step, jumping at every step: the most Taylor steps (sincos calls) and DOPRI5
-# right-hand sides (sin calls) one communication step made, at the FMU's default tolerance, from
-# the docs' 20 N.m to the largest finite torque (the docs allow any finite value).
+# right-hand sides (sin calls) one communication step made, at the FMU's default tolerance (None)
+# or a tighter one, from the docs' 20 N.m to the largest finite torque (the docs allow any
+# finite value).
 HARDEST_SIGNALS = [
-    (20.0, 2000, 1, 0),
-    (1e4, 2000, 1, 0),
-    (1e8, 2000, 6, 0),
-    (1e12, 200, 1406, 0),
-    (BUDGET_SPENT.amplitude, 5, MAX_INTERNAL_STEPS, 7),
-    (1e100, 200, 1, 7),
-    (sys.float_info.max, 200, 1, 7),
+    (20.0, None, 2000, 1, 0),
+    (20.0, 1e-16, 2000, 1, 0),
+    (1e4, None, 2000, 1, 0),
+    (1e8, None, 2000, 6, 0),
+    (1e12, None, 200, 1406, 0),
+    (BUDGET_SPENT.amplitude, None, 5, MAX_INTERNAL_STEPS, 7),
+    (1e100, None, 200, 1, 7),
+    (sys.float_info.max, None, 200, 1, 7),
 ]
 
 
-@pytest.mark.parametrize(("amplitude", "steps", "taylor_steps", "dopri5_evaluations"), HARDEST_SIGNALS)
-def test_sub_steps_at_a_jump_every_step(harness, amplitude, steps, taylor_steps, dopri5_evaluations):
-    counts = harness.counts(steps, SquareWave(amplitude, 1))
+@pytest.mark.parametrize(("amplitude", "tolerance", "steps", "taylor_steps", "dopri5_evaluations"), HARDEST_SIGNALS)
+def test_sub_steps_at_a_jump_every_step(harness, amplitude, tolerance, steps, taylor_steps, dopri5_evaluations):
+    counts = harness.counts(steps, SquareWave(amplitude, 1), tolerance=tolerance)
     assert counts["steps_done"] == steps and "discarded_at" not in counts
     assert (counts["most_sincos_per_step"], counts["most_sin_per_step"]) == (taylor_steps, dopri5_evaluations)
     assert counts["most_sincos_per_step"] <= MAX_INTERNAL_STEPS
