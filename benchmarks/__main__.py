@@ -19,10 +19,11 @@ from .floor import floor_rows
 from .own_cost import own_cost_rows
 from .peers import opensim_rows, pythonfmu_rows
 from .python_loop import python_loop_rows
+from .realtime import realtime_rows
 from .report import as_markdown, as_text, main_table
 from .scale import scale_rows
 
-PARTS = ("floor", "own-cost", "accuracy", "python-loop", "fixed-cost", "opensim", "pythonfmu", "scale")
+PARTS = ("floor", "own-cost", "accuracy", "python-loop", "fixed-cost", "opensim", "pythonfmu", "scale", "realtime")
 DEFAULT_FIGURE = Path(__file__).resolve().parent / "accuracy_cost.png"
 
 
@@ -95,6 +96,8 @@ def main(argv=None) -> int:
                 rows += pythonfmu_rows(pendulum, scratch, repetitions)
             elif part == "scale":
                 rows += scale_rows(pendulum, args.quick) + case_cost_rows(pendulum, args.quick)
+            elif part == "realtime":
+                rows += realtime_rows(pendulum, scratch)
     tables = [main_table(rows)] + ([grid] if grid else [])
     print("\n\n".join(as_text(table) for table in tables))
     if args.markdown:
