@@ -58,11 +58,17 @@ def tls_files(ca_file: str | os.PathLike, cert: str | os.PathLike, key: str | os
     Returns
     -------
     distributed.security.Security
-        Encryption required; run_sweep's security.
+        Encryption required; run_sweep's security. The files are read when run_sweep connects.
+
+    Raises
+    ------
+    TypeError
+        A path that is neither a str nor an os.PathLike (run_sweep raises MissingFile for a path
+        with no file, InvalidInput for a file that is no PEM certificate or key).
 
     Examples
     --------
-    >>> from pendulum_fmu.sweep.security import tls_files
+    >>> from pendulum_fmu import tls_files
     >>> tls_files("ca.pem", "client.pem", "client.key").tls_client_cert
     'client.pem'
     """
@@ -112,7 +118,7 @@ def _check_tls(scheduler: str, security) -> None:
     except (ssl.SSLError, OSError) as error:
         raise InvalidInput(
             f"the TLS files for {scheduler} cannot be read as a CA certificate, certificate and key "
-            f"({error.strerror or error}): give the PEM files the cluster's CA signed"
+            f"({getattr(error, 'reason', None) or error.strerror or error}): give the PEM files the cluster's CA signed"
         ) from None
     if context is None:
         raise InvalidInput(
