@@ -154,7 +154,7 @@ def _assert_the_study(output_dir) -> None:
 # is refused as much as one turned away.
 ATTACK = textwrap.dedent(
     """
-    import json, sys, threading, time
+    import json, os, sys, threading, time
     from dask.distributed import Client
     from distributed.security import Security
 
@@ -185,7 +185,8 @@ ATTACK = textwrap.dedent(
     for label, attempt in attempts:
         attempt.join(max(0.0, deadline - time.monotonic()))
         outcomes.setdefault(label, "no answer")
-    print(json.dumps(outcomes))
+    print(json.dumps(outcomes), flush=True)
+    os._exit(0)  # not waiting for the clients still waiting on a handshake
     """
 )
 

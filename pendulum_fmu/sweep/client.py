@@ -10,6 +10,7 @@ from __future__ import annotations
 import contextlib
 import logging
 import queue
+import re
 import signal
 import ssl
 import sys
@@ -135,12 +136,16 @@ TLS_REFUSED = "the TLS handshake failed"
 
 def _refused_by_tls(error: BaseException) -> str:
     """Why a TLS handshake failed, where one did (a certificate no CA of the other side's
-    signed), as dask's connect gives it up after retrying until its timeout; else "".
+    signed), as dask's connect gives it up after retrying until its timeout, or as the closed
+    connection's text says when the far end refused: OpenSSL's reason; else "".
     """
     seen: BaseException | None = error
     while seen is not None:
-        if isinstance(seen, ssl.SSLError) or "SSL" in str(seen):
-            return f"{TLS_REFUSED} ({getattr(seen, 'reason', None) or _first_line(seen)})"
+        named = re.search(r"\[SSL: (\w+)\]", str(seen))
+        if named:
+            return f"{TLS_REFUSED} ({named[1]})"
+        if isinstance(seen, ssl.SSLError):  # SSLEOFError: the far end closed it, refusing the client's
+            return f"{TLS_REFUSED} ({seen.reason or type(seen).__name__})"
         seen = seen.__cause__ or seen.__context__
     return ""
 
