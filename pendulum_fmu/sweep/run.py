@@ -104,6 +104,11 @@ def run_sweep(
     SchedulerUnreachable
         The scheduler did not answer within connect_timeout, or refused the TLS handshake.
 
+    Warns
+    -----
+    UnencryptedScheduler
+        A plain tcp:// scheduler off the loopback: whoever reaches it runs code on its workers.
+
     Examples
     --------
     >>> import tempfile

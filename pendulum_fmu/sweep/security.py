@@ -94,16 +94,19 @@ def client_security(scheduler: str, security):
         security = Security()  # dask's configuration: distributed.comm.tls.*
     elif not isinstance(security, Security):
         raise WrongType(f"security is a distributed.security.Security, e.g. tls_files(...), not {security!r}")
+    import dask
+
     scheme, _, location = scheduler.rpartition("://")
+    scheme = scheme or dask.config.get("distributed.comm.default-scheme")  # as dask reads "host:port"
     if scheme == "tls":
         _check_tls(scheduler, security)
-    elif scheme in ("", "tcp") and not _on_loopback(location):
+    elif scheme == "tcp" and not _on_loopback(location):
         warnings.warn(
             f"the scheduler at {scheduler} is plain TCP: whoever reaches its port runs code on its "
             "workers; start it with TLS and connect with --scheduler tls://... --tls-ca-file, "
             "--tls-cert and --tls-key (the docs' Sweeps at scale)",
             UnencryptedScheduler,
-            stacklevel=4,
+            stacklevel=5,  # the caller of run_sweep (through dask_client and contextlib's __enter__)
         )
     return security
 
