@@ -88,14 +88,13 @@ def client_security(scheduler: str, security):
     certificate is one line (MissingFile, InvalidInput) before anything connects. A tcp://
     address off the loopback warns (UnencryptedScheduler).
     """
+    import dask
     from distributed.security import Security
 
     if security is None:
         security = Security()  # dask's configuration: distributed.comm.tls.*
     elif not isinstance(security, Security):
         raise WrongType(f"security is a distributed.security.Security, e.g. tls_files(...), not {security!r}")
-    import dask
-
     scheme, _, location = scheduler.rpartition("://")
     scheme = scheme or dask.config.get("distributed.comm.default-scheme")  # as dask reads "host:port"
     if scheme == "tls":
@@ -112,6 +111,7 @@ def client_security(scheduler: str, security):
 
 
 def _check_tls(scheduler: str, security) -> None:
+    """The client's files for a tls:// scheduler there and readable as PEM, else one line."""
     for field, (option, setting) in TLS_FILES.items():
         value = getattr(security, field)
         if value and "\n" not in value and not os.path.isfile(value):  # a path, not PEM text
