@@ -50,6 +50,7 @@ _LAZY = {
     "sweep_grid": "sweep",
     "Study": "sweep",
     "SweepResult": "sweep",
+    "tls_files": "sweep",
     # what a user hands on: the FMU, the closed loop, the SSP
     "export_fmu": "_export",
     "create_closed_loop_fmu": "_closed_loop",
@@ -65,6 +66,7 @@ _LAZY = {
     "PlatformSkipped": "_errors",
     "NotComputed": "_errors",
     "Skipped": "_errors",
+    "UnencryptedScheduler": "_errors",
 }
 __all__ = ["FMU_FILES", "__version__", "default_fmu", *_LAZY]
 

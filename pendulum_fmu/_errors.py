@@ -214,3 +214,20 @@ class Skipped(UserWarning):
     >>> sorted(comparison.runs) == sorted(["fmu", "reference", *([] if skipped else ["opensim"])])
     True
     """
+
+
+class UnencryptedScheduler(UserWarning):
+    """A sweep's dask scheduler given by a plain tcp:// address off the loopback: whoever reaches
+    its port can run code on its workers. The message is one line naming TLS; the command line
+    prints it as that line and goes on.
+
+    Examples
+    --------
+    >>> import warnings
+    >>> from pendulum_fmu.sweep.security import client_security
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     _ = client_security("tcp://192.0.2.1:8786", None)
+    >>> [warning.category.__name__ for warning in caught], "TLS" in str(caught[0].message)
+    (['UnencryptedScheduler'], True)
+    """

@@ -351,6 +351,32 @@ CASES = [
     ),
     _case(
         "sweep",
+        "sweep --torque 5 --scheduler tls://127.0.0.1:9 --tls-ca-file {files}/ca.pem --tls-cert {files}/client.pem "
+        "--output-dir {files}/out",
+        2,
+        "TLS file {files}/ca.pem (--tls-ca-file, or dask's distributed.comm.tls.ca-file): no such file",
+    ),
+    _case(
+        "sweep",
+        "sweep --torque 5 --scheduler tls://127.0.0.1:9 --tls-ca-file {files}/result.csv --tls-cert {files}/result.csv "
+        "--output-dir {files}/out",
+        2,
+        "the TLS files for tls://127.0.0.1:9 cannot be read as a CA certificate, certificate and key",
+    ),
+    _case(
+        "sweep",
+        "sweep --torque 5 --scheduler tls://127.0.0.1:9 --tls-cert {files}/result.csv --output-dir {files}/out",
+        2,
+        "--tls-ca-file and --tls-cert go together",
+    ),
+    _case(
+        "sweep",
+        "sweep --torque 5 --tls-ca-file {files}/result.csv --tls-cert {files}/result.csv --output-dir {files}/out",
+        2,
+        "--tls-ca-file, --tls-cert and --tls-key are for --scheduler tls://...",
+    ),
+    _case(
+        "sweep",
         "sweep --torque 5 --set mass=heavy --output-dir {files}/out",
         2,
         "--set mass=heavy: expected comma-separated numbers",
@@ -577,6 +603,7 @@ from pendulum_fmu import (
     run_sweep,
     simulate,
     sweep_grid,
+    tls_files,
     write_scenarios,
 )"""
 
@@ -780,6 +807,18 @@ CALLS = [
         f'run_sweep({ONE}, {OUT}, scheduler="tcp://127.0.0.1:9", connect_timeout=1)',
         "SchedulerUnreachable",
         "no dask scheduler answered at tcp://127.0.0.1:9 within 1 s",
+    ),
+    Call(
+        "sweep",
+        f'run_sweep({ONE}, {OUT}, security=tls_files("{{files}}/result.csv", "{{files}}/result.csv"))',
+        "InvalidInput",
+        "security is for a scheduler's address",
+    ),
+    Call(
+        "sweep",
+        f'run_sweep({ONE}, {OUT}, scheduler="tls://127.0.0.1:9", security="{{files}}/result.csv")',
+        "WrongType",
+        "security is a distributed.security.Security, e.g. tls_files(...)",
     ),
     Call(
         "sweep",

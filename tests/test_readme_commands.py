@@ -65,7 +65,9 @@ EXCLUDED = {
     r"^\.venv/bin/python build_wheels\.py$": "builds every OS's wheel, longer than a README command "
     "may take; tests/test_wheels.py runs the same build",
     r"^(helm|kubectl) ": "needs a Kubernetes cluster",
-    r"--scheduler tcp://(head|localhost):8786": "needs the cluster's dask scheduler started above",
+    r"--scheduler tls://(head|localhost):8786": "needs the cluster's dask scheduler started above",
+    r"^openssl ": "makes the certificates of a cluster on other machines (tested by hand; "
+    "tests/test_sweep_security.py makes its own with cryptography and runs a TLS cluster on them)",
     r"jupyter notebook": "starts a server that runs until stopped; tests/test_notebook.py runs the notebook",
 }
 

@@ -979,6 +979,8 @@ def network_namespace():
         subprocess.run(["ip", "netns", "del", name], capture_output=True)
 
 
+# The scheduler listens on the namespaces' link, off the loopback, on plain TCP: the sweep warns so.
+@pytest.mark.filterwarnings("ignore::pendulum_fmu.UnencryptedScheduler")
 def test_a_workers_link_cut_mid_study_changes_nothing(tmp_path, monkeypatch, network_namespace):
     # Issue 32, a fault survived: the link of a worker on another host cut while it computes a
     # chunk, for longer than the scheduler waits for a silent worker, then restored.

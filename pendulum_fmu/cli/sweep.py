@@ -87,14 +87,7 @@ def add_parser(commands) -> argparse.ArgumentParser:
         help="replace the study --output-dir holds, once the new one is whole "
         "(without --resume or --overwrite, a folder holding a study is refused)",
     )
-    sweep.add_argument("--scheduler", help="address of a running dask.distributed scheduler")
-    sweep.add_argument(
-        "--connect-timeout",
-        type=float_number,
-        default=10.0,
-        help="seconds --scheduler has to answer dask's handshake, all told (default: %(default)s)",
-    )
-    sweep.add_argument("--workers", type=int, default=None, help="local cluster workers (default: 2)")
+    _add_cluster_arguments(sweep)
     sweep.add_argument(
         "--max-cases",
         type=positive_int,
@@ -104,6 +97,48 @@ def add_parser(commands) -> argparse.ArgumentParser:
     add_fmu_argument(sweep)
     sweep.set_defaults(run=run)
     return sweep
+
+
+def _add_cluster_arguments(sweep: argparse.ArgumentParser) -> None:
+    """The options that choose the cluster and how the client reaches it (TLS's as dask names them)."""
+    sweep.add_argument("--scheduler", help="address of a running dask.distributed scheduler (tls://... to secure it)")
+    sweep.add_argument(
+        "--connect-timeout",
+        type=float_number,
+        default=10.0,
+        help="seconds --scheduler has to answer dask's handshake, all told (default: %(default)s)",
+    )
+    for option, what in (
+        ("--tls-ca-file", "the CA certificate that signed the scheduler's and workers' certificates"),
+        ("--tls-cert", "the client's certificate, signed by that CA (it may hold the key too)"),
+        ("--tls-key", "the client's private key"),
+    ):
+        sweep.add_argument(
+            option,
+            type=output_location,
+            metavar="PEM",
+            help=f"{what}, for --scheduler tls://... (default: dask's configuration, distributed.comm.tls.*)",
+        )
+    sweep.add_argument("--workers", type=int, default=None, help="local cluster workers (default: 2)")
+
+
+def _security(args):
+    """The client's security from the --tls-* options; None (dask's configuration's) without them."""
+    from ..sweep import tls_files
+
+    if not (args.tls_ca_file or args.tls_cert or args.tls_key):
+        return None
+    if args.scheduler is None:
+        raise InvalidInput(
+            "--tls-ca-file, --tls-cert and --tls-key are for --scheduler tls://...; the local "
+            "cluster makes certificates of its own"
+        )
+    if not (args.tls_ca_file and args.tls_cert):
+        raise InvalidInput(
+            "--tls-ca-file and --tls-cert go together (with --tls-key where the certificate's file "
+            "does not hold the key)"
+        )
+    return tls_files(args.tls_ca_file, args.tls_cert, args.tls_key)
 
 
 def run(args) -> int:
@@ -131,6 +166,7 @@ def run(args) -> int:
             workers=args.workers,
             connect_timeout=args.connect_timeout,
             max_cases=args.max_cases,
+            security=_security(args),
         )
     except Stopped as stopped:
         what = STOPPING_SIGNALS[signal.Signals(stopped.signal_number)]

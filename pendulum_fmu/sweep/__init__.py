@@ -33,6 +33,7 @@ The package, in the order a run goes through it:
     grid.py    the cases: sweep_grid's every combination, or a list of dicts, checked
     run.py     run_sweep: the folder locked, the chunks run on dask, the figure drawn
     client.py  the dask client, the chunks submitted and gathered, the progress line
+    security.py  who can reach the cluster: the local cluster's certificates, the client's TLS
     worker.py  a chunk on a worker: its cases through the native loop, its two parts written
     store.py   the output folder: study.json, the parts, the lock, the cases table read back
     figure.py  sweep.png from the cases table
@@ -40,6 +41,7 @@ The package, in the order a run goes through it:
 
 from .grid import Grid, sweep_grid
 from .run import DEFAULT_MAX_CASES, run_sweep
+from .security import tls_files
 from .study import FORMATS, Study, SweepResult
 
 
@@ -53,4 +55,14 @@ def __getattr__(name: str):
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
-__all__ = ["DEFAULT_MAX_CASES", "FORMATS", "OUTPUTS", "Grid", "Study", "SweepResult", "run_sweep", "sweep_grid"]
+__all__ = [
+    "DEFAULT_MAX_CASES",
+    "FORMATS",
+    "OUTPUTS",
+    "Grid",
+    "Study",
+    "SweepResult",
+    "run_sweep",
+    "sweep_grid",
+    "tls_files",
+]

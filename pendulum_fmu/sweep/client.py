@@ -10,7 +10,9 @@ from __future__ import annotations
 import contextlib
 import logging
 import queue
+import re
 import signal
+import ssl
 import sys
 import threading
 import time
@@ -19,6 +21,7 @@ from concurrent.futures import CancelledError
 from dataclasses import dataclass
 
 from .._errors import PendulumFmuError
+from .security import client_security, run_certificates
 from .worker import Task, run_chunk
 
 # dask's periodic work, for a local cluster: at dask's defaults its scheduler, nannies and
@@ -52,37 +55,32 @@ class SchedulerLost(PendulumFmuError, ConnectionError):
 
 
 @contextlib.contextmanager
-def dask_client(scheduler: str | None, workers: int | None, connect_timeout: float):
-    """A dask client: on a local cluster of `workers` processes started (and closed) here, or on
-    the scheduler at an address, refused within connect_timeout when it does not answer.
+def dask_client(scheduler: str | None, workers: int | None, connect_timeout: float, security=None):
+    """A dask client: on a local cluster of `workers` processes started (and closed) here, which
+    only holders of its run's certificates can reach (security.py), or on the scheduler at an
+    address, connecting with security (a distributed.security.Security; None: dask's
+    configuration's), refused within connect_timeout when it does not answer.
     """
-    import dask
-    from dask.distributed import Client, LocalCluster
+    from dask.distributed import Client
 
     if scheduler is None:
         with contextlib.ExitStack() as stack:
-            # The scheduler and nannies read the settings as they start; each nanny hands them on
-            # to its worker.
-            with _ctrl_c_held(), dask.config.set(QUIET_DASK):
-                # Port 0 for the scheduler's HTTP server: another cluster may hold dask's usual 8787.
-                cluster = stack.enter_context(
-                    LocalCluster(
-                        n_workers=workers or 2,
-                        threads_per_worker=1,
-                        processes=True,
-                        dashboard_address=":0",
-                        silence_logs=logging.CRITICAL,
-                    )
-                )
+            cluster = _local_cluster(stack, workers or 2)
             # A Ctrl-C held while the cluster started is raised here, and the stack closes it.
-            yield stack.enter_context(Client(cluster))
+            yield stack.enter_context(Client(cluster))  # with the cluster's security
         return
-    reason = _why_no_scheduler(scheduler, connect_timeout)
+    security = client_security(scheduler, security)
+    reason = _why_no_scheduler(scheduler, connect_timeout, security)
     if reason is None:
         try:
-            client = Client(scheduler, timeout=connect_timeout)
+            client = Client(scheduler, timeout=connect_timeout, security=security)
         except Exception as error:
             reason = _first_line(error)
+    if reason is not None and reason.startswith(TLS_REFUSED):
+        raise SchedulerUnreachable(
+            f"{reason} with the dask scheduler at {scheduler}; give the CA file that signed its "
+            "certificate (--tls-ca-file) and a client certificate and key its CA signed (--tls-cert, --tls-key)"
+        )
     if reason is not None:
         raise SchedulerUnreachable(
             f"no dask scheduler answered at {scheduler} within {connect_timeout:g} s"
@@ -91,6 +89,32 @@ def dask_client(scheduler: str | None, workers: int | None, connect_timeout: flo
         )
     with _quiet(logging.getLogger("distributed.client")), client:
         yield client
+
+
+def _local_cluster(stack: contextlib.ExitStack, workers: int):
+    """A local cluster of `workers` single-threaded processes on the loopback, speaking TLS with
+    certificates made for it, with QUIET_DASK's settings and a Ctrl-C held while it starts;
+    closed by the stack, onto which it is put before a Ctrl-C can come.
+    """
+    import dask
+    from dask.distributed import LocalCluster
+
+    certificates = run_certificates()
+    # The scheduler and nannies read the settings as they start; each nanny hands them on to its
+    # worker.
+    with _ctrl_c_held(), dask.config.set(QUIET_DASK):
+        # Port 0 for the scheduler's HTTP server: another cluster may hold dask's usual 8787;
+        # on the loopback: its pages are no one else's business.
+        return stack.enter_context(
+            LocalCluster(
+                n_workers=workers,
+                threads_per_worker=1,
+                processes=True,
+                security=certificates,
+                dashboard_address="127.0.0.1:0",
+                silence_logs=logging.CRITICAL,
+            )
+        )
 
 
 @contextlib.contextmanager
@@ -107,11 +131,30 @@ def _quiet(logger: logging.Logger):
         logger.setLevel(level)
 
 
+TLS_REFUSED = "the TLS handshake failed"
+
+
+def _refused_by_tls(error: BaseException) -> str:
+    """Why a TLS handshake failed, where one did (a certificate no CA of the other side's
+    signed), as dask's connect gives it up after retrying until its timeout, or as the closed
+    connection's text says when the far end refused: OpenSSL's reason; else "".
+    """
+    seen: BaseException | None = error
+    while seen is not None:
+        named = re.search(r"\[SSL: (\w+)\]", str(seen))
+        if named:
+            return f"{TLS_REFUSED} ({named[1]})"
+        if isinstance(seen, ssl.SSLError):  # SSLEOFError: the far end closed it, refusing the client's
+            return f"{TLS_REFUSED} ({seen.reason or type(seen).__name__})"
+        seen = seen.__cause__ or seen.__context__
+    return ""
+
+
 def _first_line(error: BaseException) -> str:
     return str(error).splitlines()[0] if str(error) else type(error).__name__
 
 
-def _why_no_scheduler(scheduler: str, timeout: float) -> str | None:
+def _why_no_scheduler(scheduler: str, timeout: float, security) -> str | None:
     """Why the address does not answer dask's handshake and an identity request as a scheduler
     within timeout seconds, all told: "" when nothing answered in time (nothing listens there,
     or it never answers), else what answered; None when a scheduler did.
@@ -127,7 +170,7 @@ def _why_no_scheduler(scheduler: str, timeout: float) -> str | None:
     from distributed.comm import connect
 
     async def identity() -> dict:
-        comm = await connect(scheduler, timeout=timeout)
+        comm = await connect(scheduler, timeout=timeout, **security.get_connection_args("client"))
         try:
             await comm.write({"op": "identity", "reply": True})
             return await comm.read()
@@ -139,9 +182,9 @@ def _why_no_scheduler(scheduler: str, timeout: float) -> str | None:
     def ask() -> None:
         try:
             answers.append(asyncio.run(asyncio.wait_for(identity(), timeout)))
-        except (TimeoutError, OSError):
+        except (TimeoutError, OSError) as error:
             # Which of the two comes first, dask's connect giving up or the bound here, is chance.
-            answers.append("")
+            answers.append(_refused_by_tls(error))
         except Exception as error:  # an address dask cannot parse
             answers.append(_first_line(error))
 

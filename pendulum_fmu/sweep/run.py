@@ -9,6 +9,7 @@ import time
 import uuid
 from concurrent.futures import CancelledError
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -16,12 +17,15 @@ from .._errors import InvalidInput, MissingDependency, WrongType
 from .._model import fmu_file
 from .._parameters import pendulum_variables
 from .._time_grid import DEFAULT_MAX_CASES
-from .client import SchedulerLost, dask_client, progress_bar, run_chunks
+from .client import SchedulerLost, Totals, dask_client, progress_bar, run_chunks
 from .figure import draw
 from .grid import columns
 from .store import Held, Store, StudyExists
 from .study import Study, SweepResult
 from .worker import Task
+
+if TYPE_CHECKING:
+    from distributed.security import Security
 
 
 def run_sweep(
@@ -35,6 +39,7 @@ def run_sweep(
     connect_timeout: float = 10.0,
     progress: bool = True,
     max_cases: int = DEFAULT_MAX_CASES,
+    security: Security | None = None,
 ) -> SweepResult:
     """Run every case of a study on dask; the workers write it into output_dir.
 
@@ -68,6 +73,11 @@ def run_sweep(
         Show a progress line on stderr.
     max_cases : int, optional
         The largest study accepted.
+    security : distributed.security.Security, optional
+        How the client connects to the scheduler: for a tls:// one, its CA certificate and the
+        client's certificate and key, e.g. security.tls_files(ca_file, cert, key). Without it,
+        dask's configuration's (distributed.comm.tls.*). The local cluster makes its own, which
+        only this run holds.
 
     Returns
     -------
@@ -78,19 +88,26 @@ def run_sweep(
     Raises
     ------
     InvalidInput
-        More cases than max_cases, workers with a scheduler, a bad workers count or connect
-        timeout, or resume and overwrite together; all before anything starts.
+        More cases than max_cases, workers with a scheduler, security without one, a bad workers
+        count or connect timeout, resume and overwrite together, or TLS files that are no
+        certificates; all before anything starts.
     StudyExists
         output_dir holds a study and neither resume (for the same study) nor overwrite was
         given; before anything starts.
     MissingFile, parameters.FmuFileError
-        No file at the study's FMU, or none that is a pendulum FMU this machine can run.
+        No file at the study's FMU, or none that is a pendulum FMU this machine can run; no file
+        at a TLS file's path.
     InUse
         Another run is writing into the same local output_dir.
     CannotWrite
         output_dir cannot be written.
     SchedulerUnreachable
-        The scheduler did not answer within connect_timeout.
+        The scheduler did not answer within connect_timeout, or refused the TLS handshake.
+
+    Warns
+    -----
+    UnencryptedScheduler
+        A plain tcp:// scheduler off the loopback: whoever reaches it runs code on its workers.
 
     Examples
     --------
@@ -101,15 +118,12 @@ def run_sweep(
     >>> result.cases, result.failed, result.chunks_run == result.chunks
     (4, 0, True)
     """
-    from fsspec.implementations.local import LocalFileSystem
-
     started = time.perf_counter()
     if not isinstance(study, Study):
         raise WrongType(f"run_sweep takes a Study(cases, ...), not a {type(study).__name__}")
     if not isinstance(output_dir, str | os.PathLike):
         raise WrongType(f"output_dir is a folder's path or an fsspec URL, not {output_dir!r}")
-    cases = study.cases
-    _check_options(len(cases), max_cases, scheduler, workers, connect_timeout, resume, overwrite)
+    _check_options(len(study.cases), max_cases, scheduler, workers, connect_timeout, resume, overwrite, security)
     url = str(output_dir)
     target = Store(*_file_system(url), format=study.format)
     fmu = str(fmu_file(study.fmu_path).resolve())
@@ -118,6 +132,9 @@ def run_sweep(
     # The folder taken first, so that a second run is refused before it starts a cluster; then
     # connected, so that a scheduler that does not answer leaves the study untouched.
     with target.only_run(url):
+        # What no run owns now (the staged parts of a worker of an earlier run that wrote after
+        # its run ended, temporaries of writes cut short) goes before the folder is read.
+        target.remove_unfinished()
         chunk_cases = _chunk_cases(target.held(), definition, study, resume, overwrite, url)
         # A study that replaces another is written apart and moved into place once whole.
         store = target.staging() if overwrite else target
@@ -133,34 +150,12 @@ def run_sweep(
         )
         try:
             try:
-                with dask_client(scheduler, workers, connect_timeout) as client:
+                with dask_client(scheduler, workers, connect_timeout, security) as client:
                     store.start(definition, chunk_cases, task.run)
-                    chunks = range(math.ceil(len(cases) / chunk_cases))
-                    done = store.done_chunks()
-                    pending = [index for index in chunks if index not in done]
-                    finished = sum(min(chunk_cases, len(cases) - i * chunk_cases) for i in done)
-                    with progress_bar(len(cases), finished, progress) as bar:
-                        try:
-                            totals = run_chunks(
-                                client,
-                                task,
-                                (
-                                    (
-                                        index,
-                                        index * chunk_cases,
-                                        columns(
-                                            cases,
-                                            study.names,
-                                            index * chunk_cases,
-                                            min(len(cases), (index + 1) * chunk_cases),
-                                        ),
-                                    )
-                                    for index in pending
-                                ),
-                                bar,
-                            )
-                        except CancelledError as error:  # this run cancels none: the cluster did
-                            raise _lost(scheduler, error, url, overwrite) from None
+                    try:
+                        totals, chunks, chunks_run = _run_pending(client, task, study, chunk_cases, progress)
+                    except CancelledError as error:  # this run cancels none: the cluster did
+                        raise _lost(scheduler, error, url, overwrite) from None
             finally:
                 # After a local cluster closed, so that none of its workers writes any more (a
                 # remote cluster's may still finish the chunk they were running).
@@ -175,25 +170,49 @@ def run_sweep(
             if store is not target:
                 store.discard()
             raise
-    # Paths on the local file system, URLs elsewhere.
-    where = (
-        Path(target.root).joinpath if isinstance(target.filesystem, LocalFileSystem) else f"{url.rstrip('/')}/".__add__
-    )
+    where = _locate(target, url)
     return SweepResult(
         output_dir=where(""),
         trajectories=where("trajectories") if study.outputs else None,
         cases_table=where("cases"),
         figure=where("sweep.png"),
-        cases=len(cases),
+        cases=len(study.cases),
         failed=int(np.sum(table["status"].to_numpy(zero_copy_only=False) == "failed")),
-        chunks=len(chunks),
-        chunks_run=len(pending),
+        chunks=chunks,
+        chunks_run=chunks_run,
         bytes=totals.bytes,
         seconds=time.perf_counter() - started,
         figure_seconds=drawn - drawing,
         worker_cpu_seconds=totals.worker_cpu_seconds,
         worker_stepping_seconds=totals.worker_stepping_seconds,
     )
+
+
+def _run_pending(client, task: Task, study: Study, chunk_cases: int, progress: bool) -> tuple[Totals, int, int]:
+    """Run, with the progress line, the chunks of the study that task.store does not hold done:
+    (what they reported, the study's chunks, the chunks run).
+    """
+    cases = study.cases
+    chunks = range(math.ceil(len(cases) / chunk_cases))
+    done = task.store.done_chunks()
+    pending = [index for index in chunks if index not in done]
+    finished = sum(min(chunk_cases, len(cases) - i * chunk_cases) for i in done)
+    starts = {index: index * chunk_cases for index in pending}  # each chunk's first case
+    values = (
+        (index, start, columns(cases, study.names, start, min(len(cases), start + chunk_cases)))
+        for index, start in starts.items()
+    )
+    with progress_bar(len(cases), finished, progress) as bar:
+        return run_chunks(client, task, values, bar), len(chunks), len(pending)
+
+
+def _locate(target: Store, url: str):
+    """Where a path inside the output folder is: a Path on the local file system, a URL elsewhere."""
+    from fsspec.implementations.local import LocalFileSystem
+
+    if isinstance(target.filesystem, LocalFileSystem):
+        return Path(target.root).joinpath
+    return f"{url.rstrip('/')}/".__add__
 
 
 def _lost(scheduler: str | None, error: CancelledError, url: str, overwrite: bool) -> SchedulerLost:
@@ -258,6 +277,7 @@ def _check_options(
     connect_timeout: float,
     resume: bool,
     overwrite: bool,
+    security: Security | None,
 ) -> None:
     if count > max_cases:
         raise InvalidInput(
@@ -267,6 +287,8 @@ def _check_options(
         )
     if scheduler is not None and workers is not None:
         raise InvalidInput("workers sizes the local cluster; with a scheduler the cluster has its own")
+    if scheduler is None and security is not None:
+        raise InvalidInput("security is for a scheduler's address; the local cluster makes certificates of its own")
     if workers is not None and (not isinstance(workers, numbers.Integral) or workers < 1):
         raise InvalidInput(f"workers must be a positive integer, got {workers!r}")
     if not (isinstance(connect_timeout, numbers.Real) and 0 < connect_timeout < math.inf):
