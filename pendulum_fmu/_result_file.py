@@ -13,6 +13,7 @@ import numpy as np
 from . import _results as results
 from ._errors import InvalidInput
 from ._mapped_fmu import as_map
+from ._received_files import bounded_lines
 
 RESULT_QUANTITIES = ("time", "theta", "omega", "alpha")
 
@@ -37,6 +38,9 @@ class ResultFileError(InvalidInput):
     ...     print(str(error).replace(str(result), "result.csv"))
     result.csv:3: theta 'x' is not a number
     """
+
+
+_GIVE_CSV = "give the result CSV the tool wrote"
 
 
 def read_result(path: str | Path, mapping: str | dict | None = None) -> np.ndarray:
@@ -64,9 +68,11 @@ def read_result(path: str | Path, mapping: str | dict | None = None) -> np.ndarr
     mapped = as_map(mapping, RESULT_QUANTITIES)
     try:
         with open(path, newline="", encoding="utf-8-sig") as file:
-            rows = list(csv.reader(file))
+            rows = list(csv.reader(bounded_lines(file, str(path), ResultFileError, _GIVE_CSV)))
     except OSError as error:
         raise ResultFileError(f"{path}: cannot read: {error.strerror}") from None
+    except csv.Error as error:  # a quoted cell across lines, over csv.field_size_limit()
+        raise ResultFileError(f"{path}: not a CSV the judge reads ({error}); {_GIVE_CSV}") from None
     except UnicodeDecodeError:
         raise ResultFileError(f"{path}: not UTF-8 text; save the result as a UTF-8 CSV") from None
     numbered = [(number, row) for number, row in enumerate(rows, start=1) if any(c.strip() for c in row)]

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ._errors import InvalidInput
+from ._received_files import bounded_text
 from ._scenario_list import Scenario
 
 # The tolerance the kit's FMU is run at (its own default); the judge's, in rad.
@@ -81,9 +82,11 @@ def read_settings(path: str | Path) -> dict:
     """
     path = Path(path)
     try:
-        settings = json.loads(path.read_text(encoding="utf-8"))
+        settings = json.loads(bounded_text(path, MAX_SETTINGS_BYTES, InvalidInput, _AGAIN))
     except (json.JSONDecodeError, UnicodeDecodeError) as error:
         raise InvalidInput(f"{path}: not a scenario's settings: {error}") from None
+    except RecursionError:  # [[[[...]]]]: the decoder recurses once per level
+        raise InvalidInput(f"{path}: not a scenario's settings: nested too deep; {_AGAIN}") from None
     except OSError as error:
         raise InvalidInput(f"{path}: cannot read: {error.strerror}") from None
     if not isinstance(settings, dict):
@@ -128,6 +131,9 @@ SETTINGS_READ = (
     "tolerance",
 )
 
+
+# A NAME.json the kit writes is under 1 kB; one of a megabyte is no scenario's, and is not read.
+MAX_SETTINGS_BYTES = 2**20
 
 _AGAIN = "write the kit again with pendulum-fmu scenarios --output-dir FOLDER --overwrite"
 
@@ -178,6 +184,10 @@ class _FieldChecker:
         value = self.settings[key]
         if not (isinstance(value, str) and value.strip()):
             self._refuse(key, "a file name (a JSON string)")
+        # A kit's files lie beside its NAME.json: a received kit names no file elsewhere on the
+        # machine for the judge to read and quote.
+        if value != Path(value).name or value in (".", "..") or "\\" in value:
+            self._refuse(key, "the name of a file in the kit's folder, with no folder before it")
         return value
 
     def parameters(self, key: str) -> dict[str, float]:

@@ -15,6 +15,7 @@ from typing import Literal
 import numpy as np
 
 from ._errors import InvalidInput
+from ._received_files import check_lines
 from ._time_grid import event_tolerance, nearest
 
 
@@ -165,6 +166,7 @@ def read_torque_csv(path: str | Path) -> TorqueTable:
     except OSError as error:
         raise TorqueFileError(f"{path}: cannot read: {error.strerror}") from None
     raw = raw[3:] if raw.startswith(b"\xef\xbb\xbf") else raw  # spreadsheets write a byte-order mark
+    check_lines(raw, str(path), TorqueFileError, "give a CSV of time,torque rows")
     _decode(path, raw)  # only to refuse another encoding here, with its line
     header_line = raw[: raw.find(b"\n") if b"\n" in raw else len(raw)].decode("utf-8")
     if not header_line.strip():
