@@ -22,7 +22,7 @@ import fmpy
 from fmpy import extract, read_model_description
 
 from ._errors import InvalidInput, MissingFile, WrongType
-from ._received_files import check_archive, check_xml
+from ._received_files import check_fmu
 
 # The start values a user gives, and the FMU's variables they start.
 START_VALUES = {"theta0": "theta", "omega0": "omega"}
@@ -205,11 +205,7 @@ def _read(path: str, version: tuple, shown: str) -> FmuModel:
     try:
         with zipfile.ZipFile(path) as archive:
             names = frozenset(archive.namelist())
-            # Before fmpy parses it or unpacks the archive (FmuModel.folder): both trust it.
-            check_archive(archive, shown, FmuFileError)
-            if "modelDescription.xml" in names:
-                xml = archive.read("modelDescription.xml")
-                check_xml(xml, f"{shown}'s modelDescription.xml", FmuFileError)
+            check_fmu(archive, shown, FmuFileError)  # before fmpy parses it and unpacks it (FmuModel.folder)
     except (zipfile.BadZipFile, OSError):
         raise FmuFileError(
             f"{shown} is not an FMU (an FMU is a zip archive with a modelDescription.xml): check the path"

@@ -7,11 +7,12 @@ module or a regular expression), so that a crafted file is refused in one line, 
 and what is wrong with it, instead of writing outside the folder it is unpacked to, filling the
 disk or the memory, or keeping a core busy for hours:
 
-- a zip archive (check_archive): no entry that would be unpacked outside its folder (``..``, an
-  absolute path, a drive letter, a backslash, a symbolic link), at most MAX_ENTRIES entries and
-  MAX_UNPACKED_BYTES unpacked, no large entry that expands more than MAX_RATIO times (a zip
-  bomb); zipfile stops reading an entry at the size the archive declares for it, so the declared
-  sizes bound what is unpacked;
+- a zip archive (check_archive; check_fmu adds the model description's XML): no entry that would
+  be unpacked outside its folder (``..``, an absolute path, a drive letter, a backslash, a
+  symbolic link), at most MAX_ENTRIES entries and MAX_UNPACKED_BYTES unpacked, no large entry
+  that expands more than MAX_RATIO times (a zip bomb); zipfile stops reading an entry at the size
+  the archive declares for it, so the declared sizes bound what is unpacked; an SSP's FMUs are
+  checked as FMUs, for the master it is handed to;
 - an XML document (check_xml): no document type declaration, the only place XML entities are
   defined (a billion laughs, an external entity that reads a local file or a URL); no FMI or SSP
   file has one;
@@ -117,6 +118,20 @@ def check_archive(archive: zipfile.ZipFile, shown: str, error: type[Exception]) 
             f"{shown}: the archive unpacks to {unpacked / 2**20:,.0f} MiB, over the limit of "
             f"{MAX_UNPACKED_BYTES // 2**20} MiB; {_SENDER}"
         )
+
+
+def check_fmu(archive: zipfile.ZipFile, shown: str, error: type[Exception]) -> None:
+    """check_archive on an FMU, then check_xml on its modelDescription.xml where it has one: what
+    fmpy, or a master an SSP is handed to, trusts when it parses and unpacks the FMU.
+
+    Raises
+    ------
+    error
+        As check_archive and check_xml.
+    """
+    check_archive(archive, shown, error)
+    if "modelDescription.xml" in archive.namelist():
+        check_xml(archive.read("modelDescription.xml"), f"{shown}'s modelDescription.xml", error)
 
 
 class _PrologRead(Exception):
@@ -238,9 +253,11 @@ def check_lines(raw: bytes, shown: str, error: type[Exception], advice: str, bou
     error
         As bounded_lines, a line's length counted in bytes.
     """
-    ends = np.flatnonzero(np.frombuffer(raw, np.uint8) == ord("\n"))
+    data = np.frombuffer(raw, np.uint8)
+    ends = np.flatnonzero(data == ord("\n"))
     lengths = np.diff(ends, prepend=-1, append=len(raw)) - 1
-    long_lines = np.flatnonzero(lengths > bound + 1)  # + 1: a line may end in \r\n
+    lengths[:-1] -= (ends > 0) & (data[ends - 1] == ord("\r"))  # a line end may be \r\n
+    long_lines = np.flatnonzero(lengths > bound)
     faults = []
     if len(long_lines):
         faults.append((int(long_lines[0]) + 1, f"the line is longer than {bound:,} bytes"))

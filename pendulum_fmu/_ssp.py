@@ -22,7 +22,7 @@ from . import default_fmu
 from ._atomic_files import replacing
 from ._closed_loop import WIRES, controller_defaults, controller_fmu
 from ._errors import InvalidInput, MissingFile, PendulumFmuError
-from ._received_files import check_archive, check_xml
+from ._received_files import check_archive, check_fmu, check_xml
 from ._simulate import resolve_parameters
 
 NAMESPACES = {
@@ -404,6 +404,10 @@ def read_ssp(path: str | os.PathLike) -> SspSettings:
     try:
         with zipfile.ZipFile(path) as archive:
             check_archive(archive, str(path), SspFileError)  # before any entry is read
+            for name in archive.namelist():  # the FMUs a master will unpack
+                if name.endswith(".fmu"):
+                    with zipfile.ZipFile(archive.open(name)) as fmu:
+                        check_fmu(fmu, f"{path}'s {name}", SspFileError)
             ssd = _parsed(archive, "SystemStructure.ssd")
             bindings = {
                 _attribute(c, ".", "name"): _attribute(c, "ssd:ParameterBindings/ssd:ParameterBinding", "source")

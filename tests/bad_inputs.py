@@ -116,6 +116,7 @@ def _ssp(pendulum_set: str) -> bytes:
 
 def received_files() -> dict[str, bytes | str]:
     """The crafted files, by name."""
+    bomb = _zip_entries([("modelDescription.xml", SPRING), ("resources/zeros", bytes(8 * 2**20))], level=6)
     record = '[pendulum-calls] instance="p" fmi2DoStep(currentCommunicationPoint=0, communicationStepSize=0.001) '
     record += "time=0->0.001 status=OK\n"
     deep_kit = {"deep_kit/s.json": "[" * 100_000 + "]" * 100_000, "deep_kit/s_in.csv": "time,torque\n0,1\n1,1\n"}
@@ -124,7 +125,7 @@ def received_files() -> dict[str, bytes | str]:
         "absolute.fmu": _zip({"modelDescription.xml": SPRING, "/tmp/escaped.txt": "x"}),
         "link.fmu": _zip_entries([("modelDescription.xml", SPRING), (_link_entry(), "/etc/passwd")]),
         # 8 MiB of zeros from 8 kB, as a zip bomb's gigabytes come from a few MB.
-        "bomb.fmu": _zip_entries([("modelDescription.xml", SPRING), ("resources/zeros", bytes(8 * 2**20))], level=6),
+        "bomb.fmu": bomb,
         "huge.fmu": _zip_entries(
             [("modelDescription.xml", SPRING)] + [(f"resources/{n}", bytes(2**20)) for n in range(513)]
         ),
@@ -137,6 +138,8 @@ def received_files() -> dict[str, bytes | str]:
         ),
         "laughs.ssp": _ssp(LAUGHS + '<ssv:ParameterSet name="&lol9;"/>'),
         "bomb.ssp": _zip_entries([("SystemStructure.ssd", " " * 8 * 2**20)], level=6),
+        # The SSP is small; an FMU in it, which a master would unpack, is the bomb.
+        "bomb_inside.ssp": _zip_entries([("SystemStructure.ssd", "<a/>"), ("resources/Pendulum.fmu", bomb)]),
         "long_line.log": record + "x" * 2**20 + "\n" + record,
         "nul.log": record + "\0" + record,
         "long_line.csv": "time,torque\n0,1\n1," + "1" * 2**20 + "\n",
@@ -724,6 +727,12 @@ CASES = [
         "judge {files}/result.csv --ssp {files}/bomb.ssp",
         2,
         "bomb.ssp: the archive's entry 'SystemStructure.ssd' expands",
+    ),
+    _case(
+        "received file",
+        "judge {files}/result.csv --ssp {files}/bomb_inside.ssp",
+        2,
+        "bomb_inside.ssp's resources/Pendulum.fmu: the archive's entry 'resources/zeros' expands",
     ),
     _case(
         "received file",
