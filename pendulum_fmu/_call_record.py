@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ._errors import InvalidInput, MissingFile
-from ._received_files import MAX_CALL_LINE_CHARS, bounded_lines
+from ._received_files import bounded_lines
 
 MARKER = "[pendulum-calls]"
 
@@ -339,8 +339,11 @@ def read_calls(path: str | Path, variable_names: dict[int, str]) -> list[Call]:
     records, parts = [], []
     with open(path, encoding="utf-8", errors="replace") as file:
         advice = "give the FMU's call record, or the master's log as it wrote it"
-        for line in map(str.rstrip, bounded_lines(file, str(path), InvalidInput, advice, MAX_CALL_LINE_CHARS)):
-            if MARKER in line and (match := _RECORD.search(line)):
+        for line in map(str.rstrip, bounded_lines(file, str(path), InvalidInput, advice)):
+            # A record starts at its line's first marker (a master's log puts its own prefix
+            # before it): tried from every marker, a crafted line took time in its length squared.
+            start = line.find(MARKER)
+            if start >= 0 and (match := _RECORD.match(line, start)):
                 records.append(match)
             elif not records and (found := _master_call_parts(line)):
                 parts.append(found)

@@ -16,9 +16,9 @@ disk or the memory, or keeping a core busy for hours:
 - an XML document (check_xml): no document type declaration, the only place XML entities are
   defined (a billion laughs, an external entity that reads a local file or a URL); no FMI or SSP
   file has one;
-- a text file read line by line (bounded_lines, check_lines): no line over MAX_LINE_CHARS
-  (MAX_CALL_LINE_CHARS in a call log, which keeps a regular expression's work on a line bounded),
-  and no NUL byte, which no text has;
+- a text file read line by line (bounded_lines, check_lines): no line over MAX_LINE_CHARS, and
+  no NUL byte, which no text has (the readers' regular expressions take time linear in a line's
+  length: benchmarks/hostile_lines.py);
 - a small file read whole (bounded_text): at most a given size.
 """
 
@@ -46,14 +46,12 @@ MAX_UNPACKED_BYTES = 512 * 2**20
 # RATIO_CHECKED_BYTES are not checked: a small file may be all spaces.
 MAX_RATIO = 200
 RATIO_CHECKED_BYTES = 2**20
-# A result's row with a thousand columns is under 30 kB, a torque CSV's row under 100 bytes; the
-# csv module refuses a cell over 128 Ki characters (csv.field_size_limit()), so a line within this
-# bound holds no cell it refuses.
+# A result's row with a thousand columns is under 30 kB, a torque CSV's row under 100 bytes, a
+# line of the FMU's call record under 2 kB; the csv module refuses a cell over 128 Ki characters
+# (csv.field_size_limit()), so a line within this bound holds no cell it refuses.
 MAX_LINE_CHARS = 2**17
-# A line of the FMU's call record is under 2 kB, a master's logged call of the pendulum under 1 kB.
-# The record's regular expression takes time in the square of a crafted line's length: 0.05 s on
-# 16 Ki characters, 0.6 s on 64 Ki.
-MAX_CALL_LINE_CHARS = 2**14
+# How much of an XML document check_xml hands the parser at a time, to stop at its root element.
+_XML_CHUNK = 2**16
 
 _SENDER = "do not open it; ask whoever sent it for a file their tool wrote"
 
@@ -134,27 +132,12 @@ def check_fmu(archive: zipfile.ZipFile, shown: str, error: type[Exception]) -> N
         check_xml(archive.read("modelDescription.xml"), f"{shown}'s modelDescription.xml", error)
 
 
-class _PrologRead(Exception):
-    """The root element began: no document type declaration can follow."""
-
-
-class _DoctypeFound(Exception):
-    """The document declares a document type."""
-
-
-def _refuse_doctype(*_) -> None:
-    raise _DoctypeFound
-
-
-def _prolog_read(*_) -> None:
-    raise _PrologRead
-
-
 def check_xml(data: bytes, shown: str, error: type[Exception]) -> None:
     """Refuse an XML document that declares a document type, where entities are defined.
 
-    Only the prolog is read (expat, in whatever encoding the document declares); a document that
-    is no XML at all passes, for the reader's own parser to name its fault.
+    The document is parsed (by expat, in whatever encoding it declares) up to its root element, a
+    chunk at a time; one that is no XML at all passes, for the reader's own parser to name its
+    fault.
 
     Parameters
     ----------
@@ -179,18 +162,24 @@ def check_xml(data: bytes, shown: str, error: type[Exception]) -> None:
     ...     print(refused)
     a.xml declares a document type (<!DOCTYPE), where XML defines entities, and no FMI or SSP file has one; ...
     """
-    parser = expat.ParserCreate()
-    parser.StartDoctypeDeclHandler = _refuse_doctype
-    parser.StartElementHandler = _prolog_read
-    try:
-        parser.Parse(data, True)
-    except _DoctypeFound:
+
+    def refuse(*_) -> None:  # raised through the parser, before any entity is declared
         raise error(
             f"{shown} declares a document type (<!DOCTYPE), where XML defines entities, and no FMI "
             f"or SSP file has one; {_SENDER}"
-        ) from None
-    except (_PrologRead, expat.ExpatError):
-        pass
+        )
+
+    root = []
+    parser = expat.ParserCreate()
+    parser.StartDoctypeDeclHandler = refuse
+    parser.StartElementHandler = lambda *_: root.append(True)
+    try:
+        for start in range(0, len(data), _XML_CHUNK):
+            parser.Parse(data[start : start + _XML_CHUNK], False)
+            if root:  # no declaration can follow the root element
+                return
+    except expat.ExpatError:
+        return
 
 
 def _line_fault(line: str, bound: int) -> str | None:
@@ -267,6 +256,18 @@ def check_lines(raw: bytes, shown: str, error: type[Exception], advice: str, bou
     if faults:
         number, fault = min(faults)
         raise error(f"{shown}:{number}: {fault}; {advice}")
+
+
+def shortened(text: str, most: int = 80) -> str:
+    """Text from a received file as a message quotes it: its first `most` characters, and how long
+    it is where it is longer, so that a message stays a line one reads.
+
+    Examples
+    --------
+    >>> shortened("x" * 100, most=5)
+    'xxxxx... (100 characters)'
+    """
+    return text if len(text) <= most else f"{text[:most]}... ({len(text):,} characters)"
 
 
 def bounded_text(path: Path, limit: int, error: type[Exception], advice: str, encoding: str = "utf-8") -> str:

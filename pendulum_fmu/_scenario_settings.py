@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ._errors import InvalidInput
-from ._received_files import bounded_text
+from ._received_files import bounded_text, shortened
 from ._scenario_list import Scenario
 
 # The tolerance the kit's FMU is run at (its own default); the judge's, in rad.
@@ -160,7 +160,7 @@ class _FieldChecker:
     settings: dict
 
     def _refuse(self, key: str, what: str):
-        value = json.dumps(self.settings[key])
+        value = shortened(json.dumps(self.settings[key]))
         raise InvalidInput(f"{self.path}: {key} is {value}; it must be {what}: correct it, or {_AGAIN}")
 
     def number(self, key: str, unit: str, positive: bool = False) -> float:
@@ -197,7 +197,7 @@ class _FieldChecker:
         for name, number in value.items():
             if isinstance(number, bool) or not isinstance(number, (int, float)) or not math.isfinite(number):
                 raise InvalidInput(
-                    f"{self.path}: parameters: {name} is {json.dumps(number)}; it must be "
+                    f"{self.path}: parameters: {shortened(name)} is {shortened(json.dumps(number))}; it must be "
                     f"a finite number: correct it, or {_AGAIN}"
                 )
         return {name: float(number) for name, number in value.items()}

@@ -26,7 +26,7 @@ import numpy as np
 from ._atomic_files import replacing
 from ._call_record import MARKER
 from ._errors import CannotWrite, MissingDependency
-from ._received_files import MAX_CALL_LINE_CHARS
+from ._received_files import MAX_LINE_CHARS
 from ._ssp import read_ssp, rebind_ssp
 from ._ssp_calls import judge_ssp_calls
 from ._ssp_judge import judge_coupling
@@ -221,7 +221,7 @@ def _record_file(path: Path, ssp: str | os.PathLike) -> Path:
     elif path.exists():
         try:
             with open(path, encoding="utf-8", errors="replace") as file:
-                first = file.readline(MAX_CALL_LINE_CHARS)
+                first = file.readline(MAX_LINE_CHARS)
         except OSError as error:
             first = error.strerror or ""
         fault = "" if MARKER in first else "a file that is no call record"

@@ -15,7 +15,7 @@ from typing import Literal
 import numpy as np
 
 from ._errors import InvalidInput
-from ._received_files import check_lines
+from ._received_files import check_lines, shortened
 from ._time_grid import event_tolerance, nearest
 
 
@@ -111,9 +111,9 @@ def _first_bad_row(path: Path, lines: list[str], columns: tuple[int, int]) -> To
                 # Python's float takes 1_0 and fullwidth digits, which pyarrow refuses.
                 value = float(cell) if cell.isascii() and "_" not in cell else float("")
             except ValueError:
-                return TorqueFileError(f"{path}:{number}: {name} {cell!r} is not a number")
+                return TorqueFileError(f"{path}:{number}: {name} {shortened(repr(cell))} is not a number")
             if not math.isfinite(value):
-                return TorqueFileError(f"{path}:{number}: {name} is {cell}; values must be finite")
+                return TorqueFileError(f"{path}:{number}: {name} is {shortened(cell)}; values must be finite")
         if len(cells) > header:
             return TorqueFileError(
                 f"{path}:{number}: {len(cells)} columns, but the header names {header}; quote a cell holding a comma"
@@ -180,7 +180,7 @@ def read_torque_csv(path: str | Path) -> TorqueTable:
     for column in ("time", "torque"):
         if column not in header:
             raise TorqueFileError(
-                f"{path}:1: missing column {column!r} (header is {','.join(header)}); "
+                f"{path}:1: missing column {column!r} (header is {shortened(','.join(header))}); "
                 "the first line must name the columns, e.g. time,torque"
             )
     columns = (header.index("time"), header.index("torque"))

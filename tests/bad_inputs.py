@@ -144,6 +144,7 @@ def received_files() -> dict[str, bytes | str]:
         "nul.log": record + "\0" + record,
         "long_line.csv": "time,torque\n0,1\n1," + "1" * 2**20 + "\n",
         "nul.csv": "time,torque\n0,1\n1,\x002\n",
+        "long_cell.csv": "time,torque\n0,1\n1," + "x" * 10_000 + "\n",
         "long_result.csv": "time,theta\n0,0\n0.001," + "0" * 2**20 + "\n",
         "nul_result.csv": "time,theta\n0,0\n0.001,\x000\n",
         **deep_kit,
@@ -738,7 +739,7 @@ CASES = [
         "received file",
         "judge --calls {files}/long_line.log --torque 1",
         2,
-        "long_line.log:2: the line is longer than 16,384 characters; give the FMU's call record",
+        "long_line.log:2: the line is longer than 131,072 characters; give the FMU's call record",
     ),
     _case("received file", "judge --calls {files}/nul.log --torque 1", 2, "nul.log:2: a NUL byte, which no text holds"),
     _case(
@@ -748,6 +749,12 @@ CASES = [
         "long_line.csv:3: the line is longer than 131,072 bytes",
     ),
     _case("received file", "simulate --torque-file {files}/nul.csv", 2, "nul.csv:3: a NUL byte, which no text holds"),
+    _case(
+        "received file",
+        "simulate --torque-file {files}/long_cell.csv",
+        2,
+        "long_cell.csv:3: torque 'xxxxxxxx",
+    ),
     _case(
         "received file",
         "judge {files}/long_result.csv --torque 1",
