@@ -763,6 +763,15 @@ CASES = [
     ),
     _case("received file", "judge {files}/nul_result.csv --torque 1", 2, "nul_result.csv:3: a NUL byte"),
     _case("received file", "judge {files}/deep_kit", 2, "deep_kit/s.json: not a scenario's settings: nested too deep"),
+    _case(
+        "received file",
+        "verify {files}/escaping.fmu",
+        2,
+        "escaping.fmu: the archive's entry '../../escaped.txt' would be unpacked outside its folder",
+    ),
+    _case(
+        "received file", "verify {files}/laughs.fmu", 2, "laughs.fmu's modelDescription.xml declares a document type"
+    ),
 ]
 
 # What the calls below have in scope.
