@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ._errors import InvalidInput, MissingFile
+from ._received_files import bounded_lines
 
 MARKER = "[pendulum-calls]"
 
@@ -95,12 +96,19 @@ def printable(text: str) -> str:
     return text if text.isprintable() else repr(text)
 
 
-_MASTER = re.compile(r"(?P<function>fmi[23][A-Z]\w+)\((?P<arguments>.*)\)(?:\s*->\s*(?P<result>\S+))?\s*$")
+# A master's logged call is FUNCTION(ARGUMENTS), then `-> RESULT` or nothing, at the end of its
+# line: found by _master_call_parts, in one pass over the line.
+_WORD = re.compile(r"\w+")
+_FUNCTION = re.compile(r"fmi[23][A-Z]\w")
+# The line's end read backwards, shortest first: the closing parenthesis of the arguments, or the
+# result after it ("KO >- )" backwards).
+_CALL_END_REVERSED = re.compile(r"\s*(?:(?P<result>\S+?)\s*>-\s*)??\)")
 
 
 # One argument of a master's call log: name=value, the value a list ([...] or {...}), a quoted
-# string or one token.
-_ARGUMENT = re.compile(r'(\w+)=(\[[^\]]*\]|\{[^}]*\}|"[^"]*"|[^,]*)')
+# string or one token. The name starts a word (no value ends inside one): else each position of a
+# long word would be tried, taking time in the square of its length.
+_ARGUMENT = re.compile(r'(?<!\w)(\w+)=(\[[^\]]*\]|\{[^}]*\}|"[^"]*"|[^,]*)')
 
 
 @dataclass
@@ -246,7 +254,35 @@ def _list(text: str) -> list[str]:
     return [item.strip() for item in text.strip("[]{}").split(",") if item.strip()]
 
 
-def _master_call(match: re.Match, names: dict[int, str], handles: dict[str, str]) -> Call:
+def _master_call_parts(line: str) -> dict[str, str | None] | None:
+    r"""The function, arguments and result (None without `->`) of the call a line of a master's
+    log ends in, or None where it ends in none.
+
+    The same as re.search(r"(fmi[23][A-Z]\w+)\((.*)\)(?:\s*->\s*(\S+))?\s*$", line) finds,
+    in time linear in the line's length: a backtracking search takes the square of it, an hour on
+    a crafted line of a few hundred kB. The first function name followed by `(` is the only start
+    to try (the end found from a later one is one found from it), and the rightmost `)` that the
+    end follows is found reading the line backwards.
+    """
+    for word in _WORD.finditer(line):
+        name = _FUNCTION.search(word[0]) if line.startswith("(", word.end()) else None
+        if name:
+            break
+    else:
+        return None
+    after = line[word.end() + 1 :]
+    end = _CALL_END_REVERSED.match(after[::-1])
+    if end is None:
+        return None
+    result = end["result"]
+    return {
+        "function": word[0][name.start() :],
+        "arguments": after[: len(after) - end.end()],
+        "result": None if result is None else result[::-1],
+    }
+
+
+def _master_call(match: dict, names: dict[int, str], handles: dict[str, str]) -> Call:
     arguments = {name: value.strip() for name, value in _ARGUMENT.findall(match["arguments"])}
     function = match["function"]
     if "Instantiate" in function:
@@ -300,13 +336,22 @@ def read_calls(path: str | Path, variable_names: dict[int, str]) -> list[Call]:
     path = Path(path)
     if not path.is_file():
         raise MissingFile(f"{path}: no such file (give the FMU's call record, or the master's log)")
-    lines = path.read_text(encoding="utf-8", errors="replace").splitlines()
-    records = [match for line in lines if MARKER in line and (match := _RECORD.search(line))]
+    records, parts = [], []
+    with open(path, encoding="utf-8", errors="replace") as file:
+        advice = "give the FMU's call record, or the master's log as it wrote it"
+        for line in map(str.rstrip, bounded_lines(file, str(path), InvalidInput, advice)):
+            # A record starts at its line's first marker (a master's log puts its own prefix
+            # before it): tried from every marker, a crafted line took time in its length squared.
+            start = line.find(MARKER)
+            if start >= 0 and (match := _RECORD.match(line, start)):
+                records.append(match)
+            elif not records and (found := _master_call_parts(line)):
+                parts.append(found)
     if records:
         variables = frozenset(variable_names.values())
         return [_record_call(match, variables) for match in records]
     handles: dict[str, str] = {}
-    calls = [_master_call(match, variable_names, handles) for line in lines if (match := _MASTER.search(line))]
+    calls = [_master_call(found, variable_names, handles) for found in parts]
     if not calls:
         raise InvalidInput(
             f"{path}: no FMI call in it; turn on the FMU's call record (loggingOn, "

@@ -22,6 +22,7 @@ import fmpy
 from fmpy import extract, read_model_description
 
 from ._errors import InvalidInput, MissingFile, WrongType
+from ._received_files import check_fmu
 
 # The start values a user gives, and the FMU's variables they start.
 START_VALUES = {"theta0": "theta", "omega0": "omega"}
@@ -204,6 +205,7 @@ def _read(path: str, version: tuple, shown: str) -> FmuModel:
     try:
         with zipfile.ZipFile(path) as archive:
             names = frozenset(archive.namelist())
+            check_fmu(archive, shown, FmuFileError)  # before fmpy parses it and unpacks it (FmuModel.folder)
     except (zipfile.BadZipFile, OSError):
         raise FmuFileError(
             f"{shown} is not an FMU (an FMU is a zip archive with a modelDescription.xml): check the path"

@@ -13,6 +13,7 @@ import numpy as np
 from . import _results as results
 from ._errors import InvalidInput
 from ._mapped_fmu import as_map
+from ._received_files import bounded_lines, shortened
 
 RESULT_QUANTITIES = ("time", "theta", "omega", "alpha")
 
@@ -37,6 +38,9 @@ class ResultFileError(InvalidInput):
     ...     print(str(error).replace(str(result), "result.csv"))
     result.csv:3: theta 'x' is not a number
     """
+
+
+_GIVE_CSV = "give the result CSV the tool wrote"
 
 
 def read_result(path: str | Path, mapping: str | dict | None = None) -> np.ndarray:
@@ -64,15 +68,18 @@ def read_result(path: str | Path, mapping: str | dict | None = None) -> np.ndarr
     mapped = as_map(mapping, RESULT_QUANTITIES)
     try:
         with open(path, newline="", encoding="utf-8-sig") as file:
-            rows = list(csv.reader(file))
+            rows = list(csv.reader(bounded_lines(file, str(path), ResultFileError, _GIVE_CSV)))
     except OSError as error:
         raise ResultFileError(f"{path}: cannot read: {error.strerror}") from None
+    except csv.Error as error:  # a quoted cell across lines, over csv.field_size_limit()
+        raise ResultFileError(f"{path}: not a CSV the judge reads ({error}); {_GIVE_CSV}") from None
     except UnicodeDecodeError:
         raise ResultFileError(f"{path}: not UTF-8 text; save the result as a UTF-8 CSV") from None
     numbered = [(number, row) for number, row in enumerate(rows, start=1) if any(c.strip() for c in row)]
     if not numbered:
         raise ResultFileError(f"{path}: the file is empty; expected a header such as time,theta")
     header = [cell.strip() for cell in numbered[0][1]]
+    listed = shortened(",".join(header))
     columns = {}
     for quantity in RESULT_QUANTITIES:
         given = mapped.get(quantity)
@@ -81,11 +88,11 @@ def read_result(path: str | Path, mapping: str | dict | None = None) -> np.ndarr
             columns[quantity] = (header.index(name), given.factor if given else 1.0)
         elif given:
             raise ResultFileError(
-                f"{path}:1: no column {name!r}, which --map names for {quantity} (header is {','.join(header)})"
+                f"{path}:1: no column {name!r}, which --map names for {quantity} (header is {listed})"
             )
         elif quantity not in OPTIONAL:
             raise ResultFileError(
-                f"{path}:1: no column {quantity!r} (header is {','.join(header)}); "
+                f"{path}:1: no column {quantity!r} (header is {listed}); "
                 f"name the result's {quantity} column with --map {quantity}=NAME"
             )
     data = numbered[1:]
@@ -101,9 +108,9 @@ def read_result(path: str | Path, mapping: str | dict | None = None) -> np.ndarr
             try:
                 value = float(cell)
             except ValueError:
-                raise ResultFileError(f"{path}:{number}: {quantity} {cell!r} is not a number") from None
+                raise ResultFileError(f"{path}:{number}: {quantity} {shortened(repr(cell))} is not a number") from None
             if not math.isfinite(value):
-                raise ResultFileError(f"{path}:{number}: {quantity} is {cell}; values must be finite")
+                raise ResultFileError(f"{path}:{number}: {quantity} is {shortened(cell)}; values must be finite")
             out[quantity][i] = value * factor
         if i and out["time"][i] < out["time"][i - 1]:
             raise ResultFileError(

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ._errors import InvalidInput
+from ._received_files import bounded_text, shortened
 from ._scenario_list import Scenario
 
 # The tolerance the kit's FMU is run at (its own default); the judge's, in rad.
@@ -81,9 +82,11 @@ def read_settings(path: str | Path) -> dict:
     """
     path = Path(path)
     try:
-        settings = json.loads(path.read_text(encoding="utf-8"))
+        settings = json.loads(bounded_text(path, MAX_SETTINGS_BYTES, InvalidInput, _AGAIN))
     except (json.JSONDecodeError, UnicodeDecodeError) as error:
         raise InvalidInput(f"{path}: not a scenario's settings: {error}") from None
+    except RecursionError:  # [[[[...]]]]: the decoder recurses once per level
+        raise InvalidInput(f"{path}: not a scenario's settings: nested too deep; {_AGAIN}") from None
     except OSError as error:
         raise InvalidInput(f"{path}: cannot read: {error.strerror}") from None
     if not isinstance(settings, dict):
@@ -129,6 +132,9 @@ SETTINGS_READ = (
 )
 
 
+# A NAME.json the kit writes is under 1 kB; one of a megabyte is no scenario's, and is not read.
+MAX_SETTINGS_BYTES = 2**20
+
 _AGAIN = "write the kit again with pendulum-fmu scenarios --output-dir FOLDER --overwrite"
 
 
@@ -154,7 +160,7 @@ class _FieldChecker:
     settings: dict
 
     def _refuse(self, key: str, what: str):
-        value = json.dumps(self.settings[key])
+        value = shortened(json.dumps(self.settings[key]))
         raise InvalidInput(f"{self.path}: {key} is {value}; it must be {what}: correct it, or {_AGAIN}")
 
     def number(self, key: str, unit: str, positive: bool = False) -> float:
@@ -178,6 +184,10 @@ class _FieldChecker:
         value = self.settings[key]
         if not (isinstance(value, str) and value.strip()):
             self._refuse(key, "a file name (a JSON string)")
+        # A kit's files lie beside its NAME.json: a received kit names no file elsewhere on the
+        # machine for the judge to read and quote.
+        if value != Path(value).name or value in (".", "..") or "\\" in value:
+            self._refuse(key, "the name of a file in the kit's folder, with no folder before it")
         return value
 
     def parameters(self, key: str) -> dict[str, float]:
@@ -187,7 +197,7 @@ class _FieldChecker:
         for name, number in value.items():
             if isinstance(number, bool) or not isinstance(number, (int, float)) or not math.isfinite(number):
                 raise InvalidInput(
-                    f"{self.path}: parameters: {name} is {json.dumps(number)}; it must be "
+                    f"{self.path}: parameters: {shortened(name)} is {shortened(json.dumps(number))}; it must be "
                     f"a finite number: correct it, or {_AGAIN}"
                 )
         return {name: float(number) for name, number in value.items()}

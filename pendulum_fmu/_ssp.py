@@ -22,6 +22,7 @@ from . import default_fmu
 from ._atomic_files import replacing
 from ._closed_loop import WIRES, controller_defaults, controller_fmu
 from ._errors import InvalidInput, MissingFile, PendulumFmuError
+from ._received_files import check_archive, check_fmu, check_xml
 from ._simulate import resolve_parameters
 
 NAMESPACES = {
@@ -355,9 +356,16 @@ def _attribute(element: ElementTree.Element, path: str, attribute: str) -> str:
     return value
 
 
+def _parsed(archive: zipfile.ZipFile, name: str) -> ElementTree.Element:
+    """The XML document the SSP holds as name, refused (SspFileError) where it declares entities."""
+    data = archive.read(name)
+    check_xml(data, f"{archive.filename}'s {name}", SspFileError)
+    return ElementTree.fromstring(data)
+
+
 def _parameter_set(archive: zipfile.ZipFile, name: str, kind: str = "Real") -> dict:
     """{name: value} of the set's parameters of one kind: Real (as float) or String."""
-    root = ElementTree.fromstring(archive.read(name))
+    root = _parsed(archive, name)
     values = {
         _attribute(p, ".", "name"): _attribute(p, f"ssv:{kind}", "value")
         for p in root.iterfind("ssv:Parameters/ssv:Parameter", NAMESPACES)
@@ -395,7 +403,12 @@ def read_ssp(path: str | os.PathLike) -> SspSettings:
         raise MissingFile(f"no SSP at {path}: write one with `pendulum-fmu export-ssp {path}`")
     try:
         with zipfile.ZipFile(path) as archive:
-            ssd = ElementTree.fromstring(archive.read("SystemStructure.ssd"))
+            check_archive(archive, str(path), SspFileError)  # before any entry is read
+            for name in archive.namelist():  # the FMUs a master will unpack
+                if name.endswith(".fmu"):
+                    with zipfile.ZipFile(archive.open(name)) as fmu:
+                        check_fmu(fmu, f"{path}'s {name}", SspFileError)
+            ssd = _parsed(archive, "SystemStructure.ssd")
             bindings = {
                 _attribute(c, ".", "name"): _attribute(c, "ssd:ParameterBindings/ssd:ParameterBinding", "source")
                 for c in ssd.iterfind("ssd:System/ssd:Elements/ssd:Component", NAMESPACES)
@@ -408,6 +421,8 @@ def read_ssp(path: str | os.PathLike) -> SspSettings:
                 pendulum=sets["pendulum"],
                 call_record=_parameter_set(archive, bindings["pendulum"], "String").get("callRecordFile", ""),
             )
+    except SspFileError:  # a ValueError too, but its message is whole
+        raise
     except (zipfile.BadZipFile, KeyError, ValueError, ElementTree.ParseError) as error:
         raise SspFileError(
             f"{path} is not the closed loop's SSP ({type(error).__name__}: {error}): "

@@ -13,6 +13,7 @@ gives its command).
 from __future__ import annotations
 
 import contextlib
+import io
 import os
 import shutil
 import subprocess
@@ -23,7 +24,9 @@ from pathlib import Path
 import numpy as np
 
 from ._atomic_files import replacing
-from ._errors import MissingDependency
+from ._call_record import MARKER
+from ._errors import CannotWrite, MissingDependency
+from ._received_files import MAX_LINE_CHARS
 from ._ssp import read_ssp, rebind_ssp
 from ._ssp_calls import judge_ssp_calls
 from ._ssp_judge import judge_coupling
@@ -159,6 +162,8 @@ def run_fmucontainer(ssp: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     ------
     MissingDependency
         fmu-manipulation-toolbox is not installed.
+    CannotWrite
+        The callRecordFile the SSP names is a symbolic link, or a file that is no call record.
 
     Examples
     --------
@@ -171,6 +176,7 @@ def run_fmucontainer(ssp: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     except ImportError:
         raise MissingDependency("fmucontainer comes with pip install fmu-manipulation-toolbox") from None
     settings = read_ssp(ssp)
+    record = settings.call_record and _record_file(Path(settings.call_record), ssp)
     with tempfile.TemporaryDirectory(prefix="pendulum_fmu_fmucontainer_") as work:
         # fmucontainer writes its FMU beside the SSP it reads: a copy, so the user's folder stays as it was.
         copy = Path(shutil.copy(ssp, Path(work) / "ClosedLoop.ssp"))
@@ -190,16 +196,43 @@ def run_fmucontainer(ssp: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
             capture_output=True,
         )
         container = str(copy.with_suffix(".fmu"))
-        if not settings.call_record:
+        if not record:
             result = simulate_fmu(container, stop_time=settings.stop_time, output_interval=settings.step_size)
         else:
             # The container passes no parameter set on, but forwards its FMUs' log messages: with
-            # logging on, its log (fmpy prints it) holds the pendulum's record.
-            with replacing(settings.call_record) as log, contextlib.redirect_stdout(log):
+            # logging on, its log (fmpy prints it) holds the pendulum's record, whose lines are kept.
+            printed = io.StringIO()
+            with contextlib.redirect_stdout(printed):
                 result = simulate_fmu(
                     container, stop_time=settings.stop_time, output_interval=settings.step_size, debug_logging=True
                 )
+            with replacing(record) as log:
+                log.writelines(line for line in printed.getvalue().splitlines(keepends=True) if MARKER in line)
     return result["time"], result["pendulum.theta"]
+
+
+def _record_file(path: Path, ssp: str | os.PathLike) -> Path:
+    """The call record file a (received) SSP names, where writing destroys nothing: a new file, or
+    one whose first line is a line of a call record; never a symbolic link, which replacing()
+    would follow.
+    """
+    if path.is_symlink():
+        fault = "a symbolic link"
+    elif path.exists():
+        try:
+            with open(path, encoding="utf-8", errors="replace") as file:
+                first = file.readline(MAX_LINE_CHARS)
+        except OSError as error:
+            first = error.strerror or ""
+        fault = "" if MARKER in first else "a file that is no call record"
+    else:
+        fault = ""
+    if fault:
+        raise CannotWrite(
+            f"{ssp} names {path} as the pendulum's call record, but it is {fault}: left as it is; "
+            "name a new file (pendulum-fmu export-ssp --call-record FILE)"
+        )
+    return path
 
 
 MASTERS = {

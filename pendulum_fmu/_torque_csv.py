@@ -15,6 +15,7 @@ from typing import Literal
 import numpy as np
 
 from ._errors import InvalidInput
+from ._received_files import check_lines, shortened
 from ._time_grid import event_tolerance, nearest
 
 
@@ -110,9 +111,9 @@ def _first_bad_row(path: Path, lines: list[str], columns: tuple[int, int]) -> To
                 # Python's float takes 1_0 and fullwidth digits, which pyarrow refuses.
                 value = float(cell) if cell.isascii() and "_" not in cell else float("")
             except ValueError:
-                return TorqueFileError(f"{path}:{number}: {name} {cell!r} is not a number")
+                return TorqueFileError(f"{path}:{number}: {name} {shortened(repr(cell))} is not a number")
             if not math.isfinite(value):
-                return TorqueFileError(f"{path}:{number}: {name} is {cell}; values must be finite")
+                return TorqueFileError(f"{path}:{number}: {name} is {shortened(cell)}; values must be finite")
         if len(cells) > header:
             return TorqueFileError(
                 f"{path}:{number}: {len(cells)} columns, but the header names {header}; quote a cell holding a comma"
@@ -165,6 +166,7 @@ def read_torque_csv(path: str | Path) -> TorqueTable:
     except OSError as error:
         raise TorqueFileError(f"{path}: cannot read: {error.strerror}") from None
     raw = raw[3:] if raw.startswith(b"\xef\xbb\xbf") else raw  # spreadsheets write a byte-order mark
+    check_lines(raw, str(path), TorqueFileError, "give a CSV of time,torque rows")
     _decode(path, raw)  # only to refuse another encoding here, with its line
     header_line = raw[: raw.find(b"\n") if b"\n" in raw else len(raw)].decode("utf-8")
     if not header_line.strip():
@@ -178,7 +180,7 @@ def read_torque_csv(path: str | Path) -> TorqueTable:
     for column in ("time", "torque"):
         if column not in header:
             raise TorqueFileError(
-                f"{path}:1: missing column {column!r} (header is {','.join(header)}); "
+                f"{path}:1: missing column {column!r} (header is {shortened(','.join(header))}); "
                 "the first line must name the columns, e.g. time,torque"
             )
     columns = (header.index("time"), header.index("torque"))

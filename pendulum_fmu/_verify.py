@@ -17,6 +17,7 @@ from __future__ import annotations
 import json
 import os
 import platform
+import re
 import shlex
 import shutil
 import subprocess
@@ -29,6 +30,7 @@ from xml.etree import ElementTree
 
 from ._build_record import OBJECTS, RECORD_FILE, SIGNATURE_FILE, read_entries, sha256
 from ._errors import InvalidInput, MissingFile
+from ._received_files import check_fmu, check_xml
 
 PASS, FAIL, SKIP = "pass", "fail", "not checked"
 LS_REF_MANIFEST = "extra/org.fmi-standard.fmi-ls-ref/fmi-ls-manifest.xml"
@@ -36,6 +38,19 @@ LS_REF_MANIFEST = "extra/org.fmi-standard.fmi-ls-ref/fmi-ls-manifest.xml"
 # of each column's range (at least 1): a replay on the result's own grid differs by rounding only
 # (a Modelica Reference FMU: 5e-13), a changed model by far more.
 RESULT_TOLERANCE = 1e-6
+# What the rebuild runs from a build record, which is the FMU author's word: the compilers and the
+# shapes of the arguments fmu_build records for a Linux binary. A compiler named by a path, or an
+# argument that loads or runs another program (-fplugin=, -wrapper, -B, -specs=, @FILE), would
+# run the author's code here; the rebuild refuses the record instead (issue 38).
+REBUILD_COMPILERS = frozenset({"cc", "gcc", "clang", "zig", "aarch64-linux-gnu-gcc", "x86_64-linux-gnu-gcc"})
+REBUILD_ARGUMENT = re.compile(
+    r"-D\w+|-O[0-3s]|-std=c\d\d|-W(?:all|extra|error)|-f(?:PIC|pic|lto=auto|no-fat-lto-objects|visibility=hidden"
+    r"|fp-contract=off)|-shared|-s|-l[a-z]+|-static-libgcc|-Wl,-soname,[\w.-]+|-Wl,--version-script=exports\.map"
+    r"|-target|" + re.escape(OBJECTS)
+)
+# What follows -target (zig cc -target x86_64-linux-gnu.2.17), and a source's file name.
+REBUILD_WORD = re.compile(r"[\w.-]+")
+REBUILD_SOURCE = re.compile(r"[\w-]+\.c")
 # This machine's binary folders, FMI 2.0's and FMI 3.0's.
 HOST_FOLDERS = {
     ("linux", "x86_64"): ("linux64", "x86_64-linux"),
@@ -163,6 +178,31 @@ def _find_compiler(name: str) -> str:
     return shutil.which(name) or ""
 
 
+def _unsafe_rebuild(made: dict, entries: dict[str, bytes]) -> str:
+    """What in a binary's record of its build the rebuild will not run ('' where nothing is);
+    TypeError where the record is not of the shape fmu_build writes.
+    """
+    commands = ("compiler", "compile", "link", "sources")
+    if not all(isinstance(made[key], list) and all(isinstance(a, str) for a in made[key]) for key in commands):
+        raise TypeError("the commands are lists of text")
+    compiler, *options = made["compiler"]
+    if compiler not in REBUILD_COMPILERS:
+        return f"the compiler {compiler!r}, which no build of this package records"
+    arguments = [*options, *made["compile"], *made["link"]]
+    for before, argument in zip(["", *arguments], arguments, strict=False):
+        allowed = REBUILD_ARGUMENT.fullmatch(argument) or (
+            REBUILD_WORD.fullmatch(argument) and (before == "-target" or (before, compiler) == ("", "zig"))
+        )
+        if not allowed:
+            return f"the argument {argument!r}, which no build of this package records"
+    for source in made["sources"]:
+        if not (REBUILD_SOURCE.fullmatch(source) and f"sources/{source}" in entries):
+            return f"the source {source!r}, which is no C file of its sources/"
+    if not all(isinstance(made[key], str) for key in ("compiler_id", "compiler_version")):
+        raise TypeError("the compiler's name and version are text")
+    return ""
+
+
 def _rebuild(entries: dict[str, bytes], record: dict | None) -> Check:
     folders = HOST_FOLDERS.get((sys.platform, platform.machine()))
     binaries = [name for name in entries if name.startswith("binaries/") and name.split("/")[1] in (folders or ())]
@@ -173,7 +213,13 @@ def _rebuild(entries: dict[str, bytes], record: dict | None) -> Check:
         return Check("rebuild", SKIP, f"{name}: the FMU carries no sources/")
     if record is None or name not in record.get("binaries", {}):
         return Check("rebuild", SKIP, f"{name}: carries sources/ but no record of the toolchain that made it")
-    [made] = record["binaries"][name]
+    try:
+        [made] = record["binaries"][name]
+        refused = _unsafe_rebuild(made, entries)
+    except (KeyError, TypeError, ValueError):  # a record no build of this package wrote
+        refused = "commands no build of this package records"
+    if refused:
+        return Check("rebuild", FAIL, f"{name}: its record asks the rebuild to run {refused}: not run")
     compiler = [_find_compiler(made["compiler"][0]), *made["compiler"][1:]]
     if not compiler[0]:
         return Check("rebuild", SKIP, f"{name}: its compiler {made['compiler'][0]} is not here")
@@ -197,21 +243,29 @@ def _references(fmu: Path, entries: dict[str, bytes]) -> Check:
         return Check("references", SKIP, "the FMU carries no FMI-LS-REF references")
     from ._scenarios import LS_REF_FOLDER
 
-    settings = {
-        name[len(LS_REF_FOLDER) : -len(".json")]: json.loads(data)
+    kit_files = {
+        name[len(LS_REF_FOLDER) :]: data
         for name, data in entries.items()
-        if name.startswith(LS_REF_FOLDER) and name.endswith(".json")
+        if name.startswith(LS_REF_FOLDER) and "/" not in name[len(LS_REF_FOLDER) :]
     }
-    if not settings:
+    if not any(name.endswith(".json") for name in kit_files):
         return _replay_results(fmu, entries)
     from ._judge import judge_kit
-    from ._scenario_settings import KIT_FMU
+    from ._scenario_settings import KIT_FMU, read_settings
 
     with tempfile.TemporaryDirectory(prefix="pendulum_fmu_verify_") as tmp:
         kit = Path(tmp)
-        for name, data in entries.items():
-            if name.startswith(LS_REF_FOLDER) and "/" not in name[len(LS_REF_FOLDER) :]:
-                (kit / name[len(LS_REF_FOLDER) :]).write_bytes(data)
+        for name, data in kit_files.items():
+            (kit / name).write_bytes(data)
+        # The FMU author's settings: checked as a kit's (files in the kit's folder, numbers
+        # finite, one line naming the file otherwise) before a replay writes the output they name.
+        paths = {name[: -len(".json")]: kit / name for name in kit_files if name.endswith(".json")}
+        for path in paths.values():
+            try:
+                read_settings(path)
+            except InvalidInput as error:  # named as the FMU holds it, not as the folder it was put in
+                raise InvalidInput(str(error).replace(f"{kit}{os.sep}", f"{fmu}'s {LS_REF_FOLDER}")) from None
+        settings = {name: json.loads(path.read_text(encoding="utf-8")) for name, path in paths.items()}
         shutil.copyfile(fmu, kit / KIT_FMU)
         # fmpy can neither send input derivatives nor keep an FMU state: the held scenarios only.
         held = [name for name, s in settings.items() if not s["ramp"] and s["resume_time"] is None]
@@ -235,6 +289,7 @@ def _replay_results(fmu: Path, entries: dict[str, bytes]) -> Check:
     from fmpy import simulate_fmu
 
     folder = LS_REF_MANIFEST.rsplit("/", 1)[0] + "/"
+    check_xml(entries[LS_REF_MANIFEST], f"{fmu}'s {LS_REF_MANIFEST}", InvalidInput)
     manifest = ElementTree.fromstring(entries[LS_REF_MANIFEST])
     results = [e.get("source", "") for e in manifest.iter() if e.tag.endswith("Related") and e.get("role") == "result"]
     results = [source for source in results if source.endswith(".csv") and folder + source in entries]
@@ -321,6 +376,8 @@ def verify_fmu(
     if not fmu.is_file():
         raise MissingFile(f"{fmu}: no such file (give an .fmu)")
     try:
+        with zipfile.ZipFile(fmu) as archive:
+            check_fmu(archive, str(fmu), InvalidInput)  # before its entries are read whole
         entries = read_entries(fmu)
     except (zipfile.BadZipFile, OSError) as error:
         raise InvalidInput(f"{fmu}: not an FMU ({error}); give an .fmu, a zip archive") from None
@@ -328,8 +385,12 @@ def verify_fmu(
         raise InvalidInput(f"{fmu}: not an FMU (no modelDescription.xml at its top)")
     try:
         record = json.loads(entries[RECORD_FILE]) if RECORD_FILE in entries else None
-    except ValueError as error:
+    except (ValueError, RecursionError) as error:
         raise InvalidInput(f"{fmu}: {RECORD_FILE} is not JSON ({error})") from None
+    if record is not None and not (
+        isinstance(record, dict) and all(isinstance(record.get(key, {}), dict) for key in ("entries", "binaries"))
+    ):
+        raise InvalidInput(f"{fmu}: {RECORD_FILE} is not a build record (an object of entries and binaries)")
     rebuilt = _rebuild(entries, record) if rebuild else Check("rebuild", SKIP, "--no-rebuild")
     return [_checksums(entries, record), _signature(entries, public_key), rebuilt, _references(fmu, entries)]
 

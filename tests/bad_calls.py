@@ -88,9 +88,10 @@ class Harness:
     def __getattr__(self, name):
         return getattr(self.lib, name)
 
-    def instantiate(self, name=b"robust", kind=CO_SIMULATION, guid=None, callbacks="default"):
+    def instantiate(self, name=b"robust", kind=CO_SIMULATION, guid=None, callbacks="default", resources=b""):
         callbacks = ctypes.byref(self.callbacks) if callbacks == "default" else callbacks
-        component = self.lib.fmi2Instantiate(name, kind, self.guid if guid is None else guid, b"", callbacks, 0, 0)
+        token = self.guid if guid is None else guid
+        component = self.lib.fmi2Instantiate(name, kind, token, resources, callbacks, 0, 0)
         if component:
             self.live.append(component)
         return ctypes.c_void_p(component) if component else None
@@ -101,9 +102,9 @@ class Harness:
         assert self.fmi2EnterInitializationMode(component) == OK
         return component
 
-    def ready(self, kind=CO_SIMULATION, **parameters):
+    def ready(self, kind=CO_SIMULATION, name=b"robust", resources=b"", **parameters):
         """An instance after initialization: step complete (or event mode)."""
-        component = self.instantiate(kind=kind)
+        component = self.instantiate(name=name, kind=kind, resources=resources)
         for name, value in parameters.items():
             assert self.fmi2SetReal(component, refs(globals()[name.upper()]), 1, reals(value)) == OK
         assert (
@@ -172,15 +173,15 @@ class Harness3(Harness):
 
         return call
 
-    def instantiate(self, name=b"robust", kind=CO_SIMULATION, guid=None, logger="default"):
+    def instantiate(self, name=b"robust", kind=CO_SIMULATION, guid=None, logger="default", resources=b""):
         logger = self.logger if logger == "default" else logger
         token = self.guid if guid is None else guid
         if kind == CO_SIMULATION:
             component = self.lib.fmi3InstantiateCoSimulation(
-                name, token, b"", False, False, False, False, None, ctypes.c_size_t(0), None, logger, None
+                name, token, resources, False, False, False, False, None, ctypes.c_size_t(0), None, logger, None
             )
         else:
-            component = self.lib.fmi3InstantiateModelExchange(name, token, b"", False, False, None, logger)
+            component = self.lib.fmi3InstantiateModelExchange(name, token, resources, False, False, None, logger)
         if component:
             self.live.append(component)
         return ctypes.c_void_p(component) if component else None
@@ -195,8 +196,8 @@ class Harness3(Harness):
         )
         return component
 
-    def ready(self, kind=CO_SIMULATION, **parameters):
-        component = self.instantiate(kind=kind)
+    def ready(self, kind=CO_SIMULATION, name=b"robust", resources=b"", **parameters):
+        component = self.instantiate(name=name, kind=kind, resources=resources)
         for name, value in parameters.items():
             assert self.fmi3SetFloat64(component, refs(globals()[name.upper()]), 1, reals(value), 1) == OK
         assert (
@@ -525,6 +526,25 @@ def _no_instance(check):
 
 
 NAN, INF = float("nan"), float("inf")
+MEGABYTE = 2**20
+
+
+def _huge_token(h):
+    """A GUID (instantiation token) of a megabyte is refused in one message the FMU's buffer bounds."""
+    refused = h.instantiate(guid=b"{" + b"g" * MEGABYTE) is None
+    assert len(h.last_message()) < 1024, "the message is cut to the FMU's buffer"
+    return refused
+
+
+def _huge_name_and_resources(h, read):
+    """An instance named by a megabyte, whose resources are at a megabyte's path broken by line ends:
+    it keeps the name's first 127 bytes, reads no resource, steps and is read (read is the getter).
+    """
+    component = h.ready(name=b"n" * MEGABYTE, resources=b"file:///" + b"r\n" * (MEGABYTE // 2))
+    assert h.step(component, 0.0, 1e-3) == OK
+    return read(component)
+
+
 MAX_FMU_STATES = 10000  # fmu_src/include/instance.h: the FMU states one instance holds at most
 
 
@@ -950,6 +970,22 @@ CASES = [
         ERROR,
         "instanceName must be a non-empty string",
         _no_instance(lambda h: h.instantiate(name=b"") is None),
+    ),
+    Case(
+        "fmi2Instantiate",
+        "a GUID of a megabyte",
+        "fmi2Instantiate",
+        ERROR,
+        "fmuGUID {ggg",
+        _no_instance(_huge_token),
+    ),
+    Case(
+        "fmi2Instantiate",
+        "an instance name and a resource location of a megabyte, the location with line ends",
+        "fmi2GetReal",
+        OK,
+        "",
+        lambda h: _huge_name_and_resources(h, lambda c: h.fmi2GetReal(c, refs(THETA), 1, reals(0.0))),
     ),
     Case(
         "fmi2Instantiate",
@@ -1442,6 +1478,22 @@ CASES_FMI3 = [
         ERROR,
         "instanceName must be a non-empty string",
         _no_instance(lambda h: h.instantiate(name=b"", kind=MODEL_EXCHANGE) is None),
+    ),
+    Case(
+        "fmi3Instantiate",
+        "an instantiation token of a megabyte",
+        "fmi3InstantiateCoSimulation",
+        ERROR,
+        "instantiationToken {ggg",
+        _no_instance(_huge_token),
+    ),
+    Case(
+        "fmi3Instantiate",
+        "an instance name and a resource path of a megabyte, the path with line ends",
+        "fmi3GetFloat64",
+        OK,
+        "",
+        lambda h: _huge_name_and_resources(h, lambda c: h.fmi3GetFloat64(c, refs(THETA), 1, reals(0.0), 1)),
     ),
     Case(
         "fmi3Instantiate",

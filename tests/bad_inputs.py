@@ -14,6 +14,7 @@ import contextlib
 import io
 import json
 import re
+import stat
 import sys
 import warnings
 import zipfile
@@ -72,6 +73,86 @@ def _settings(**changes) -> str:
         "tolerance": 1e-9,
     }
     return json.dumps({**settings, **changes}) + "\n"
+
+
+# Files a user may have received, crafted to harm whoever opens them (issue 38): refused before
+# anything unpacks, parses or searches them.
+LAUGHS = (  # a billion laughs: 10^9 "lol" from a few hundred bytes
+    '<?xml version="1.0"?>\n<!DOCTYPE lolz [<!ENTITY lol0 "lol">'
+    + "".join(f'<!ENTITY lol{k} "{f"&lol{k - 1};" * 10}">' for k in range(1, 10))
+    + "]>\n"
+)
+EXTERNAL = '<?xml version="1.0"?>\n<!DOCTYPE m [<!ENTITY secret SYSTEM "file:///etc/hostname">]>\n'
+
+
+def _link_entry() -> zipfile.ZipInfo:
+    """An archive's entry that unpacks (with unzip or tar) as a symbolic link."""
+    entry = zipfile.ZipInfo("resources/link")
+    entry.create_system, entry.external_attr = 3, (stat.S_IFLNK | 0o777) << 16
+    return entry
+
+
+def _zip_entries(entries: list[tuple[str | zipfile.ZipInfo, bytes | str]], level: int = 1) -> bytes:
+    """A deflated archive; level 1 (fastest) shrinks a MiB of zeros 229 times, level 6 1000 times."""
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w", zipfile.ZIP_DEFLATED, compresslevel=level) as archive:
+        for entry, data in entries:
+            archive.writestr(entry, data)
+    return buffer.getvalue()
+
+
+def _ssp(pendulum_set: str) -> bytes:
+    """A closed loop's SSP whose pendulum parameter set is pendulum_set."""
+    from pendulum_fmu._ssp import parameter_set_xml, system_structure_xml
+
+    return _zip(
+        {
+            "SystemStructure.ssd": system_structure_xml(3.0, 1e-3).decode(),
+            "resources/controller.ssv": parameter_set_xml("controller", {"kp": 1.0}).decode(),
+            "resources/pendulum.ssv": pendulum_set,
+        }
+    )
+
+
+def received_files() -> dict[str, bytes | str]:
+    """The crafted files, by name."""
+    bomb = _zip_entries([("modelDescription.xml", SPRING), ("resources/zeros", bytes(8 * 2**20))], level=6)
+    record = '[pendulum-calls] instance="p" fmi2DoStep(currentCommunicationPoint=0, communicationStepSize=0.001) '
+    record += "time=0->0.001 status=OK\n"
+    deep_kit = {"deep_kit/s.json": "[" * 100_000 + "]" * 100_000, "deep_kit/s_in.csv": "time,torque\n0,1\n1,1\n"}
+    return {
+        "escaping.fmu": _zip({"modelDescription.xml": SPRING, "../../escaped.txt": "x"}),
+        "absolute.fmu": _zip({"modelDescription.xml": SPRING, "/tmp/escaped.txt": "x"}),
+        "link.fmu": _zip_entries([("modelDescription.xml", SPRING), (_link_entry(), "/etc/passwd")]),
+        # 8 MiB of zeros from 8 kB, as a zip bomb's gigabytes come from a few MB.
+        "bomb.fmu": bomb,
+        "huge.fmu": _zip_entries(
+            [("modelDescription.xml", SPRING)] + [(f"resources/{n}", bytes(2**20)) for n in range(513)]
+        ),
+        "crowded.fmu": _zip_entries(
+            [("modelDescription.xml", SPRING)] + [(f"resources/{n}", "") for n in range(10_000)]
+        ),
+        "laughs.fmu": _zip({"modelDescription.xml": LAUGHS + SPRING.split("?>", 1)[1].replace("Spring", "&lol9;", 1)}),
+        "external.fmu": _zip(
+            {"modelDescription.xml": EXTERNAL + SPRING.split("?>", 1)[1].replace("Spring", "&secret;", 1)}
+        ),
+        "laughs.ssp": _ssp(LAUGHS + '<ssv:ParameterSet name="&lol9;"/>'),
+        "bomb.ssp": _zip_entries([("SystemStructure.ssd", " " * 8 * 2**20)], level=6),
+        # The SSP is small; an FMU in it, which a master would unpack, is the bomb.
+        "bomb_inside.ssp": _zip_entries([("SystemStructure.ssd", "<a/>"), ("resources/Pendulum.fmu", bomb)]),
+        "long_line.log": record + "x" * 2**20 + "\n" + record,
+        "nul.log": record + "\0" + record,
+        "long_line.csv": "time,torque\n0,1\n1," + "1" * 2**20 + "\n",
+        "nul.csv": "time,torque\n0,1\n1,\x002\n",
+        "long_cell.csv": "time,torque\n0,1\n1," + "x" * 10_000 + "\n",
+        "long_result.csv": "time,theta\n0,0\n0.001," + "0" * 2**20 + "\n",
+        "nul_result.csv": "time,theta\n0,0\n0.001,\x000\n",
+        **deep_kit,
+        "settings/deep.json": "[" * 100_000 + "]" * 100_000,
+        "settings/large.json": _settings(note="x" * 2**20),
+        "settings/input_elsewhere.json": _settings(input="../../.ssh/id_rsa"),
+        "settings/input_absolute.json": _settings(input="/etc/hostname"),
+    }
 
 
 # Input files the cases name, written into {files} before they run.
@@ -587,6 +668,110 @@ CASES = [
         2,
         "argument --overwrite: not allowed with argument --resume",
     ),
+    # Files a user received, crafted to harm whoever opens them (issue 38).
+    _case(
+        "received file",
+        "simulate --torque 1 --fmu {files}/escaping.fmu",
+        2,
+        "escaping.fmu: the archive's entry '../../escaped.txt' would be unpacked outside its folder; do not open it",
+    ),
+    _case(
+        "received file",
+        "simulate --torque 1 --fmu {files}/absolute.fmu",
+        2,
+        "absolute.fmu: the archive's entry '/tmp/escaped.txt' would be unpacked outside its folder",
+    ),
+    _case(
+        "received file",
+        "simulate --torque 1 --fmu {files}/link.fmu",
+        2,
+        "link.fmu: the archive's entry 'resources/link' is a symbolic link",
+    ),
+    _case(
+        "received file",
+        "simulate --torque 1 --fmu {files}/bomb.fmu",
+        2,
+        "bomb.fmu: the archive's entry 'resources/zeros' expands 1,0",
+    ),
+    _case(
+        "received file",
+        "compare --torque 1 --tools fmu,theirs={files}/huge.fmu --output-dir {files}/out",
+        2,
+        "huge.fmu: the archive unpacks to 513 MiB, over the limit of 512 MiB",
+    ),
+    _case(
+        "received file",
+        "sweep --torque 1 --fmu {files}/crowded.fmu --output-dir {files}/out",
+        2,
+        "crowded.fmu: the archive holds 10,001 entries, over 10,000",
+    ),
+    _case(
+        "received file",
+        "simulate --torque 1 --fmu {files}/laughs.fmu",
+        2,
+        "laughs.fmu's modelDescription.xml declares a document type (<!DOCTYPE), where XML defines entities",
+    ),
+    _case(
+        "received file",
+        "simulate --torque 1 --fmu {files}/external.fmu",
+        2,
+        "external.fmu's modelDescription.xml declares a document type",
+    ),
+    _case(
+        "received file",
+        "judge {files}/result.csv --ssp {files}/laughs.ssp",
+        2,
+        "laughs.ssp's resources/pendulum.ssv declares a document type",
+    ),
+    _case(
+        "received file",
+        "judge {files}/result.csv --ssp {files}/bomb.ssp",
+        2,
+        "bomb.ssp: the archive's entry 'SystemStructure.ssd' expands",
+    ),
+    _case(
+        "received file",
+        "judge {files}/result.csv --ssp {files}/bomb_inside.ssp",
+        2,
+        "bomb_inside.ssp's resources/Pendulum.fmu: the archive's entry 'resources/zeros' expands",
+    ),
+    _case(
+        "received file",
+        "judge --calls {files}/long_line.log --torque 1",
+        2,
+        "long_line.log:2: the line is longer than 131,072 characters; give the FMU's call record",
+    ),
+    _case("received file", "judge --calls {files}/nul.log --torque 1", 2, "nul.log:2: a NUL byte, which no text holds"),
+    _case(
+        "received file",
+        "simulate --torque-file {files}/long_line.csv",
+        2,
+        "long_line.csv:3: the line is longer than 131,072 bytes",
+    ),
+    _case("received file", "simulate --torque-file {files}/nul.csv", 2, "nul.csv:3: a NUL byte, which no text holds"),
+    _case(
+        "received file",
+        "simulate --torque-file {files}/long_cell.csv",
+        2,
+        "long_cell.csv:3: torque 'xxxxxxxx",
+    ),
+    _case(
+        "received file",
+        "judge {files}/long_result.csv --torque 1",
+        2,
+        "long_result.csv:3: the line is longer than 131,072 characters",
+    ),
+    _case("received file", "judge {files}/nul_result.csv --torque 1", 2, "nul_result.csv:3: a NUL byte"),
+    _case("received file", "judge {files}/deep_kit", 2, "deep_kit/s.json: not a scenario's settings: nested too deep"),
+    _case(
+        "received file",
+        "verify {files}/escaping.fmu",
+        2,
+        "escaping.fmu: the archive's entry '../../escaped.txt' would be unpacked outside its folder",
+    ),
+    _case(
+        "received file", "verify {files}/laughs.fmu", 2, "laughs.fmu's modelDescription.xml declares a document type"
+    ),
 ]
 
 # What the calls below have in scope.
@@ -917,6 +1102,43 @@ CALLS = [
         "WrongType",
         "fmu_path is the FMU file's path (a str or Path), not 0",
     ),
+    Call(
+        "received file",
+        'simulate(20.0, fmu_path="{files}/escaping.fmu")',
+        "FmuFileError",
+        "escaping.fmu: the archive's entry '../../escaped.txt' would be unpacked outside its folder",
+    ),
+    Call("received file", 'simulate("{files}/nul.csv")', "TorqueFileError", "nul.csv:3: a NUL byte"),
+    Call(
+        "received file",
+        'judge("{files}/long_result.csv", 1.0, stop_time=0.001)',
+        "ResultFileError",
+        "long_result.csv:3: the line is longer than 131,072 characters",
+    ),
+    Call(
+        "received file",
+        'read_settings("{files}/settings/deep.json")',
+        "InvalidInput",
+        "deep.json: not a scenario's settings: nested too deep",
+    ),
+    Call(
+        "received file",
+        'read_settings("{files}/settings/large.json")',
+        "InvalidInput",
+        "large.json: over 1,048,576 bytes, longer than any such file",
+    ),
+    Call(
+        "received file",
+        'read_settings("{files}/settings/input_elsewhere.json")',
+        "InvalidInput",
+        'input_elsewhere.json: input is "../../.ssh/id_rsa"; it must be the name of a file in the kit\'s folder',
+    ),
+    Call(
+        "received file",
+        'read_settings("{files}/settings/input_absolute.json")',
+        "InvalidInput",
+        'input_absolute.json: input is "/etc/hostname"; it must be the name of a file in the kit\'s folder',
+    ),
     Call("other", "default_fmu(fmi_version=4)", "InvalidInput", "no FMI 4 FMU: the FMI versions are 2, 3"),
     Call(
         "other",
@@ -958,7 +1180,7 @@ def alpha_not_an_output(xml: str) -> str:
 
 
 def write_files(folder: Path) -> None:
-    files = {**FILES, **{name: _edited_fmu(edit) for name, edit in EDITED_FMUS.items()}}
+    files = {**FILES, **received_files(), **{name: _edited_fmu(edit) for name, edit in EDITED_FMUS.items()}}
     for name, content in files.items():
         path = folder / name
         path.parent.mkdir(exist_ok=True)

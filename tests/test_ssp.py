@@ -282,6 +282,26 @@ def test_the_pendulums_call_record_names_each_masters_coupling_and_sets(master, 
     assert verdict.problems == expected_problems
 
 
+@pytest.mark.parametrize("target", ["a file of the user's", "a link to it"])
+def test_a_received_ssp_cannot_make_fmucontainers_record_replace_a_users_file(target, ssp, tmp_path):
+    # Issue 38: the record's path is the SSP author's choice; before, the user's file became the log.
+    from pendulum_fmu import CannotWrite
+    from pendulum_fmu._ssp_masters import run_fmucontainer
+
+    pytest.importorskip("fmu_manipulation_toolbox")
+    bashrc = tmp_path / "bashrc"
+    bashrc.write_text("echo my settings\n")
+    named = bashrc if target == "a file of the user's" else tmp_path / "link"
+    if named != bashrc:
+        named.symlink_to(bashrc)
+    received = rebind_ssp(ssp, tmp_path / "Received.ssp", call_record=named)
+    fault = "a file that is no call record" if named == bashrc else "a symbolic link"
+    with pytest.raises(CannotWrite, match=f"names {named} as the pendulum's call record, but it is {fault}"):
+        run_fmucontainer(received)
+    assert bashrc.read_text() == "echo my settings\n"
+    assert {path.name for path in tmp_path.iterdir()} == {"bashrc", "Received.ssp", named.name}
+
+
 def _one_torque_a_step_late(log, step):
     """The record with the torque set before step `step` moved after that step."""
     lines = log.read_text().splitlines(keepends=True)

@@ -206,3 +206,51 @@ def test_a_result_an_fmu_carries_is_replayed_from_its_default_experiment(fmu, tm
     checks = _verified(capsys, wrong, "--no-rebuild")[1]
     assert checks["references"]["status"] == "fail"
     assert "largest difference 0.5 (Pendulum_out.csv, theta)" in checks["references"]["detail"]
+
+
+@pytest.mark.parametrize(
+    ("change", "refused"),
+    [
+        ({"compiler": ["sh", "-c", "touch {marker}"]}, "the compiler 'sh'"),
+        ({"compiler": ["/usr/bin/cc"]}, "the compiler '/usr/bin/cc'"),
+        ({"compile": ["-O3", "-wrapper", "sh,-c,touch {marker}"]}, "the argument '-wrapper'"),
+        ({"compile": ["-fplugin=/tmp/plugin.so"]}, "the argument '-fplugin=/tmp/plugin.so'"),
+        ({"link": ["@{marker}"]}, "the argument '@"),
+        ({"sources": ["../../../x.c"]}, "the source '../../../x.c'"),
+        ({"compiler": "cc"}, "commands no build of this package records"),
+    ],
+)
+def test_a_build_record_cannot_make_the_rebuild_run_another_program(change, refused, fmu, tmp_path, capsys):
+    # Issue 38: the record is the FMU author's; before, `verify` ran its compiler command as given.
+    marker = tmp_path / "ran"
+    linux = "binaries/linux64/Pendulum.so"
+
+    def crafted(data):
+        record = json.loads(data)
+        [made] = record["binaries"][linux]
+        made.update(json.loads(json.dumps(change).replace("{marker}", str(marker))))
+        return json.dumps(record).encode()
+
+    status, checks = _verified(capsys, _changed(fmu, tmp_path / "crafted.fmu", RECORD, crafted))
+    assert status == 1
+    assert checks["rebuild"]["status"] == "fail"
+    assert checks["rebuild"]["detail"].startswith(f"{linux}: its record asks the rebuild to run {refused}")
+    assert not marker.exists()
+
+
+def test_a_kits_reference_naming_a_file_elsewhere_is_refused_before_anything_is_replayed(tmp_path, capsys):
+    # Issue 38: before, the replay wrote its result over the file a reference's "output" named.
+    assert main(["scenarios", "--output-dir", str(tmp_path / "kit")]) == 0
+    capsys.readouterr()
+    precious = tmp_path / "precious.txt"
+    precious.write_text("mine\n")
+    name = "extra/org.fmi-standard.fmi-ls-ref/constant_torque.json"
+
+    def elsewhere(data):
+        return json.dumps({**json.loads(data), "output": str(precious)}).encode()
+
+    crafted = _changed(tmp_path / "kit" / "Pendulum.fmu", tmp_path / "crafted.fmu", name, elsewhere)
+    assert main(["verify", str(crafted), "--no-rebuild"]) == 2
+    [line] = capsys.readouterr().err.strip().splitlines()
+    assert f"{crafted}'s {name}: output is \"{precious}\"; it must be the name of a file in the kit's folder" in line
+    assert precious.read_text() == "mine\n"
