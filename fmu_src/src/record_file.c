@@ -26,7 +26,8 @@ const char *escape_text(char *out, size_t size, const char *text) {
     char escape[5];
     size_t total = 0, used = 0;
     if (!size) return out;
-    for (const char *c = text; c && *c; c++) total += escape_byte((unsigned char)*c, escape);
+    /* Only whether it all fits matters, so a megabyte from a master costs no more than size. */
+    for (const char *c = text; c && *c && total < size; c++) total += escape_byte((unsigned char)*c, escape);
     /* Cut: room for "..." and the terminating zero after the last whole escape. */
     const size_t limit = total < size ? total : size > 4 ? size - 4 : 0;
     for (const char *c = text; c && *c; c++) {
