@@ -28,6 +28,7 @@ def test_every_command_has_help():
         "judge",
         "scenarios",
         "export-ssp",
+        "verify",
     }
     for name, command in commands.items():
         assert command.description, name
