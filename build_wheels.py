@@ -16,6 +16,9 @@ wheels load on that glibc and every later one. The steps, with the wheel package
    the wheel's machine together (shown to it beside the loop, since it does not look inside an
    .fmu); on macOS the newest minimum macOS of the x86_64 slices (the arm64 slices' 11.0 is
    every Apple Silicon Mac's).
+Every wheel is the same bytes from one commit (fmu_build/release_files.py): its entries dated by
+$SOURCE_DATE_EPOCH, the commit's time unless given, which `python -m build`, `wheel pack` and
+`wheel tags` all read, and its files given fixed permissions before `wheel pack`.
 Each wheel is written to a temporary beside its target and renamed into place; a wheel of the
 same name from an earlier run is replaced. A missing tool stops the command before anything is
 built, with one line naming what installs it.
@@ -36,6 +39,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from fmu_build import PLATFORMS, BuildError, check_toolchain, compile_native_loop
+from fmu_build.build_record import source_date_epoch
+from fmu_build.release_files import normalize_modes
 from pendulum_fmu import CONTROLLER_FMU_FILE, FMU_FILES
 from pendulum_fmu._atomic_files import replacing_path
 
@@ -83,7 +88,7 @@ class WheelhouseError(RuntimeError):
 
 def _run(command: list, what: str) -> str:
     command = [str(part) for part in command]
-    result = subprocess.run(command, capture_output=True, text=True)
+    result = subprocess.run(command, capture_output=True, text=True, env=_build_environment())
     if result.returncode != 0:
         raise WheelhouseError(f"{what} failed: {' '.join(command)}\n{result.stdout}{result.stderr}")
     return result.stdout
@@ -104,14 +109,16 @@ def check_tools() -> None:
             raise WheelhouseError(f"the {wheel.system} {wheel.machine} wheel: {missing}") from None
 
 
-def _zig_on_path() -> dict:
-    """The environment with the ziglang package's zig on PATH, so that the isolated build
-    environment of `python -m build` compiles the macOS binaries of the FMUs too.
+def _build_environment() -> dict:
+    """The environment with SOURCE_DATE_EPOCH set (the commit's time unless given), which dates
+    the entries of every wheel written, and with the ziglang package's zig on PATH, so that the
+    isolated build environment of `python -m build` compiles the macOS binaries of the FMUs too.
     """
+    environment = {**os.environ, "SOURCE_DATE_EPOCH": str(source_date_epoch())}
     spec = importlib.util.find_spec("ziglang")
-    if spec is None or spec.origin is None:
-        return dict(os.environ)
-    return {**os.environ, "PATH": os.pathsep.join([str(Path(spec.origin).parent), os.environ["PATH"]])}
+    if spec is not None and spec.origin is not None:
+        environment["PATH"] = os.pathsep.join([str(Path(spec.origin).parent), os.environ["PATH"]])
+    return environment
 
 
 def _extract_fmu_binaries(wheel: Path, out_dir: Path) -> None:
@@ -214,7 +221,7 @@ def _build_base_wheel(out_dir: Path) -> Path:
         f"--config-setting=--build-option=--linux-glibc={MANYLINUX_GLIBC}",
         ROOT,
     ]
-    result = subprocess.run([str(part) for part in command], capture_output=True, text=True, env=_zig_on_path())
+    result = subprocess.run([str(part) for part in command], capture_output=True, text=True, env=_build_environment())
     if result.returncode != 0:
         raise WheelhouseError(f"python -m build --wheel failed:\n{result.stdout[-4000:]}{result.stderr[-4000:]}")
     [wheel] = out_dir.glob("*.whl")
@@ -270,6 +277,7 @@ def build_wheels(output_dir: str | os.PathLike = ROOT / "wheelhouse") -> list[Pa
         for target in WHEELS:
             native_loop = compile_native_loop(target.platform, tmp / target.platform, MANYLINUX_GLIBC)
             placed = Path(shutil.copyfile(native_loop, tree / "pendulum_fmu" / target.native_loop))
+            normalize_modes(tree)
             packed = tmp / "packed" / target.platform
             packed.mkdir(parents=True)
             _run([sys.executable, "-m", "wheel", "pack", "--dest-dir", packed, tree], "wheel pack")

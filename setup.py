@@ -11,9 +11,16 @@
 - bdist_wheel --linux-glibc 2.17 has both build the Linux binaries with zig for that oldest glibc
   (fmu_build's linux_glibc); build_wheels.py passes it, through
   python -m build -C--build-option=--linux-glibc=2.17.
+- The wheel and the sdist are the same bytes from one commit, in any folder, at any time
+  (fmu_build/release_files.py): bdist_wheel dates every entry by $SOURCE_DATE_EPOCH, which
+  defaults to the commit's time (fmu_build/build_record.py), and zips files of fixed
+  permissions; sdist writes its tar.gz in sorted order, every entry dated so and owned by root,
+  and carries the commit and its time (source_commit.json), so that the wheel built from the
+  sdist is the wheel built from the clone.
 """
 
 import importlib.machinery
+import os
 import shutil
 import sys
 import tempfile
@@ -26,6 +33,7 @@ from setuptools import Extension, setup
 from setuptools.command.bdist_wheel import bdist_wheel
 from setuptools.command.build_ext import build_ext
 from setuptools.command.build_py import build_py
+from setuptools.command.sdist import sdist
 
 # This tree's pendulum_fmu (not an installed one) knows where the sources are.
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -117,6 +125,47 @@ class PlatformWheel(bdist_wheel):
         """py3, none and bdist_wheel's platform tag: one wheel for every Python 3 on a platform."""
         return "py3", "none", super().get_tag()[2]
 
+    def run(self):
+        """bdist_wheel, every entry dated by $SOURCE_DATE_EPOCH, the commit's time unless given."""
+        from fmu_build.build_record import source_date_epoch
+
+        # bdist_wheel's zip writer reads $SOURCE_DATE_EPOCH, else each file's time; so do the
+        # compilers (__DATE__), which this sets it for too.
+        os.environ["SOURCE_DATE_EPOCH"] = str(source_date_epoch())
+        super().run()
+
+    def write_wheelfile(self, wheelfile_base, *args, **kwargs):
+        """bdist_wheel's WHEEL file, then fixed permissions for every file the wheel will hold."""
+        from fmu_build.release_files import normalize_modes
+
+        super().write_wheelfile(wheelfile_base, *args, **kwargs)
+        # The last step before bdist_wheel zips bdist_dir, which takes each entry's permissions
+        # from its file (the checkout's umask): it has no option for them.
+        normalize_modes(self.bdist_dir)
+
+
+class ReproducibleSdist(sdist):
+    """sdist whose tar.gz is the same bytes from one commit, carrying that commit and its time."""
+
+    def make_release_tree(self, base_dir, files):
+        """The tree sdist makes, and in it source_commit.json: the commit and its time, for builds from it."""
+        from fmu_build.build_record import write_source_record
+
+        super().make_release_tree(base_dir, files)
+        write_source_record(base_dir)
+
+    def make_archive(self, base_name, format, root_dir=None, base_dir=None, owner=None, group=None):
+        """The .tar.gz by fmu_build's write_tarball (sorted, dated by the commit, owned by root);
+        other formats as sdist writes them.
+        """
+        if format != "gztar" or root_dir is not None:
+            return super().make_archive(base_name, format, root_dir, base_dir, owner, group)
+        from fmu_build.build_record import source_date_epoch
+        from fmu_build.release_files import write_tarball
+
+        write_tarball(f"{base_name}.tar.gz", base_dir, source_date_epoch())
+        return f"{base_name}.tar.gz"
+
 
 def _linux_glibc(command):
     """The glibc floor the wheel build was given (bdist_wheel --linux-glibc), or None."""
@@ -127,5 +176,10 @@ setup(
     # Declared so that setuptools builds it (in place too) and tags the wheel for a platform;
     # BuildNativeLoop builds it with CMake, not with setuptools' compiler.
     ext_modules=[Extension("pendulum_fmu._cs_loop", sources=["pendulum_fmu/_cs_loop.c"])],
-    cmdclass={"build_py": BuildPyWithFmu, "build_ext": BuildNativeLoop, "bdist_wheel": PlatformWheel},
+    cmdclass={
+        "build_py": BuildPyWithFmu,
+        "build_ext": BuildNativeLoop,
+        "bdist_wheel": PlatformWheel,
+        "sdist": ReproducibleSdist,
+    },
 )

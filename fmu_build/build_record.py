@@ -6,6 +6,10 @@ A command is recorded without the build's paths: each source by its name in sour
 include folders left out (the FMU's sources/ and the FMI headers take their place), the export
 list by its content. So the record is the same in any folder, and `pendulum-fmu verify` can run
 the commands again on the FMU's sources/ (tested: the same bytes on linux64).
+
+An sdist has no .git: setup.py writes SOURCE_RECORD_FILE into it (source_record()), the commit
+and the time, so that what is built from the unpacked sdist, the FMUs and the wheel, records the
+same commit and carries the same time as a build from the clone.
 """
 
 from __future__ import annotations
@@ -23,6 +27,8 @@ from .sources import ROOT
 
 # What a build's inputs are, for whether the tree differs from its commit.
 BUILD_INPUTS = ("fmu_src", "modelDescription.xml", "CMakeLists.txt", "cmake", "fmu_build")
+# What an sdist carries in place of .git, at its top: source_record() as JSON.
+SOURCE_RECORD_FILE = "source_commit.json"
 
 
 def _git(*arguments: str) -> str | None:
@@ -33,12 +39,22 @@ def _git(*arguments: str) -> str | None:
     return done.stdout.strip() if done.returncode == 0 else None
 
 
+def _sdist_record() -> dict:
+    """The unpacked sdist's SOURCE_RECORD_FILE, or {} (a clone, or no such file)."""
+    try:
+        recorded = json.loads((ROOT / SOURCE_RECORD_FILE).read_text())
+    except (OSError, ValueError):
+        return {}
+    return recorded if isinstance(recorded, dict) else {}
+
+
 def source_commit() -> dict:
-    """{"commit": the checkout's commit or None (an sdist), "modified": whether the build's inputs
-    differ from it}.
+    """{"commit": the checkout's commit, or the one the sdist records, or None; "modified":
+    whether the build's inputs differ from it (in an sdist: as they did when it was made)}.
     """
     if not (ROOT / ".git").exists():
-        return {"commit": None, "modified": False}
+        recorded = _sdist_record()
+        return {"commit": recorded.get("commit"), "modified": bool(recorded.get("modified", False))}
     commit = _git("rev-parse", "HEAD")
     changes = _git("status", "--porcelain", "--", *BUILD_INPUTS)
     return {"commit": commit, "modified": bool(changes)}
@@ -46,13 +62,28 @@ def source_commit() -> dict:
 
 def source_date_epoch() -> int:
     """The time every entry carries: $SOURCE_DATE_EPOCH (reproducible-builds.org), else the
-    commit's, else 1980-01-01 (zip's first date).
+    commit's, else the one the sdist records, else 1980-01-01 (zip's first date).
     """
     given = os.environ.get("SOURCE_DATE_EPOCH", "").strip()
     if given.isdigit():
         return int(given)
     committed = _git("log", "-1", "--format=%ct") if (ROOT / ".git").exists() else None
-    return int(committed) if committed and committed.isdigit() else ZIP_EPOCH
+    if committed and committed.isdigit():
+        return int(committed)
+    recorded = _sdist_record().get("source_date_epoch")
+    return recorded if isinstance(recorded, int) and recorded >= 0 else ZIP_EPOCH
+
+
+def source_record() -> dict:
+    """What an sdist records of its source (SOURCE_RECORD_FILE): source_commit() and
+    "source_date_epoch", source_date_epoch().
+    """
+    return {**source_commit(), "source_date_epoch": source_date_epoch()}
+
+
+def write_source_record(folder: str | os.PathLike) -> None:
+    """Write source_record() into folder's SOURCE_RECORD_FILE (setup.py: into the sdist's tree)."""
+    Path(folder, SOURCE_RECORD_FILE).write_text(json.dumps(source_record(), indent=1, sort_keys=True) + "\n")
 
 
 def _cmake_variable(text: str, name: str) -> str:
