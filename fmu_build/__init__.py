@@ -15,6 +15,8 @@ each of which imports only those listed before it:
 - documentation.py: the FMU's documentation/index.html;
 - fmu_file.py: an FMU file, its binaries, sources and documentation zipped (build_fmu,
   build_pid_controller).
+- release_files.py: the sdist's tar.gz and the wheel's files, the same bytes from one commit
+  (setup.py, build_wheels.py; the commit and its time from build_record.py).
 
 model_variables.py writes the C code's value references, names and start values from the
 model's modelDescription.xml, so the XML stays the single source of truth; fmi3.py generates the

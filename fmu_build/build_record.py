@@ -118,8 +118,9 @@ def _link_flags(arguments: list[str]) -> list[str]:
         elif argument.endswith((".o", ".obj")) or argument.endswith("/objects.a"):
             if OBJECTS not in flags:
                 flags.append(OBJECTS)
-        elif argument.startswith("-Wl,--version-script="):
-            flags.append("-Wl,--version-script=exports.map")
+        elif argument.startswith(("-Wl,--version-script=", "--version-script=")):
+            # gcc's -Wl,--version-script=PATH, or clang's (zig's) -Xlinker --version-script=PATH.
+            flags.append(argument.split("=", 1)[0] + "=exports.map")
         else:
             flags.extend(_without_paths([argument]))
     return flags

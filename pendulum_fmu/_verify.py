@@ -131,8 +131,8 @@ def _rebuild_commands(made: dict, compiler: list[str], sources: Path, headers: P
     for argument in made["link"]:
         if argument == OBJECTS:
             link.extend(objects)
-        elif argument == "-Wl,--version-script=exports.map":
-            link.append(f"-Wl,--version-script={out / 'exports.map'}")
+        elif argument in ("-Wl,--version-script=exports.map", "--version-script=exports.map"):
+            link.append(argument.replace("exports.map", str(out / "exports.map")))
         else:
             link.append(argument)
     return [*compile_commands, [*compiler, *link, "-o", str(out / "binary")]]
