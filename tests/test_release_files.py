@@ -17,8 +17,9 @@ import zipfile
 from pathlib import Path
 
 import pytest
+from elftools.elf.elffile import ELFFile
 
-from fmu_build import build_record
+from fmu_build import build_fmu, build_record, find_zig
 from fmu_build.release_files import normalize_modes, write_tarball
 from pendulum_fmu._build_record import RECORD_FILE
 
@@ -91,6 +92,23 @@ def test_an_unpacked_sdist_gives_the_commit_and_time_it_records(tmp_path, monkey
     assert build_record.source_record() == recorded
     monkeypatch.setenv("SOURCE_DATE_EPOCH", "1234567890")  # a date given wins over the record
     assert build_record.source_date_epoch() == 1234567890
+
+
+@pytest.mark.skipif(find_zig() is None, reason="needs zig (pip install ziglang)")
+def test_zigs_linux_binaries_name_no_folder_of_the_build(tmp_path):
+    # zig links its glibc stubs in with their DWARF, naming zig's folder and the build's: a
+    # build in a fresh environment (pip's isolated one, another clone) gave other bytes.
+    fmu = build_fmu(tmp_path / "Pendulum.fmu", platforms=("linux64", "aarch64-linux"), linux_glibc="2.17")
+    zig_folder = str(Path(find_zig()).resolve().parent).encode()
+    with zipfile.ZipFile(fmu) as archive:
+        record = json.loads(archive.read(RECORD_FILE))
+        for name in ("binaries/linux64/Pendulum.so", "binaries/aarch64-linux/Pendulum.so"):
+            binary = archive.read(name)
+            sections = [section.name for section in ELFFile(io.BytesIO(binary)).iter_sections()]
+            assert not [section for section in sections if section.startswith(".debug")], name
+            assert b"/tmp/" not in binary and zig_folder not in binary and str(ROOT).encode() not in binary
+            [made] = record["binaries"][name]
+            assert [flag for flag in made["link"] if "/" in flag] == [], name
 
 
 def _run(command: list, cwd: Path, umask: int) -> None:
