@@ -139,9 +139,11 @@ class PlatformWheel(bdist_wheel):
         from fmu_build.release_files import normalize_modes
 
         super().write_wheelfile(wheelfile_base, *args, **kwargs)
-        # The last step before bdist_wheel zips bdist_dir, which takes each entry's permissions
-        # from its file (the checkout's umask): it has no option for them.
-        normalize_modes(self.bdist_dir)
+        # The last step of run() before bdist_wheel zips bdist_dir, taking each entry's
+        # permissions from its file (the checkout's umask): it has no option for them. An
+        # editable install calls this too, for a dist-info folder of its own, left as it is.
+        if Path(wheelfile_base).resolve().parent == Path(self.bdist_dir).resolve():
+            normalize_modes(self.bdist_dir)
 
 
 class ReproducibleSdist(sdist):
