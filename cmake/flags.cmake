@@ -39,9 +39,15 @@ function(export_only target prefix)
         # which differ from build folder to build folder), so one commit gives the same bytes.
         target_link_options(${target} PRIVATE -s)
     elseif(MINGW)
-        # No dependency on the mingw runtime DLLs: the binary loads on any Windows. No link time
-        # in the PE header, so one commit gives the same bytes.
-        target_link_options(${target} PRIVATE -static-libgcc -s "LINKER:--no-insert-timestamp")
+        # No dependency on the mingw runtime DLLs: the binary loads on any Windows.
+        target_link_options(${target} PRIVATE -static-libgcc -s)
+        # No link time in the PE header, so one commit gives the same bytes: GNU ld's option, or
+        # for zig's linker (LLD, which refuses GNU ld's) -Brepro, a hash of the content in its place.
+        if(CMAKE_C_COMPILER_ID STREQUAL "GNU")
+            target_link_options(${target} PRIVATE "LINKER:--no-insert-timestamp")
+        else()
+            target_link_options(${target} PRIVATE "LINKER:-Brepro")
+        endif()
     elseif(UNIX AND NOT APPLE)
         set(script "${CMAKE_CURRENT_BINARY_DIR}/${target}.exports.map")
         file(WRITE "${script}" "{ global: ${prefix}*; local: *; };\n")

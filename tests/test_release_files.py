@@ -22,6 +22,7 @@ from elftools.elf.elffile import ELFFile
 from fmu_build import build_fmu, build_record, find_zig
 from fmu_build.release_files import normalize_modes, write_tarball
 from pendulum_fmu._build_record import RECORD_FILE
+from tests.test_platforms import _path_without_cross_gccs
 
 ROOT = Path(__file__).resolve().parent.parent
 EPOCH = 1_700_000_000  # 2023-11-14 22:13:20 UTC
@@ -109,6 +110,22 @@ def test_zigs_linux_binaries_name_no_folder_of_the_build(tmp_path):
             assert b"/tmp/" not in binary and zig_folder not in binary and str(ROOT).encode() not in binary
             [made] = record["binaries"][name]
             assert [flag for flag in made["link"] if "/" in flag] == [], name
+
+
+@pytest.mark.skipif(find_zig() is None, reason="needs zig (pip install ziglang)")
+def test_zigs_windows_dll_is_the_same_bytes_built_twice(tmp_path, monkeypatch):
+    # Where the mingw gcc is missing zig builds win64, and its linker writes the link time into
+    # the PE header unless given -Brepro (it refuses GNU ld's --no-insert-timestamp).
+    monkeypatch.setenv("PATH", _path_without_cross_gccs(tmp_path / "bin"))
+    built = []
+    for name in ("first", "second"):
+        fmu = build_fmu(tmp_path / name / "Pendulum.fmu", platforms=("win64",))
+        with zipfile.ZipFile(fmu) as archive:
+            built.append(archive.read("binaries/win64/Pendulum.dll"))
+            [made] = json.loads(archive.read(RECORD_FILE))["binaries"]["binaries/win64/Pendulum.dll"]
+        assert made["compiler"][0] == "zig" and "-Brepro" in made["link"]
+        time.sleep(2)  # a PE header's time counts seconds
+    assert built[0] == built[1]
 
 
 def _run(command: list, cwd: Path, umask: int) -> None:
