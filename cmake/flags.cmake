@@ -52,9 +52,12 @@ function(export_only target prefix)
         set(script "${CMAKE_CURRENT_BINARY_DIR}/${target}.exports.map")
         file(WRITE "${script}" "{ global: ${prefix}*; local: *; };\n")
         target_link_options(${target} PRIVATE "LINKER:--version-script=${script}")
-        # Without debug sections: zig links in its glibc stubs (libc_nonshared) with their DWARF,
-        # which names zig's install folder and the build folder; so one commit gives the same bytes.
-        target_link_options(${target} PRIVATE "LINKER:--strip-debug")
+        # zig's without debug sections: it links in its glibc stubs (libc_nonshared) with their
+        # DWARF, which names zig's install folder and the build folder; so one commit gives the
+        # same bytes. (gcc links none: its builds, and their records, stay as they are.)
+        if(NOT CMAKE_C_COMPILER_ID STREQUAL "GNU")
+            target_link_options(${target} PRIVATE "LINKER:--strip-debug")
+        endif()
         set_property(TARGET ${target} APPEND PROPERTY LINK_DEPENDS "${script}")
         target_link_libraries(${target} PRIVATE m)
     endif()
