@@ -46,7 +46,7 @@ REBUILD_COMPILERS = frozenset({"cc", "gcc", "clang", "zig", "aarch64-linux-gnu-g
 REBUILD_ARGUMENT = re.compile(
     r"-D\w+|-O[0-3s]|-std=c\d\d|-W(?:all|extra|error)|-f(?:PIC|pic|lto=auto|no-fat-lto-objects|visibility=hidden"
     r"|fp-contract=off)|-shared|-s|-l[a-z]+|-static-libgcc|-Wl,-soname,[\w.-]+|-Wl,--version-script=exports\.map"
-    r"|-target|" + re.escape(OBJECTS)
+    r"|-target|-g0|-Xlinker|--version-script=exports\.map|--strip-debug|" + re.escape(OBJECTS)
 )
 # What follows -target (zig cc -target x86_64-linux-gnu.2.17), and a source's file name.
 REBUILD_WORD = re.compile(r"[\w.-]+")
@@ -123,8 +123,11 @@ def _compiler_version(command: list[str], compiler_id: str) -> str:
 
 def _rebuild_commands(made: dict, compiler: list[str], sources: Path, headers: Path, out: Path) -> list[list[str]]:
     objects = [str(out / f"{source}.o") for source in made["sources"]]
+    # A dependency file, as CMake's Makefiles ask for one (compile_commands.json leaves it out):
+    # zig's driver compiles another way without (no .llvm_addrsig), to other bytes.
+    flags = [*compiler, *made["compile"], f"-I{sources}", f"-I{headers}", "-MD", "-MF"]
     compile_commands = [
-        [*compiler, *made["compile"], f"-I{sources}", f"-I{headers}", "-o", obj, "-c", str(sources / source)]
+        [*flags, f"{obj}.d", "-o", obj, "-c", str(sources / source)]
         for source, obj in zip(made["sources"], objects, strict=True)
     ]
     link = []

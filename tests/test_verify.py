@@ -265,3 +265,14 @@ def test_a_kits_reference_naming_a_file_elsewhere_is_refused_before_anything_is_
     [line] = capsys.readouterr().err.strip().splitlines()
     assert f"{crafted}'s {name}: output is \"{precious}\"; it must be the name of a file in the kit's folder" in line
     assert precious.read_text() == "mine\n"
+
+
+def test_the_wheels_zig_built_binary_is_rebuilt_from_its_sources_too(tmp_path, capsys):
+    # The wheels carry Linux binaries zig builds for glibc 2.17: verify rebuilds them with zig from PyPI.
+    pytest.importorskip("ziglang")
+    from fmu_build import build_fmu
+
+    built = build_fmu(tmp_path / "Pendulum.fmu", platforms=("linux64",), linux_glibc="2.17")
+    status, checks = _verified(capsys, built)
+    assert (status, checks["rebuild"]["status"]) == (0, "pass")
+    assert "with Clang" in checks["rebuild"]["detail"]
