@@ -10,6 +10,7 @@ long; each such test carries the marker that says why (pyproject's markers), and
 markers implies `slow`.
 """
 
+import contextlib
 import os
 import pickle
 import shutil
@@ -25,15 +26,19 @@ from filelock import FileLock
 from fmu_build import build_fmu
 
 # The markers of tests the fast loop leaves out; each implies `slow` (pyproject says what each means).
-SLOW_MARKERS = ("wine", "qemu", "sanitizers", "fuzz", "packaging", "docs", "notebook", "readme", "cluster")
+SLOW_MARKERS = ("packaging", "wine", "qemu", "sanitizers", "fuzz", "docs", "build", "notebook", "readme", "cluster")
 
 
 @pytest.hookimpl(tryfirst=True)
 def pytest_collection_modifyitems(items):
-    """Mark `slow` every test that carries one of SLOW_MARKERS, before `-m` selects."""
+    """Mark `slow` every test that carries one of SLOW_MARKERS, before `-m` selects; and run the
+    slow tests first, so that the workers share out the short ones at the end rather than wait
+    for a long one that came last (each kind keeps its order).
+    """
     for item in items:
         if any(item.get_closest_marker(name) for name in SLOW_MARKERS):
             item.add_marker(pytest.mark.slow)
+    items.sort(key=lambda item: item.get_closest_marker("slow") is None)
 
 
 @pytest.fixture(scope="session")
@@ -56,11 +61,13 @@ def checkout_build_lock(session_folder) -> FileLock:
 def _checkout_fmus_built_once(session_folder):
     """The checkout's dist/ FMUs (default_fmu(), controller_fmu()), rebuilt when stale by the
     first worker, before any test asks for them: else each worker would rebuild them at once.
+    A build that fails here fails again in the tests that need it, which say so.
     """
     from pendulum_fmu import FMU_FILES, default_fmu
     from pendulum_fmu._closed_loop import controller_fmu
+    from pendulum_fmu._errors import BuildError
 
-    with FileLock(session_folder / "checkout-fmus.lock"):
+    with FileLock(session_folder / "checkout-fmus.lock"), contextlib.suppress(BuildError):
         for fmi_version in FMU_FILES:
             default_fmu(fmi_version)
         controller_fmu()

@@ -1,6 +1,6 @@
 """libFuzzer on the state deserializer and on random call sequences, for a bounded time.
 
-Run longer with FUZZ_SECONDS=3600 pytest tests/test_fuzz.py (or see the README).
+Run longer with FUZZ_SECONDS=3600 pytest tests/test_fuzz.py -rP (-rP shows what each printed).
 """
 
 import os

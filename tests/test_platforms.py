@@ -302,6 +302,7 @@ def _glibc_versions(library):
     }
 
 
+@pytest.mark.build
 @pytest.mark.parametrize("platform", RUNS_ZIG)
 @EACH_FMI_VERSION
 def test_zig_builds_for_the_wheels_glibc_give_the_gcc_builds_theta_bit_for_bit(
@@ -347,6 +348,7 @@ def test_zig_builds_for_the_wheels_glibc_give_the_gcc_builds_theta_bit_for_bit(
     assert np.array_equal(run, gcc), np.max(np.abs(run - gcc))
 
 
+@pytest.mark.build
 @pytest.mark.skipif(find_zig() is None, reason="needs zig (pip install ziglang)")
 def test_build_command_builds_for_any_glibc_floor_and_refuses_a_malformed_one_in_one_line(tmp_path, capsys):
     # Older than the wheels' 2.17: then x86-64's memcpy binds GLIBC_2.2.5, not GLIBC_2.14.
@@ -382,6 +384,7 @@ def _without_compiler(monkeypatch, platform):
     )
 
 
+@pytest.mark.build
 @pytest.mark.parametrize(
     "platform, missing",
     [
@@ -404,6 +407,7 @@ def test_default_build_skips_a_platform_without_its_compiler_in_one_line(tmp_pat
     assert "linux64" in folders and platform not in folders
 
 
+@pytest.mark.build
 def test_a_platform_named_explicitly_must_build(tmp_path, monkeypatch):
     _without_compiler(monkeypatch, "aarch64-linux")
     with pytest.raises(BuildError, match="apt-get install gcc-aarch64-linux-gnu, or pip install ziglang"):
@@ -411,6 +415,7 @@ def test_a_platform_named_explicitly_must_build(tmp_path, monkeypatch):
     assert not (tmp_path / "Pendulum.fmu").exists()
 
 
+@pytest.mark.build
 def test_build_command_says_what_it_skipped_in_one_line(tmp_path, monkeypatch, capsys):
     _without_compiler(monkeypatch, "aarch64-linux")
     assert main(["build", "--output", str(tmp_path / "Pendulum.fmu")]) == 0
