@@ -23,7 +23,7 @@ from typing import Any
 import pytest
 from filelock import FileLock
 
-from fmu_build import build_fmu
+from fmu_build import build_fmu, build_pid_controller
 
 # The markers of tests the fast loop leaves out; each implies `slow` (pyproject says what each means).
 SLOW_MARKERS = ("packaging", "wine", "qemu", "sanitizers", "fuzz", "docs", "build", "notebook", "readme", "cluster")
@@ -107,6 +107,12 @@ def fmu(build_once):
 def fmu3(build_once):
     """The FMI 3.0 FMU built from the same sources, once per test session."""
     return build_once("fmu3", lambda folder: build_fmu(folder / "Pendulum-fmi3.fmu", fmi_version=3))
+
+
+@pytest.fixture(scope="session")
+def pid_controller(build_once):
+    """The closed loop's PID controller FMU built from this checkout's sources, once per session."""
+    return build_once("pid_controller", lambda folder: build_pid_controller(folder / "PIDController.fmu"))
 
 
 @pytest.fixture
