@@ -31,9 +31,10 @@ SLOW_MARKERS = ("packaging", "wine", "qemu", "sanitizers", "fuzz", "docs", "buil
 
 @pytest.hookimpl(tryfirst=True)
 def pytest_collection_modifyitems(items):
-    """Mark `slow` every test that carries one of SLOW_MARKERS, before `-m` selects; and run the
-    slow tests first, so that the workers share out the short ones at the end rather than wait
-    for a long one that came last (each kind keeps its order).
+    """Mark `slow` every test that carries one of SLOW_MARKERS, before `-m` selects; and put the
+    slow tests first, so that the workers (one module each, pyproject's --dist loadfile) start
+    with the modules that hold them and share out the short ones at the end, rather than wait for
+    a long one that came last (each kind keeps its order).
     """
     for item in items:
         if any(item.get_closest_marker(name) for name in SLOW_MARKERS):

@@ -15,8 +15,7 @@ import pytest
 ROOT = Path(__file__).resolve().parent.parent
 
 pytest.importorskip("sphinx", reason="the [docs] extra (in [test]) builds the docs site")
-# One worker builds the site and reads it: another would only wait for the build.
-pytestmark = [pytest.mark.docs, pytest.mark.xdist_group("docs_site")]
+pytestmark = pytest.mark.docs
 
 
 def readme_build_command() -> list[str]:

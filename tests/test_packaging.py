@@ -32,9 +32,7 @@ from pendulum_fmu import CONTROLLER_FMU_FILE, FMU_FILES, __version__
 from pendulum_fmu._closed_loop import sampled_loop_reference
 from pendulum_fmu._reference import reference
 
-# One worker runs the builds into the checkout (here and tests/test_wheels.py): they take turns
-# anyway (conftest's checkout_build_lock), and another worker would only wait for them.
-pytestmark = [pytest.mark.packaging, pytest.mark.xdist_group("checkout_builds")]
+pytestmark = pytest.mark.packaging
 
 ROOT = Path(__file__).resolve().parent.parent
 # In a clean environment: no PYTHONPATH pointing back at the checkout.

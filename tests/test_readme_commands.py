@@ -139,10 +139,8 @@ def copy_key(document: str) -> str:
 
 def readme_commands():
     for readme in DOCUMENTS:
-        # One worker runs a copy's commands, in document order; the copies run side by side.
-        in_order = pytest.mark.xdist_group(f"readme_commands:{copy_key(readme)}")
         for index, command in enumerate(commands_in((ROOT / readme).read_text(encoding="utf-8"))):
-            yield pytest.param(readme, command, id=f"{readme}:{index}:{command[:60]}", marks=in_order)
+            yield pytest.param(readme, command, id=f"{readme}:{index}:{command[:60]}")
 
 
 COMMANDS = list(readme_commands())

@@ -47,9 +47,6 @@ MACHO_CPU_TYPES = {0x01000007: "x86_64", 0x0100000C: "arm64"}
 WINDOWS_SYSTEM_DLLS = {"kernel32.dll", "msvcrt.dll"}
 
 needs_build = pytest.mark.packaging
-# One worker runs the builds into the checkout (here and tests/test_packaging.py): they take turns
-# anyway (conftest's checkout_build_lock), and another worker would only wait for them.
-pytestmark = pytest.mark.xdist_group("checkout_builds")
 
 
 @pytest.fixture(scope="session")
