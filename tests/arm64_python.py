@@ -26,6 +26,8 @@ import zipfile
 from email.parser import HeaderParser
 from pathlib import Path
 
+from filelock import FileLock
+
 ROOT = Path(__file__).resolve().parent.parent
 CACHE = ROOT / ".cache" / "arm64-python"
 # Debian bookworm's, as its python3.11 needs them at run time: the interpreter and its standard
@@ -155,6 +157,13 @@ class Arm64Python:
         """
         wanted = ["pip", *requirements]
         marker = self.wheels / "requirements.txt"
+        self.cache.mkdir(parents=True, exist_ok=True)
+        # Tests on other workers may download into the same folder at the same time.
+        with FileLock(self.cache / "wheels.lock"):
+            self._download_missing(wanted, marker)
+        return self.wheels
+
+    def _download_missing(self, wanted: list[str], marker: Path) -> None:
         have = set(marker.read_text().splitlines()) if marker.is_file() else set()
         if not set(wanted) <= have:
             self.wheels.mkdir(parents=True, exist_ok=True)
@@ -179,7 +188,6 @@ class Arm64Python:
                 "pip download of the aarch64 wheels",
             )
             marker.write_text("\n".join(sorted(have | set(wanted))) + "\n")
-        return self.wheels
 
     def command(self, arguments) -> list[str]:
         return ["qemu-aarch64", "-L", str(self.sysroot), str(self.python), *map(str, arguments)]

@@ -15,7 +15,7 @@ from pendulum_fmu._reference import reference
 from pendulum_fmu.cli import main
 from tests.arm64_python import ROOT, Arm64Python, Unavailable
 
-pytestmark = pytest.mark.packaging
+pytestmark = [pytest.mark.packaging, pytest.mark.qemu]
 
 ELF_MACHINE_AARCH64 = 183  # e_machine in the ELF header
 

@@ -60,5 +60,6 @@ def test_the_documented_table_is_what_the_cases_give(files):
     assert documented == markdown(rows, calls), "regenerate: python tests/bad_inputs.py docs/bad_inputs.md"
 
 
+@pytest.mark.docs
 def test_the_generator_documents_the_clone_whatever_package_is_installed(generated_by_script):
     assert generated_by_script("bad_inputs.py") == (ROOT / "docs" / "bad_inputs.md").read_text()

@@ -67,6 +67,7 @@ def test_cc_and_cflags_with_arguments_and_lto_only_where_it_links(tmp_path, monk
     assert _theta_error(fmu) < 1e-9
 
 
+@pytest.mark.build
 def test_eight_builds_into_one_path_at_once_all_succeed(tmp_path):
     target = tmp_path / "Pendulum.fmu"
     builds = [
@@ -89,6 +90,7 @@ def test_eight_builds_into_one_path_at_once_all_succeed(tmp_path):
     assert _theta_error(target) < 1e-9
 
 
+@pytest.mark.build
 def test_checkout_fmu_is_rebuilt_when_a_source_is_newer(tmp_path):
     for name in ("pendulum_fmu", "fmu_build", "fmu_src", "cmake"):
         shutil.copytree(ROOT / name, tmp_path / name, ignore=shutil.ignore_patterns("__pycache__"))

@@ -6,6 +6,7 @@ from importlib import import_module
 
 import numpy as np
 import pyarrow.parquet as pq
+import pytest
 
 from pendulum_fmu._errors import InvalidInput
 from pendulum_fmu._reference import reference
@@ -36,6 +37,7 @@ def test_every_command_has_help():
             assert action.help, f"{name} {action.option_strings}"
 
 
+@pytest.mark.build
 def test_build(tmp_path, capsys):
     assert main(["build", "--output", str(tmp_path / "P.fmu")]) == 0
     assert (tmp_path / "P.fmu").stat().st_size > 10_000

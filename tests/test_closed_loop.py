@@ -4,12 +4,11 @@ import numpy as np
 from fmpy import simulate_fmu
 from fmpy.validation import validate_fmu
 
-from fmu_build import build_pid_controller
 from pendulum_fmu._closed_loop import create_closed_loop_fmu, sampled_loop_reference
 
 
-def test_controller_fmu_is_valid(tmp_path):
-    assert validate_fmu(str(build_pid_controller(tmp_path / "PIDController.fmu"))) == []
+def test_controller_fmu_is_valid(pid_controller):
+    assert validate_fmu(str(pid_controller)) == []
 
 
 def test_container_fmu_settles_on_the_setpoint_like_the_sampled_reference(tmp_path):

@@ -34,12 +34,15 @@ FULL_MAP = ",".join(f"{ours}={theirs}" for ours, theirs in RENAMES.items())
 PLAN = schedule(lambda t: 50.0 if t < 0.25 else -80.0, stop_time=0.5, step_size=1e-3)
 
 
-@pytest.fixture(scope="module")
-def renamed_fmu(tmp_path_factory):
+@pytest.fixture(scope="session")
+def renamed_fmu(build_once):
     """The pendulum under other variable names and another model identifier, built over the same
-    plumbing from a copied model.c and modelDescription.xml.
+    plumbing from a copied model.c and modelDescription.xml, once per session, for this machine.
     """
-    folder = tmp_path_factory.mktemp("renamed")
+    return build_once("renamed", _renamed_build)
+
+
+def _renamed_build(folder):
     model = folder / "model"
     model.mkdir()
     shutil.copy2(PENDULUM_DIR / "config.h", model)
@@ -50,7 +53,10 @@ def renamed_fmu(tmp_path_factory):
         xml = xml.replace(f'name="{ours}"', f'name="{theirs}"')
     (model / "model.c").write_text(code)
     (model / "modelDescription.xml").write_text(xml)
-    return build_fmu(folder / "Renamed.fmu", model_dir=model, model_description_file=model / "modelDescription.xml")
+    description = model / "modelDescription.xml"
+    return build_fmu(
+        folder / "Renamed.fmu", model_dir=model, model_description_file=description, platforms=("linux64",)
+    )
 
 
 def max_error(run, expected, field="theta"):
@@ -202,7 +208,7 @@ def test_every_tool_takes_its_defaults_from_the_fmu_compared(tmp_path):
     xml = MODEL_DESCRIPTION.read_text()
     assert xml.count('<Real unit="kg" start="40" min="0"/>') == 1
     description.write_text(xml.replace('<Real unit="kg" start="40" min="0"/>', '<Real unit="kg" start="10" min="0"/>'))
-    lighter = build_fmu(tmp_path / "Lighter.fmu", model_description_file=description)
+    lighter = build_fmu(tmp_path / "Lighter.fmu", model_description_file=description, platforms=("linux64",))
     runs = run_tools(PLAN, "fmu,reference", fmu_path=lighter)
     assert max_error(runs["fmu"], runs["reference"]) < 1e-9
     expected = reference_schedule(PLAN, parameters={"mass": 10.0})

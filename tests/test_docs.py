@@ -15,6 +15,7 @@ import pytest
 ROOT = Path(__file__).resolve().parent.parent
 
 pytest.importorskip("sphinx", reason="the [docs] extra (in [test]) builds the docs site")
+pytestmark = pytest.mark.docs
 
 
 def readme_build_command() -> list[str]:
@@ -24,12 +25,9 @@ def readme_build_command() -> list[str]:
     return shlex.split(commands[0])
 
 
-@pytest.fixture(scope="module")
-def site(tmp_path_factory):
-    """The site built by the README's command, into a temporary folder (its last argument)."""
+def _built_site(output: Path) -> Path:
     argv = readme_build_command()
     assert "-W" in argv and argv[-2:] == ["docs", "docs/_build/html"]
-    output = tmp_path_factory.mktemp("site")
     done = subprocess.run(
         [sys.executable, "-m", "sphinx", *argv[1:-1], str(output)],
         cwd=ROOT,
@@ -39,6 +37,14 @@ def site(tmp_path_factory):
     )
     assert done.returncode == 0, f"the docs build failed (warnings are errors):\n{done.stderr[-4000:]}"
     return output
+
+
+@pytest.fixture(scope="session")
+def site(build_once):
+    """The site built by the README's command, into a temporary folder (its last argument), once
+    per session.
+    """
+    return build_once("site", _built_site)
 
 
 def test_every_docs_page_is_in_the_site(site):

@@ -99,6 +99,7 @@ def test_archive_holds_fmi3_binary_and_build_description(fmu3, tmp_path):
     assert not [s for s in symbols if s.startswith(("instance_", "model_", "dopri5"))]
 
 
+@pytest.mark.build
 def test_build_command_writes_the_fmi3_fmu(tmp_path, capsys):
     assert main(["build", "--fmi-version", "3", "--output", str(tmp_path / "P3.fmu")]) == 0
     assert read_model_description(str(tmp_path / "P3.fmu")).fmiVersion == "3.0"

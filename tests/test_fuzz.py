@@ -1,6 +1,6 @@
 """libFuzzer on the state deserializer and on random call sequences, for a bounded time.
 
-Run longer with FUZZ_SECONDS=3600 pytest tests/test_fuzz.py (or see the README).
+Run longer with FUZZ_SECONDS=3600 pytest tests/test_fuzz.py -rP (-rP shows what each printed).
 """
 
 import os
@@ -16,9 +16,12 @@ from fmu_build import FMI_HEADERS, PLUMBING_DIR, assemble_sources
 HARNESSES = Path(__file__).resolve().parent / "fuzz"
 DEFAULT_SECONDS = 15  # per harness, as CI runs it
 SECONDS = int(os.environ.get("FUZZ_SECONDS", DEFAULT_SECONDS))
-pytestmark = pytest.mark.skipif(
-    shutil.which("clang") is None, reason="needs clang with libFuzzer (apt-get install clang libclang-rt-14-dev)"
-)
+pytestmark = [
+    pytest.mark.fuzz,
+    pytest.mark.skipif(
+        shutil.which("clang") is None, reason="needs clang with libFuzzer (apt-get install clang libclang-rt-14-dev)"
+    ),
+]
 
 
 @pytest.fixture(scope="module")

@@ -11,7 +11,6 @@ from fmpy import read_model_description
 from fmpy.fmi2 import FMU2Slave
 from scipy.integrate import solve_ivp
 
-from fmu_build import build_pid_controller
 from pendulum_fmu._closed_loop import controller_defaults, sampled_loop_reference
 from pendulum_fmu._instance import MessageLog, _unzipped, open_fmu
 from pendulum_fmu._parameters import default_parameters, total_inertia
@@ -141,12 +140,11 @@ def _loop_with_exact_integral(stop_time, h):
     return np.array(theta)
 
 
-def test_closed_loop_with_order_2_derivatives_every_step(fmu, tmp_path):
-    controller_fmu = build_pid_controller(tmp_path / "PIDController.fmu")
+def test_closed_loop_with_order_2_derivatives_every_step(fmu, pid_controller):
     stop_time, errors, differences = 2.0, [], []
     for h in (1e-2, 5e-3):
-        held = _closed_loop(fmu, controller_fmu, stop_time, h, extrapolate=False)
-        extrapolated = _closed_loop(fmu, controller_fmu, stop_time, h, extrapolate=True)
+        held = _closed_loop(fmu, pid_controller, stop_time, h, extrapolate=False)
+        extrapolated = _closed_loop(fmu, pid_controller, stop_time, h, extrapolate=True)
         assert np.max(np.abs(held - sampled_loop_reference(stop_time, h)["theta"])) < 1e-9
         errors.append(np.max(np.abs(extrapolated - _loop_with_exact_integral(stop_time, h))))
         differences.append(np.max(np.abs(extrapolated - held)))

@@ -4,7 +4,6 @@ import numpy as np
 import pytest
 from fmpy import read_model_description
 
-from fmu_build import build_pid_controller
 from pendulum_fmu._closed_loop import WIRES, sampled_loop_reference
 from pendulum_fmu._reference import reference
 
@@ -50,16 +49,15 @@ def test_override_manipulator_and_observer_match_the_reference(fmu):
     assert np.max(np.abs(np.array(theta) - expected["theta"])) < 1e-10
 
 
-def test_two_slaves_close_the_loop_through_connections(fmu, tmp_path):
-    controller_fmu = build_pid_controller(tmp_path / "PIDController.fmu")
+def test_two_slaves_close_the_loop_through_connections(fmu, pid_controller):
     execution = CosimExecution.from_step_size(step_size=STEP_NS)
     slaves = {
         "pendulum": execution.add_local_slave(CosimLocalSlave(fmu_path=str(fmu), instance_name="pendulum")),
         "controller": execution.add_local_slave(
-            CosimLocalSlave(fmu_path=str(controller_fmu), instance_name="controller")
+            CosimLocalSlave(fmu_path=str(pid_controller), instance_name="controller")
         ),
     }
-    vr = {"pendulum": _references(fmu), "controller": _references(controller_fmu)}
+    vr = {"pendulum": _references(fmu), "controller": _references(pid_controller)}
     for source, output, target, into in WIRES:
         execution.connect_real_variables(slaves[source], vr[source][output], slaves[target], vr[target][into])
     series = CosimObserver.create_time_series()

@@ -9,6 +9,7 @@ from pendulum_fmu._compare_tools import KINDS, installed
 
 nbformat = pytest.importorskip("nbformat")
 nbclient = pytest.importorskip("nbclient")
+pytestmark = pytest.mark.notebook
 
 NOTEBOOK = Path(__file__).resolve().parent.parent / "examples" / "engines.ipynb"
 

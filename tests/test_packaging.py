@@ -50,23 +50,36 @@ def _run(command, cwd=None, check=True):
     return result
 
 
-@pytest.fixture(scope="module")
-def artefacts(tmp_path_factory):
-    """{'wheel': path, 'sdist': path}, built from this checkout."""
-    out = tmp_path_factory.mktemp("dist")
+def _built_artefacts(out: Path) -> dict[str, Path]:
     _run([sys.executable, "-m", "build", "--outdir", out, ROOT])
     [wheel], [sdist] = out.glob("*.whl"), out.glob("*.tar.gz")
     return {"wheel": wheel, "sdist": sdist}
+
+
+@pytest.fixture(scope="session")
+def artefacts(build_once, checkout_build_lock):
+    """{'wheel': path, 'sdist': path}, built from this checkout once per session."""
+
+    def built(out: Path) -> dict[str, Path]:
+        with checkout_build_lock:  # the sdist's egg_info writes into the checkout
+            return _built_artefacts(out)
+
+    return build_once("dist", built)
 
 
 def _files_under(folder: Path) -> set[Path]:
     return {p for p in folder.rglob("*") if "__pycache__" not in p.parts}
 
 
-@pytest.fixture(scope="module", params=["wheel", "sdist"])
-def installed(request, artefacts, tmp_path_factory):
-    """(venv, its site-packages) with the artefact installed and nothing of the checkout."""
-    venv = tmp_path_factory.mktemp(f"venv_{request.param}")
+@pytest.fixture(scope="session", params=["wheel", "sdist"])
+def installed(request, artefacts, build_once):
+    """(venv, its site-packages) with the artefact installed and nothing of the checkout, made
+    once per session.
+    """
+    return build_once(f"venv_{request.param}", lambda venv: _venv_with(artefacts[request.param], venv))
+
+
+def _venv_with(artefact: Path, venv: Path) -> tuple[Path, Path]:
     _run([sys.executable, "-m", "venv", venv])
     [site_packages] = venv.glob("lib/python*/site-packages")
     (site_packages / "dependencies_from_the_test_environment.pth").write_text(sysconfig.get_paths()["purelib"] + "\n")
@@ -82,7 +95,7 @@ def installed(request, artefacts, tmp_path_factory):
             "--no-deps",
             "--ignore-installed",
             "--no-cache-dir",
-            artefacts[request.param],
+            artefact,
         ]
     )
     _run([venv / "bin/python", "-m", "pip", "check"])

@@ -33,14 +33,20 @@ STEPS, STEP_SIZE = 3000, 1e-3  # the tutorial case: 20 N.m, gravity on, 3 s
 POW_INPUTS = 1_000_000
 # How each platform's master runs here: natively, under wine, under qemu with the cross libc.
 RUNNERS = {"linux64": [], "win64": ["wine"], "aarch64-linux": ["qemu-aarch64", "-L", "/usr/aarch64-linux-gnu"]}
+# The marker (pyproject's) of the tests that build or run a platform's binary with its cross tools.
+CROSS_MARKERS = {"win64": pytest.mark.wine, "aarch64-linux": pytest.mark.qemu}
 CROSS = [
     pytest.param(
         platform,
-        marks=pytest.mark.skipif(
-            shutil.which(PLATFORMS[platform].targets[0].cross_compiler) is None
-            or shutil.which(RUNNERS[platform][0]) is None,
-            reason=f"needs {PLATFORMS[platform].targets[0].package} and {RUNNERS[platform][0]} (.ci/run installs them)",
-        ),
+        marks=[
+            CROSS_MARKERS[platform],
+            pytest.mark.skipif(
+                shutil.which(PLATFORMS[platform].targets[0].cross_compiler) is None
+                or shutil.which(RUNNERS[platform][0]) is None,
+                reason=f"needs {PLATFORMS[platform].targets[0].package} and {RUNNERS[platform][0]} "
+                "(.ci/run installs them)",
+            ),
+        ],
     )
     for platform in ("win64", "aarch64-linux")
 ]
@@ -82,12 +88,12 @@ def _unzipped_build(fmu, work):
 
 
 @pytest.fixture(scope="module")
-def every_platform(tmp_path_factory):
-    """{FMI version: its UnzippedBuild}."""
+def every_platform(tmp_path_factory, fmu, fmu3):
+    """{FMI version: its UnzippedBuild}, of the session's default builds (conftest's fmu, fmu3)."""
     builds = {}
-    for fmi_version in FMI_VERSIONS:
+    for fmi_version, built in zip(FMI_VERSIONS, (fmu, fmu3), strict=True):
         work = tmp_path_factory.mktemp(f"platforms_fmi{fmi_version}")
-        builds[fmi_version] = _unzipped_build(build_fmu(work / "Pendulum.fmu", fmi_version=fmi_version), work)
+        builds[fmi_version] = _unzipped_build(built, work)
         assert builds[fmi_version].fmi_version == fmi_version
     return builds
 
@@ -308,13 +314,16 @@ def test_every_macos_slice_exports_the_fmi_functions_and_loads_only_libsystem(ev
 RUNS_ZIG = [
     pytest.param(
         platform,
-        marks=pytest.mark.skipif(
-            find_zig() is None
-            or shutil.which(RUNNERS[platform][0] if RUNNERS[platform] else "true") is None
-            or shutil.which(PLATFORMS[platform].targets[0].compiler()[0]) is None,
-            reason=f"needs zig (pip install ziglang) and {PLATFORMS[platform].targets[0].compiler()[0]}, "
-            f"{(RUNNERS[platform] or ['nothing'])[0]} to build and run the master",
-        ),
+        marks=[
+            *([CROSS_MARKERS[platform]] if platform in CROSS_MARKERS else []),
+            pytest.mark.skipif(
+                find_zig() is None
+                or shutil.which(RUNNERS[platform][0] if RUNNERS[platform] else "true") is None
+                or shutil.which(PLATFORMS[platform].targets[0].compiler()[0]) is None,
+                reason=f"needs zig (pip install ziglang) and {PLATFORMS[platform].targets[0].compiler()[0]}, "
+                f"{(RUNNERS[platform] or ['nothing'])[0]} to build and run the master",
+            ),
+        ],
     )
     for platform in ("linux64", "aarch64-linux")
 ]
@@ -334,6 +343,7 @@ def _glibc_versions(library):
     }
 
 
+@pytest.mark.build
 @pytest.mark.parametrize("platform", RUNS_ZIG)
 @EACH_FMI_VERSION
 def test_zig_builds_for_the_wheels_glibc_give_the_gcc_builds_theta_bit_for_bit(
@@ -379,6 +389,7 @@ def test_zig_builds_for_the_wheels_glibc_give_the_gcc_builds_theta_bit_for_bit(
     assert np.array_equal(run, gcc), np.max(np.abs(run - gcc))
 
 
+@pytest.mark.build
 @pytest.mark.skipif(find_zig() is None, reason="needs zig (pip install ziglang)")
 def test_build_command_builds_for_any_glibc_floor_and_refuses_a_malformed_one_in_one_line(tmp_path, capsys):
     # Older than the wheels' 2.17: then x86-64's memcpy binds GLIBC_2.2.5, not GLIBC_2.14.
@@ -414,6 +425,7 @@ def _without_compiler(monkeypatch, platform):
     )
 
 
+@pytest.mark.build
 @pytest.mark.parametrize(
     "platform, missing",
     [
@@ -436,6 +448,7 @@ def test_default_build_skips_a_platform_without_its_compiler_in_one_line(tmp_pat
     assert "linux64" in folders and platform not in folders
 
 
+@pytest.mark.build
 def test_a_platform_named_explicitly_must_build(tmp_path, monkeypatch):
     _without_compiler(monkeypatch, "aarch64-linux")
     with pytest.raises(BuildError, match="apt-get install gcc-aarch64-linux-gnu, or pip install ziglang"):
@@ -443,6 +456,7 @@ def test_a_platform_named_explicitly_must_build(tmp_path, monkeypatch):
     assert not (tmp_path / "Pendulum.fmu").exists()
 
 
+@pytest.mark.build
 def test_build_command_says_what_it_skipped_in_one_line(tmp_path, monkeypatch, capsys):
     _without_compiler(monkeypatch, "aarch64-linux")
     assert main(["build", "--output", str(tmp_path / "Pendulum.fmu")]) == 0

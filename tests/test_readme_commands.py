@@ -134,6 +134,11 @@ def to_run(command: str):
     return command, None
 
 
+def copy_key(document: str) -> str:
+    """The copy of the repository a document's commands run in: the docs pages share one."""
+    return "docs" if document in DOCS_PAGES else document
+
+
 def readme_commands():
     for readme in DOCUMENTS:
         for index, command in enumerate(commands_in((ROOT / readme).read_text(encoding="utf-8"))):
@@ -217,7 +222,7 @@ def copies(tmp_path_factory):
     made = {}
 
     def copy_for(document):
-        key = "docs" if document in DOCS_PAGES else document
+        key = copy_key(document)
         if key not in made:
             made[key] = copy_of_the_clone(ROOT, tmp_path_factory.mktemp("readme") / "pendulum-fmu")
         return made[key]
@@ -252,6 +257,7 @@ def fresh_shell_environment():
     return environment
 
 
+@pytest.mark.readme
 @pytest.mark.parametrize(("readme", "command"), COMMANDS)
 def test_readme_command_runs_as_written(readme, command, copies):
     command, reason = to_run(command)

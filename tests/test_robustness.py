@@ -56,6 +56,7 @@ def test_the_documented_table_is_what_the_cases_give(harness, harness3):
     assert documented == markdown(rows, rows_fmi3), "regenerate: python tests/bad_calls.py docs/robustness.md"
 
 
+@pytest.mark.docs
 def test_the_generator_documents_the_clone_whatever_package_is_installed(generated_by_script):
     # The README says either set-up serves to run it; the main job's installs the package.
     assert generated_by_script("bad_calls.py") == (ROOT / "docs" / "robustness.md").read_text()

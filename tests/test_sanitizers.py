@@ -18,7 +18,7 @@ DRIVER = Path(__file__).resolve().parent / "c" / "driver.c"
 INSTANCES, THREADS, SANITIZED_CYCLES = 1000, 8, 20_000
 ENERGY_STEPS, ENERGY_DRIFT_BOUND = 10_000_000, 1e-9
 CYCLES, GROWTH_BOUND_KIB = 100_000, 256
-pytestmark = pytest.mark.skipif(shutil.which("gcc") is None, reason="needs gcc")
+pytestmark = [pytest.mark.sanitizers, pytest.mark.skipif(shutil.which("gcc") is None, reason="needs gcc")]
 
 
 def _compile(sources, out, flags):

@@ -640,6 +640,7 @@ def test_overwrite_on_an_fsspec_url(threads_scheduler):
     ]
 
 
+@pytest.mark.cluster
 def test_ctrl_c_during_overwrite_leaves_the_old_study_whole(tmp_path):
     old = tmp_path / "study"
     assert (
@@ -692,6 +693,7 @@ def dask_processes():
         yield address
 
 
+@pytest.mark.cluster
 def test_a_study_on_a_scheduler_and_workers_started_as_processes(tmp_path, dask_processes, fmu, capsys):
     assert (
         main(
@@ -737,6 +739,7 @@ def test_a_study_on_a_scheduler_and_workers_started_as_processes(tmp_path, dask_
         ) == [1, 1]
 
 
+@pytest.mark.cluster
 def test_a_chunk_whose_worker_dies_is_run_again(tmp_path, dask_processes):
     # 64 chunks of 4 cases of 60 s: a chunk takes several times what finding and killing the
     # worker does, so chunks are still queued when it dies.
@@ -769,6 +772,7 @@ def test_a_chunk_whose_worker_dies_is_run_again(tmp_path, dask_processes):
     assert not list(tmp_path.glob("**/.*"))
 
 
+@pytest.mark.cluster
 def test_a_scheduler_killed_mid_study_is_one_line_and_resume_on_a_new_one_finishes(tmp_path):
     # Issue 32, fault 2: the cluster's failure, not ours: exit 2 (as for an unreachable
     # scheduler), one line naming --resume, none of dask's log.
@@ -814,6 +818,7 @@ def test_a_scheduler_killed_mid_study_is_one_line_and_resume_on_a_new_one_finish
         assert table["final_theta"][number] == expected["theta"][-1]
 
 
+@pytest.mark.cluster
 @pytest.mark.skipif(not hasattr(signal, "SIGSTOP"), reason="no SIGSTOP on this platform")
 def test_a_worker_stopped_mid_study_and_continued_after_an_overwrite_changes_nothing(tmp_path, monkeypatch):
     # Issue 32, fault 1 with the real fault: a worker (no nanny) stopped with SIGSTOP mid-study;
@@ -981,6 +986,7 @@ def network_namespace():
 
 # The scheduler listens on the namespaces' link, off the loopback, on plain TCP: the sweep warns so.
 @pytest.mark.filterwarnings("ignore::pendulum_fmu.UnencryptedScheduler")
+@pytest.mark.cluster
 def test_a_workers_link_cut_mid_study_changes_nothing(tmp_path, monkeypatch, network_namespace):
     # Issue 32, a fault survived: the link of a worker on another host cut while it computes a
     # chunk, for longer than the scheduler waits for a silent worker, then restored.
@@ -1002,6 +1008,7 @@ def test_a_workers_link_cut_mid_study_changes_nothing(tmp_path, monkeypatch, net
     _assert_every_case_once(tmp_path, FAULT_TORQUES, 300.0, stride=1000)
 
 
+@pytest.mark.cluster
 @pytest.mark.skipif(not hasattr(signal, "SIGSTOP"), reason="no SIGSTOP on this platform")
 def test_a_worker_stopped_mid_study_under_a_nanny_changes_nothing(tmp_path, monkeypatch):
     # Issue 32, a fault survived: a worker (the process its nanny started) stopped while it
@@ -1047,6 +1054,7 @@ def small_disk(tmp_path):
         subprocess.run(["umount", "-l", str(disk)], check=True)
 
 
+@pytest.mark.cluster
 def test_a_disk_filling_mid_study_is_one_line_and_resume_finishes_it(small_disk):
     # Issue 32, a fault survived: the output's disk fills while the workers write. One line,
     # only whole chunks kept; once space is freed, --resume runs the rest.
@@ -1073,6 +1081,7 @@ def test_a_disk_filling_mid_study_is_one_line_and_resume_finishes_it(small_disk)
     assert not list(folder.glob("**/.*"))
 
 
+@pytest.mark.cluster
 def test_an_unreachable_silent_or_wrong_scheduler_is_one_line_within_the_timeout(tmp_path, capsys):
     closed = f"tcp://127.0.0.1:{benchmarks.scale.free_port()}"
     held = []  # the silent server's connections, open till the test ends
@@ -1130,6 +1139,7 @@ def _sweep_command(output_dir, *arguments):
     return [sys.executable, "-m", "pendulum_fmu", "sweep", "--output-dir", str(output_dir), *arguments]
 
 
+@pytest.mark.cluster
 @pytest.mark.parametrize(
     "signal_number, code, word", [(signal.SIGINT, 130, "interrupted"), (signal.SIGTERM, 143, "terminated")]
 )
@@ -1165,6 +1175,7 @@ def test_a_signal_stops_a_sweep_cleanly(tmp_path, signal_number, code, word):
     assert np.array_equal(trajectories["time"], np.tile(np.arange(601.0), len(cases)))
 
 
+@pytest.mark.cluster
 @pytest.mark.parametrize("delay", [0.3, 0.6, 1.0, 1.5, 2.0, 2.5, 3.0, 4.0])
 def test_ctrl_c_to_the_process_group_is_one_line_whenever_it_comes(tmp_path, delay):
     # As a terminal sends it: to every process of the group, the local cluster's workers too.
@@ -1216,6 +1227,7 @@ def _in_group(pid: int, group: int) -> bool:
         return False
 
 
+@pytest.mark.cluster
 def test_eight_sweeps_into_eight_directories_at_once(tmp_path):
     processes = [
         subprocess.Popen(
@@ -1237,6 +1249,7 @@ def test_eight_sweeps_into_eight_directories_at_once(tmp_path):
             assert table["final_theta"][number] == run["theta"][-1]
 
 
+@pytest.mark.cluster
 def test_a_second_run_into_a_folder_in_use_is_refused_and_the_first_is_whole(tmp_path, capsys):
     first = subprocess.Popen(
         _sweep_command(tmp_path, "--torque", *map(str, range(1, 201)), "--stop-time", "0.5", "--workers", "1"),

@@ -49,14 +49,19 @@ WINDOWS_SYSTEM_DLLS = {"kernel32.dll", "msvcrt.dll"}
 needs_build = pytest.mark.packaging
 
 
-@pytest.fixture(scope="module")
-def wheelhouse(tmp_path_factory):
-    """{platform of fmu_build.PLATFORMS: its wheel}."""
+@pytest.fixture(scope="session")
+def wheelhouse(build_once, checkout_build_lock):
+    """{platform of fmu_build.PLATFORMS: its wheel}, built once per session."""
     try:
         check_tools()
     except WheelhouseError as missing:
         pytest.skip(str(missing))
-    wheels = build_wheels(tmp_path_factory.mktemp("wheelhouse"))
+
+    def built(out: Path) -> list[Path]:
+        with checkout_build_lock:  # python -m build --wheel writes build/ and *.egg-info into the checkout
+            return build_wheels(out)
+
+    wheels = build_once("wheelhouse", built)
     return {target.platform: wheel for target, wheel in zip(WHEELS, wheels, strict=False)}
 
 
@@ -307,6 +312,7 @@ def test_x86_64_wheel_installs_and_simulates_in_a_venv(wheelhouse, x86_64_csv, t
 
 
 @needs_build
+@pytest.mark.qemu
 def test_aarch64_wheel_installs_and_simulates_on_arm64_python_under_qemu(wheelhouse, x86_64_csv, tmp_path):
     try:
         arm64 = Arm64Python()
@@ -357,6 +363,7 @@ def _theta_by_harness(platform: str, wheel: Path, folder: Path) -> np.ndarray:
 
 
 @needs_build
+@pytest.mark.wine
 @pytest.mark.skipif(shutil.which("wine") is None, reason="needs wine (apt-get install wine64)")
 def test_windows_wheels_native_loop_steps_its_fmu_binary_under_wine_as_on_linux(wheelhouse, x86_64_csv, tmp_path):
     windows = _theta_by_harness("win64", wheelhouse["win64"], tmp_path / "win64")
