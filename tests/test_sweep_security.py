@@ -24,6 +24,9 @@ from pendulum_fmu.sweep.client import SchedulerUnreachable, dask_client
 from pendulum_fmu.sweep.security import _on_loopback
 from pendulum_fmu.sweep.store import Store
 
+# Every test here starts a dask cluster of processes, or a scheduler and workers of its own.
+pytestmark = pytest.mark.cluster
+
 I_TOTAL = 20.0 + 40.0 * 0.5**2  # the tutorial's pendulum about its pivot
 STOP_TIME = 0.2
 

@@ -43,6 +43,7 @@ def _verified(capsys, *arguments):
     return status, {check["name"]: check for check in json.loads(capsys.readouterr().out)["checks"]}
 
 
+@pytest.mark.build
 @pytest.mark.skipif(not (ROOT / ".git").exists(), reason="clones the checkout's commit, which needs git")
 def test_two_clones_of_one_commit_build_byte_identical_fmus(tmp_path):
     built = []
@@ -267,6 +268,7 @@ def test_a_kits_reference_naming_a_file_elsewhere_is_refused_before_anything_is_
     assert precious.read_text() == "mine\n"
 
 
+@pytest.mark.build
 def test_the_wheels_zig_built_binary_is_rebuilt_from_its_sources_too(tmp_path, capsys):
     # The wheels carry Linux binaries zig builds for glibc 2.17: verify rebuilds them with zig from PyPI.
     pytest.importorskip("ziglang")
