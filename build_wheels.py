@@ -272,11 +272,11 @@ def build_wheels(output_dir: str | os.PathLike = ROOT / "wheelhouse") -> list[Pa
         _extract_fmu_binaries(base, tmp / "fmus")
         _run([sys.executable, "-m", "wheel", "unpack", "--dest", tmp / "unpacked", base], "wheel unpack")
         [tree] = (tmp / "unpacked").iterdir()
-        for built_here in (tree / "pendulum_fmu").glob("_cs_loop*"):
+        for built_here in (tree / "pendulum_fmu" / "fmu").glob("_cs_loop*"):
             built_here.unlink()
         for target in WHEELS:
             native_loop = compile_native_loop(target.platform, tmp / target.platform, MANYLINUX_GLIBC)
-            placed = Path(shutil.copyfile(native_loop, tree / "pendulum_fmu" / target.native_loop))
+            placed = Path(shutil.copyfile(native_loop, tree / "pendulum_fmu" / "fmu" / target.native_loop))
             normalize_modes(tree)
             packed = tmp / "packed" / target.platform
             packed.mkdir(parents=True)

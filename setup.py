@@ -3,9 +3,9 @@
 - build_py also builds the FMI 2.0 and 3.0 FMUs and the closed loop's PID controller FMU into the
   wheel's pendulum_fmu/data/, from this source tree (a clone or the unpacked sdist), for every
   platform whose compiler is installed.
-- build_ext builds the native co-simulation loop, pendulum_fmu/_cs_loop.c, through the project's
+- build_ext builds the native co-simulation loop, pendulum_fmu/fmu/_cs_loop.c, through the project's
   one build description (CMakeLists.txt, driven by fmu_build/) with this machine's
-  compiler. It is plain C loaded with ctypes (pendulum_fmu/_native_loop.py), not a CPython module:
+  compiler. It is plain C loaded with ctypes (pendulum_fmu/fmu/_native_loop.py), not a CPython module:
   it has the platform's plain name (_cs_loop.so, _cs_loop.pyd) and the wheel is tagged
   py3-none-<platform>, one wheel for every Python 3 on a platform.
 - bdist_wheel --linux-glibc 2.17 has both build the Linux binaries with zig for that oldest glibc
@@ -52,7 +52,7 @@ class BuildPyWithFmu(build_py):
         from fmu_build import build_fmu, build_pid_controller
         from pendulum_fmu import CONTROLLER_FMU_FILE, FMU_FILES, __version__
         from pendulum_fmu._errors import PlatformSkipped
-        from pendulum_fmu._export import fmu_platforms
+        from pendulum_fmu.fmu._export import fmu_platforms
 
         data = Path(self.build_lib, "pendulum_fmu", "data")
         builds = {
@@ -177,7 +177,7 @@ def _linux_glibc(command):
 setup(
     # Declared so that setuptools builds it (in place too) and tags the wheel for a platform;
     # BuildNativeLoop builds it with CMake, not with setuptools' compiler.
-    ext_modules=[Extension("pendulum_fmu._cs_loop", sources=["pendulum_fmu/_cs_loop.c"])],
+    ext_modules=[Extension("pendulum_fmu.fmu._cs_loop", sources=["pendulum_fmu/fmu/_cs_loop.c"])],
     cmdclass={
         "build_py": BuildPyWithFmu,
         "build_ext": BuildNativeLoop,

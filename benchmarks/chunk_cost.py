@@ -25,7 +25,7 @@ import pyarrow.parquet as pq
 from fsspec.implementations.local import LocalFileSystem
 
 from pendulum_fmu import default_fmu
-from pendulum_fmu._time_grid import communication_points
+from pendulum_fmu.signals._time_grid import communication_points
 from pendulum_fmu.sweep import OUTPUTS
 from pendulum_fmu.sweep.store import Store, parquet_options
 from pendulum_fmu.sweep.worker import Task, _runner, run_chunk

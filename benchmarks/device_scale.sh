@@ -6,7 +6,7 @@
 #
 # CARRY holds whl/ (wheels of what the machine lacks: dask, distributed, tornado, zict, tblib,
 # locket, partd, fmpy, lark) and two trees, after/ and before/, each with its dist/Pendulum.fmu
-# and pendulum_fmu/_cs_loop.so built (plain C: any Python of the same processor loads them) and
+# and pendulum_fmu/fmu/_cs_loop.so built (plain C: any Python of the same processor loads them) and
 # this branch's benchmarks/scale.py, so that both are measured alike. CASES: 3-s cases per study;
 # SECONDS: the most each tree may take. Each tree's table goes to $OUT/<tree>.txt (OUT defaults to
 # ./device-out) and is printed last, "after" first, as it matters more.

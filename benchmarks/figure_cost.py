@@ -67,7 +67,7 @@ def sweep_figure(scratch: Path, fmu: Path, torques: int, gravities: int) -> Call
 def comparison_figure(scratch: Path, fmu: Path) -> Callable[[], object]:
     """A call that draws the comparison figure of the FMU against the reference, 3 s at 20 N.m."""
     from pendulum_fmu import reference, simulate
-    from pendulum_fmu._plot import plot_comparison
+    from pendulum_fmu.figures._plot import plot_comparison
 
     runs = {"reference": reference(20.0, stop_time=3.0), "fmu": simulate(20.0, stop_time=3.0, fmu_path=fmu)}
     return lambda: plot_comparison(runs, scratch / "compare.png", "20 N.m from rest")

@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import importlib.util
 
-from pendulum_fmu._instance import open_fmu
-from pendulum_fmu._simulate import run_schedule, simulate
-from pendulum_fmu._torque_schedule import schedule
+from pendulum_fmu.fmu._instance import open_fmu
+from pendulum_fmu.fmu._simulate import run_schedule, simulate
+from pendulum_fmu.signals._torque_schedule import schedule
 
 from .builds import BuiltFmu
 from .report import Row, microseconds, ratio, skipped

@@ -15,9 +15,9 @@ import tempfile
 import time
 from pathlib import Path
 
-from pendulum_fmu._call_record import read_calls
 from pendulum_fmu._errors import InvalidInput
 from pendulum_fmu._received_files import MAX_LINE_CHARS
+from pendulum_fmu.judging._call_record import read_calls
 
 TOTAL_BYTES = 20 * 2**20
 MARKER_PREFIX = '[pendulum-calls] instance="" fmi2A('

@@ -1,5 +1,5 @@
 """Masters written as a vendor would, on fmpy's FMU2Slave and FMU2Model, that run a scenario of
-the kit (pendulum_fmu._scenarios) and write NAME_out.csv: a correct one, and ones that make each
+the kit (pendulum_fmu.scenarios._scenarios) and write NAME_out.csv: a correct one, and ones that make each
 mistake the judge names on purpose.
 
 tests/test_scenarios.py and tests/test_judge.py run them; this prints what the judge says of
@@ -255,9 +255,9 @@ def main() -> int:
     """Every wrong master of WRONG_MASTERS on a fresh kit, and what the judge says of it."""
     import tempfile
 
-    from pendulum_fmu._judge import judge
-    from pendulum_fmu._scenario_settings import read_settings
-    from pendulum_fmu._scenarios import write_scenarios
+    from pendulum_fmu.judging._judge import judge
+    from pendulum_fmu.scenarios._scenario_settings import read_settings
+    from pendulum_fmu.scenarios._scenarios import write_scenarios
 
     # residual: of the diagnosis (for integration error without a variant, the difference
     # itself); others: the smallest residual of every other candidate; both as fractions of

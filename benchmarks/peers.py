@@ -9,8 +9,8 @@ from __future__ import annotations
 import importlib.util
 from pathlib import Path
 
-from pendulum_fmu._simulate import simulate
-from pendulum_fmu._torque_schedule import schedule
+from pendulum_fmu.fmu._simulate import simulate
+from pendulum_fmu.signals._torque_schedule import schedule
 
 from .builds import BuiltFmu, unzipped
 from .fmpy_loop import timed_tutorial_loop

@@ -8,11 +8,11 @@ from __future__ import annotations
 import numpy as np
 from fmpy.fmi2 import FMU2Slave
 
-from pendulum_fmu import _native_loop as cs_loop, _results as results
-from pendulum_fmu._instance import open_fmu
-from pendulum_fmu._parameters import value_reference
-from pendulum_fmu._simulate import run_schedule, run_schedule_python
-from pendulum_fmu._torque_schedule import TorqueSchedule, schedule
+from pendulum_fmu.fmu import _native_loop as cs_loop, _results as results
+from pendulum_fmu.fmu._instance import open_fmu
+from pendulum_fmu.fmu._parameters import value_reference
+from pendulum_fmu.fmu._simulate import run_schedule, run_schedule_python
+from pendulum_fmu.signals._torque_schedule import TorqueSchedule, schedule
 
 from . import tutorial
 from .builds import BuiltFmu

@@ -194,7 +194,7 @@ def measure_client(
 
 def simulate_repeatedly(fmu: str, cases: int) -> None:
     """Run in a control process: `cases` 3-second cases through simulate(), no dask, no files."""
-    from pendulum_fmu._simulate import simulate
+    from pendulum_fmu.fmu._simulate import simulate
 
     for case in range(cases):
         simulate(5.0 + case % 30, stop_time=3.0, fmu_path=fmu)

@@ -14,8 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
-from pendulum_fmu._reference import reference
-from pendulum_fmu._simulate import simulate
+from pendulum_fmu.fmu._simulate import simulate
+from pendulum_fmu.oracle._reference import reference
 
 
 def random_step_rows(rng: np.random.Generator, stop_time: float = 4.0, running_sum: bool = False) -> list[tuple]:

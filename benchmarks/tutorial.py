@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pendulum_fmu._reference import reference
+from pendulum_fmu.oracle._reference import reference
 
 TORQUE = 20.0  # N.m, held from t = 0 with the pendulum at rest at theta = 0, gravity on
 STOP_TIME = 3.0  # s

@@ -116,7 +116,7 @@ def merged_binary(slices: list[Path], out_file: Path) -> Path:
 
 
 def compile_native_loop(platform: str, out_dir: str | os.PathLike, linux_glibc: str | None = None) -> Path:
-    """Build the native co-simulation loop (pendulum_fmu/_cs_loop.c) for a platform of PLATFORMS
+    """Build the native co-simulation loop (pendulum_fmu/fmu/_cs_loop.c) for a platform of PLATFORMS
     into out_dir, named as that platform's Python loads it (_cs_loop.so, or _cs_loop.pyd on
     Windows); for darwin64 one universal binary.
 

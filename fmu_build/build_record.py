@@ -1,4 +1,4 @@
-"""What the build records in an FMU (pendulum_fmu/_build_record.py): the commit and the time its
+"""What the build records in an FMU (pendulum_fmu/fmu/_build_record.py): the commit and the time its
 entries carry, and for each binary the toolchain and the commands that make it from the FMU's own
 sources/, read from the CMake build that made it.
 
@@ -21,7 +21,7 @@ import shlex
 import subprocess
 from pathlib import Path
 
-from pendulum_fmu._build_record import OBJECTS, ZIP_EPOCH
+from pendulum_fmu.fmu._build_record import OBJECTS, ZIP_EPOCH
 
 from .sources import ROOT
 

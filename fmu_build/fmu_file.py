@@ -16,8 +16,8 @@ from fmpy import read_model_description
 
 from pendulum_fmu import __version__
 from pendulum_fmu._atomic_files import check_writable, replacing_path
-from pendulum_fmu._build_record import RECORD_FORMAT, with_record, write_archive
 from pendulum_fmu._errors import BuildError
+from pendulum_fmu.fmu._build_record import RECORD_FORMAT, with_record, write_archive
 
 from . import fmi3
 from .binaries import cmake_build, merged_binary

@@ -1,6 +1,8 @@
 """A torque-driven pendulum as an FMI 2.0 Co-Simulation FMU, and the tools to compare it.
 
-The API is this package's names; its modules are private (``_simulate``, ``_judge``, ...). Each
+The API is this package's names. Its folders are its jobs, bottom up: signals/, fmu/, oracle/,
+engines/, figures/, sweep/, comparing/, scenarios/, judging/, ssp/, cli/ (each one's docstring
+says what it may import; docs/layout.md draws them); the modules in them are private. Each
 name is imported from its module on first use, so that ``import pendulum_fmu`` loads neither
 numpy, fmpy, scipy, matplotlib nor dask::
 
@@ -17,34 +19,34 @@ __version__ = "0.1.0"
 # The public name -> the private module that holds it, imported on first use (__getattr__ below).
 _LAZY = {
     # running the FMU
-    "simulate": "_simulate",
-    "open_fmu": "_instance",
-    "FmuError": "_instance",
-    "fmu_model": "_model",
-    "FmuModel": "_model",
-    "FmuInstance": "_instance",
-    "FmuFileError": "_model",
-    "total_inertia": "_parameters",
+    "simulate": "fmu._simulate",
+    "open_fmu": "fmu._instance",
+    "FmuError": "fmu._instance",
+    "fmu_model": "fmu._model",
+    "FmuModel": "fmu._model",
+    "FmuInstance": "fmu._instance",
+    "FmuFileError": "fmu._model",
+    "total_inertia": "fmu._parameters",
     # torque signals
-    "schedule": "_torque_schedule",
-    "TorqueSchedule": "_torque_schedule",
-    "write_torque_csv": "_torque_schedule",
-    "TorqueFileError": "_torque_csv",
+    "schedule": "signals._torque_schedule",
+    "TorqueSchedule": "signals._torque_schedule",
+    "write_torque_csv": "signals._torque_schedule",
+    "TorqueFileError": "signals._torque_csv",
     # references and comparisons
-    "reference": "_reference",
-    "reference_schedule": "_reference",
-    "compare": "_compare",
-    "Comparison": "_compare",
-    "format_table": "_compare",
-    "list_tools": "_compare_tools",
-    "plot_overlay": "_plot",
+    "reference": "oracle._reference",
+    "reference_schedule": "oracle._reference",
+    "compare": "comparing._compare",
+    "Comparison": "comparing._compare",
+    "format_table": "comparing._compare",
+    "list_tools": "comparing._compare_tools",
+    "plot_overlay": "figures._plot",
     # judging a master's result, and the kit of scenarios to judge
-    "judge": "_judge",
-    "judge_kit": "_judge",
-    "Judgement": "_judge",
-    "ResultFileError": "_result_file",
-    "write_scenarios": "_scenarios",
-    "read_settings": "_scenario_settings",
+    "judge": "judging._judge",
+    "judge_kit": "judging._judge",
+    "Judgement": "judging._judge",
+    "ResultFileError": "judging._result_file",
+    "write_scenarios": "scenarios._scenarios",
+    "read_settings": "scenarios._scenario_settings",
     # sweeps
     "run_sweep": "sweep",
     "sweep_grid": "sweep",
@@ -52,9 +54,9 @@ _LAZY = {
     "SweepResult": "sweep",
     "tls_files": "sweep",
     # what a user hands on: the FMU, the closed loop, the SSP
-    "export_fmu": "_export",
-    "create_closed_loop_fmu": "_closed_loop",
-    "export_ssp": "_ssp",
+    "export_fmu": "fmu._export",
+    "create_closed_loop_fmu": "ssp._closed_loop",
+    "export_ssp": "ssp._ssp",
     # errors and warnings
     "PendulumFmuError": "_errors",
     "InvalidInput": "_errors",

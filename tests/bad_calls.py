@@ -21,7 +21,7 @@ if __name__ == "__main__":  # a script documents the clone it is in, whatever pa
 from fmpy.fmi2 import fmi2CallbackFunctions
 from fmpy.fmi3 import fmi3LogMessageCallback
 
-from pendulum_fmu._instance import MessageLog
+from pendulum_fmu.fmu._instance import MessageLog
 
 OK, WARNING, DISCARD, ERROR = 0, 1, 2, 3
 STATUS_NAMES = ["fmi2OK", "fmi2Warning", "fmi2Discard", "fmi2Error", "fmi2Fatal", "fmi2Pending"]

@@ -103,7 +103,7 @@ def _zip_entries(entries: list[tuple[str | zipfile.ZipInfo, bytes | str]], level
 
 def _ssp(pendulum_set: str) -> bytes:
     """A closed loop's SSP whose pendulum parameter set is pendulum_set."""
-    from pendulum_fmu._ssp import parameter_set_xml, system_structure_xml
+    from pendulum_fmu.ssp._ssp import parameter_set_xml, system_structure_xml
 
     return _zip(
         {

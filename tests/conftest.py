@@ -65,8 +65,8 @@ def _checkout_fmus_built_once(session_folder):
     A build that fails here fails again in the tests that need it, which say so.
     """
     from pendulum_fmu import FMU_FILES, default_fmu
-    from pendulum_fmu._closed_loop import controller_fmu
     from pendulum_fmu._errors import BuildError
+    from pendulum_fmu.ssp._closed_loop import controller_fmu
 
     with FileLock(session_folder / "checkout-fmus.lock"), contextlib.suppress(BuildError):
         for fmi_version in FMU_FILES:

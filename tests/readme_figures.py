@@ -85,7 +85,7 @@ def _wrapped(text: str) -> str:
 
 def sweeps() -> str:
     """The sweep's limits and the figure's kinds, from the package."""
-    from pendulum_fmu._plot import QUANTILE_BANDS
+    from pendulum_fmu.figures._plot import QUANTILE_BANDS
     from pendulum_fmu.sweep import DEFAULT_MAX_CASES
     from pendulum_fmu.sweep.figure import LINES_UP_TO
 

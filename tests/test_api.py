@@ -44,7 +44,7 @@ def test_importing_the_sweep_looks_no_fmu_up():
     # Every FMU the package reads is parsed by _model._read, and the default one is found by
     # pendulum_fmu.default_fmu: both refuse, so a lookup at import fails the import.
     loaded = _loaded_after(
-        "import pendulum_fmu, pendulum_fmu._model as model\n"
+        "import pendulum_fmu, pendulum_fmu.fmu._model as model\n"
         "def refuse(*args, **kwargs):\n"
         "    raise AssertionError('an FMU was looked up')\n"
         "pendulum_fmu.default_fmu = model._read = refuse\n"
@@ -63,7 +63,7 @@ def test_the_command_lines_simulate_loads_neither_the_sweep_nor_matplotlib():
     loaded = _loaded_after("from pendulum_fmu.cli import main\nmain(['simulate', '--torque', '20'])")
     assert "matplotlib" not in loaded["top"] and "dask" not in loaded["top"]
     assert not [name for name in loaded["ours"] if name.startswith("pendulum_fmu.sweep")]
-    assert "pendulum_fmu._plot" not in loaded["ours"]
+    assert "pendulum_fmu.figures._plot" not in loaded["ours"]
     # It still simulated: the final angle it printed against the scipy reference.
     theta = float(loaded["printed"][0].split("theta = ")[1].split(" rad")[0])
     assert theta == pytest.approx(pendulum_fmu.reference(20.0)["theta"][-1], abs=1e-9)
@@ -83,7 +83,7 @@ def test_the_names_at_the_top_are_the_api():
 
 def test_a_name_that_is_also_a_module_stays_the_function_once_the_module_is_imported():
     loaded = _loaded_after(
-        "import pendulum_fmu._simulate, pendulum_fmu._judge\n"
+        "import pendulum_fmu.fmu._simulate, pendulum_fmu.judging._judge\n"
         "import pendulum_fmu\n"
         "print(type(pendulum_fmu.simulate).__name__, type(pendulum_fmu.judge).__name__)"
     )

@@ -11,8 +11,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pendulum_fmu._reference import reference
 from pendulum_fmu.cli import main
+from pendulum_fmu.oracle._reference import reference
 from tests.arm64_python import ROOT, Arm64Python, Unavailable
 
 pytestmark = [pytest.mark.packaging, pytest.mark.qemu]

@@ -19,10 +19,10 @@ from fmpy import read_model_description
 
 from fmu_build import MODEL_DESCRIPTION, build_fmu
 from pendulum_fmu import __version__
-from pendulum_fmu._parameters import default_parameters
-from pendulum_fmu._reference import reference
-from pendulum_fmu._simulate import simulate
 from pendulum_fmu.cli import main
+from pendulum_fmu.fmu._parameters import default_parameters
+from pendulum_fmu.fmu._simulate import simulate
+from pendulum_fmu.oracle._reference import reference
 
 ROOT = Path(__file__).resolve().parent.parent
 ENVIRONMENT = {name: value for name, value in os.environ.items() if name != "PYTHONPATH"}

@@ -18,8 +18,8 @@ import pytest
 from fmpy import extract, read_model_description, simulate_fmu
 from fmpy.fmi2 import FMU2Slave
 
-from pendulum_fmu._call_judge import IntendedRun, judge_calls
 from pendulum_fmu.cli import main
+from pendulum_fmu.judging._call_judge import IntendedRun, judge_calls
 
 STEP = 1e-3
 N_STEPS = 10

@@ -9,8 +9,8 @@ import pyarrow.parquet as pq
 import pytest
 
 from pendulum_fmu._errors import InvalidInput
-from pendulum_fmu._reference import reference
 from pendulum_fmu.cli import build_parser, main
+from pendulum_fmu.oracle._reference import reference
 
 I_TOTAL = 30.0
 
@@ -103,14 +103,14 @@ def test_a_users_error_is_one_line_and_anything_else_an_internal_error(monkeypat
     def refuse(*arguments, **options):
         raise InvalidInput("stop time -1 must be after start time 0")
 
-    monkeypatch.setattr(import_module("pendulum_fmu._simulate"), "simulate", refuse)
+    monkeypatch.setattr(import_module("pendulum_fmu.fmu._simulate"), "simulate", refuse)
     assert main(["simulate", "--torque", "1"]) == 2
     assert capsys.readouterr().err == "pendulum-fmu simulate: error: stop time -1 must be after start time 0\n"
 
     def fail(*arguments, **options):
         raise ValueError("a bug of ours")  # a ValueError, but no user's error
 
-    monkeypatch.setattr(import_module("pendulum_fmu._simulate"), "simulate", fail)
+    monkeypatch.setattr(import_module("pendulum_fmu.fmu._simulate"), "simulate", fail)
     assert main(["simulate", "--torque", "1"]) == 3
     err = capsys.readouterr().err
     assert err.startswith("pendulum-fmu simulate: internal error: ValueError: a bug of ours") and "report it" in err

@@ -4,7 +4,7 @@ import numpy as np
 from fmpy import simulate_fmu
 from fmpy.validation import validate_fmu
 
-from pendulum_fmu._closed_loop import create_closed_loop_fmu, sampled_loop_reference
+from pendulum_fmu.ssp._closed_loop import create_closed_loop_fmu, sampled_loop_reference
 
 
 def test_controller_fmu_is_valid(pid_controller):

@@ -11,13 +11,13 @@ import numpy as np
 import pytest
 
 from fmu_build import MODEL_DESCRIPTION, PENDULUM_DIR, SOURCE_DIR, build_fmu
-from pendulum_fmu import _compare_tools as compare_tools
-from pendulum_fmu._compare import run_tools
 from pendulum_fmu._errors import NotComputed, Skipped
-from pendulum_fmu._mapped_fmu import MapError, Mapped, MappedFmu, parse_map
-from pendulum_fmu._reference import reference_schedule
-from pendulum_fmu._torque_schedule import schedule
 from pendulum_fmu.cli import main
+from pendulum_fmu.comparing import _compare_tools as compare_tools
+from pendulum_fmu.comparing._compare import run_tools
+from pendulum_fmu.comparing._mapped_fmu import MapError, Mapped, MappedFmu, parse_map
+from pendulum_fmu.oracle._reference import reference_schedule
+from pendulum_fmu.signals._torque_schedule import schedule
 
 RENAMES = {
     "torque": "u",

@@ -11,9 +11,9 @@ from fmpy.cross_check.validate_vendor_repo import read_csv, validate_repo
 from fmpy.util import read_ref_opt_file
 
 from pendulum_fmu import __version__
-from pendulum_fmu._reference import reference
-from pendulum_fmu._torque_csv import read_torque_csv
 from pendulum_fmu.cli import main
+from pendulum_fmu.oracle._reference import reference
+from pendulum_fmu.signals._torque_csv import read_torque_csv
 
 
 @pytest.fixture(scope="module")

@@ -7,16 +7,16 @@ from importlib import import_module
 import numpy as np
 import pytest
 
-from pendulum_fmu import _native_loop as cs_loop
-from pendulum_fmu._instance import FmuError, open_fmu
-from pendulum_fmu._parameters import value_reference
-from pendulum_fmu._reference import reference_schedule
-from pendulum_fmu._torque_csv import TorqueTable
-from pendulum_fmu._torque_schedule import schedule
+from pendulum_fmu.fmu import _native_loop as cs_loop
+from pendulum_fmu.fmu._instance import FmuError, open_fmu
+from pendulum_fmu.fmu._parameters import value_reference
+from pendulum_fmu.oracle._reference import reference_schedule
+from pendulum_fmu.signals._torque_csv import TorqueTable
+from pendulum_fmu.signals._torque_schedule import schedule
 from pendulum_fmu.sweep import OUTPUTS
 
 # The module; the package's attribute of that name is its function.
-simulate = import_module("pendulum_fmu._simulate")
+simulate = import_module("pendulum_fmu.fmu._simulate")
 
 
 def test_the_native_loop_is_built():

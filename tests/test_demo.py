@@ -9,7 +9,7 @@ from pendulum_fmu.cli import main
 
 
 def test_demo_runs_the_tutorial_end_to_end(tmp_path, capsys, monkeypatch):
-    from pendulum_fmu import _plot as plot
+    from pendulum_fmu.figures import _plot as plot
 
     texts, finish = [], plot._finish
 

@@ -8,10 +8,10 @@ shares no code with the adapters.
 import numpy as np
 import pytest
 
-from pendulum_fmu._reference import reference_schedule
-from pendulum_fmu._simulate import resolve_parameters
-from pendulum_fmu._torque_schedule import schedule
 from pendulum_fmu.engines import ToolCannotRamp
+from pendulum_fmu.fmu._simulate import resolve_parameters
+from pendulum_fmu.oracle._reference import reference_schedule
+from pendulum_fmu.signals._torque_schedule import schedule
 
 THETA0, OMEGA0 = 0.3, -0.5
 
@@ -222,7 +222,7 @@ def test_pybullet_velocity_limit_is_raised():
 
 def off_grid_plan():
     """A CSV jump off the 1 ms grid and a short last step: communication steps of three sizes."""
-    from pendulum_fmu._torque_csv import TorqueTable
+    from pendulum_fmu.signals._torque_csv import TorqueTable
 
     table = TorqueTable(np.array([0.0, 0.0305, 0.0305, 0.1003]), np.array([40.0, 40.0, -60.0, -60.0]))
     plan = schedule(table, step_size=1e-3)

@@ -22,7 +22,7 @@ ENGINES = {
 def test_every_exception_class_of_the_package_is_a_user_error():
     defined = {}
     for module in pkgutil.walk_packages(pendulum_fmu.__path__, "pendulum_fmu."):
-        if module.name in ("pendulum_fmu.__main__", "pendulum_fmu._cs_loop") or (
+        if module.name in ("pendulum_fmu.__main__", "pendulum_fmu.fmu._cs_loop") or (
             module.name in ENGINES and importlib.util.find_spec(ENGINES[module.name]) is None
         ):
             continue
@@ -34,9 +34,9 @@ def test_every_exception_class_of_the_package_is_a_user_error():
             ):
                 defined[f"{value.__module__}.{name}"] = value
     assert {
-        "pendulum_fmu._torque_csv.TorqueFileError",
-        "pendulum_fmu._instance.FmuError",
-        "pendulum_fmu._model.FmuFileError",
+        "pendulum_fmu.signals._torque_csv.TorqueFileError",
+        "pendulum_fmu.fmu._instance.FmuError",
+        "pendulum_fmu.fmu._model.FmuFileError",
         "pendulum_fmu._errors.BuildError",
         "pendulum_fmu.sweep.store.InUse",
     } <= set(defined)

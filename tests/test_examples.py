@@ -6,8 +6,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pendulum_fmu._reference import reference, reference_schedule
-from pendulum_fmu._torque_schedule import TorqueSchedule
+from pendulum_fmu.oracle._reference import reference, reference_schedule
+from pendulum_fmu.signals._torque_schedule import TorqueSchedule
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 

@@ -7,8 +7,8 @@ import pytest
 
 from fmu_build import available_platforms
 from pendulum_fmu import default_fmu
-from pendulum_fmu._export import FmuExists, export_fmu
 from pendulum_fmu.cli import main
+from pendulum_fmu.fmu._export import FmuExists, export_fmu
 
 # Each FMI 2.0 platform's binary, and its folders in an FMI 3.0 FMU (the standards' own names).
 LIBRARY = {

@@ -16,12 +16,12 @@ from fmpy.fmi3 import FMU3Model
 from fmpy.validation import validate_fmu
 
 from fmu_build import MODEL_DESCRIPTION
-from pendulum_fmu._instance import open_fmu
-from pendulum_fmu._parameters import default_parameters, total_inertia
-from pendulum_fmu._reference import reference, reference_schedule
-from pendulum_fmu._simulate import run_schedule, simulate
-from pendulum_fmu._torque_schedule import TorqueSchedule, schedule
 from pendulum_fmu.cli import main
+from pendulum_fmu.fmu._instance import open_fmu
+from pendulum_fmu.fmu._parameters import default_parameters, total_inertia
+from pendulum_fmu.fmu._simulate import run_schedule, simulate
+from pendulum_fmu.oracle._reference import reference, reference_schedule
+from pendulum_fmu.signals._torque_schedule import TorqueSchedule, schedule
 
 TORQUE, THETA, OMEGA, ALPHA, MASS, DAMPING = 0, 1, 2, 3, 4, 8
 TIME = 10  # the independent variable's value reference in the FMI 3.0 description
@@ -275,7 +275,7 @@ def test_fmpy_validate_on_the_command_line(fmu3):
 def test_compare_and_sweep_take_the_fmi3_fmu(fmu, fmu3, tmp_path):
     import pyarrow.parquet as pq
 
-    from pendulum_fmu._compare import run_tools
+    from pendulum_fmu.comparing._compare import run_tools
     from pendulum_fmu.sweep import Study, run_sweep
 
     plan = schedule(lambda t: 20.0 if t < 0.5 else -5.0, stop_time=1.0)

@@ -8,7 +8,7 @@ import zipfile
 import numpy as np
 import pytest
 
-from pendulum_fmu._simulate import simulate
+from pendulum_fmu.fmu._simulate import simulate
 
 
 @pytest.mark.skipif(shutil.which("cmake") is None, reason="fmpy compile needs cmake")

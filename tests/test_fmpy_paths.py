@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 from fmpy import simulate_fmu
 
-from pendulum_fmu._reference import reference
-from pendulum_fmu._simulate import simulate
+from pendulum_fmu.fmu._simulate import simulate
+from pendulum_fmu.oracle._reference import reference
 
 
 def write(path, rows):

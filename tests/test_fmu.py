@@ -9,11 +9,11 @@ import pytest
 from fmpy import read_model_description
 from fmpy.validation import validate_fmu
 
-from pendulum_fmu._instance import FmuError, open_fmu
-from pendulum_fmu._parameters import default_parameters, total_inertia
-from pendulum_fmu._reference import reference
-from pendulum_fmu._simulate import run_schedule, simulate
-from pendulum_fmu._torque_schedule import schedule
+from pendulum_fmu.fmu._instance import FmuError, open_fmu
+from pendulum_fmu.fmu._parameters import default_parameters, total_inertia
+from pendulum_fmu.fmu._simulate import run_schedule, simulate
+from pendulum_fmu.oracle._reference import reference
+from pendulum_fmu.signals._torque_schedule import schedule
 
 I_TOTAL = 20.0 + 40.0 * 0.5**2  # the tutorial's pendulum about its pivot
 THETA, OMEGA, ALPHA, TORQUE = 1, 2, 3, 0

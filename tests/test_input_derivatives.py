@@ -11,9 +11,9 @@ from fmpy import read_model_description
 from fmpy.fmi2 import FMU2Slave
 from scipy.integrate import solve_ivp
 
-from pendulum_fmu._closed_loop import controller_defaults, sampled_loop_reference
-from pendulum_fmu._instance import MessageLog, _unzipped, open_fmu
-from pendulum_fmu._parameters import default_parameters, total_inertia
+from pendulum_fmu.fmu._instance import MessageLog, _unzipped, open_fmu
+from pendulum_fmu.fmu._parameters import default_parameters, total_inertia
+from pendulum_fmu.ssp._closed_loop import controller_defaults, sampled_loop_reference
 
 TORQUE, THETA, OMEGA = 0, 1, 2
 I_TOTAL = total_inertia(default_parameters())

@@ -10,7 +10,10 @@ import numpy as np
 import pytest
 
 from benchmarks.masters import WRONG_MASTERS, run
-from pendulum_fmu._diagnoses import (
+from pendulum_fmu.cli import main
+from pendulum_fmu.figures._plot import _log_difference
+from pendulum_fmu.fmu._parameters import total_inertia
+from pendulum_fmu.judging._diagnoses import (
     AGREES,
     DRIFT,
     EARLY,
@@ -23,13 +26,10 @@ from pendulum_fmu._diagnoses import (
     NOT_RESTORED,
     UNEXPLAINED,
 )
-from pendulum_fmu._judge import judge
-from pendulum_fmu._parameters import total_inertia
-from pendulum_fmu._plot import _log_difference
-from pendulum_fmu._result_file import ResultFileError, read_result
-from pendulum_fmu._scenario_settings import KIT_FMU, read_settings
-from pendulum_fmu._scenarios import write_scenarios
-from pendulum_fmu.cli import main
+from pendulum_fmu.judging._judge import judge
+from pendulum_fmu.judging._result_file import ResultFileError, read_result
+from pendulum_fmu.scenarios._scenario_settings import KIT_FMU, read_settings
+from pendulum_fmu.scenarios._scenarios import write_scenarios
 
 
 @pytest.fixture(scope="module")

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 from fmpy import read_model_description
 
-from pendulum_fmu._closed_loop import WIRES, sampled_loop_reference
-from pendulum_fmu._reference import reference
+from pendulum_fmu.oracle._reference import reference
+from pendulum_fmu.ssp._closed_loop import WIRES, sampled_loop_reference
 
 libcosim = pytest.importorskip("libcosimpy", reason="libcosimpy not installed: pip install -e '.[test]'")
 from libcosimpy.CosimEnums import CosimVariableType

@@ -7,8 +7,8 @@ import pytest
 from fmpy import extract, read_model_description, simulate_fmu
 from fmpy.fmi2 import FMU2Model
 
-from pendulum_fmu._parameters import default_parameters, total_inertia
-from pendulum_fmu._simulate import simulate
+from pendulum_fmu.fmu._parameters import default_parameters, total_inertia
+from pendulum_fmu.fmu._simulate import simulate
 
 THETA, OMEGA, ALPHA, TORQUE, DAMPING = 1, 2, 3, 0, 8
 

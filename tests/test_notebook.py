@@ -5,7 +5,7 @@ from pathlib import Path
 
 import pytest
 
-from pendulum_fmu._compare_tools import KINDS, installed
+from pendulum_fmu.comparing._compare_tools import KINDS, installed
 
 nbformat = pytest.importorskip("nbformat")
 nbclient = pytest.importorskip("nbclient")
@@ -36,9 +36,9 @@ def test_engines_notebook_runs_with_the_tools_installed(tmp_path):
     notebook.cells.insert(
         1,
         nbformat.v4.new_code_cell(
-            "import pendulum_fmu._compare_tools\n"
-            "_installed = pendulum_fmu._compare_tools.installed\n"
-            "pendulum_fmu._compare_tools.installed = lambda name: name != 'opensim' and _installed(name)"
+            "import pendulum_fmu.comparing._compare_tools\n"
+            "_installed = pendulum_fmu.comparing._compare_tools.installed\n"
+            "pendulum_fmu.comparing._compare_tools.installed = lambda name: name != 'opensim' and _installed(name)"
         ),
     )
     nbclient.NotebookClient(

@@ -5,8 +5,8 @@ import re
 import numpy as np
 import pytest
 
-from pendulum_fmu._compare import compare
 from pendulum_fmu.cli import main
+from pendulum_fmu.comparing._compare import compare
 from pendulum_fmu.engines.opensim import _build_pendulum_model, _import_opensim, opensim_simulate
 
 try:

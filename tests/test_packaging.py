@@ -29,8 +29,8 @@ from packaging.requirements import Requirement
 from readme_figures import measured_figures
 
 from pendulum_fmu import CONTROLLER_FMU_FILE, FMU_FILES, __version__
-from pendulum_fmu._closed_loop import sampled_loop_reference
-from pendulum_fmu._reference import reference
+from pendulum_fmu.oracle._reference import reference
+from pendulum_fmu.ssp._closed_loop import sampled_loop_reference
 
 pytestmark = pytest.mark.packaging
 
@@ -170,7 +170,9 @@ def test_installed_package_runs_from_an_empty_folder(installed, tmp_path):
     )
     assert fmu == package / "data" / "Pendulum.fmu"
     assert read_model_description(str(fmu)).generationTool == f"pendulum_fmu {__version__}"
-    _run([python, "-c", "from pendulum_fmu import _native_loop as cs_loop; assert cs_loop.available()"], cwd=tmp_path)
+    _run(
+        [python, "-c", "from pendulum_fmu.fmu import _native_loop as cs_loop; assert cs_loop.available()"], cwd=tmp_path
+    )
 
     expected = reference(20.0, stop_time=3.0, step_size=1e-3)
     _run([cli, "simulate", "--torque", "20", "--output", "simulated.csv"], cwd=tmp_path)

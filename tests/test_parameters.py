@@ -12,13 +12,13 @@ import numpy as np
 import pytest
 from bad_inputs import write_files
 
-from pendulum_fmu._compare_tools import KINDS, parse_tools
-from pendulum_fmu._cross_check import write_cross_check
-from pendulum_fmu._model import FmuFileError
-from pendulum_fmu._parameters import default_parameters, model_description
-from pendulum_fmu._reference import reference
-from pendulum_fmu._simulate import simulate
-from pendulum_fmu._torque_schedule import schedule
+from pendulum_fmu.comparing._compare_tools import KINDS, parse_tools
+from pendulum_fmu.fmu._cross_check import write_cross_check
+from pendulum_fmu.fmu._model import FmuFileError
+from pendulum_fmu.fmu._parameters import default_parameters, model_description
+from pendulum_fmu.fmu._simulate import simulate
+from pendulum_fmu.oracle._reference import reference
+from pendulum_fmu.signals._torque_schedule import schedule
 
 BAD = [
     ({"mass": 0.0}, "mass must be > 0"),

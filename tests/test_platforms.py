@@ -26,8 +26,8 @@ import fmu_build
 from benchmarks.builds import build_bare_master, build_step_master
 from build_wheels import MANYLINUX_GLIBC
 from fmu_build import FMI_VERSIONS, PLATFORMS, BuildError, PlatformSkipped, build_fmu, find_zig
-from pendulum_fmu._reference import reference
 from pendulum_fmu.cli import main
+from pendulum_fmu.oracle._reference import reference
 
 STEPS, STEP_SIZE = 3000, 1e-3  # the tutorial case: 20 N.m, gravity on, 3 s
 POW_INPUTS = 1_000_000

@@ -6,9 +6,10 @@ import numpy as np
 import pytest
 from matplotlib import rcParams
 
-from pendulum_fmu import _plot as plot, _results as results
-from pendulum_fmu._reference import reference
 from pendulum_fmu.cli import main
+from pendulum_fmu.figures import _plot as plot
+from pendulum_fmu.fmu import _results as results
+from pendulum_fmu.oracle._reference import reference
 
 
 @pytest.fixture

@@ -10,8 +10,8 @@ import re
 
 import pytest
 
-from pendulum_fmu._call_record import _ARGUMENT, _master_call_parts
 from pendulum_fmu._received_files import bounded_lines, check_lines
+from pendulum_fmu.judging._call_record import _ARGUMENT, _master_call_parts
 
 # What _call_record.py searched a master's log with before: the reference.
 BACKTRACKING_CALL = re.compile(r"(?P<function>fmi[23][A-Z]\w+)\((?P<arguments>.*)\)(?:\s*->\s*(?P<result>\S+))?\s*$")

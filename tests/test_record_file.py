@@ -17,7 +17,7 @@ from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Model, FMU2Slave
 from fmpy.fmi3 import FMU3Model, FMU3Slave
 
-from pendulum_fmu._call_record import MARKER, read_calls
+from pendulum_fmu.judging._call_record import MARKER, read_calls
 
 ROOT = Path(__file__).resolve().parent.parent
 VARIABLE_NAMES = {0: "torque"}

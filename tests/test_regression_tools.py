@@ -1,4 +1,4 @@
-"""csv-compare's tube and the FMI cross-check's band (pendulum_fmu/_regression_tools.py).
+"""csv-compare's tube and the FMI cross-check's band (pendulum_fmu/judging/_regression_tools.py).
 
 Against the tube's definition evaluated plainly, hand-checkable steps, and a one-step-late master
 that the tube passes while the judge names it late.
@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from pendulum_fmu import judge, simulate
-from pendulum_fmu._regression_tools import cross_check_band, csv_compare_tube, tube_envelopes
+from pendulum_fmu.judging._regression_tools import cross_check_band, csv_compare_tube, tube_envelopes
 
 
 def brute_force_envelopes(t_ref, y_ref, at, half_width, half_height):

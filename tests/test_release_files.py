@@ -21,7 +21,7 @@ from elftools.elf.elffile import ELFFile
 
 from fmu_build import build_fmu, build_record, find_zig
 from fmu_build.release_files import normalize_modes, write_tarball
-from pendulum_fmu._build_record import RECORD_FILE
+from pendulum_fmu.fmu._build_record import RECORD_FILE
 from tests.test_platforms import _path_without_cross_gccs
 
 ROOT = Path(__file__).resolve().parent.parent

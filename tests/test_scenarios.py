@@ -17,18 +17,18 @@ from fmpy import simulate_fmu
 from fmpy.validation import validate_fmu
 
 from benchmarks.masters import run
-from pendulum_fmu import _native_loop as cs_loop
-from pendulum_fmu._diagnoses import AGREES
 from pendulum_fmu._errors import InvalidInput
-from pendulum_fmu._instance import open_fmu
-from pendulum_fmu._judge import judge, judge_kit
-from pendulum_fmu._parameters import default_parameters, total_inertia
-from pendulum_fmu._scenario_list import SCENARIOS
-from pendulum_fmu._scenario_settings import KIT_FMU, read_settings
-from pendulum_fmu._scenarios import LS_REF_FOLDER, LS_REF_VERSION, KitExists, kit_files, write_scenarios
-from pendulum_fmu._simulate import run_schedule
-from pendulum_fmu._torque_schedule import TorqueSchedule, schedule
 from pendulum_fmu.cli import main
+from pendulum_fmu.fmu import _native_loop as cs_loop
+from pendulum_fmu.fmu._instance import open_fmu
+from pendulum_fmu.fmu._parameters import default_parameters, total_inertia
+from pendulum_fmu.fmu._simulate import run_schedule
+from pendulum_fmu.judging._diagnoses import AGREES
+from pendulum_fmu.judging._judge import judge, judge_kit
+from pendulum_fmu.scenarios._scenario_list import SCENARIOS
+from pendulum_fmu.scenarios._scenario_settings import KIT_FMU, read_settings
+from pendulum_fmu.scenarios._scenarios import LS_REF_FOLDER, LS_REF_VERSION, KitExists, kit_files, write_scenarios
+from pendulum_fmu.signals._torque_schedule import TorqueSchedule, schedule
 
 NAMES = [s.name for s in SCENARIOS]
 # The role values of the FMI-LS-REF 1.0.0-beta.1 schema (fmi3LayeredStandardReferenceManifest.xsd).
@@ -243,7 +243,7 @@ def test_a_folder_without_a_kit_is_written_into(tmp_path):
 
 
 def test_a_kit_that_fails_to_write_leaves_the_folder_as_it_was(tmp_path, monkeypatch):
-    from pendulum_fmu import _scenarios as scenarios
+    from pendulum_fmu.scenarios import _scenarios as scenarios
 
     write_scenarios(tmp_path)
     before = {path.name: path.read_bytes() for path in tmp_path.iterdir()}

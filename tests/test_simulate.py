@@ -12,10 +12,10 @@ from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
 from fmu_build import MODEL_DESCRIPTION, build_fmu
-from pendulum_fmu._instance import open_fmu
-from pendulum_fmu._simulate import RECORDED, run_schedule_python, simulate, simulate_plan, simulator
-from pendulum_fmu._torque_csv import TorqueTable
-from pendulum_fmu._torque_schedule import schedule
+from pendulum_fmu.fmu._instance import open_fmu
+from pendulum_fmu.fmu._simulate import RECORDED, run_schedule_python, simulate, simulate_plan, simulator
+from pendulum_fmu.signals._torque_csv import TorqueTable
+from pendulum_fmu.signals._torque_schedule import schedule
 
 # Runs one after the other through the same cached instance: each must come out as a fresh one.
 RUNS = [

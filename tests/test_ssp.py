@@ -12,12 +12,12 @@ import lxml.etree
 import numpy as np
 import pytest
 
-from pendulum_fmu._call_record import read_calls, reconstruct
-from pendulum_fmu._closed_loop import COUPLINGS, controller_defaults, sampled_loop_reference
-from pendulum_fmu._ssp import DEFAULT_SETPOINT, export_ssp, read_ssp, rebind_ssp
-from pendulum_fmu._ssp_calls import judge_ssp_calls
-from pendulum_fmu._ssp_judge import judge_coupling
 from pendulum_fmu.cli import main
+from pendulum_fmu.judging._call_record import read_calls, reconstruct
+from pendulum_fmu.ssp._closed_loop import COUPLINGS, controller_defaults, sampled_loop_reference
+from pendulum_fmu.ssp._ssp import DEFAULT_SETPOINT, export_ssp, read_ssp, rebind_ssp
+from pendulum_fmu.ssp._ssp_calls import judge_ssp_calls
+from pendulum_fmu.ssp._ssp_judge import judge_coupling
 
 SCHEMAS = os.path.join(os.path.dirname(fmpy.__file__), "ssp", "schema")
 
@@ -100,7 +100,7 @@ def test_libcosim_runs_the_ssp_as_it_is_jacobi_with_its_parameter_sets(ssp):
     pytest.importorskip("libcosimpy")
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
 
-    from pendulum_fmu._ssp_masters import run_libcosim
+    from pendulum_fmu.ssp._ssp_masters import run_libcosim
 
     log_output_level(CosimLogLevel.WARNING)
     time, theta = run_libcosim(ssp)
@@ -113,7 +113,7 @@ def test_libcosim_runs_the_ssp_as_it_is_jacobi_with_its_parameter_sets(ssp):
 
 
 def test_fmpy_ssp_is_jacobi_without_the_first_exchange_and_ignores_the_bound_sets(ssp):
-    from pendulum_fmu._ssp_masters import run_fmpy_ssp
+    from pendulum_fmu.ssp._ssp_masters import run_fmpy_ssp
 
     settings = read_ssp(ssp)
     for given, applied in ((False, False), (True, True)):
@@ -134,7 +134,7 @@ def test_fmpy_ssp_is_jacobi_without_the_first_exchange_and_ignores_the_bound_set
 
 def test_fmucontainer_is_jacobi_and_ignores_the_parameter_bindings(ssp):
     pytest.importorskip("fmu_manipulation_toolbox")
-    from pendulum_fmu._ssp_masters import run_fmucontainer
+    from pendulum_fmu.ssp._ssp_masters import run_fmucontainer
 
     settings = read_ssp(ssp)
     time, theta = run_fmucontainer(ssp)
@@ -199,8 +199,8 @@ def test_the_kits_closed_loop_names_each_couplings_reference_as_that_coupling(tm
 
 def test_an_installed_package_without_its_packaged_controller_is_one_line(tmp_path, monkeypatch, capsys):
     # An installed package (no fmu_src/ beside it) whose data/ lacks the controller: reinstall.
-    monkeypatch.setattr("pendulum_fmu._closed_loop.ROOT", tmp_path)
-    monkeypatch.setattr("pendulum_fmu._closed_loop.is_source_checkout", lambda: False)
+    monkeypatch.setattr("pendulum_fmu.ssp._closed_loop.ROOT", tmp_path)
+    monkeypatch.setattr("pendulum_fmu.ssp._closed_loop.is_source_checkout", lambda: False)
     monkeypatch.setattr("pendulum_fmu.CONTROLLER_FMU_FILE", "Absent.fmu")
     assert main(["export-ssp", str(tmp_path / "ClosedLoop.ssp")]) == 2
     [line] = capsys.readouterr().err.strip().splitlines()
@@ -234,7 +234,7 @@ MASTERS_AS_KNOWN = {
 
 @pytest.mark.parametrize("master", MASTERS_AS_KNOWN)
 def test_the_pendulums_call_record_names_each_masters_coupling_and_sets(master, ssp, tmp_path):
-    from pendulum_fmu import _ssp_masters
+    from pendulum_fmu.ssp import _ssp_masters
 
     if master == "libcosim":
         _libcosim_quiet()
@@ -286,7 +286,7 @@ def test_the_pendulums_call_record_names_each_masters_coupling_and_sets(master, 
 def test_a_received_ssp_cannot_make_fmucontainers_record_replace_a_users_file(target, ssp, tmp_path):
     # Issue 38: the record's path is the SSP author's choice; before, the user's file became the log.
     from pendulum_fmu import CannotWrite
-    from pendulum_fmu._ssp_masters import run_fmucontainer
+    from pendulum_fmu.ssp._ssp_masters import run_fmucontainer
 
     pytest.importorskip("fmu_manipulation_toolbox")
     bashrc = tmp_path / "bashrc"
@@ -314,7 +314,7 @@ def _one_torque_a_step_late(log, step):
 
 def test_a_doctored_record_with_a_late_torque_and_no_setpoint_is_named(ssp, tmp_path, capsys):
     _libcosim_quiet()
-    from pendulum_fmu._ssp_masters import run_libcosim
+    from pendulum_fmu.ssp._ssp_masters import run_libcosim
 
     settings = read_ssp(ssp)
     log = tmp_path / "calls.log"
@@ -347,7 +347,7 @@ def test_fmpys_container_fmu_read_from_its_log_is_gauss_seidel_pendulum_first(ss
 
     from fmpy import simulate_fmu
 
-    from pendulum_fmu._closed_loop import create_closed_loop_fmu
+    from pendulum_fmu.ssp._closed_loop import create_closed_loop_fmu
 
     container, log = create_closed_loop_fmu(tmp_path / "ClosedLoop.fmu"), tmp_path / "container.log"
     with open(log, "w") as file, contextlib.redirect_stdout(file):

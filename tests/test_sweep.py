@@ -29,14 +29,14 @@ from fsspec.implementations.local import LocalFileSystem
 import benchmarks.scale
 from pendulum_fmu import default_fmu
 from pendulum_fmu._errors import InvalidInput
-from pendulum_fmu._reference import reference
 from pendulum_fmu.cli import main
+from pendulum_fmu.oracle._reference import reference
 from pendulum_fmu.sweep import OUTPUTS, Study, run_sweep, sweep_grid
 from pendulum_fmu.sweep.store import Store, StudyExists
 from pendulum_fmu.sweep.worker import Task, kept_points, run_chunk
 
 # The module; the package's attribute of that name is its function.
-simulate = import_module("pendulum_fmu._simulate")
+simulate = import_module("pendulum_fmu.fmu._simulate")
 
 I_TOTAL = 20.0 + 40.0 * 0.5**2  # the tutorial's pendulum about its pivot
 STOP_TIME, STEP_SIZE = 0.5, 1e-3

@@ -6,9 +6,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pendulum_fmu._time_grid import BYTES_PER_STEP, step_count
-from pendulum_fmu._torque_csv import TorqueFileError, read_torque_csv
-from pendulum_fmu._torque_schedule import schedule, write_torque_csv
+from pendulum_fmu.signals._time_grid import BYTES_PER_STEP, step_count
+from pendulum_fmu.signals._torque_csv import TorqueFileError, read_torque_csv
+from pendulum_fmu.signals._torque_schedule import schedule, write_torque_csv
 
 
 def test_csv_jumps_become_communication_points(tmp_path):

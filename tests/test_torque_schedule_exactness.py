@@ -12,13 +12,13 @@ import numpy as np
 import pytest
 
 from benchmarks.signal_cases import random_step_rows, write_rows
-from pendulum_fmu._compare import compare
-from pendulum_fmu._reference import reference
-from pendulum_fmu._simulate import simulate
-from pendulum_fmu._torque_schedule import schedule
+from pendulum_fmu.comparing._compare import compare
+from pendulum_fmu.fmu._simulate import simulate
+from pendulum_fmu.oracle._reference import reference
+from pendulum_fmu.signals._torque_schedule import schedule
 
 # The module; the package's attribute of that name is its function.
-compare_module = import_module("pendulum_fmu._compare")
+compare_module = import_module("pendulum_fmu.comparing._compare")
 
 # 0.0003, 0.0006, 0.0007, 0.0009, 0.009, 0.03 and 0.3 are doubles below their decimals, so k*h
 # falls an ulp below a jump written at a multiple of them; 1/3 ms is no decimal at all.

@@ -29,8 +29,8 @@ from benchmarks.builds import build_bare_master
 from build_wheels import LEGACY_MANYLINUX, MANYLINUX_GLIBC, WHEELS, WheelhouseError, build_wheels, check_tools, main
 from fmu_build import PLATFORMS
 from pendulum_fmu import FMU_FILES, __version__
-from pendulum_fmu._reference import reference
 from pendulum_fmu.cli import main as cli
+from pendulum_fmu.oracle._reference import reference
 from tests.arm64_python import Arm64Python, Unavailable
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -67,7 +67,7 @@ def wheelhouse(build_once, checkout_build_lock):
 
 def _native_loop(wheel: Path) -> tuple[str, bytes]:
     with zipfile.ZipFile(wheel) as archive:
-        [name] = [name for name in archive.namelist() if name.startswith("pendulum_fmu/_cs_loop")]
+        [name] = [name for name in archive.namelist() if name.startswith("pendulum_fmu/fmu/_cs_loop")]
         return name, archive.read(name)
 
 
@@ -124,7 +124,7 @@ def test_every_wheel_has_the_same_fmus_and_its_own_native_loop(wheelhouse, tmp_p
                 if name.startswith("pendulum_fmu/") and "_cs_loop" not in name
             }
         native_loop, _ = _native_loop(wheel)
-        assert native_loop == f"pendulum_fmu/_cs_loop{'.pyd' if platform == 'win64' else '.so'}"
+        assert native_loop == f"pendulum_fmu/fmu/_cs_loop{'.pyd' if platform == 'win64' else '.so'}"
         assert not any(name.startswith(("fmu_src/", "tests/", "dist/")) for name in names)
     first = contents["linux64"]
     assert all(files == first for files in contents.values())  # one build of the FMUs and modules
@@ -292,7 +292,7 @@ def test_x86_64_wheel_installs_and_simulates_in_a_venv(wheelhouse, x86_64_csv, t
         [
             venv / "bin/python",
             "-c",
-            "from pendulum_fmu import _native_loop as cs_loop; print(cs_loop.__file__, cs_loop.available())",
+            "from pendulum_fmu.fmu import _native_loop as cs_loop; print(cs_loop.__file__, cs_loop.available())",
         ],
         check=True,
         cwd=tmp_path,
@@ -300,7 +300,7 @@ def test_x86_64_wheel_installs_and_simulates_in_a_venv(wheelhouse, x86_64_csv, t
         text=True,
         env=ENVIRONMENT,
     )
-    assert loaded.stdout.split() == [str(site_packages / "pendulum_fmu/_native_loop.py"), "True"]
+    assert loaded.stdout.split() == [str(site_packages / "pendulum_fmu/fmu/_native_loop.py"), "True"]
     subprocess.run(
         [venv / "bin/pendulum-fmu", "simulate", "--torque", "20", "--output", "out.csv"],
         check=True,
@@ -320,7 +320,9 @@ def test_aarch64_wheel_installs_and_simulates_on_arm64_python_under_qemu(wheelho
         pytest.skip(str(missing))
     site = arm64.install([wheelhouse["aarch64-linux"]], tmp_path / "site")  # pip there judges the tag
     loaded = arm64.run(
-        ["-c", "from pendulum_fmu import _native_loop as cs_loop; print(cs_loop.available())"], site=site, cwd=tmp_path
+        ["-c", "from pendulum_fmu.fmu import _native_loop as cs_loop; print(cs_loop.available())"],
+        site=site,
+        cwd=tmp_path,
     )
     assert loaded.stdout.split()[-1:] == ["True"], loaded.stderr
     ran = arm64.run(

@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from .._errors import InvalidInput
-from .._time_grid import DEFAULT_MAX_STEPS
+from ..signals._time_grid import DEFAULT_MAX_STEPS
 
 
 def assignment(text: str) -> tuple[str, str]:
@@ -128,7 +128,7 @@ def check_outputs(outputs: dict, inputs: dict) -> None:
     given = {option: Path(path) for option, path in outputs.items() if path}
     check_writable(*given.values())
     if given.get("--plot"):
-        from .._plot import check_figure_path  # here: matplotlib only for a command that draws
+        from ..figures._plot import check_figure_path  # here: matplotlib only for a command that draws
 
         check_figure_path(given["--plot"])
     read = {option: Path(path) for option, path in inputs.items() if path}

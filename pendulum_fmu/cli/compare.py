@@ -63,7 +63,7 @@ def add_parser(commands) -> argparse.ArgumentParser:
 
 def run(args) -> int:
     """Run `pendulum-fmu compare` with the parsed arguments; returns the exit status."""
-    from .._compare import compare, format_comparison
+    from ..comparing._compare import compare, format_comparison
 
     comparison = compare(
         torque_signal(args),

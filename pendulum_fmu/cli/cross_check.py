@@ -24,7 +24,7 @@ def add_parser(commands) -> argparse.ArgumentParser:
 
 def run(args) -> int:
     """Run `pendulum-fmu cross-check` with the parsed arguments; returns the exit status."""
-    from .._cross_check import write_cross_check
+    from ..fmu._cross_check import write_cross_check
 
     for folder in write_cross_check(args.output_dir, args.fmu):
         print(f"wrote {folder}")

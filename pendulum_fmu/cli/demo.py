@@ -36,6 +36,6 @@ def add_parser(commands) -> argparse.ArgumentParser:
 
 def run(args) -> int:
     """Run `pendulum-fmu demo` with the parsed arguments; returns the exit status."""
-    from .._demo import run_demo
+    from ..comparing._demo import run_demo
 
     return 0 if run_demo(args.output_dir, workers=args.workers, overwrite=args.overwrite) else 1

@@ -1,4 +1,4 @@
-"""pendulum-fmu export: the FMU written into the current folder (pendulum_fmu._export)."""
+"""pendulum-fmu export: the FMU written into the current folder (pendulum_fmu.fmu._export)."""
 
 from __future__ import annotations
 
@@ -45,7 +45,7 @@ def add_parser(commands) -> argparse.ArgumentParser:
 
 def run(args) -> int:
     """Run `pendulum-fmu export` with the parsed arguments; returns the exit status."""
-    from .._export import export_fmu
+    from ..fmu._export import export_fmu
 
     exported = export_fmu(args.output, fmi_version=args.fmi_version, overwrite=args.overwrite, sign=args.sign)
     signed = ", its build record signed" if args.sign else ""

@@ -62,7 +62,7 @@ def add_parser(commands) -> argparse.ArgumentParser:
 
 def run(args) -> int:
     """Run `pendulum-fmu export-ssp` with the parsed arguments; returns the exit status."""
-    from .._ssp import export_ssp
+    from ..ssp._ssp import export_ssp
 
     written = export_ssp(
         args.output,

@@ -18,7 +18,7 @@ from ._arguments import (
 )
 
 if TYPE_CHECKING:
-    from .._judge import Judgement
+    from ..judging._judge import Judgement
 
 
 def add_parser(commands) -> argparse.ArgumentParser:
@@ -96,8 +96,8 @@ def add_parser(commands) -> argparse.ArgumentParser:
 
 def run(args) -> int:
     """Run `pendulum-fmu judge` with the parsed arguments; returns the exit status."""
-    from .._judge import format_judgement, format_kit, judge, judge_kit, write_json
-    from .._plot import plot_judgement
+    from ..figures._plot import plot_judgement
+    from ..judging._judge import format_judgement, format_kit, judge, judge_kit, write_json
 
     if args.ssp is not None:
         return _judge_ssp(args)
@@ -162,12 +162,12 @@ def _judge_ssp(args) -> int:
             "pendulum-fmu judge --calls LOG --ssp ClosedLoop.ssp"
         )
     if args.calls is not None:
-        from .._ssp_calls import format_ssp_calls_verdict, judge_ssp_calls
+        from ..ssp._ssp_calls import format_ssp_calls_verdict, judge_ssp_calls
 
         calls_verdict = judge_ssp_calls(args.calls, args.ssp)
         print(format_ssp_calls_verdict(calls_verdict))
         return 0 if calls_verdict.passed else 1
-    from .._ssp_judge import format_ssp_verdict, judge_ssp_result
+    from ..ssp._ssp_judge import format_ssp_verdict, judge_ssp_result
 
     verdict = judge_ssp_result(args.result, args.ssp, mapping=args.mapping)
     print(format_ssp_verdict(verdict))
@@ -178,8 +178,8 @@ def _judge_calls(args, signal) -> int:
     """`judge --calls LOG`: the master's calls (read by _call_record) against the intended run
     (_call_judge).
     """
-    from .._call_judge import IntendedRun, format_calls, judge_calls, write_calls_json
-    from .._parameters import variables
+    from ..fmu._parameters import variables
+    from ..judging._call_judge import IntendedRun, format_calls, judge_calls, write_calls_json
 
     if args.result is not None:
         raise InvalidInput(f"--calls judges a log, not a result: leave out {args.result}")
@@ -199,7 +199,7 @@ def _judge_calls(args, signal) -> int:
     judged = judge_calls(args.calls, intended, names)
     print(format_calls(judged))
     if args.plot:
-        from .._plot import plot_calls
+        from ..figures._plot import plot_calls
 
         print(f"wrote {plot_calls(judged, args.plot, args.calls.name)}")
     if args.json:

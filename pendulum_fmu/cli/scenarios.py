@@ -38,11 +38,11 @@ def add_parser(commands) -> argparse.ArgumentParser:
 
 def run(args) -> int:
     """Run `pendulum-fmu scenarios` with the parsed arguments; returns the exit status."""
-    from .._scenarios import write_scenarios
+    from ..scenarios._scenarios import write_scenarios
 
     written = write_scenarios(args.output_dir, args.fmu, overwrite=args.overwrite)
     if args.closed_loop:
-        from .._ssp_kit import write_closed_loop_kit
+        from ..ssp._ssp_kit import write_closed_loop_kit
 
         written += write_closed_loop_kit(args.output_dir, overwrite=args.overwrite)
     for path in written:

@@ -42,9 +42,9 @@ def add_parser(commands) -> argparse.ArgumentParser:
 
 def run(args) -> int:
     """Run `pendulum-fmu simulate` with the parsed arguments; returns the exit status."""
-    from .. import _results as results
-    from .._model import fmu_model
-    from .._simulate import simulate
+    from ..fmu import _results as results
+    from ..fmu._model import fmu_model
+    from ..fmu._simulate import simulate
 
     check_outputs(
         {"--output": args.output, "--plot": args.plot}, {"--torque-file": args.torque_file, "--fmu": args.fmu}
@@ -63,7 +63,7 @@ def run(args) -> int:
         results.write_csv(run, args.output)
         print(f"wrote {args.output} ({','.join(units)}; units {', '.join(units.values())})")
     if args.plot:
-        from .._plot import case_title, plot_overlay
+        from ..figures._plot import case_title, plot_overlay
 
         title = case_title(torque_signal(args), parameters_of(args.assignments), args.theta0, args.omega0, args.fmu)
         print(f"wrote {plot_overlay({'FMU': run}, args.plot, title)}")

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from .._errors import InvalidInput
 from .._stop_signals import STOPPING_SIGNALS, Stopped
-from .._time_grid import DEFAULT_MAX_CASES
+from ..signals._time_grid import DEFAULT_MAX_CASES
 from ._arguments import add_fmu_argument, assignment, float_number, output_location, positive_int
 
 

@@ -1,4 +1,4 @@
-"""pendulum-fmu verify: whether a received FMU is what its build record says (pendulum_fmu._verify)."""
+"""pendulum-fmu verify: whether a received FMU is what its build record says (pendulum_fmu.judging._verify)."""
 
 from __future__ import annotations
 
@@ -30,7 +30,7 @@ def add_parser(commands) -> argparse.ArgumentParser:
 
 def run(args) -> int:
     """Run `pendulum-fmu verify` with the parsed arguments; returns the exit status."""
-    from .._verify import FAIL, checks_json, format_checks, verify_fmu
+    from ..judging._verify import FAIL, checks_json, format_checks, verify_fmu
 
     checks = verify_fmu(args.fmu, public_key=args.public_key, rebuild=not args.no_rebuild)
     print(checks_json(args.fmu, checks) if args.json else format_checks(args.fmu, checks))

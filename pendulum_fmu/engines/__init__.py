@@ -19,11 +19,11 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import _results as results
 from .._errors import InvalidInput
-from .._model import FmuModel
-from .._simulate import resolve_parameters
-from .._torque_schedule import TorqueSchedule
+from ..fmu import _results as results
+from ..fmu._model import FmuModel
+from ..fmu._simulate import resolve_parameters
+from ..signals._torque_schedule import TorqueSchedule
 
 MODES = ("accurate", "default")
 

@@ -29,7 +29,7 @@ from pydrake.systems.analysis import ResetIntegratorFromFlags, Simulator
 from pydrake.systems.framework import DiagramBuilder
 
 from .._errors import InvalidInput
-from .._torque_schedule import TorqueSchedule
+from ..signals._torque_schedule import TorqueSchedule
 from . import held_results, runner
 
 

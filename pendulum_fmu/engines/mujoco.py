@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from .._torque_schedule import TorqueSchedule
+from ..signals._torque_schedule import TorqueSchedule
 from . import held_results, runner, substeps
 
 

@@ -15,9 +15,9 @@ import os
 
 import numpy as np
 
-from .. import _results as results
 from .._errors import InvalidInput, MissingDependency
-from .._torque_schedule import TorqueSchedule
+from ..fmu import _results as results
+from ..signals._torque_schedule import TorqueSchedule
 from . import runner
 
 

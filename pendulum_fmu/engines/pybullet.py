@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._torque_schedule import TorqueSchedule
+from ..signals._torque_schedule import TorqueSchedule
 from . import held_results, runner, substeps
 
 

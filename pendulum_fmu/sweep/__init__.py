@@ -49,7 +49,7 @@ def __getattr__(name: str):
     # OUTPUTS: the default FMU's outputs (a Study's default outputs on it), read from its model
     # description on first use, not at import; a Study on another FMU takes that FMU's.
     if name == "OUTPUTS":
-        from .._model import fmu_model
+        from ..fmu._model import fmu_model
 
         return fmu_model().outputs
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

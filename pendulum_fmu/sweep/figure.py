@@ -9,7 +9,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from .._atomic_files import replacing_on
-from .._parameters import unit
+from ..fmu._parameters import unit
 from .store import Store
 
 # Up to this many cases the figure draws every trajectory; above, quantile bands of the summaries.
@@ -22,7 +22,7 @@ def draw(store: Store, cases_table, names: list[str], outputs: Sequence[str], fm
     """
     import pyarrow.dataset as ds
 
-    from .._plot import plot_case_bands, plot_cases  # here: workers never draw, nor import matplotlib
+    from ..figures._plot import plot_case_bands, plot_cases  # here: workers never draw, nor import matplotlib
 
     title = f"Parameter study: {cases_table.num_rows} cases of the torque-driven pendulum"
     units = {name: unit(name, fmu) for name in names}

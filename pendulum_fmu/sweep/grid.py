@@ -13,8 +13,8 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from .._errors import InvalidInput, WrongType
-from .._model import START_VALUES
-from .._parameters import default_parameters
+from ..fmu._model import START_VALUES
+from ..fmu._parameters import default_parameters
 
 
 def sweepable(fmu_path=None) -> list[str]:

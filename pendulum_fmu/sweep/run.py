@@ -14,9 +14,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .._errors import InvalidInput, MissingDependency, WrongType
-from .._model import fmu_file
-from .._parameters import pendulum_variables
-from .._time_grid import DEFAULT_MAX_CASES
+from ..fmu._model import fmu_file
+from ..fmu._parameters import pendulum_variables
+from ..signals._time_grid import DEFAULT_MAX_CASES
 from .client import SchedulerLost, Totals, dask_client, progress_bar, run_chunks
 from .figure import draw
 from .grid import columns

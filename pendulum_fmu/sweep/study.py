@@ -12,8 +12,8 @@ from pathlib import Path
 import numpy as np
 
 from .._errors import InvalidInput, WrongType
-from .._model import fmu_model
-from .._time_grid import communication_points
+from ..fmu._model import fmu_model
+from ..signals._time_grid import communication_points
 from .grid import Grid, check_cases, columns
 
 FORMATS = ("parquet", "csv")

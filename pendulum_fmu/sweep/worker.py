@@ -15,13 +15,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import _native_loop as cs_loop
-from .._instance import FmuError, initialize
-from .._model import START_VALUES
-from .._parameters import value_reference
-from .._simulate import run_schedule_python, simulator
-from .._time_grid import communication_points
-from .._torque_schedule import TorqueSchedule
+from ..fmu import _native_loop as cs_loop
+from ..fmu._instance import FmuError, initialize
+from ..fmu._model import START_VALUES
+from ..fmu._parameters import value_reference
+from ..fmu._simulate import run_schedule_python, simulator
+from ..signals._time_grid import communication_points
+from ..signals._torque_schedule import TorqueSchedule
 from .store import SUMMARIES, Store
 
 

@@ -1,4 +1,4 @@
-/* Runs the native co-simulation loop (pendulum_fmu/_cs_loop.c, built as the wheel ships it) over
+/* Runs the native co-simulation loop (pendulum_fmu/fmu/_cs_loop.c, built as the wheel ships it) over
    an FMU binary with no Python around it, so that a platform without a Python here still runs
    both: the win64 DLLs under wine. It loads both libraries, instantiates the FMU and hands
    cs_loop_run the FMU's functions and a held torque for STEPS communication steps, twice, each

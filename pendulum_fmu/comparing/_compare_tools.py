@@ -1,0 +1,319 @@
+"""The tools compare runs, and the parsing of --tools and --map.
+
+    --tools fmu,reference,opensim,mujoco,drake:default,pybullet,theirs=path/to/Their.fmu
+    --map torque=u,theta=phi*0.0174532925
+
+An item is a tool's name, optionally with a mode (accurate, the default, or default: what the
+engine does with its own settings), or LABEL=PATH for any other FMU, run through the --map (see
+_mapped_fmu.py). Every tool has the same runner:
+
+    tool.run(plan, parameters=..., theta0=..., omega0=...) -> results array (_results.py)
+
+A tool returns the time, the torque and the outputs it computes; Tool.run hands back the outputs
+asked for (the FMU's, FmuModel.outputs, unless told otherwise), one it cannot compute as NaN with a
+one-line warning (errors.NotComputed), never zeros.
+
+A tool whose Python package is missing is refused when the list names it, with the pip command
+that installs it; of the default list, compare runs the tools that are installed and warns
+(errors.Skipped) which it left out.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+import re
+import warnings
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from functools import partial
+from pathlib import Path
+
+import numpy as np
+
+from .._errors import InvalidInput, Skipped, WrongType
+from ..engines import MODES, check_mode
+from ..fmu import _results as results
+from ..fmu._model import FmuModel, fmu_model
+from ..fmu._simulate import simulate_plan
+from ..oracle._reference import reference_schedule
+from ..signals._torque_schedule import TorqueSchedule
+
+
+class ToolSpecError(InvalidInput):
+    """A --tools or --map that names no runnable tool; the message says which and what to do."""
+
+
+@dataclass(frozen=True)
+class Tool:
+    """A tool as compare runs it: its label in tables and figures, its runner, and the FMU (a
+    path, a model or None for the default) whose outputs it is asked for.
+    """
+
+    label: str
+    runner: Callable[..., np.ndarray]
+    fmu: str | Path | FmuModel | None = None
+
+    def run(
+        self,
+        plan: TorqueSchedule,
+        *,
+        parameters: dict | None = None,
+        theta0: float = 0.0,
+        omega0: float = 0.0,
+        outputs: Sequence[str] | None = None,
+    ) -> np.ndarray:
+        """The tool's result for a schedule, with exactly the outputs asked for.
+
+        Parameters
+        ----------
+        plan : TorqueSchedule
+            The schedule.
+        parameters : dict, optional
+            The pendulum's parameters (the FMU's defaults for those not given).
+        theta0, omega0 : float, optional
+            Start angle (rad) and rate (rad/s).
+        outputs : sequence of str, optional
+            The outputs asked for (default: the FMU's, FmuModel.outputs).
+
+        Returns
+        -------
+        numpy.ndarray
+            A result array (_results.py): time, torque, then outputs in that order.
+
+        Warns
+        -----
+        NotComputed
+            One line naming the outputs the tool cannot compute; their columns are NaN.
+        """
+        run = self.runner(plan, parameters=parameters, theta0=theta0, omega0=omega0)
+        asked = fmu_model(self.fmu).outputs if outputs is None else tuple(outputs)
+        return results.with_outputs(run, asked, self.label)
+
+
+def run_fmu(
+    plan: TorqueSchedule,
+    *,
+    parameters: dict | None = None,
+    theta0: float = 0.0,
+    omega0: float = 0.0,
+    mode: str = "accurate",
+    fmu_path: str | Path | FmuModel | None = None,
+) -> np.ndarray:
+    """The project's FMU (the checkout's, or fmu_path) through fmpy; ramps are passed on."""
+    check_mode(mode, "fmu")
+    return simulate_plan(plan, parameters=parameters, theta0=theta0, omega0=omega0, fmu_path=fmu_path)
+
+
+def run_reference(
+    plan: TorqueSchedule,
+    *,
+    parameters: dict | None = None,
+    theta0: float = 0.0,
+    omega0: float = 0.0,
+    mode: str = "accurate",
+    fmu_path: str | Path | FmuModel | None = None,
+) -> np.ndarray:
+    """The schedule's own torques through scipy (_reference.py); fmu_path's defaults apply."""
+    check_mode(mode, "reference")
+    return reference_schedule(plan, parameters=parameters, theta0=theta0, omega0=omega0, fmu_path=fmu_path)
+
+
+@dataclass(frozen=True)
+class Kind:
+    """A tool that --tools names: where its runner is, the package it needs, its modes."""
+
+    runner: str  # "module:function", imported only when the tool is used
+    package: str | None = None  # the module its extra installs
+    extra: str | None = None
+    modes: tuple[str, ...] = ("accurate",)
+
+    def load(self) -> Callable[..., np.ndarray]:
+        """The tool's runner, its module imported now."""
+        module, function = self.runner.split(":")
+        return getattr(importlib.import_module(module), function)
+
+
+KINDS = {
+    "fmu": Kind("pendulum_fmu.comparing._compare_tools:run_fmu"),
+    "reference": Kind("pendulum_fmu.comparing._compare_tools:run_reference"),
+    "opensim": Kind("pendulum_fmu.engines.opensim:run", "opensim", "opensim", MODES),
+    "mujoco": Kind("pendulum_fmu.engines.mujoco:run", "mujoco", "mujoco", MODES),
+    "drake": Kind("pendulum_fmu.engines.drake:run", "pydrake", "drake", MODES),
+    "pybullet": Kind("pendulum_fmu.engines.pybullet:run", "pybullet", "pybullet", MODES),
+}
+# The tools compare runs when none are named: of these, the ones installed here.
+DEFAULT_TOOLS = ("fmu", "reference", "opensim")
+_LABEL = re.compile(r"^[A-Za-z_][A-Za-z0-9_.-]*$")
+
+
+def _label(name: str, mode: str) -> str:
+    """The tool's label in --tools, tables and figures: its name, with the mode unless accurate."""
+    return name if mode == "accurate" else f"{name}:{mode}"
+
+
+@dataclass(frozen=True)
+class ToolInfo:
+    """One tool compare() runs by name, as list_tools() describes it.
+
+    Attributes
+    ----------
+    name : str
+        The tool's name: fmu, reference, opensim, mujoco, drake or pybullet.
+    installed : bool
+        Whether its Python package can be imported here.
+    labels : tuple of str
+        What compare's tools (and --tools) take to run it, one per mode, such as "mujoco" (its
+        accurate mode) and "mujoco:default"; each is also the run's label in tables and figures.
+    install : str or None
+        The pip command that installs what it needs; None when it needs nothing beyond this package.
+    """
+
+    name: str
+    installed: bool
+    labels: tuple[str, ...]
+    install: str | None
+
+
+def list_tools() -> list[ToolInfo]:
+    """Every tool compare() runs by name: whether it is installed here, and how to install it.
+
+    Parameters
+    ----------
+    None
+        It takes no arguments; an FMU given as LABEL=path/to/Their.fmu is a tool too, not listed.
+
+    Returns
+    -------
+    list of ToolInfo
+        fmu, reference, then the engines: opensim, mujoco, drake, pybullet.
+
+    Raises
+    ------
+    Nothing
+        A tool that is not installed is listed with installed False.
+
+    Examples
+    --------
+    >>> from pendulum_fmu import list_tools
+    >>> [(tool.name, tool.labels) for tool in list_tools()][:3]
+    [('fmu', ('fmu',)), ('reference', ('reference',)), ('opensim', ('opensim', 'opensim:default'))]
+    >>> mujoco = next(tool for tool in list_tools() if tool.name == "mujoco")
+    >>> mujoco.install
+    'pip install ".[mujoco]" in a clone of pendulum-fmu (or "WHEEL.whl[mujoco]" for its wheel)'
+
+    The installed engines, as compare's tools:
+
+    >>> tools = [label for tool in list_tools() if tool.installed for label in tool.labels]
+    >>> tools[:2]
+    ['fmu', 'reference']
+    """
+    return [
+        ToolInfo(
+            name,
+            installed(name),
+            tuple(_label(name, mode) for mode in kind.modes),
+            None if kind.package is None else install_hint(name),
+        )
+        for name, kind in KINDS.items()
+    ]
+
+
+def installed(name: str) -> bool:
+    """Whether the tool's Python package can be imported here."""
+    package = KINDS[name].package
+    return package is None or importlib.util.find_spec(package) is not None
+
+
+def install_hint(name: str) -> str:
+    """The pip command that installs what the tool needs: its extra of this package, which is
+    installed from a clone or a wheel (it is on no package registry).
+    """
+    extra = KINDS[name].extra
+    return f'pip install ".[{extra}]" in a clone of pendulum-fmu (or "WHEEL.whl[{extra}]" for its wheel)'
+
+
+def installed_defaults() -> list[str]:
+    """The default tools that are installed here; warns (errors.Skipped) in one line which are not
+    and how to install them.
+
+    Returns
+    -------
+    list of str
+        Of DEFAULT_TOOLS, those whose Python package can be imported, in order.
+
+    Examples
+    --------
+    >>> installed_defaults()[:2]
+    ['fmu', 'reference']
+    """
+    missing = [name for name in DEFAULT_TOOLS if not installed(name)]
+    if missing:
+        warnings.warn(
+            "skipped "
+            + "; ".join(f"{name} ({KINDS[name].package} is not installed: {install_hint(name)})" for name in missing),
+            Skipped,
+            stacklevel=3,
+        )
+    return [name for name in DEFAULT_TOOLS if name not in missing]
+
+
+def _mapped_fmu(label: str, path: str, mapping: str | dict | None, fmu: str | Path | FmuModel | None) -> Tool:
+    from ._mapped_fmu import MappedFmu
+
+    if not _LABEL.match(label) or label.split(":")[0] in KINDS:
+        raise ToolSpecError(
+            f"--tools {label}={path}: the label must be a name (letters, digits, _ . -) other than {', '.join(KINDS)}"
+        )
+    try:
+        return Tool(label, MappedFmu(path, mapping, label=label).run, fmu)
+    except ValueError as error:
+        raise ToolSpecError(str(error)) from None
+
+
+def _named(item: str, fmu_path: str | Path | FmuModel | None) -> Tool:
+    name, _, mode = item.partition(":")
+    kind = KINDS[name]
+    mode = mode or "accurate"
+    if mode not in kind.modes:
+        raise ToolSpecError(
+            f"--tools {item}: {name} has mode{'s' if len(kind.modes) > 1 else ''} {', '.join(kind.modes)}, not {mode!r}"
+        )
+    if not installed(name):
+        raise ToolSpecError(f"--tools {name}: {kind.package} is not installed; install it with: {install_hint(name)}")
+    # Every runner takes the FMU whose defaults (and, for fmu, whose binary) apply.
+    runner = partial(kind.load(), mode=mode, fmu_path=fmu_path)
+    return Tool(_label(name, mode), runner, fmu_path)
+
+
+def parse_tools(
+    spec: str | Sequence[str], *, mapping: str | dict | None = None, fmu_path: str | Path | FmuModel | None = None
+) -> list[Tool]:
+    """The tools of a --tools list (a comma-separated string or its items), in order.
+
+    mapping is the --map for the tools given as LABEL=PATH (its text, or a dict as
+    mapped_fmu.as_map takes it); fmu_path the FMU that "fmu" runs.
+    """
+    if isinstance(spec, str):
+        spec = spec.split(",")
+    if not (isinstance(spec, Sequence) and all(isinstance(item, str) for item in spec)):
+        raise WrongType(f"tools is a comma-separated string or a list of names, e.g. 'fmu,reference'; got {spec!r}")
+    items = [item.strip() for item in spec]
+    items = [item for item in items if item]
+    if not items:
+        raise ToolSpecError("--tools is empty: name at least one of " + ", ".join(KINDS))
+    unknown = [item for item in items if "=" not in item and item.partition(":")[0] not in KINDS]
+    if unknown:
+        raise ToolSpecError(
+            f"unknown tool(s) {', '.join(unknown)}: choose from {', '.join(KINDS)}, or LABEL=path/to/Their.fmu"
+        )
+    if mapping and not any("=" in item for item in items):
+        raise ToolSpecError("--map applies to FMUs given as LABEL=path/to/Their.fmu in --tools, and there is none")
+    tools: list[Tool] = []
+    for item in items:
+        label, equals, path = (part.strip() for part in item.partition("="))
+        tool = _mapped_fmu(label, path, mapping, fmu_path) if equals else _named(item, fmu_path)
+        if any(tool.label == other.label for other in tools):
+            raise ToolSpecError(f"--tools names {tool.label} twice")
+        tools.append(tool)
+    return tools

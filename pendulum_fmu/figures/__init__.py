@@ -1,0 +1,7 @@
+"""Every figure the package draws: runs overlaid, their differences, a sweep's cases, a judgement.
+
+matplotlib is imported here and only here, and only by a command that draws.
+
+May import: fmu/ (the units and parameters in the labels) and the basics. It draws what it is
+given (runs, a judgement, a sweep's cases) and imports none of the jobs that give them.
+"""

@@ -1,0 +1,472 @@
+"""Judge a result file from any tool against the independent reference, and name the mistake.
+
+    pendulum-fmu judge RESULT.csv --torque-file torque.csv [--step-size 0.001] [--map ...]
+    pendulum-fmu judge KIT          (every NAME_out.csv beside a scenario kit's inputs)
+
+A result is a CSV with a time column and theta, optionally omega and alpha (any names and units,
+through --map as compare's: theta=phi*0.0174532925). The verdict compares it with the
+independent reference (reference.reference: the signal read by its own reader, scipy DOP853 at
+1e-12) at the result's own times: pass when max |dtheta| <= the tolerance.
+
+A result that fails gets a diagnosis. Each candidate mistake is a variant of the run with that
+mistake made: the schedule a master should feed (torque_schedule.schedule) changed as the mistake changes
+it, integrated exactly (reference.reference_schedule) and compared with the result at the
+result's times. A candidate's residual is max |theta_result - theta_variant|: the mistake that
+explains the result leaves only rounding and solver noise (about 1e-11 rad). The candidates:
+
+- input one step late: step k holds what step k-1 should (the first step holds the signal's first
+  value, or the FMU's start value);
+- input one step early: step k holds what step k+1 should;
+- input interpolated linearly: each step ramps to the next step's value where the signal holds;
+- input held: each step holds where the run asked for a ramp (ramp runs only);
+- time grid drift: the master stepped on the result's own times, off the communication points,
+  sampling the signal there (only when the result's times are off the grid);
+- state not restored: from the last row that agrees, the run restarts from the initial state
+  (a resumed run that did not restore its saved FMU state);
+- integration error: the FMU's equation stepped by explicit or semi-implicit Euler at the
+  communication step (a master that integrates the Model Exchange interface itself).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .._atomic_files import replacing
+from .._errors import InvalidInput
+from ..fmu._model import FmuModel, fmu_model
+from ..fmu._simulate import resolve_parameters
+from ..oracle._reference import reference
+from ..scenarios._scenario_settings import JUDGE_TOLERANCE as DEFAULT_TOLERANCE, read_settings, settings_files
+from ..signals._time_grid import event_tolerance
+from ..signals._torque_schedule import TorqueSchedule, schedule
+from ._diagnoses import AGREES, INPUT_TIMING, Run, candidate_variants, diagnose
+from ._regression_tools import format_verdicts, regression_verdicts
+from ._result_file import OPTIONAL, ResultFileError, read_result
+
+
+@dataclass
+class Judgement:
+    """The verdict on one result and its diagnosis (see the module's docstring).
+
+    Attributes
+    ----------
+    verdict : {"pass", "fail"}
+        Whether max |dtheta| is within the tolerance; ``passed`` says the same as a bool.
+    diagnosis : str
+        The mistake that explains the difference, "agrees" or "unexplained".
+    residual, max_abs_dtheta, worst_time, tolerance : float
+        What is left once the diagnosis is explained (rad); the largest |dtheta| (rad) and its time
+        (s); the tolerance (rad).
+    candidates : dict
+        Per candidate mistake, the residual of its best variant (rad); None where it does not apply.
+    smallest_input_effect : float or None
+        The smallest difference an input-timing variant makes to this run (rad).
+    result, reference, explanation : numpy.ndarray
+        The result as read, the reference at its times, the variant the diagnosis names.
+    source : str
+        The result file's name, as reports show it.
+
+    Examples
+    --------
+    A run whose torque steps 1 ms after the signal's step, and the mistake it is given:
+
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from pendulum_fmu import judge, simulate
+    >>> from pendulum_fmu.fmu._results import write_csv
+    >>> late = simulate(lambda t: 0.0 if t < 0.251 else 20.0, stop_time=0.5)
+    >>> judgement = judge(write_csv(late, Path(tempfile.mkdtemp()) / "late.csv"),
+    ...                   lambda t: 0.0 if t < 0.25 else 20.0, stop_time=0.5)
+    >>> judgement.verdict, judgement.diagnosis, f"{judgement.max_abs_dtheta:.2e} rad"
+    ('fail', 'input one step late', '1.55e-04 rad')
+    """
+
+    verdict: str
+    diagnosis: str
+    residual: float
+    max_abs_dtheta: float
+    worst_time: float
+    tolerance: float
+    # Per candidate: the residual of its best variant and how far that variant is from the
+    # reference (rad); None where the candidate does not apply to this run.
+    candidates: dict[str, dict | None]
+    # The smallest difference from the reference an input-timing variant that changes this run
+    # makes (rad; None when none does): an integration error must be small beside it.
+    smallest_input_effect: float | None
+    result: np.ndarray = field(repr=False)
+    reference: np.ndarray = field(repr=False)
+    # The variant the diagnosis names, at the result's times (None for agrees and unexplained).
+    explanation: np.ndarray | None = field(default=None, repr=False)
+    source: str = "result"
+    # csv-compare's tube and the FMI cross-check's band on theta (regression_tools.regression_verdicts).
+    regression_tools: list[dict] = field(default_factory=list)
+
+    @property
+    def passed(self) -> bool:
+        """Whether the verdict is pass."""
+        return self.verdict == "pass"
+
+    def summary(self) -> dict:
+        """What --json writes: plain numbers, rad and s."""
+        worst = {}
+        for name in OPTIONAL:
+            given = self.result[name] if name in (self.result.dtype.names or ()) else np.nan
+            if np.all(np.isfinite(given)):
+                worst[f"max_abs_d{name}"] = float(np.max(np.abs(given - self.reference[name])))
+        return {
+            "result": self.source,
+            "verdict": self.verdict,
+            "diagnosis": self.diagnosis,
+            "residual": self.residual,
+            "max_abs_dtheta": self.max_abs_dtheta,
+            **worst,
+            "worst_time": self.worst_time,
+            "tolerance": self.tolerance,
+            "points": len(self.result),
+            "candidates": self.candidates,
+            "smallest_input_effect": self.smallest_input_effect,
+            "regression_tools": self.regression_tools,
+            "units": {
+                "residual": "rad",
+                "max_abs_dtheta": "rad",
+                "max_abs_domega": "rad/s",
+                "max_abs_dalpha": "rad/s2",
+                "worst_time": "s",
+                "tolerance": "rad",
+                "candidates": "rad",
+                "smallest_input_effect": "rad",
+            },
+        }
+
+
+def _check_span(result: np.ndarray, plan: TorqueSchedule, step_size: float, source: str) -> None:
+    """Refuse a result that is not a record of this run: times outside it, or a first or last row
+    that is not the run's start or stop. A result that stops short (a master that crashed, a file
+    cut off, only the t = 0 row) agrees with the reference wherever it has rows, so judged it would
+    pass a run that never happened.
+    """
+    start, stop = float(plan.time[0]), float(plan.time[-1])
+    slack = float(event_tolerance(max(abs(start), abs(stop)), step_size))
+    first, last = float(result["time"][0]), float(result["time"][-1])
+    if first < start - slack:
+        raise ResultFileError(
+            f"{source}: time {first:.17g} is before the run's start time {start:g} s; give the run's --start-time"
+        )
+    if last > stop + slack:
+        raise ResultFileError(
+            f"{source}: time {last:.17g} is after the run's stop time {stop:g} s; give the run's --stop-time"
+        )
+    # Half the first and the last step: a master's times may drift off the grid (a diagnosis of
+    # its own), but a first or last row nearer another communication point is another run's.
+    if first > start + (plan.time[1] - start) / 2:
+        raise ResultFileError(
+            f"{source}: the result starts at {first:.17g} s, not at the run's start "
+            f"time {start:g} s: write a row per communication point from the start "
+            "(judging a file alone, give the run's --start-time)"
+        )
+    if last < stop - (stop - plan.time[-2]) / 2:
+        raise ResultFileError(
+            f"{source}: the result ends at {last:.17g} s, before the run's stop "
+            f"time {stop:g} s, so it covers only part of the run: run it to the stop "
+            "time (judging a file alone, give the run's --stop-time)"
+        )
+
+
+def judge(
+    result,
+    torque,
+    *,
+    start_time: float = 0.0,
+    stop_time: float | None = None,
+    step_size: float = 1e-3,
+    ramp: bool = False,
+    parameters: dict | None = None,
+    theta0: float = 0.0,
+    omega0: float = 0.0,
+    tolerance: float | None = None,
+    mapping: str | dict | None = None,
+    fmu_path: str | Path | FmuModel | None = None,
+    max_steps: int | None = None,
+) -> Judgement:
+    """Judge a result from any tool against the independent reference, and diagnose a failure.
+
+    Parameters
+    ----------
+    result : str, Path or numpy.ndarray
+        A result CSV (read_result) or an array with fields time and theta (omega, alpha: optional).
+    torque : float, callable, str or Path
+        The run's signal, as simulate() takes it: a constant (N.m), a callable of time or a
+        time,torque CSV (docs/signals.md).
+    start_time, stop_time, step_size, ramp, parameters, theta0, omega0, max_steps, fmu_path
+        The run's definition, as simulate() takes it; fmu_path may also be the FMU's model
+        (fmu_model), looked up once here and passed to everything the judgement runs.
+    tolerance : float, optional
+        The largest ``|dtheta|`` (rad) that passes (default: DEFAULT_TOLERANCE, 1e-9 rad).
+    mapping : str or dict, optional
+        The result's column names and unit factors (--map), for a CSV.
+
+    Returns
+    -------
+    Judgement
+        The verdict, the diagnosis and its residual, ``max |dtheta|`` and where, every candidate's
+        residual and effect.
+
+    Raises
+    ------
+    ResultFileError
+        A result file that cannot be read, whose times fall outside the run, or whose first
+        and last rows are not the run's start and stop (a result of part of the run).
+    InvalidInput
+        A tolerance that is not positive and finite, or a run definition simulate() would refuse.
+
+    Examples
+    --------
+    The FMU's own run, written as a result file and judged:
+
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from pendulum_fmu import judge, simulate
+    >>> from pendulum_fmu.fmu._results import write_csv
+    >>> result = write_csv(simulate(20.0, stop_time=1.0), Path(tempfile.mkdtemp()) / "fmu.csv")
+    >>> judgement = judge(result, 20.0, stop_time=1.0)
+    >>> judgement.passed, judgement.diagnosis
+    (True, 'agrees')
+    """
+    tolerance = DEFAULT_TOLERANCE if tolerance is None else tolerance
+    if not (math.isfinite(tolerance) and tolerance > 0):
+        raise InvalidInput(f"the tolerance {tolerance} must be a positive finite number (rad)")
+    source = str(result) if isinstance(result, (str, Path)) else "result"
+    if isinstance(result, (str, Path)):
+        result = read_result(result, mapping)
+    elif mapping:
+        raise InvalidInput(
+            "a map renames and scales a result file's columns: an array result is "
+            "judged as it is, in the fields time and theta (rad); leave out mapping"
+        )
+    model = fmu_model(fmu_path)
+    parameters = resolve_parameters(parameters, model)
+    plan = schedule(
+        torque, start_time=start_time, stop_time=stop_time, step_size=step_size, ramp=ramp, max_steps=max_steps
+    )
+    _check_span(result, plan, step_size, source)
+    times = np.asarray(result["time"], dtype=float)
+    correct = reference(
+        torque,
+        start_time=start_time,
+        stop_time=stop_time,
+        step_size=step_size,
+        ramp=ramp,
+        parameters=parameters,
+        theta0=theta0,
+        omega0=omega0,
+        at=times,
+        fmu_path=model,
+    )
+    difference = np.abs(result["theta"] - correct["theta"])
+    raw = float(np.max(difference))
+    worst_time = float(times[int(np.argmax(difference))])
+    run = Run(plan, times, step_size, parameters, theta0, omega0, model)
+    start_torque = float(model.variables["torque"].start or 0.0)
+    held = schedule(torque, start_time=start_time, stop_time=stop_time, step_size=step_size) if ramp else None
+    variants = candidate_variants(run, torque, held, correct, result, tolerance, start_torque)
+    scores: dict[str, dict | None] = {}
+    best_variant: dict[str, np.ndarray] = {}
+    timing_effects: list[float] = []
+    for name, made in variants.items():
+        if not made:
+            scores[name] = None
+            continue
+        residuals = [float(np.max(np.abs(result["theta"] - v["theta"]))) for v in made]
+        effects = [float(np.max(np.abs(v["theta"] - correct["theta"]))) for v in made]
+        if name in INPUT_TIMING:
+            timing_effects += [effect for effect in effects if effect > tolerance]
+        i = int(np.argmin(residuals))
+        best_variant[name] = made[i]
+        scores[name] = {"residual": residuals[i], "effect": effects[i]}
+    smallest_input_effect = min(timing_effects, default=None)
+    if raw <= tolerance:
+        diagnosis, residual = AGREES, raw
+    else:
+        diagnosis, residual = diagnose(raw, tolerance, scores, smallest_input_effect)
+    return Judgement(
+        verdict="pass" if raw <= tolerance else "fail",
+        diagnosis=diagnosis,
+        residual=residual,
+        max_abs_dtheta=raw,
+        worst_time=worst_time,
+        tolerance=tolerance,
+        candidates=scores,
+        smallest_input_effect=smallest_input_effect,
+        result=result,
+        reference=correct,
+        explanation=best_variant.get(diagnosis) if diagnosis != AGREES else None,
+        source=source,
+        regression_tools=regression_verdicts(times, correct["theta"], result["theta"]),
+    )
+
+
+def format_judgement(judgement: Judgement) -> str:
+    """The lines the command prints for one result: verdict and diagnosis, max |dtheta| and
+    where, and every candidate's residual and effect.
+
+    Parameters
+    ----------
+    judgement : Judgement
+        What judge() returned.
+
+    Returns
+    -------
+    str
+        The lines, joined.
+    """
+    lines = [
+        f"{judgement.source}: {judgement.verdict}: {judgement.diagnosis} (residual {judgement.residual:.2e} rad)",
+        f"max |dtheta| = {judgement.max_abs_dtheta:.3e} rad at t = {judgement.worst_time!r} s "
+        f"(tolerance {judgement.tolerance:g} rad; {len(judgement.result)} points)",
+        f"{'candidate':<28} {'residual rad':>12} {'effect rad':>11}",
+    ]
+    for name, score in judgement.candidates.items():
+        if score is None:
+            lines.append(f"{name:<28} {'does not apply to this run':>24}")
+        else:
+            lines.append(f"{name:<28} {score['residual']:>12.2e} {score['effect']:>11.2e}")
+    if judgement.regression_tools:
+        lines.append("what regression tools would say, on theta against the reference:")
+        lines.extend(f"  {line}" for line in format_verdicts(judgement.regression_tools))
+    return "\n".join(lines)
+
+
+def format_kit(verdicts: dict[str, Judgement | None]) -> str:
+    """The lines the command prints for a kit: one per scenario, then how many pass.
+
+    Parameters
+    ----------
+    verdicts : dict
+        What judge_kit() returned: {scenario: Judgement, or None where it was not run}.
+
+    Returns
+    -------
+    str
+        The lines, joined.
+    """
+    lines = []
+    for name, judgement in verdicts.items():
+        if judgement is None:
+            lines.append(f"{name:<18} not run: no {name}_out.csv")
+        else:
+            lines.append(
+                f"{name:<18} {judgement.verdict:<4}  {judgement.diagnosis:<28} max|dtheta| "
+                f"{judgement.max_abs_dtheta:.2e} rad at t = {judgement.worst_time:.6g} s, "
+                f"residual {judgement.residual:.1e} rad"
+            )
+    judged = [judgement for judgement in verdicts.values() if judgement is not None]
+    not_run = len(verdicts) - len(judged)
+    lines.append(
+        f"{sum(j.passed for j in judged)} of {len(judged)} results pass"
+        + (f"; {not_run} scenarios not run" if not_run else "")
+    )
+    return "\n".join(lines)
+
+
+def judge_kit(
+    folder: str | Path,
+    *,
+    tolerance: float | None = None,
+    mapping: str | None = None,
+    fmu_path: str | Path | FmuModel | None = None,
+) -> dict[str, Judgement | None]:
+    """Judge every NAME_out.csv beside the settings NAME.json of a scenario kit (_scenarios.py).
+
+    Parameters
+    ----------
+    folder : str or Path
+        The kit's folder, as `pendulum-fmu scenarios` wrote it.
+    tolerance : float, optional
+        Overrides each scenario's own tolerance (rad).
+    mapping, fmu_path
+        As judge() takes them.
+
+    Returns
+    -------
+    dict
+        {scenario: Judgement, or None where the folder has no NAME_out.csv}, in the kit's order.
+
+    Raises
+    ------
+    ResultFileError
+        A folder that holds no scenario, or none with a result.
+
+    Examples
+    --------
+    A kit in which one scenario has a result (its reference, copied: it passes) and the others none:
+
+    >>> import shutil, tempfile
+    >>> from pathlib import Path
+    >>> from pendulum_fmu import judge_kit, write_scenarios
+    >>> kit = Path(tempfile.mkdtemp())
+    >>> _ = write_scenarios(kit)
+    >>> _ = shutil.copy(kit / "constant_torque_ref.csv", kit / "constant_torque_out.csv")
+    >>> verdicts = judge_kit(kit)
+    >>> verdicts["constant_torque"].passed, [name for name, judgement in verdicts.items() if judgement is None]
+    (True, ['decimal_steps', 'ramp', 'random_steps', 'resume', 'steps_on_grid'])
+    """
+    folder = Path(folder)
+    found = settings_files(folder)
+    if not found:
+        raise ResultFileError(
+            f"{folder}: no scenario settings (NAME.json) in this folder; write a kit "
+            "with pendulum-fmu scenarios --output-dir FOLDER"
+        )
+    model = None  # the FMU's model, looked up once, for the first result there is
+    verdicts: dict[str, Judgement | None] = {}
+    for name, settings_path in found.items():
+        settings = read_settings(settings_path)
+        output = folder / settings.pop("output")
+        if not output.is_file():
+            verdicts[name] = None
+            continue
+        if tolerance is not None:
+            settings["tolerance"] = tolerance
+        model = model or fmu_model(fmu_path)
+        verdicts[name] = judge(output, mapping=mapping, fmu_path=model, **settings)
+    if all(v is None for v in verdicts.values()):
+        raise ResultFileError(
+            f"{folder}: no result to judge: run each scenario and write NAME_out.csv "
+            f"(time,theta[,omega,alpha]) beside its NAME_in.csv, e.g. "
+            f"{next(iter(found))}_out.csv"
+        )
+    return verdicts
+
+
+def write_json(verdicts: dict[str, Judgement | None] | Judgement, path: str | Path) -> Path:
+    """Write --json whole or not at all: one judgement's summary (Judgement.summary), or
+    {"scenarios": {name: summary or null}} for a kit.
+
+    Parameters
+    ----------
+    verdicts : Judgement or dict
+        What judge() or judge_kit() returned.
+    path : str or Path
+        The JSON file.
+
+    Returns
+    -------
+    Path
+        path.
+    """
+    if isinstance(verdicts, Judgement):
+        content = verdicts.summary()
+    else:
+        content = {"scenarios": {name: j.summary() if j else None for name, j in verdicts.items()}}
+    with replacing(path) as file:
+        json.dump(content, file, indent=2)
+        file.write("\n")
+    return Path(path)
+
+
+__all__ = ["Judgement", "format_judgement", "format_kit", "judge", "judge_kit", "write_json"]

@@ -1,0 +1,485 @@
+"""The independent oracle: a torque signal as docs/signals.md defines it, through scipy.
+
+`reference()` shares no code with the path that feeds the tools (`torque_schedule.schedule`)
+beyond its checks of what it is given (a file that is no signal, a run length, refused in the
+same words), never how it reads or samples a signal. It reads a CSV with its own small reader,
+keeps the times as exact fractions of the decimals written in the file, and finds the
+communication points and the torque of each step from the written definition. A schedule that
+does not carry the user's signal to the tools then shows as a difference between them and this
+oracle. `reference_schedule()` integrates a given schedule, to
+judge a tool on exactly the torques it was fed.
+
+Both integrate the equation of motion with solve_ivp (DOP853, rtol = atol = 1e-12) over pieces
+on which the torque is linear (held or ramped), restarting at every piece boundary.
+"""
+
+from __future__ import annotations
+
+import bisect
+import csv
+import itertools
+import math
+import numbers
+from collections.abc import Callable
+from fractions import Fraction
+from pathlib import Path
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from .._errors import InvalidInput, WrongType
+from ..fmu import _results as results
+from ..fmu._parameters import Fmu, start_value, total_inertia
+from ..fmu._simulate import resolve_parameters
+from ..signals._time_grid import step_count
+from ..signals._torque_csv import read_torque_csv
+from ..signals._torque_schedule import TorqueSchedule
+
+# docs/signals.md: an event within max(1e-9 step, 64 ulp of its time) of a communication point
+# is that point. Written again here on purpose: the oracle must not borrow the schedule's code.
+_TOLERANCE_STEPS, _TOLERANCE_ULPS = Fraction(1, 10**9), 64
+_DEFAULT_STOP_TIME = Fraction(3)
+
+
+def _exact(value) -> Fraction:
+    """A number as the decimal a person wrote: 0.009 is 9/1000, not the double nearest it."""
+    return Fraction(repr(float(value))) if not isinstance(value, (str, Fraction)) else Fraction(value)
+
+
+def _seconds(name: str, value) -> Fraction:
+    """A time argument as the decimal a person wrote; InvalidInput unless a finite number."""
+    if not (isinstance(value, numbers.Real) and math.isfinite(value)):
+        raise InvalidInput(f"{name} {value!r} must be a finite number of seconds")
+    return _exact(value)
+
+
+def _torque(value, where: str) -> float:
+    """A torque value of the signal; InvalidInput unless a finite number."""
+    # A signal written with numpy may return a 0-d array (np.where, np.interp of a scalar).
+    if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
+        value = value.item()
+    if not (isinstance(value, numbers.Real) and math.isfinite(value)):
+        raise InvalidInput(f"the torque is {value!r} {where}; it must be a finite number of N.m")
+    return float(value)
+
+
+def _tolerance(time: Fraction, step: Fraction) -> Fraction:
+    return max(_TOLERANCE_STEPS * step, Fraction(_TOLERANCE_ULPS * math.ulp(float(time))))
+
+
+class _TorqueFile:
+    """A time,torque CSV as exact times and float torques: linear between rows, a jump where a
+    time repeats, held outside.
+    """
+
+    def __init__(self, path: Path):
+        with open(path, newline="", encoding="utf-8-sig") as file:
+            rows = [row for row in csv.reader(file) if any(cell.strip() for cell in row)]
+        header = [cell.strip() for cell in rows[0]]
+        time_column, torque_column = header.index("time"), header.index("torque")
+        self.times = [Fraction(row[time_column].strip()) for row in rows[1:]]
+        self.torques = [float(row[torque_column]) for row in rows[1:]]
+
+    def after(self, t: Fraction) -> float:
+        times, torques = self.times, self.torques
+        if t >= times[-1]:
+            return torques[-1]
+        if t < times[0]:
+            return torques[0]
+        j = bisect.bisect_right(times, t)  # times[j-1] <= t < times[j]
+        return self._between(j, t)
+
+    def before(self, t: Fraction) -> float:
+        times, torques = self.times, self.torques
+        if t > times[-1]:
+            return torques[-1]
+        if t <= times[0]:
+            return torques[0]
+        j = bisect.bisect_left(times, t)  # times[j-1] < t <= times[j]
+        return self._between(j, t)
+
+    def _between(self, j: int, t: Fraction) -> float:
+        t0, t1, u0, u1 = self.times[j - 1], self.times[j], self.torques[j - 1], self.torques[j]
+        share = float((t - t0) / (t1 - t0))
+        value = u0 + (u1 - u0) * share
+        # docs/signals.md's form, unless rows near the largest double differ by inf.
+        return value if math.isfinite(value) else u0 * (1 - share) + u1 * share
+
+    def jumps(self) -> list[Fraction]:
+        return sorted({a for a, b in zip(self.times, self.times[1:], strict=False) if a == b})
+
+    def latest_event_near(self, t: Fraction, step: Fraction) -> Fraction:
+        """t, or the latest row time within the tolerance of t: that event is at t."""
+        tolerance = _tolerance(t, step)
+        j = bisect.bisect_right(self.times, t + tolerance)
+        return max(t, self.times[j - 1]) if j and self.times[j - 1] >= t - tolerance else t
+
+
+def _grid(start: Fraction, stop: Fraction, step: Fraction) -> list[Fraction]:
+    """Start + k*step up to stop; stop itself ends a shorter last step unless it is on the grid."""
+    # Only checked by the schedule's code, in simulate()'s words (a step that is not positive, a
+    # stop not after the start, a run too long to hold): the grid below is the oracle's own.
+    step_count(float(start), float(stop), float(step))
+    points, k, last = [], 0, stop - _tolerance(stop, step)
+    point = start
+    while point < last:
+        points.append(point)
+        k += 1
+        point = start + k * step
+    return [*points, stop]
+
+
+def _with_events(grid: list[Fraction], events: list[Fraction], step: Fraction) -> list[Fraction]:
+    """The grid plus every event inside it that is not within the tolerance of a grid point."""
+    extra = []
+    for event in events:
+        if not grid[0] < event < grid[-1]:
+            continue
+        j = bisect.bisect_left(grid, event)
+        if min(grid[j] - event, event - grid[j - 1]) > _tolerance(event, step):
+            extra.append(event)
+    return sorted(set(grid) | set(extra))
+
+
+class _Pieces:
+    """The torque as pieces [start, end) on which it is u0 + rate * (t - start), the
+    communication points the signal defines, and the torque just after any time.
+    """
+
+    def __init__(
+        self,
+        starts: list[Fraction],
+        stop: Fraction,
+        u0: list[float],
+        rate: list[float],
+        points: list[Fraction],
+        value_after: Callable[[Fraction], float],
+    ):
+        self.starts, self.stop, self.u0, self.rate = starts, stop, u0, rate
+        self.points, self.value_after = points, value_after
+
+
+def _signal_pieces(torque, start: Fraction, stop: Fraction | None, step: Fraction, ramp: bool) -> _Pieces:
+    if isinstance(torque, (str, Path)):
+        read_torque_csv(torque)  # a file that is no signal refused where it is wrong; read below anew
+        signal = _TorqueFile(Path(torque))
+        stop = signal.times[-1] if stop is None else stop
+        grid = _grid(start, stop, step)
+        if ramp:
+            # The file's own piecewise-linear signal: a piece between consecutive row times.
+            points = sorted({start, stop} | {t for t in signal.times if start < t < stop})
+            u0 = [signal.after(a) for a in points[:-1]]
+            rate = [(signal.before(b) - signal.after(a)) / float(b - a) for a, b in itertools.pairwise(points)]
+            return _Pieces(
+                points[:-1],
+                stop,
+                u0,
+                rate,
+                _with_events(grid, signal.times, step),
+                lambda t: signal.after(signal.latest_event_near(t, step)),
+            )
+        points = _with_events(grid, signal.jumps(), step)
+        held = [signal.after(signal.latest_event_near(p, step)) for p in points[:-1]]
+        return _Pieces(points[:-1], stop, held, [0.0] * len(held), points, _holding(points, held, step))
+
+    if isinstance(torque, (list, tuple, np.ndarray)):
+        values = [_torque(u, f"at step {k} of the array") for k, u in enumerate(torque)]
+        points = _grid(start, start + len(values) * step if stop is None else stop, step)
+        if len(points) - 1 != len(values):
+            raise InvalidInput(f"the torque array has {len(values)} values for {len(points) - 1} steps")
+    else:
+        points = _grid(start, _DEFAULT_STOP_TIME if stop is None else stop, step)
+        sample = torque if callable(torque) else (lambda t, u=torque: u)
+        values = [_torque(sample(float(p)), f"at t = {float(p)}") for p in points]
+    if ramp:
+        rate = [(b - a) / float(t1 - t0) for a, b, t0, t1 in zip(values, values[1:], points, points[1:], strict=False)]
+    else:
+        rate = [0.0] * (len(points) - 1)
+    u0 = values[: len(points) - 1]
+    return _Pieces(points[:-1], points[-1], u0, rate, points, _holding(points, u0, step))
+
+
+def _holding(points: list[Fraction], values: list[float], step: Fraction) -> Callable[[Fraction], float]:
+    """The torque just after t of a signal holding values[k] from points[k]: the step holding t
+    is the one starting at the latest point at or (within the tolerance) just after t.
+    """
+
+    def value_after(t: Fraction) -> float:
+        j = max(bisect.bisect_right(points, t + _tolerance(t, step)) - 1, 0)
+        return values[min(j, len(values) - 1)]
+
+    return value_after
+
+
+def equation_of_motion(parameters: dict[str, float]) -> Callable:
+    """alpha(theta, omega, torque) of the pendulum with these (resolved) parameters, in rad/s2;
+    works on scalars and numpy arrays alike.
+
+    Parameters
+    ----------
+    parameters : dict
+        mass, length, inertia, gravity and damping, as resolve_parameters gives them.
+
+    Returns
+    -------
+    callable
+        acceleration(theta, omega, torque).
+    """
+    inverse_inertia = 1.0 / total_inertia(parameters)
+    gravity_moment = parameters["mass"] * parameters["gravity"] * parameters["length"]
+    damping = parameters["damping"]
+
+    def acceleration(theta, omega, u):
+        return (u - gravity_moment * np.sin(theta) - damping * omega) * inverse_inertia
+
+    return acceleration
+
+
+def _integrate(
+    pieces: _Pieces,
+    at: np.ndarray,
+    parameters: dict | None,
+    theta0: float,
+    omega0: float,
+    rtol: float,
+    atol: float,
+    fmu_path: Fmu,
+    method: str = "DOP853",
+    max_step: float = np.inf,
+) -> np.ndarray:
+    theta0, omega0 = start_value("theta0", theta0, "rad"), start_value("omega0", omega0, "rad/s")
+    for name, value in (("rtol", rtol), ("atol", atol)):
+        if not (isinstance(value, numbers.Real) and 0 < value < math.inf):
+            raise InvalidInput(f"{name} {value!r} must be a positive finite number (solve_ivp's tolerance)")
+    parameters = resolve_parameters(parameters, fmu_path)
+    acceleration = equation_of_motion(parameters)
+    starts = [float(s) for s in pieces.starts]
+    ends = [*starts[1:], float(pieces.stop)]
+    # Each reported time belongs to the first piece that reaches it (a time a rounding past the
+    # end of the run belongs to the last).
+    owner = np.minimum(np.searchsorted(ends, at, side="left"), len(ends) - 1)
+    out = results.empty(len(at))
+    out["time"] = at
+    state = np.array([theta0, omega0], dtype=float)
+    first = 0
+    while first < len(starts):
+        # Merge pieces that continue one another (the same held torque), so solve_ivp restarts
+        # only where the torque changes.
+        last = first
+        while (
+            last + 1 < len(starts)
+            and pieces.rate[first] == 0
+            and pieces.rate[last + 1] == 0
+            and pieces.u0[last + 1] == pieces.u0[first]
+        ):
+            last += 1
+        t0, t1, u0, rate = starts[first], ends[last], pieces.u0[first], pieces.rate[first]
+        mine = np.flatnonzero((owner >= first) & (owner <= last))
+        if t1 > t0:
+            report = np.clip(at[mine], t0, t1)
+            times = np.unique(np.append(report, t1))  # solve_ivp wants them strictly increasing
+            # Values the FMU would refuse (mass*gravity*length past the largest double) make
+            # the derivative inf or NaN: solve_ivp then fails, and that failure is the error to
+            # show, not numpy's warnings on the way to it.
+            with np.errstate(over="ignore", invalid="ignore"):
+                solution = solve_ivp(
+                    lambda t, y, u0=u0, rate=rate, t0=t0: (y[1], acceleration(y[0], y[1], u0 + rate * (t - t0))),
+                    (t0, t1),
+                    state,
+                    method=method,
+                    rtol=rtol,
+                    atol=atol,
+                    t_eval=times,
+                    max_step=max_step,
+                )
+            if not solution.success:
+                raise _failed(solution.message, t0, parameters, theta0, omega0, pieces)
+            row = np.searchsorted(times, report)
+            out["theta"][mine], out["omega"][mine] = solution.y[0, row], solution.y[1, row]
+            state = solution.y[:, -1].copy()
+        else:
+            out["theta"][mine], out["omega"][mine] = state
+        first = last + 1
+    out["torque"] = [pieces.value_after(_exact(t)) for t in at.tolist()]
+    # The end of the run reports the torque the last piece reached, as a master reads it back.
+    at_end = at >= ends[-1]
+    out["torque"][at_end] = pieces.u0[-1] + pieces.rate[-1] * (ends[-1] - starts[-1])
+    with np.errstate(over="ignore", invalid="ignore"):
+        out["alpha"] = acceleration(out["theta"], out["omega"], out["torque"])
+    if not np.isfinite(out["alpha"]).all():  # the states stayed finite, the acceleration did not
+        at_time = float(out["time"][np.flatnonzero(~np.isfinite(out["alpha"]))[0]])
+        raise _failed("the acceleration is not finite", at_time, parameters, theta0, omega0, pieces)
+    return out
+
+
+def _failed(why: str, t: float, parameters: dict, theta0: float, omega0: float, pieces: _Pieces) -> InvalidInput:
+    """The one-line error for an integration these values break, naming every value."""
+    values = ", ".join(
+        f"{name} = {value:g}" for name, value in {**parameters, "theta0": theta0, "omega0": omega0}.items()
+    )
+    torque = max(abs(u) for u in pieces.u0)
+    return InvalidInput(
+        f"the reference cannot integrate the pendulum from t = {t:g} s with {values} "
+        f"and torques up to {torque:g}: {why.rstrip('.')}; values near the largest "
+        "double (mass*gravity*length, mass*length^2, the torque over the inertia) "
+        "break it: give physically meaningful values"
+    )
+
+
+def reference(
+    torque=20.0,
+    *,
+    start_time: float = 0.0,
+    stop_time: float | None = None,
+    step_size: float = 1e-3,
+    ramp: bool = False,
+    parameters: dict | None = None,
+    theta0: float = 0.0,
+    omega0: float = 0.0,
+    at: np.ndarray | None = None,
+    rtol: float = 1e-12,
+    atol: float = 1e-12,
+    fmu_path: Fmu = None,
+    method: str = "DOP853",
+    max_step: float = np.inf,
+) -> np.ndarray:
+    """The trajectory under a signal as docs/signals.md defines it, through scipy's solve_ivp
+    (DOP853 by default): the independent oracle, which reads the signal itself.
+
+    Parameters
+    ----------
+    torque : float, callable, sequence of float, str or Path
+        As simulate() takes it: a constant (N.m), a callable of time, a per-step array or a CSV
+        path.
+    start_time, stop_time, step_size, ramp, theta0, omega0
+        As simulate() takes them.
+    parameters : dict, optional
+        Overrides of the defaults of the FMU at fmu_path.
+    at : numpy.ndarray, optional
+        The times to report, in s (default: the signal's communication points).
+    rtol, atol : float, optional
+        solve_ivp's tolerances.
+    method : str, optional
+        solve_ivp's method (another one checks this one).
+    max_step : float, optional
+        solve_ivp's bound on its steps in s, which takes it below the error its tolerance alone
+        reaches.
+    fmu_path : str or Path, optional
+        The FMU whose parameters and defaults apply (default: pendulum_fmu.default_fmu()).
+
+    Returns
+    -------
+    numpy.ndarray
+        Same result format as simulate(); torque is the signal's value just after each time.
+
+    Raises
+    ------
+    InvalidInput
+        A signal the reference cannot read, parameters the FMU refuses, or values with which
+        solve_ivp fails (mass*gravity*length past the largest double, say).
+
+    Examples
+    --------
+    The FMU's run against the oracle, which shares no code with it:
+
+    >>> from pendulum_fmu import reference, simulate
+    >>> oracle = reference(20.0, stop_time=1.0)
+    >>> round(float(oracle["theta"][-1]), 6)
+    0.187205
+    >>> bool(abs(simulate(20.0, stop_time=1.0)["theta"] - oracle["theta"]).max() < 1e-9)
+    True
+    """
+    if not (isinstance(torque, (str, Path, list, tuple, np.ndarray, int, float)) or callable(torque)):
+        raise InvalidInput(
+            f"the reference takes a constant, a callable, a per-step array or a CSV path, "
+            f"not a {type(torque).__name__}: it reads the signal itself"
+        )
+    if isinstance(torque, (list, tuple, np.ndarray)) and ramp:
+        raise InvalidInput("a per-step torque array is held over each step; ramp needs a CSV or a callable")
+    step, start = _seconds("step size", step_size), _seconds("start time", start_time)
+    stop = None if stop_time is None else _seconds("stop time", stop_time)
+    pieces = _signal_pieces(torque, start, stop, step, ramp)
+    if at is None:
+        at = np.array([float(t) for t in pieces.points])
+    return _integrate(
+        pieces, _times(at, pieces, step), parameters, theta0, omega0, rtol, atol, fmu_path, method, max_step
+    )
+
+
+def _times(at, pieces: _Pieces, step: Fraction) -> np.ndarray:
+    """The times to report: within the run, or a rounding past its ends."""
+    try:
+        times = np.asarray(at, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidInput(f"at is the times to report, numbers in s; got {at!r}") from None
+    start, stop = pieces.starts[0], pieces.stop
+    earliest, latest = float(start - _tolerance(start, step)), float(stop + _tolerance(stop, step))
+    outside = times.ravel()[~((times.ravel() >= earliest) & (times.ravel() <= latest))]
+    if times.ndim != 1 or len(outside):
+        shown = float(outside[0]) if len(outside) else at
+        raise InvalidInput(f"at: {shown!r} is no time of the run, {float(start):g} to {float(stop):g} s")
+    return times
+
+
+def reference_schedule(
+    plan,
+    *,
+    parameters: dict | None = None,
+    theta0: float = 0.0,
+    omega0: float = 0.0,
+    at: np.ndarray | None = None,
+    rtol: float = 1e-12,
+    atol: float = 1e-12,
+    fmu_path: Fmu = None,
+) -> np.ndarray:
+    """Integrate exactly the torques of a schedule, reported at its communication points (or at
+    the times `at`): the judge of a tool that was fed that schedule, and the judge's variants of
+    a run with a mistake made (_judge.py).
+
+    Parameters
+    ----------
+    plan : TorqueSchedule
+        time (N + 1 points, s), torque (N start values, N.m) and torque_rate (N, N.m/s).
+    parameters, theta0, omega0, rtol, atol, fmu_path
+        As reference() takes them.
+    at : numpy.ndarray, optional
+        The times to report, in s (default: the schedule's communication points).
+
+    Returns
+    -------
+    numpy.ndarray
+        Same result format as simulate().
+
+    Raises
+    ------
+    WrongType
+        plan is no TorqueSchedule.
+    InvalidInput
+        Parameters the FMU refuses, times in `at` outside the run, or values with which
+        solve_ivp fails.
+
+    Examples
+    --------
+    20 N.m for 1 s with gravity off: theta(1 s) = 20 / (2 * 30 kg.m^2) = 1/3 rad.
+
+    >>> from pendulum_fmu import reference_schedule, schedule
+    >>> run = reference_schedule(schedule(20.0, stop_time=1.0), parameters={"gravity": 0.0})
+    >>> run.dtype.names, len(run), round(float(run["theta"][-1]), 12)
+    (('time', 'torque', 'theta', 'omega', 'alpha'), 1001, 0.333333333333)
+    """
+    if not isinstance(plan, TorqueSchedule):
+        raise WrongType(f"plan is a TorqueSchedule (torque_schedule.schedule(...)), not a {type(plan).__name__}")
+    points = [Fraction(float(t)) for t in plan.time]
+    u0, rate = plan.torque.tolist(), plan.torque_rate.tolist()
+    # The schedule's points are the tools' own: no tolerance beyond rounding.
+    pieces = _Pieces(points[:-1], points[-1], u0, rate, points, _holding(points, u0, Fraction(0)))
+    return _integrate(
+        pieces,
+        np.asarray(plan.time if at is None else at, dtype=float),
+        parameters,
+        theta0,
+        omega0,
+        rtol,
+        atol,
+        fmu_path,
+    )
