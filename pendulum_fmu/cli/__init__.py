@@ -5,6 +5,9 @@ options, and its ``run(args)``, which turns them into one call of the package's 
 what came back. A command imports what it runs only when it runs, so that ``pendulum-fmu
 simulate`` loads neither the sweep nor matplotlib. A user's error (a PendulumFmuError) is one line
 and exit 2; anything else is a bug of ours, one line too, with the traceback on --debug.
+
+May import: every folder of the package, the basics and the top's own names (__version__): it is
+the top floor, which nothing of the package imports but the program (_entry).
 """
 
 from __future__ import annotations

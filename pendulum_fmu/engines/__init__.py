@@ -10,6 +10,8 @@ whose defaults fill the parameters not given. mode "accurate" sets the engine's
 best integrator tight; "default" keeps the engine's own integrator and settings, stepping once per
 communication step, so a comparison shows the price of the defaults. docs/engines.md says what
 each adapter sets and why. The engine modules import their engine, so import them only when used.
+
+May import: fmu/, signals/ and the basics. Not the reference: an engine is held to it, in tests.
 """
 
 from __future__ import annotations

@@ -37,6 +37,8 @@ The package, in the order a run goes through it:
     worker.py  a chunk on a worker: its cases through the native loop, its two parts written
     store.py   the output folder: study.json, the parts, the lock, the cases table read back
     figure.py  sweep.png from the cases table
+
+May import: figures/, fmu/, signals/ and the basics.
 """
 
 from .grid import Grid, sweep_grid
