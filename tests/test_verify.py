@@ -264,7 +264,9 @@ def test_a_kits_reference_naming_a_file_elsewhere_is_refused_before_anything_is_
     crafted = _changed(changed, tmp_path / "crafted.fmu", RECORD, lambda _: json.dumps(record).encode())
     assert main(["verify", str(crafted), "--no-rebuild"]) == 2
     [line] = capsys.readouterr().err.strip().splitlines()
-    assert f"{crafted}'s {name}: output is \"{precious}\"; it must be the name of a file in the kit's folder" in line
+    # The value quoted is cut to its first 80 characters, which a long temporary path passes.
+    assert line.startswith(f"pendulum-fmu verify: error: {crafted}'s {name}: output is \"/")
+    assert "it must be the name of a file in the kit's folder" in line
     assert precious.read_text() == "mine\n"
 
 
