@@ -141,8 +141,9 @@ Status instance_error(const Instance *instance, const char *function, const char
 /* The call record: one line per call the instance receives, under category logCalls, so that a
    user can show what a master did to the FMU. Each line starts with CALL_RECORD_MARKER and names
    the instance inside the message, because masters print messages in formats of their own and
-   some drop the instance name; pendulum_fmu/_calls.py reads the lines back. The adapters test
-   instance_recording before they format anything, so that a step costs one test when it is off. */
+   some drop the instance name; pendulum_fmu/judging/_call_record.py reads the lines back. The
+   adapters test instance_recording before they format anything, so that a step costs one test
+   when it is off. */
 #define CALL_RECORD_MARKER "[pendulum-calls]"
 /* For the out-of-line recording paths of the functions a master calls every step. */
 #if defined(_MSC_VER)
