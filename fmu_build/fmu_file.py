@@ -49,6 +49,64 @@ def _stamped_model_description(xml: Path, fmi_version: int = 2) -> str:
     return text
 
 
+def _binaries(
+    platforms: tuple[str, ...], tmp: Path, definitions: dict, identifier: str, fmi_version: int, linux_glibc
+) -> tuple[dict[str, Path], dict[str, list]]:
+    """Each platform's binary built in tmp, by its entry name in the FMU (FMI 3.0: one per slice,
+    FMI 2.0: macOS's slices merged), and the toolchain each was made with (for its build record).
+    """
+    binaries: dict[str, Path] = {}
+    toolchains: dict[str, list] = {}
+    for name in platforms:
+        platform = PLATFORMS[name]
+        slices = {
+            target.name: cmake_build(target, tmp / name / target.name, "fmu", definitions, linux_glibc=linux_glibc)
+            for target in platform.targets
+        }
+        made = {
+            folder: {"target": folder, **toolchain(binary.parent.parent / "build", "fmu")}
+            for folder, binary in slices.items()
+        }
+        if fmi_version == 3:
+            for folder, binary in slices.items():
+                binaries[f"binaries/{folder}/{binary.name}"] = binary
+                toolchains[f"binaries/{folder}/{binary.name}"] = [made[folder]]
+        else:
+            binary = merged_binary(list(slices.values()), tmp / name / f"{identifier}{platform.suffix}")
+            binaries[f"binaries/{name}/{binary.name}"] = binary
+            toolchains[f"binaries/{name}/{binary.name}"] = list(made.values())
+    return binaries, toolchains
+
+
+def _write_fmu(
+    out_file,
+    model_description_file: Path,
+    model_description,
+    fmi_version: int,
+    binaries: dict,
+    toolchains: dict,
+    sources: Path,
+) -> None:
+    """Zip the FMU's entries and its build record into out_file, whole or not at all."""
+    entries = {
+        "modelDescription.xml": _stamped_model_description(model_description_file, fmi_version).encode(),
+        **{name: binary.read_bytes() for name, binary in binaries.items()},
+        **{f"sources/{source.name}": source.read_bytes() for source in sorted(sources.iterdir())},
+        "documentation/index.html": documentation_html(model_description, fmi_version).encode(),
+    }
+    epoch = source_date_epoch()
+    record = {
+        "format": RECORD_FORMAT,
+        "generator": f"pendulum_fmu {__version__}",
+        **source_commit(),
+        "source_date_epoch": epoch,
+        "fmi_version": fmi_version,
+        "binaries": toolchains,
+    }
+    with replacing_path(out_file) as partial:
+        write_archive(partial, with_record(entries, record).items(), epoch)
+
+
 def build_fmu(
     out_file: str | os.PathLike = DEFAULT_FMU,
     *,
@@ -58,10 +116,8 @@ def build_fmu(
     fmi_version: int = 2,
     linux_glibc: str | None = None,
 ) -> Path:
-    """Build an FMU (binaries/, sources/, documentation/) of a model over the FMI plumbing.
-
-    Everything is compiled in a private temporary folder and the zip is renamed into place
-    whole, so builds into the same path at the same time all succeed.
+    """Build an FMU (binaries/, sources/, documentation/) of a model over the FMI plumbing, as
+    the module's docstring says: in a private folder, renamed into place whole.
 
     Parameters
     ----------
@@ -126,42 +182,10 @@ def build_fmu(
             "MODEL_DESCRIPTION": Path(model_description_file).resolve(),
             "FMI_VERSION": fmi_version,
         }
-        binaries, toolchains = {}, {}
-        for name in platforms:
-            platform = PLATFORMS[name]
-            slices = {
-                target.name: cmake_build(target, tmp / name / target.name, "fmu", definitions, linux_glibc=linux_glibc)
-                for target in platform.targets
-            }
-            made = {
-                folder: {"target": folder, **toolchain(binary.parent.parent / "build", "fmu")}
-                for folder, binary in slices.items()
-            }
-            if fmi_version == 3:
-                for folder, binary in slices.items():
-                    binaries[f"binaries/{folder}/{binary.name}"] = binary
-                    toolchains[f"binaries/{folder}/{binary.name}"] = [made[folder]]
-            else:
-                binary = merged_binary(list(slices.values()), tmp / name / f"{identifier}{platform.suffix}")
-                binaries[f"binaries/{name}/{binary.name}"] = binary
-                toolchains[f"binaries/{name}/{binary.name}"] = list(made.values())
-        entries = {
-            "modelDescription.xml": _stamped_model_description(Path(model_description_file), fmi_version).encode(),
-            **{name: binary.read_bytes() for name, binary in binaries.items()},
-            **{f"sources/{source.name}": source.read_bytes() for source in sorted(sources.iterdir())},
-            "documentation/index.html": documentation_html(model_description, fmi_version).encode(),
-        }
-        epoch = source_date_epoch()
-        record = {
-            "format": RECORD_FORMAT,
-            "generator": f"pendulum_fmu {__version__}",
-            **source_commit(),
-            "source_date_epoch": epoch,
-            "fmi_version": fmi_version,
-            "binaries": toolchains,
-        }
-        with replacing_path(out_file) as partial:
-            write_archive(partial, with_record(entries, record).items(), epoch)
+        binaries, toolchains = _binaries(platforms, tmp, definitions, identifier, fmi_version, linux_glibc)
+        _write_fmu(
+            out_file, Path(model_description_file), model_description, fmi_version, binaries, toolchains, sources
+        )
     return Path(out_file)
 
 

@@ -82,5 +82,4 @@ def rewrite_fmu(out_file: str | os.PathLike, entries: dict[str, bytes], record_c
     dropped, as it was of the old record).
     """
     record = json.loads(entries[RECORD_FILE]) if RECORD_FILE in entries else {"format": RECORD_FORMAT}
-    epoch = int(record.get("source_date_epoch", ZIP_EPOCH))
-    write_archive(out_file, with_record(entries, {**record, **record_changes}).items(), epoch)
+    write_archive(out_file, with_record(entries, {**record, **record_changes}).items(), recorded_epoch(entries))

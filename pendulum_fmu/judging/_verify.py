@@ -211,7 +211,7 @@ def _rebuild(entries: dict[str, bytes], record: dict | None) -> Check:
     binaries = [name for name in entries if name.startswith("binaries/") and name.split("/")[1] in (folders or ())]
     if not binaries:
         return Check("rebuild", SKIP, f"no binary for this machine ({sys.platform} {platform.machine()})")
-    [name] = binaries[:1]
+    name = binaries[0]
     if not any(entry.startswith("sources/") for entry in entries):
         return Check("rebuild", SKIP, f"{name}: the FMU carries no sources/")
     if record is None or name not in record.get("binaries", {}):
