@@ -33,7 +33,7 @@ import numpy as np
 
 from .._errors import InvalidInput, Skipped, WrongType
 from ..engines import MODES, check_mode
-from ..fmu import _results as results
+from ..fmu import WASM_PLATFORM, _results as results
 from ..fmu._model import FmuModel, fmu_model
 from ..fmu._simulate import simulate_plan
 from ..oracle._reference import reference_schedule
@@ -105,6 +105,24 @@ def run_fmu(
     return simulate_plan(plan, parameters=parameters, theta0=theta0, omega0=omega0, fmu_path=fmu_path)
 
 
+def run_wasm(
+    plan: TorqueSchedule,
+    *,
+    parameters: dict | None = None,
+    theta0: float = 0.0,
+    omega0: float = 0.0,
+    mode: str = "accurate",
+    fmu_path: str | Path | FmuModel | None = None,
+) -> np.ndarray:
+    """The FMU's WebAssembly binary through wasmtime: fmu_path's, which must be FMI 3.0, or the
+    FMI 3.0 FMU of the checkout (the package); the torque held over each step.
+    """
+    check_mode(mode, "wasm")
+    return simulate_plan(
+        plan, parameters=parameters, theta0=theta0, omega0=omega0, fmu_path=fmu_path, platform=WASM_PLATFORM
+    )
+
+
 def run_reference(
     plan: TorqueSchedule,
     *,
@@ -141,6 +159,7 @@ KINDS = {
     "mujoco": Kind("pendulum_fmu.engines.mujoco:run", "mujoco", "mujoco", MODES),
     "drake": Kind("pendulum_fmu.engines.drake:run", "pydrake", "drake", MODES),
     "pybullet": Kind("pendulum_fmu.engines.pybullet:run", "pybullet", "pybullet", MODES),
+    "wasm": Kind("pendulum_fmu.comparing._compare_tools:run_wasm", "wasmtime", "wasm"),
 }
 # The tools compare runs when none are named: of these, the ones installed here.
 DEFAULT_TOOLS = ("fmu", "reference", "opensim")
@@ -159,7 +178,7 @@ class ToolInfo:
     Attributes
     ----------
     name : str
-        The tool's name: fmu, reference, opensim, mujoco, drake or pybullet.
+        The tool's name: fmu, reference, opensim, mujoco, drake, pybullet or wasm.
     installed : bool
         Whether its Python package can be imported here.
     labels : tuple of str
@@ -186,7 +205,8 @@ def list_tools() -> list[ToolInfo]:
     Returns
     -------
     list of ToolInfo
-        fmu, reference, then the engines: opensim, mujoco, drake, pybullet.
+        fmu, reference, the engines (opensim, mujoco, drake, pybullet), then wasm: the FMU's
+        WebAssembly binary.
 
     Raises
     ------
