@@ -12,7 +12,7 @@ import tempfile
 from pathlib import Path
 
 from .accuracy_cost import accuracy_cost_rows
-from .builds import build_null_fmu, build_pendulum_fmu, build_step_master
+from .builds import build_fmi3_fmu, build_null_fmu, build_pendulum_fmu, build_step_master
 from .case_cost import case_cost_rows
 from .fixed_cost import fixed_cost_rows
 from .floor import floor_rows
@@ -22,8 +22,20 @@ from .python_loop import python_loop_rows
 from .realtime import realtime_rows
 from .report import as_markdown, as_text, main_table
 from .scale import scale_rows
+from .wasm_cost import wasm_cost_rows
 
-PARTS = ("floor", "own-cost", "accuracy", "python-loop", "fixed-cost", "opensim", "pythonfmu", "scale", "realtime")
+PARTS = (
+    "floor",
+    "own-cost",
+    "accuracy",
+    "python-loop",
+    "fixed-cost",
+    "opensim",
+    "pythonfmu",
+    "scale",
+    "realtime",
+    "wasm",
+)
 DEFAULT_FIGURE = Path(__file__).resolve().parent / "accuracy_cost.png"
 
 
@@ -98,6 +110,8 @@ def main(argv=None) -> int:
                 rows += scale_rows(pendulum, args.quick) + case_cost_rows(pendulum, args.quick)
             elif part == "realtime":
                 rows += realtime_rows(pendulum, scratch)
+            elif part == "wasm":
+                rows += wasm_cost_rows(build_fmi3_fmu(scratch), repetitions)
     tables = [main_table(rows)] + ([grid] if grid else [])
     print("\n\n".join(as_text(table) for table in tables))
     if args.markdown:

@@ -35,7 +35,7 @@ from .._errors import InvalidInput, Skipped, WrongType
 from ..engines import MODES, check_mode
 from ..fmu import WASM_PLATFORM, _results as results
 from ..fmu._model import FmuModel, fmu_model
-from ..fmu._simulate import simulate_plan
+from ..fmu._simulate import resolve_parameters, simulate_plan
 from ..oracle._reference import reference_schedule
 from ..signals._torque_schedule import TorqueSchedule
 
@@ -99,28 +99,23 @@ def run_fmu(
     omega0: float = 0.0,
     mode: str = "accurate",
     fmu_path: str | Path | FmuModel | None = None,
+    platform: str | None = None,
 ) -> np.ndarray:
-    """The project's FMU (the checkout's, or fmu_path) through fmpy; ramps are passed on."""
-    check_mode(mode, "fmu")
-    return simulate_plan(plan, parameters=parameters, theta0=theta0, omega0=omega0, fmu_path=fmu_path)
-
-
-def run_wasm(
-    plan: TorqueSchedule,
-    *,
-    parameters: dict | None = None,
-    theta0: float = 0.0,
-    omega0: float = 0.0,
-    mode: str = "accurate",
-    fmu_path: str | Path | FmuModel | None = None,
-) -> np.ndarray:
-    """The FMU's WebAssembly binary through wasmtime: fmu_path's, which must be FMI 3.0, or the
-    FMI 3.0 FMU of the checkout (the package); the torque held over each step.
+    """The project's FMU (the checkout's, or fmu_path) through fmpy; ramps are passed on.
+    platform: its binary, as simulate's (the wasm tool's: WASM_PLATFORM).
     """
-    check_mode(mode, "wasm")
+    check_mode(mode, "fmu")
+    if platform:
+        # A set the FMU refuses, in its words as every tool says them, before the binary is looked for.
+        resolve_parameters(parameters, fmu_path)
     return simulate_plan(
-        plan, parameters=parameters, theta0=theta0, omega0=omega0, fmu_path=fmu_path, platform=WASM_PLATFORM
+        plan, parameters=parameters, theta0=theta0, omega0=omega0, fmu_path=fmu_path, platform=platform
     )
+
+
+# The wasm tool: the FMU's WebAssembly binary through wasmtime, fmu_path's (FMI 3.0) or the
+# checkout's FMI 3.0 FMU; the torque held over each step.
+run_wasm = partial(run_fmu, platform=WASM_PLATFORM)
 
 
 def run_reference(
