@@ -144,7 +144,11 @@ class _Types:
         if "result" in kind:
             inner = self.free(kind["result"]["ok"], f"{value}.val.ok") if kind["result"]["ok"] is not None else []
             return [f"if (!{value}.is_err) {{ {' '.join(inner)} }}"] if inner else []
-        parts = [f["type"] for f in kind["record"]["fields"]] if "record" in kind else kind.get("tuple", {}).get("types", [])
+        parts = (
+            [f["type"] for f in kind["record"]["fields"]]
+            if "record" in kind
+            else kind.get("tuple", {}).get("types", [])
+        )
         if any(self.free(part, "part") for part in parts):
             raise WitGlueError(f"WIT type {entry.get('name') or kind}: the glue frees no records holding memory")
         return []
@@ -222,7 +226,9 @@ class _Glue:
             arguments.append(local)
             frees += self.types.free(param["type"], local)
         if len(core_params) > MAX_FLAT_PARAMS:
-            raise WitGlueError(f"{export}: {len(core_params)} flat parameters, the glue passes at most {MAX_FLAT_PARAMS}")
+            raise WitGlueError(
+                f"{export}: {len(core_params)} flat parameters, the glue passes at most {MAX_FLAT_PARAMS}"
+            )
         result = function.get("result")
         locals_ = [
             f"    {c.rsplit(' ', 1)[0]} {a} = {_lift_param(self.types, p['name'], p['type'])[1]};"
@@ -249,7 +255,10 @@ class _Glue:
             post = self.types.free(result, "(*value)")
             if post:
                 body += [f'__attribute__((export_name("cabi_post_{export}")))']
-                body += [f"void {symbol}_post(int32_t ret) {{", f"    {c_result} *value = ({c_result} *)(uintptr_t)ret;"]
+                body += [
+                    f"void {symbol}_post(int32_t ret) {{",
+                    f"    {c_result} *value = ({c_result} *)(uintptr_t)ret;",
+                ]
                 body += [*(f"    {f}" for f in post), "}"]
         self.source += ["", *body]
 
