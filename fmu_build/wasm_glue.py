@@ -184,7 +184,7 @@ def _lift_param(types: _Types, name: str, ref) -> tuple[list[str], str]:
     raise WitGlueError(f"parameter {name}: the glue lifts no parameter of this WIT type")
 
 
-def _export_name(interface: str, function: str) -> str:
+def _export_name(function: str) -> str:
     """The C adapter's name of an exported function: a method's or static's without its resource."""
     return "fmi3_wit_" + c_name(function.split("]", 1)[-1].split(".")[-1])
 
@@ -215,14 +215,15 @@ class _Glue:
     def export_function(self, interface: str, function: dict) -> None:
         """The core export of one function: lift, call the adapter, lower, free; its cabi_post_."""
         export = f"{interface}#{function['name']}"
-        adapter = _export_name(interface, function["name"])
-        core_params, arguments, frees, c_params = [], [], [], []
+        adapter = _export_name(function["name"])
+        core_params, arguments, frees, c_params, locals_ = [], [], [], [], []
         for param in function["params"]:
             flat, lifted = _lift_param(self.types, param["name"], param["type"])
             core_params += flat
             local = f"arg_{c_name(param['name'])}"
             c_type = "WitInstance *" if "WitInstance" in lifted else self.types.c_type(param["type"])
             c_params.append(f"{c_type} {c_name(param['name'])}")
+            locals_.append(f"    {c_type} {local} = {lifted};")
             arguments.append(local)
             frees += self.types.free(param["type"], local)
         if len(core_params) > MAX_FLAT_PARAMS:
@@ -230,10 +231,6 @@ class _Glue:
                 f"{export}: {len(core_params)} flat parameters, the glue passes at most {MAX_FLAT_PARAMS}"
             )
         result = function.get("result")
-        locals_ = [
-            f"    {c.rsplit(' ', 1)[0]} {a} = {_lift_param(self.types, p['name'], p['type'])[1]};"
-            for c, a, p in zip(c_params, arguments, function["params"], strict=True)
-        ]
         symbol = f"fmi3_wit_export_{c_name(interface.split('/')[-1].split('@')[0])}_{adapter.removeprefix('fmi3_wit_')}"
         body = [f'__attribute__((export_name("{export}")))']
         if result is None:
