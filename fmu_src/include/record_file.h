@@ -25,4 +25,11 @@ const char *escape_text(char *out, size_t size, const char *text);
    bytes) saying which. */
 FILE *record_file_open(const char *name, const char *marker, char *why, size_t why_size);
 
+/* Appends one line (line and a newline) to a record file record_file_open opened, flushed at
+   once, so that the record is whole up to a master's crash. */
+void record_file_append(FILE *file, const char *line);
+
+/* Closes a record file record_file_open opened. */
+void record_file_close(FILE *file);
+
 #endif
