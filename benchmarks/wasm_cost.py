@@ -56,10 +56,8 @@ class RawCall:
         (slot.of.list.data[element] if element is not None else slot).of.f64 = value
 
     def call(self) -> None:
-        context = self.store._context()
-        error = self.ffi.wasmtime_component_func_call(
-            ctypes.byref(self.function._func), context, self.arguments, len(self.arguments), ctypes.byref(self.result), 1
-        )
+        function, context, count = ctypes.byref(self.function._func), self.store._context(), len(self.arguments)
+        error = self.ffi.wasmtime_component_func_call(function, context, self.arguments, count, ctypes.byref(self.result), 1)
         if error:
             raise RuntimeError("a raw call failed")
 
