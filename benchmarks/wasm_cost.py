@@ -57,7 +57,9 @@ class RawCall:
 
     def call(self) -> None:
         function, context, count = ctypes.byref(self.function._func), self.store._context(), len(self.arguments)
-        error = self.ffi.wasmtime_component_func_call(function, context, self.arguments, count, ctypes.byref(self.result), 1)
+        error = self.ffi.wasmtime_component_func_call(
+            function, context, self.arguments, count, ctypes.byref(self.result), 1
+        )
         if error:
             raise RuntimeError("a raw call failed")
 
