@@ -186,3 +186,28 @@ def test_a_held_torque_only(wasm_fmu, tmp_path):
     ramp.write_text("time,torque\n0,0\n3,30\n")
     with pytest.raises(InvalidInput, match=r"FMI 3\.0 has no input derivatives"):
         simulate(ramp, ramp=True, fmu_path=wasm_fmu, platform=WASM_PLATFORM)
+
+
+def test_a_trap_in_a_step_is_one_line_naming_the_step(wasm_fmu):
+    import wasmtime
+
+    model = fmu_model(wasm_fmu)
+    slave = wasm.instantiated(model, "pendulum")
+    initialize(slave)
+    name = "[method]co-simulation-instance.do-step"
+    step = slave.function(name)
+    calls = []
+
+    def trapping(store, resource, t, h, rollback):
+        calls.append(t)
+        if len(calls) == 3:  # as the binary's own trap would arrive: a WasmtimeError out of the call
+            raise wasmtime.WasmtimeError("error while executing at wasm backtrace:\n    0: 0x1234 - <unknown>!do_step")
+        return step(store, resource, t, h, rollback)
+
+    slave._functions[name] = trapping
+    with pytest.raises(FmuError) as stopped:
+        wasm.run_schedule(slave, schedule(20.0, stop_time=0.01, step_size=1e-3))
+    assert str(stopped.value) == (
+        f"the step from t = 0.002: the {WASM_PLATFORM} binary stopped: error while executing at wasm backtrace:"
+    )
+    slave.freeInstance()

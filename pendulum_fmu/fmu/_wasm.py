@@ -17,6 +17,7 @@ extra); without it, running the binary is refused in one line.
 
 from __future__ import annotations
 
+import atexit
 from functools import lru_cache
 from pathlib import Path
 from typing import Any
@@ -78,6 +79,11 @@ def _component(model: FmuModel) -> Any:
             f"{model.path}: its {name} is no WebAssembly component wasmtime can load ({shortened(first, 200)}): "
             "give an FMU whose binary was made by pendulum-fmu build"
         ) from None
+
+
+# wasmtime's objects free themselves through its module, which may be gone when the interpreter
+# tears the modules down at exit: the compiled components go before that.
+atexit.register(_component.cache_clear)
 
 
 def _no_effect(store: Any, *arguments: Any) -> None:
