@@ -211,3 +211,13 @@ def test_a_trap_in_a_step_is_one_line_naming_the_step(wasm_fmu):
         f"the step from t = 0.002: the {WASM_PLATFORM} binary stopped: error while executing at wasm backtrace:"
     )
     slave.freeInstance()
+
+
+def test_compare_without_an_fmu_runs_the_packages_fmi3_wasm_binary(tmp_path):
+    from pendulum_fmu import compare, default_fmu
+
+    with zipfile.ZipFile(default_fmu(3)) as archive:
+        if BINARY not in archive.namelist():
+            pytest.skip(f"{default_fmu(3)} carries no {BINARY} (built without the wasm toolchain)")
+    comparison = compare(20.0, "fmu,wasm", output_dir=tmp_path, stop_time=1.0)
+    assert np.max(np.abs(comparison.runs["fmu"]["theta"] - comparison.runs["wasm"]["theta"])) <= 1e-12

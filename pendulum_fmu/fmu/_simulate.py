@@ -208,8 +208,8 @@ def simulate(
     tolerance : float, optional
         Relative tolerance of the FMU's integrator (None: the FMU's 1e-10).
     fmu_path : str or Path, optional
-        The FMU to run (default: pendulum_fmu.default_fmu(), its FMI 3.0 one for platform
-        "wasm32-wasip2"); its own parameters apply.
+        The FMU to run (default: pendulum_fmu.default_fmu(); for platform "wasm32-wasip2" the
+        package's FMI 3.0 FMU stands for it); its own parameters apply.
     max_steps : int, optional
         The longest run accepted (default _time_grid.DEFAULT_MAX_STEPS); a longer one, or
         one that would not fit in memory, is refused before anything is allocated.
@@ -408,7 +408,8 @@ def simulator(fmu_path: str | Path | FmuModel | None = None, platform: str | Non
     ----------
     fmu_path
         The FMU file or its model; None: pendulum_fmu.default_fmu(), looked up once per process
-        (the FMI 3.0 one for the WebAssembly binary, which is FMI 3.0 only).
+        (for the WebAssembly binary, which is FMI 3.0 only, the package's FMI 3.0 FMU stands for
+        it, given or not).
     platform : {None, "wasm32-wasip2"}
         Which binary: this machine's native one, or the WebAssembly one (see simulate).
 
@@ -428,7 +429,11 @@ def simulator(fmu_path: str | Path | FmuModel | None = None, platform: str | Non
         raise InvalidInput(
             f"platform {platform!r} is none the package runs: None (this machine's binary) or {WASM_PLATFORM!r}"
         )
-    path = _default_fmu(3 if platform else 2) if fmu_path is None else fmu_file(fmu_path)
+    path = _default_fmu() if fmu_path is None else fmu_file(fmu_path)
+    if platform and path.resolve() == _default_fmu().resolve():
+        # The package's FMU, whose WebAssembly binary its FMI 3.0 file carries (same sources,
+        # same numbers: docs/fmi3.md); compare hands every tool the FMI 2.0 file it resolved.
+        path = _default_fmu(3)
     version = file_version(path)
     kept = getattr(_simulators, "kept", None)
     if kept is None:
