@@ -221,3 +221,11 @@ def test_compare_without_an_fmu_runs_the_packages_fmi3_wasm_binary(tmp_path):
             pytest.skip(f"{default_fmu(3)} carries no {BINARY} (built without the wasm toolchain)")
     comparison = compare(20.0, "fmu,wasm", output_dir=tmp_path, stop_time=1.0)
     assert np.max(np.abs(comparison.runs["fmu"]["theta"] - comparison.runs["wasm"]["theta"])) <= 1e-12
+
+
+def test_a_log_message_is_kept_on_one_line_and_bounded(wasm_fmu):
+    slave = wasm.instantiated(fmu_model(wasm_fmu), "pendulum")
+    slave._log(None, "pendulum", "error", "logStatusError", "two\nlines")
+    slave._log(None, "pendulum", "warning", "logStatusWarning", "x" * 5000)
+    assert slave.messages.lines == ["[ERROR] 'two\\nlines'", f"[WARNING] {'x' * 1000}... (5,000 characters)"]
+    slave.freeInstance()

@@ -171,9 +171,13 @@ class WasmInstance:
             raise self.messages.instantiation_error(f"{model.path} ({WASM_PLATFORM})")
 
     def _log(self, store: Any, instance_name: str, status: str, category: str, message: str) -> None:
-        """The log-message callback: the message kept in the instance's MessageLog."""
+        """The log-message callback: the message kept in the instance's MessageLog, bounded, and
+        with Python's escapes where it holds a character that is not printable (a line break
+        would start a line of its own in an error's one line).
+        """
         index = STATUS.index(status) if status in STATUS else len(STATUS)
-        self.messages.log_fmi3(None, index, category, shortened(message, MESSAGE_CHARS).encode())
+        kept = shortened(message, MESSAGE_CHARS)
+        self.messages.log_fmi3(None, index, category, (kept if kept.isprintable() else repr(kept)).encode())
 
     def function(self, name: str) -> Any:
         """The component's function of the instance's interface, such as
