@@ -158,6 +158,8 @@ def test_a_wasm_only_fmu_names_the_platform_to_run_it(wasm_fmu, tmp_path, capsys
         simulate(20.0, stop_time=0.1, fmu_path=wasm_only)
     run = simulate(20.0, stop_time=3.0, fmu_path=wasm_only, platform=WASM_PLATFORM)
     assert np.max(np.abs(run["theta"] - simulate(20.0, fmu_path=wasm_fmu)["theta"])) <= 1e-12
+    with pytest.raises(InvalidInput, match=r"^the FMU refuses the parameters: mass must be > 0$"):
+        simulate(20.0, stop_time=0.1, parameters={"mass": -1.0}, fmu_path=wasm_only, platform=WASM_PLATFORM)
     assert main(["simulate", "--torque", "20", "--fmu", str(wasm_only)]) == 2
     (line,) = capsys.readouterr().err.strip().splitlines()
     assert "run its WebAssembly binary instead" in line
