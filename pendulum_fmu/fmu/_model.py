@@ -22,7 +22,7 @@ import fmpy
 from fmpy import extract, read_model_description
 
 from .._errors import InvalidInput, MissingFile, WrongType
-from .._received_files import check_fmu
+from .._received_files import open_fmu
 from . import WASM_PLATFORM
 
 # The start values a user gives, and the FMU's variables they start.
@@ -242,9 +242,8 @@ def _read(path: str, version: tuple, shown: str) -> FmuModel:
     user gave it, for the messages.
     """
     try:
-        with zipfile.ZipFile(path) as archive:
+        with open_fmu(path, shown, FmuFileError) as archive:  # before fmpy parses and unpacks it
             names = frozenset(archive.namelist())
-            check_fmu(archive, shown, FmuFileError)  # before fmpy parses it and unpacks it (FmuModel.folder)
     except (zipfile.BadZipFile, OSError):
         raise FmuFileError(
             f"{shown} is not an FMU (an FMU is a zip archive with a modelDescription.xml): check the path"

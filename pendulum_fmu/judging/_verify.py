@@ -29,7 +29,7 @@ from pathlib import Path
 from xml.etree import ElementTree
 
 from .._errors import InvalidInput, MissingFile
-from .._received_files import check_fmu, check_xml
+from .._received_files import check_xml, open_fmu
 from ..fmu._build_record import OBJECTS, RECORD_FILE, SIGNATURE_FILE, read_entries, sha256
 
 PASS, FAIL, SKIP = "pass", "fail", "not checked"
@@ -379,8 +379,7 @@ def verify_fmu(
     if not fmu.is_file():
         raise MissingFile(f"{fmu}: no such file (give an .fmu)")
     try:
-        with zipfile.ZipFile(fmu) as archive:
-            check_fmu(archive, str(fmu), InvalidInput)  # before its entries are read whole
+        open_fmu(fmu, str(fmu), InvalidInput).close()  # before its entries are read whole
         entries = read_entries(fmu)
     except (zipfile.BadZipFile, OSError) as error:
         raise InvalidInput(f"{fmu}: not an FMU ({error}); give an .fmu, a zip archive") from None
