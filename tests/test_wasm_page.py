@@ -1,0 +1,137 @@
+"""The FMU's wasm binary in Node (through jco) and in the docs page in headless Chromium, held to
+the native FMI 3.0 binary on the same schedule: theta within 1e-12 rad at every point.
+
+The native runs are pendulum_fmu.simulate() of the FMI 3.0 FMU's linux64 binary, an independent
+host (fmpy's loader, ctypes) of an independent build (gcc) of the same C sources.
+"""
+
+import json
+import shutil
+import struct
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+import wasm_page
+from test_docs import _built_site
+
+from fmu_build.wasm_page import WEB, write_page_files
+from pendulum_fmu import simulate
+from pendulum_fmu.judging._result_file import read_result
+
+ROOT = Path(__file__).resolve().parent.parent
+SCREENSHOT = ROOT / "docs" / "images" / "wasm_page.png"
+THETA_TOLERANCE = 1e-12  # rad, the issue's bar for every host of the wasm binary
+SEED = {"torque": 20.0, "stop_time": 3.0, "step_size": 1e-3}
+JUMP_CSV = "time,torque\n0,20\n1,20\n1,-20\n3,-20\n"  # the README quick start's
+
+
+def _need_node() -> None:
+    if shutil.which("node") is None:
+        pytest.skip("needs Node 20 (node on PATH)")
+    if not (WEB / "node_modules" / ".bin" / "jco").is_file():
+        pytest.skip("needs jco: npm ci --prefix web")
+
+
+@pytest.fixture(scope="session")
+def page_files(build_once, fmu3):
+    """The page's files (jco's module, fmu.json, native.json, the scripts) from the session's FMI
+    3.0 FMU, once per session.
+    """
+    _need_node()
+    return build_once("wasm-page", lambda folder: (write_page_files(fmu3, folder), folder)[1])
+
+
+def _native(torque, fmu3):
+    return simulate(torque, stop_time=SEED["stop_time"], step_size=SEED["step_size"], fmu_path=fmu3)
+
+
+def _node_run(page_files: Path, out: Path, *signal: str) -> dict:
+    done = subprocess.run(
+        ["node", str(WEB / "run_node.js"), str(page_files), *signal, "--output-file", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=False,
+    )
+    assert done.returncode == 0, done.stderr
+    return json.loads(done.stdout)
+
+
+@pytest.mark.node
+@pytest.mark.parametrize("case", ["seed", "jump"])
+def test_node_runs_the_wasm_fmu_as_the_native_binary(page_files, fmu3, tmp_path, case):
+    torque_file = tmp_path / "torque.csv"
+    torque_file.write_text(JUMP_CSV)
+    signal = ["--torque", "20"] if case == "seed" else ["--torque-file", str(torque_file)]
+    printed = _node_run(page_files, tmp_path / "node.csv", *signal)
+    native = _native(SEED["torque"] if case == "seed" else torque_file, fmu3)
+    ran = read_result(tmp_path / "node.csv")
+    # The same schedule (the JS host's grid and held torques are the package's), to the bit.
+    assert np.array_equal(ran["time"], native["time"])
+    assert np.array_equal(ran["torque"], native["torque"])
+    difference = np.max(np.abs(ran["theta"] - native["theta"]))
+    print(f"{case}: theta(3 s) Node {printed['theta']!r}, native {native['theta'][-1]!r}, max |diff| {difference:.3g}")
+    assert printed["theta"] == ran["theta"][-1]
+    assert difference <= THETA_TOLERANCE
+    assert not printed["messages"], printed["messages"]
+
+
+@pytest.fixture(scope="module")
+def seed_in_chromium(build_once, tmp_path_factory):
+    """The built site's page in headless Chromium after the seed case: what it showed, the CSV it
+    offered (downloaded) and a screenshot of it.
+    """
+    pytest.importorskip("playwright", reason="needs Playwright's Python package (the [test] extra)")
+    if not wasm_page.CHROMIUM.is_file():
+        pytest.skip("needs Debian's chromium (apt-get install chromium)")
+    _need_node()
+    site = build_once("site", _built_site)
+    folder = tmp_path_factory.mktemp("chromium")
+    with wasm_page.served(site) as base_url, wasm_page.browser_page() as page:
+        shown = wasm_page.run_seed_case(page, base_url)
+        with page.expect_download() as download:
+            page.click("#download")
+        download.value.save_as(folder / "downloaded.csv")
+        wasm_page.screenshot(page, folder / "page.png")
+    return shown, folder
+
+
+@pytest.mark.browser
+def test_the_page_runs_the_seed_case_in_chromium_as_the_native_binary(seed_in_chromium, fmu3):
+    shown, _ = seed_in_chromium
+    native = _native(SEED["torque"], fmu3)
+    print(f"theta(3 s) Chromium {shown['theta']!r}, native {native['theta'][-1]!r}; page: {shown['status']}")
+    assert not shown["errors"], shown["errors"]
+    assert abs(shown["theta"] - native["theta"][-1]) <= THETA_TOLERANCE
+    # The page found its shipped native run and drew the two together.
+    assert shown["difference"] is not None and shown["difference"] <= THETA_TOLERANCE
+
+
+@pytest.mark.browser
+def test_the_page_s_download_is_the_csv_judge_reads(seed_in_chromium, fmu3):
+    _, folder = seed_in_chromium
+    downloaded = read_result(folder / "downloaded.csv")
+    native = _native(SEED["torque"], fmu3)
+    assert np.array_equal(downloaded["time"], native["time"])
+    assert np.max(np.abs(downloaded["theta"] - native["theta"])) <= THETA_TOLERANCE
+    assert np.max(np.abs(downloaded["omega"] - native["omega"])) <= THETA_TOLERANCE
+
+
+def _png_size(path: Path) -> tuple[int, int]:
+    header = path.read_bytes()[:24]
+    assert header[:8] == b"\x89PNG\r\n\x1a\n", f"{path} is not a PNG"
+    return struct.unpack(">II", header[16:24])
+
+
+@pytest.mark.browser
+def test_the_docs_screenshot_is_the_page_as_it_runs(seed_in_chromium):
+    """The screenshot docs/browser.md shows is the page's app as tests/wasm_page.py takes it: the
+    same size (its pixels differ with the fonts a machine has).
+    """
+    _, folder = seed_in_chromium
+    assert _png_size(SCREENSHOT) == _png_size(folder / "page.png"), (
+        "docs/images/wasm_page.png is not the page as it runs now: remake it with "
+        "`.venv/bin/python tests/wasm_page.py docs/_build/html docs/images/wasm_page.png`"
+    )
