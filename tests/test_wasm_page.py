@@ -17,7 +17,7 @@ import wasm_page
 from test_docs import _built_site
 
 from fmu_build.wasm_page import WEB, write_page_files
-from pendulum_fmu import simulate
+from pendulum_fmu import schedule, simulate
 from pendulum_fmu.judging._result_file import read_result
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -25,6 +25,7 @@ SCREENSHOT = ROOT / "docs" / "images" / "wasm_page.png"
 THETA_TOLERANCE = 1e-12  # rad, the issue's bar for every host of the wasm binary
 SEED = {"torque": 20.0, "stop_time": 3.0, "step_size": 1e-3}
 JUMP_CSV = "time,torque\n0,20\n1,20\n1,-20\n3,-20\n"  # the README quick start's
+BAD_CSV = b"time,torque\n0,1\n0.5,x\n"
 
 
 def _need_node() -> None:
@@ -70,7 +71,8 @@ def test_node_runs_the_wasm_fmu_as_the_native_binary(page_files, fmu3, tmp_path,
     ran = read_result(tmp_path / "node.csv")
     # The same schedule (the JS host's grid and held torques are the package's), to the bit.
     assert np.array_equal(ran["time"], native["time"])
-    assert np.array_equal(ran["torque"], native["torque"])
+    torque = np.loadtxt(tmp_path / "node.csv", delimiter=",", skiprows=1, usecols=1)
+    assert np.array_equal(torque, native["torque"])
     difference = np.max(np.abs(ran["theta"] - native["theta"]))
     print(f"{case}: theta(3 s) Node {printed['theta']!r}, native {native['theta'][-1]!r}, max |diff| {difference:.3g}")
     assert printed["theta"] == ran["theta"][-1]
@@ -78,10 +80,41 @@ def test_node_runs_the_wasm_fmu_as_the_native_binary(page_files, fmu3, tmp_path,
     assert not printed["messages"], printed["messages"]
 
 
+# Torque CSVs whose schedule the JS host must make as the package does: ramps, a jump between
+# grid points (a point of its own) and a stop off the grid; a running-sum jump time within the
+# event tolerance of a grid point (that point); a start off zero with a coarse step.
+SCHEDULES = [
+    ("time,torque\n0,0\n0.5,10\n1.00049,10\n1.00049,-3\n2,7\n", 0.0, 2.9995, 1e-3),
+    ("time,torque\n0.1,5\n0.39100000000000029,5\n0.39100000000000029,-5\n1,2.5\n", 0.0, 1.0, 1e-3),
+    ("time,torque\n0,1\n0.3,1\n0.3,2\n0.7,2\n0.7,0.25\n", 0.05, 1.3, 0.1),
+]
+
+
+@pytest.mark.node
+@pytest.mark.parametrize(("csv", "start", "stop", "step"), SCHEDULES)
+def test_the_js_host_s_schedule_is_the_package_s(tmp_path, csv, start, stop, step):
+    if shutil.which("node") is None:
+        pytest.skip("needs Node 20 (node on PATH)")
+    torque_file = tmp_path / "torque.csv"
+    torque_file.write_text(csv)
+    script = (
+        f"import {{ parseTorqueCsv, schedule }} from {json.dumps((WEB / 'fmu_host.js').as_uri())};"
+        f"const rows = parseTorqueCsv({json.dumps(csv)});"
+        f"console.log(JSON.stringify(schedule({{ kind: 'csv', rows }}, {start!r}, {stop!r}, {step!r})));"
+    )
+    done = subprocess.run(["node", "--input-type=module", "-e", script], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr
+    made = json.loads(done.stdout)
+    plan = schedule(torque_file, start_time=start, stop_time=stop, step_size=step)
+    assert np.array_equal(made["time"], plan.time)
+    assert np.array_equal(made["torque"], plan.torque)
+
+
 @pytest.fixture(scope="module")
-def seed_in_chromium(build_once, tmp_path_factory):
-    """The built site's page in headless Chromium after the seed case: what it showed, the CSV it
-    offered (downloaded) and a screenshot of it.
+def chromium_runs(build_once, tmp_path_factory):
+    """The built site's page in headless Chromium: what it showed after the seed case (then its
+    CSV downloaded and a screenshot taken), after the quick start's jump (its step signal), and
+    after a bad torque CSV was dropped; and the folder holding the download and the screenshot.
     """
     pytest.importorskip("playwright", reason="needs Playwright's Python package (the [test] extra)")
     if not wasm_page.CHROMIUM.is_file():
@@ -90,17 +123,20 @@ def seed_in_chromium(build_once, tmp_path_factory):
     site = build_once("site", _built_site)
     folder = tmp_path_factory.mktemp("chromium")
     with wasm_page.served(site) as base_url, wasm_page.browser_page() as page:
-        shown = wasm_page.run_seed_case(page, base_url)
+        shown = {"seed": wasm_page.run_seed_case(page, base_url)}
         with page.expect_download() as download:
             page.click("#download")
         download.value.save_as(folder / "downloaded.csv")
         wasm_page.screenshot(page, folder / "page.png")
+        shown["jump"] = wasm_page.run_case(page, "step")
+        page.set_input_files("#torque-file", files=[{"name": "bad.csv", "mimeType": "text/csv", "buffer": BAD_CSV}])
+        shown["bad csv"] = page.inner_text("#wasm-status.wasm-error")
     return shown, folder
 
 
 @pytest.mark.browser
-def test_the_page_runs_the_seed_case_in_chromium_as_the_native_binary(seed_in_chromium, fmu3):
-    shown, _ = seed_in_chromium
+def test_the_page_runs_the_seed_case_in_chromium_as_the_native_binary(chromium_runs, fmu3):
+    shown = chromium_runs[0]["seed"]
     native = _native(SEED["torque"], fmu3)
     print(f"theta(3 s) Chromium {shown['theta']!r}, native {native['theta'][-1]!r}; page: {shown['status']}")
     assert not shown["errors"], shown["errors"]
@@ -110,9 +146,23 @@ def test_the_page_runs_the_seed_case_in_chromium_as_the_native_binary(seed_in_ch
 
 
 @pytest.mark.browser
-def test_the_page_s_download_is_the_csv_judge_reads(seed_in_chromium, fmu3):
-    _, folder = seed_in_chromium
-    downloaded = read_result(folder / "downloaded.csv")
+def test_the_page_runs_the_quick_start_s_jump_as_the_native_binary(chromium_runs, fmu3, tmp_path):
+    shown = chromium_runs[0]["jump"]
+    torque_file = tmp_path / "torque.csv"
+    torque_file.write_text(JUMP_CSV)
+    native = _native(torque_file, fmu3)
+    assert abs(shown["theta"] - native["theta"][-1]) <= THETA_TOLERANCE
+    assert shown["difference"] is not None and shown["difference"] <= THETA_TOLERANCE
+
+
+@pytest.mark.browser
+def test_the_page_says_in_one_line_what_is_wrong_with_a_dropped_csv(chromium_runs):
+    assert chromium_runs[0]["bad csv"] == "bad.csv: line 3: '0.5,x' is not a time and a torque"
+
+
+@pytest.mark.browser
+def test_the_page_s_download_is_the_csv_judge_reads(chromium_runs, fmu3):
+    downloaded = read_result(chromium_runs[1] / "downloaded.csv")
     native = _native(SEED["torque"], fmu3)
     assert np.array_equal(downloaded["time"], native["time"])
     assert np.max(np.abs(downloaded["theta"] - native["theta"])) <= THETA_TOLERANCE
@@ -126,11 +176,11 @@ def _png_size(path: Path) -> tuple[int, int]:
 
 
 @pytest.mark.browser
-def test_the_docs_screenshot_is_the_page_as_it_runs(seed_in_chromium):
+def test_the_docs_screenshot_is_the_page_as_it_runs(chromium_runs):
     """The screenshot docs/browser.md shows is the page's app as tests/wasm_page.py takes it: the
     same size (its pixels differ with the fonts a machine has).
     """
-    _, folder = seed_in_chromium
+    folder = chromium_runs[1]
     assert _png_size(SCREENSHOT) == _png_size(folder / "page.png"), (
         "docs/images/wasm_page.png is not the page as it runs now: remake it with "
         "`.venv/bin/python tests/wasm_page.py docs/_build/html docs/images/wasm_page.png`"

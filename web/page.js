@@ -43,7 +43,7 @@ function sameSchedule(plan, run) {
 function draw(columns, shipped) {
   const canvas = element("theta-plot");
   const context = canvas.getContext("2d");
-  const [width, height, margin] = [canvas.width, canvas.height, 56];
+  const [width, height, margin] = [canvas.width, canvas.height, 64];
   const series = [columns.theta, ...(shipped ? [shipped.theta] : [])];
   const low = series.reduce((least, values) => values.reduce((a, b) => Math.min(a, b), least), Infinity);
   const high = series.reduce((most, values) => values.reduce((a, b) => Math.max(a, b), most), -Infinity);
@@ -72,13 +72,16 @@ function draw(columns, shipped) {
     context.setLineDash([]);
   };
   line(columns.time, columns.theta, "#1f77b4", []);
+  // The legend above the frame, right-aligned, clear of the curves.
+  context.textAlign = "right";
   context.fillStyle = "#1f77b4";
-  context.fillText("wasm, in this browser", margin + 10, margin + 20);
+  context.fillText("wasm, in this browser", width - margin, margin - 28);
   if (shipped) {
     line(shipped.time, shipped.theta, "#ff7f0e", [8, 6]);
     context.fillStyle = "#ff7f0e";
-    context.fillText("native linux64 binary (shipped)", margin + 10, margin + 40);
+    context.fillText("- - native linux64 binary (shipped)", width - margin, margin - 10);
   }
+  context.textAlign = "left";
 }
 
 function run() {
@@ -95,7 +98,7 @@ function run() {
     element("theta-final").dataset.value = String(columns.theta[last]);
     const difference = shipped ? shipped.theta.reduce((most, v, k) => Math.max(most, Math.abs(v - columns.theta[k])), 0) : null;
     element("max-difference").textContent = shipped
-      ? `${difference.toExponential(2)} rad, the largest |wasm - native| over the run (the ${name} case)`
+      ? `${difference === 0 ? "0 rad: the same to the last bit" : `${difference.toExponential(2)} rad`}, the largest |wasm - native| over the run (the ${name} case)`
       : "no native run shipped for this signal";
     element("max-difference").dataset.value = shipped ? String(difference) : "";
     draw(columns, shipped);
