@@ -50,7 +50,9 @@ function draw(columns, shipped) {
   const [t0, t1] = [columns.time[0], columns.time[columns.time.length - 1]];
   const x = (t) => margin + ((t - t0) / (t1 - t0)) * (width - 2 * margin);
   const y = (v) => height - margin - ((v - low) / (high - low || 1)) * (height - 2 * margin);
-  context.clearRect(0, 0, width, height);
+  // White behind the plot whatever the theme (the site has a dark one).
+  context.fillStyle = "#fff";
+  context.fillRect(0, 0, width, height);
   context.font = "14px sans-serif";
   context.strokeStyle = "#888";
   context.strokeRect(margin, margin, width - 2 * margin, height - 2 * margin);
