@@ -11,6 +11,7 @@ import json
 import shutil
 import struct
 import subprocess
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -18,6 +19,7 @@ import pytest
 import wasm_page
 from test_docs import _built_site
 
+from fmu_build import wasm_page as wasm_page_build
 from fmu_build.wasm_page import WEB, write_page_files
 from pendulum_fmu import schedule, simulate
 from pendulum_fmu.judging._result_file import read_result
@@ -44,6 +46,24 @@ def page_files(build_once, fmu3):
     """
     _need_node()
     return build_once("wasm-page", lambda folder: (write_page_files(fmu3, folder), folder)[1])
+
+
+@pytest.mark.node
+def test_the_page_s_build_says_in_one_line_what_an_fmu_lacks(fmu, fmu3, tmp_path, capsys):
+    _need_node()
+    without_wasm = tmp_path / "no-wasm.fmu"
+    with zipfile.ZipFile(fmu3) as source, zipfile.ZipFile(without_wasm, "w") as copy:
+        for member in source.namelist():
+            if not member.startswith("binaries/wasm32-wasip2/"):
+                copy.writestr(member, source.read(member))
+    expected = {
+        without_wasm: f"error: {without_wasm}: no binaries/wasm32-wasip2/Pendulum.wasm; build the FMI 3.0 FMU "
+        "with its wasm binary",
+        Path(fmu): f"error: {fmu}: not an FMI 3.0 Co-Simulation FMU; give the FMI 3.0 one (Pendulum-fmi3.fmu)",
+    }
+    for given, message in expected.items():
+        assert wasm_page_build.main([str(tmp_path / "out"), "--fmu", str(given)]) == 1
+        assert capsys.readouterr().err == message + "\n"
 
 
 def _native(torque, fmu3):
