@@ -205,8 +205,9 @@ def test_the_js_host_s_schedule_is_the_package_s(tmp_path, csv, start, stop, ste
 @pytest.fixture(scope="module")
 def chromium_runs(build_once, tmp_path_factory):
     """The built site's page in headless Chromium: what it showed after the seed case (then its
-    CSV downloaded and a screenshot taken), after the quick start's jump (its step signal), and
-    after a bad torque CSV was dropped; and the folder holding the download and the screenshot.
+    CSV downloaded and a screenshot taken), after the quick start's jump (its step signal), after
+    a bad torque CSV was dropped, and after the quick start's torque.csv was; and the folder
+    holding the download and the screenshot.
     """
     pytest.importorskip("playwright", reason="needs Playwright's Python package (the [test] extra)")
     if not wasm_page.CHROMIUM.is_file():
@@ -223,6 +224,10 @@ def chromium_runs(build_once, tmp_path_factory):
         shown["jump"] = wasm_page.run_case(page, "step")
         page.set_input_files("#torque-file", files=[{"name": "bad.csv", "mimeType": "text/csv", "buffer": BAD_CSV}])
         shown["bad csv"] = page.inner_text("#wasm-status.wasm-error")
+        jump_file = {"name": "torque.csv", "mimeType": "text/csv", "buffer": JUMP_CSV.encode()}
+        page.set_input_files("#torque-file", files=[jump_file])
+        page.wait_for_selector("#wasm-status:not(.wasm-error)")
+        shown["jump csv"] = wasm_page.run_case(page, "csv")
     return shown, folder
 
 
@@ -238,8 +243,10 @@ def test_the_page_runs_the_seed_case_in_chromium_as_the_native_binary(chromium_r
 
 
 @pytest.mark.browser
-def test_the_page_runs_the_quick_start_s_jump_as_the_native_binary(chromium_runs, fmu3, tmp_path):
-    shown = chromium_runs[0]["jump"]
+@pytest.mark.parametrize("given_as", ["jump", "jump csv"])
+def test_the_page_runs_the_quick_start_s_jump_as_the_native_binary(chromium_runs, fmu3, tmp_path, given_as):
+    """The jump as the page's step signal, and as the quick start's torque.csv dropped on it."""
+    shown = chromium_runs[0][given_as]
     torque_file = tmp_path / "torque.csv"
     torque_file.write_text(JUMP_CSV)
     native = _native(torque_file, fmu3)
