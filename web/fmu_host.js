@@ -45,8 +45,12 @@ export function communicationPoints(startTime, stopTime, stepSize) {
   return grid;
 }
 
+// The largest torque CSV read (characters): far past any signal a page runs (MAX_STEPS rows).
+export const MAX_CSV_CHARS = 256 * 2 ** 20;
+
 /** A torque CSV (time,torque; fmpy's convention) as rows [time, value], or an Error naming the line. */
 export function parseTorqueCsv(text) {
+  if (text.length > MAX_CSV_CHARS) throw new Error(`over ${MAX_CSV_CHARS / 2 ** 20} MiB: not a torque CSV this page reads`);
   const lines = text.replace(/^\uFEFF/, "").split(/\r?\n/);
   const header = lines[0].split(",").map((cell) => cell.trim());
   const timeColumn = header.indexOf("time");
@@ -62,6 +66,9 @@ export function parseTorqueCsv(text) {
       throw new Error(`line ${index + 2}: '${line.slice(0, 40)}' is not a time and a torque`);
     }
     if (rows.length && time < rows[rows.length - 1][0]) throw new Error(`line ${index + 2}: the time goes back`);
+    if (rows.length > 1 && time === rows[rows.length - 1][0] && time === rows[rows.length - 2][0]) {
+      throw new Error(`line ${index + 2}: time ${time} appears three times; a jump is two rows with the same time`);
+    }
     rows.push([time, value]);
   });
   if (!rows.length) throw new Error("no rows after the header");

@@ -1,7 +1,7 @@
 // The docs page's script (docs/browser.md): the visitor's torque signal through the FMU's wasm
 // binary, in the browser, theta drawn over the native binary's where the page ships that run
 // (native.json), and the result offered as the CSV `pendulum-fmu judge` reads.
-import { fmiCallbacks, parseTorqueCsv, resultCsv, runCoSimulation, schedule } from "./fmu_host.js";
+import { MAX_CSV_CHARS, fmiCallbacks, parseTorqueCsv, resultCsv, runCoSimulation, schedule } from "./fmu_host.js";
 
 const here = (name) => new URL(name, import.meta.url);
 const element = (id) => document.getElementById(id);
@@ -113,6 +113,10 @@ function run() {
 }
 
 function readDropped(file) {
+  if (file.size > MAX_CSV_CHARS * 4) {
+    say(`${file.name}: ${file.size} bytes, too large for a torque CSV`, true);
+    return;
+  }
   file.text().then((text) => {
     try {
       droppedRows = parseTorqueCsv(text);
