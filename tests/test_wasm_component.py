@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import json
 import subprocess
-from ctypes import c_double
 import zipfile
+from ctypes import c_double
 from pathlib import Path
 
 import numpy as np
@@ -20,6 +20,7 @@ from fmpy.fmi3 import FMU3Model, FMU3Slave
 from fmu_build import PLATFORMS, WASM, build_fmu, find_wasm_tools, find_zig
 from fmu_build.wasm_component import MANIFEST_ENTRY
 from fmu_build.wasm_glue import generate_glue
+from pendulum_fmu.cli import main
 
 wasmtime = pytest.importorskip("wasmtime")
 component_model = pytest.importorskip("wasmtime.component")
@@ -273,6 +274,12 @@ def test_strings_lists_of_strings_and_the_record_file(component, fmu_files):
     assert warning[:3] == ("pendulum \u00e9 1", "warning", "logStatusWarning")
     assert 'callRecordFile "calls.txt" cannot be opened: the WebAssembly binary has no files' in warning[3]
     assert component.method(CS, handle, "get-string", [CALL_RECORD_FILE, CALL_RECORD_FILE]) == ["calls.txt"] * 2
+    # What the record file would hold goes to the logger instead, with the category switched on.
+    assert component.method(CS, handle, "set-debug-logging", True, ["logCalls"]) == "ok"
+    component.method(CS, handle, "enter-initialization-mode", None, 0.0, None)
+    category, line = component.logs[-1][2:]
+    assert category == "logCalls"
+    assert line.startswith('[pendulum-calls] instance="pendulum \\xc3\\xa9 1" fmi3EnterInitializationMode(')
 
 
 def test_state_round_trip_and_garbage_state(component, fmu_files):
@@ -313,3 +320,13 @@ def test_wrong_token_and_dropped_instances(component, fmu_files):
     handle = component.instantiate(CS, fmu_files[1])
     assert component.method(CS, handle, "get-float64", [THETA]) == [0.0]
     assert component.call("fmi:fmi3/common@3.0.0", "get-version") == "3.0"
+
+
+def test_verify_rebuilds_the_native_binary_and_says_the_component_is_not_rebuilt(fmu3_wasm, capsys):
+    assert main(["verify", str(fmu3_wasm), "--json"]) == 0
+    checks = {check["name"]: check for check in json.loads(capsys.readouterr().out)["checks"]}
+    assert checks["rebuild"]["status"] == "pass"
+    assert checks["rebuild"]["detail"].endswith(
+        f"the same bytes; binaries/{WASM}/Pendulum.wasm is not rebuilt (its glue is not in sources/)"
+    )
+    assert checks["checksums"]["status"] == "pass"  # the component and the manifest among the entries
