@@ -19,7 +19,7 @@ from fmpy.fmi3 import FMU3Model, FMU3Slave
 
 from fmu_build import PLATFORMS, WASM, build_fmu, find_wasm_tools, find_zig
 from fmu_build.wasm_component import MANIFEST_ENTRY
-from fmu_build.wasm_glue import generate_glue
+from fmu_build.wasm_glue import WitGlueError, generate_glue
 from pendulum_fmu.cli import main
 
 wasmtime = pytest.importorskip("wasmtime")
@@ -330,3 +330,32 @@ def test_verify_rebuilds_the_native_binary_and_says_the_component_is_not_rebuilt
         f"the same bytes; binaries/{WASM}/Pendulum.wasm is not rebuilt (its glue is not in sources/)"
     )
     assert checks["checksums"]["status"] == "pass"  # the component and the manifest among the entries
+
+
+def _resolved(tmp_path: Path, wit: str) -> Path:
+    """A WIT package's resolved JSON, as CMake passes it to the generator."""
+    (tmp_path / "wit").mkdir()
+    (tmp_path / "wit" / "w.wit").write_text(wit)
+    resolved = tmp_path / "w.json"
+    subprocess.run([find_wasm_tools(), "component", "wit", tmp_path / "wit", "--json", "-o", resolved], check=True)
+    return resolved
+
+
+@pytest.mark.parametrize(
+    ("wit", "message"),
+    [
+        ("interface i { variant v { a(u32), b } f: func(x: v); } world w { export i; }", "parameter x: the glue lifts"),
+        ("interface i { f: func() -> result<list<tuple<string, u8>>, u8>; } world w { export i; }", "frees no records"),
+        ("interface i { f: func() -> result<u8>; } world w { export i; }", "a result without an ok or an err type"),
+        ("interface i { f: func() -> u32; } world w { import i; }", "imports no functions with results"),
+    ],
+)
+def test_glue_refuses_what_it_cannot_map_naming_it(tmp_path, wit, message):
+    """A WIT type outside what the draft's interfaces use stops the build, the function or type named."""
+    with pytest.raises(WitGlueError, match=message):
+        generate_glue(_resolved(tmp_path, f"package t:t;\n{wit}\n"), "w", tmp_path / "out")
+
+
+def test_glue_refuses_a_missing_world(tmp_path):
+    with pytest.raises(WitGlueError, match="no world 'fmu' \\(it has w\\)"):
+        generate_glue(_resolved(tmp_path, "package t:t;\nworld w {}\n"), "fmu", tmp_path / "out")
