@@ -50,6 +50,15 @@ def _stamped_model_description(xml: Path, fmi_version: int = 2) -> str:
     return text
 
 
+def _check_toolchains(platforms: tuple[str, ...], fmi_version: int, linux_glibc: str | None) -> None:
+    """BuildError naming what to install unless every platform's tools are here."""
+    for name in platforms:
+        if name == WASM:
+            check_wasm_toolchain(fmi_version)
+        else:
+            check_toolchain(PLATFORMS[name], fmi_version, linux_glibc)
+
+
 def _binaries(
     platforms: tuple[str, ...], tmp: Path, definitions: dict, identifier: str, fmi_version: int, linux_glibc
 ) -> tuple[dict[str, Path], dict[str, list]]:
@@ -172,11 +181,7 @@ def build_fmu(
         platforms = available_platforms(fmi_version, linux_glibc)
     check_platforms(platforms)
     check_writable(out_file)  # before the compilers run
-    for name in platforms:
-        if name == WASM:
-            check_wasm_toolchain(fmi_version)
-        else:
-            check_toolchain(PLATFORMS[name], fmi_version, linux_glibc)
+    _check_toolchains(platforms, fmi_version, linux_glibc)
     model_dir = Path(model_dir)
     model_description = read_model_description(str(model_description_file))
     identifier = model_description.coSimulation.modelIdentifier

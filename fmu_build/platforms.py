@@ -191,7 +191,9 @@ def check_wasm_toolchain(fmi_version: int = 3) -> None:
     compiler and wasm-tools here.
     """
     if fmi_version != 3:
-        raise BuildError(f"{WASM}: the WebAssembly component is an FMI 3.0 binary (FMI-LS-WASM): build FMI 3.0")
+        raise BuildError(
+            f"{WASM}: the WebAssembly component is an FMI 3.0 binary (FMI-LS-WASM): build FMI 3.0 (--fmi-version 3)"
+        )
     if find_zig() is None:
         raise BuildError(f"{WASM}: C compiler zig not found ({ZIG_PACKAGE})")
     if find_wasm_tools() is None:

@@ -116,6 +116,8 @@ class _Types:
             name = f"wit_option_{_stem(value)}_t"
             return self._define(name, f"typedef struct {{ bool is_some; {value} val; }} {name};")
         if "result" in kind:
+            if None in (kind["result"]["ok"], kind["result"]["err"]):
+                raise WitGlueError("a result without an ok or an err type: the glue has no C type for it")
             ok, err = (self.c_type(kind["result"][case]) for case in ("ok", "err"))
             name = f"wit_result_{_stem(ok)}_{_stem(err)}_t"
             body = f"typedef struct {{ bool is_err; union {{ {ok} ok; {err} err; }} val; }} {name};"

@@ -36,6 +36,7 @@ DOCS_PAGES = tuple(
         "install",
         "fmu",
         "fmi3",
+        "wasm",
         "torque_signals",
         "python_api",
         "command_line",

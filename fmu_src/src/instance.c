@@ -81,8 +81,8 @@ static Status record_to_file(Instance *instance, const char *function, const cha
     if (!instance->record_file) {
         char escaped[ESCAPED_SIZE(MAX_RECORD_FILE_NAME)];
         instance_log(instance, STATUS_WARNING, LOG_STATUS_WARNING,
-                     "%s: callRecordFile \"%s\" %s: the FMU writes no record file (name a new file, "
-                     "or one of its records)", function, escape_text(escaped, sizeof(escaped), name), why);
+                     "%s: callRecordFile \"%s\" %s: the FMU writes no record file (" RECORD_FILE_ADVICE ")",
+                     function, escape_text(escaped, sizeof(escaped), name), why);
         return STATUS_WARNING;
     }
     instance->log_categories |= RECORD_TO_FILE;

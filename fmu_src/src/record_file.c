@@ -52,12 +52,12 @@ static int starts_with_marker(const char *head, size_t read, const char *marker)
 
 #if defined(__wasm__)
 /* A WebAssembly component of the FMU imports nothing but the FMI callbacks (no WASI file system),
-   so it has no file to open: the record goes to the logger alone (category logCalls). Nothing
-   is ever opened, so nothing is ever written or closed, and no file function is linked in. */
+   so it has no file to open: the record goes to the logger alone (category logCalls,
+   RECORD_FILE_ADVICE). Nothing is ever opened, so nothing is ever written or closed, and no file
+   function is linked in. */
 FILE *record_file_open(const char *name, const char *marker, char *why, size_t why_size) {
     (void)name, (void)marker;
-    snprintf(why, why_size, "cannot be opened: the WebAssembly binary has no files (the log "
-             "category logCalls has the record)");
+    snprintf(why, why_size, "cannot be opened: the WebAssembly binary has no files");
     return NULL;
 }
 

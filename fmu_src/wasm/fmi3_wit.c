@@ -84,6 +84,13 @@ static void forward_log_message(fmi3InstanceEnvironment environment, fmi3Status 
     fmi3_wit_log_message(name, (uint8_t)status, category_text, message_text);
 }
 
+/* fmi3Error, with why logged as the native functions log theirs, for what the WIT allows and no
+   C function takes. */
+static uint8_t refuse(const WitInstance *self, const char *why) {
+    forward_log_message((fmi3InstanceEnvironment)self, fmi3Error, "logStatusError", why);
+    return (uint8_t)fmi3Error;
+}
+
 void fmi3_wit_get_version(wit_string_t *ret) { *ret = wit_string(fmi3GetVersion()); }
 
 /* A WitInstance with its name, before the instance: the logger may speak during instantiation. */
@@ -231,7 +238,8 @@ void fmi3_wit_get_clock(WitInstance *self, wit_list_uint32_t value_references, w
 }
 
 uint8_t fmi3_wit_set_clock(WitInstance *self, wit_list_uint32_t value_references, wit_list_bool_t values) {
-    if (values.len != value_references.len) return (uint8_t)fmi3Error;
+    if (values.len != value_references.len)
+        return refuse(self, "set-clock: not as many values as value references");
     return (uint8_t)fmi3SetClock(self->instance, value_references.ptr, value_references.len, values.ptr);
 }
 
@@ -414,16 +422,17 @@ void fmi3_wit_get_shift_fraction(WitInstance *self, wit_list_uint32_t value_refe
 }
 
 /* The C API takes as many values as value references, with no count of its own. */
-#define SAME_COUNT(values, value_references)                                      \
-    if ((values).len != (value_references).len) return (uint8_t)fmi3Error;
+#define SAME_COUNT(function, values, value_references)                            \
+    if ((values).len != (value_references).len)                                   \
+        return refuse(self, function ": not as many values as value references");
 
 uint8_t fmi3_wit_set_interval_decimal(WitInstance *self, wit_list_uint32_t value_references, wit_list_double_t intervals) {
-    SAME_COUNT(intervals, value_references)
+    SAME_COUNT("set-interval-decimal", intervals, value_references)
     return (uint8_t)fmi3SetIntervalDecimal(self->instance, value_references.ptr, value_references.len, intervals.ptr);
 }
 
 uint8_t fmi3_wit_set_shift_decimal(WitInstance *self, wit_list_uint32_t value_references, wit_list_double_t shifts) {
-    SAME_COUNT(shifts, value_references)
+    SAME_COUNT("set-shift-decimal", shifts, value_references)
     return (uint8_t)fmi3SetShiftDecimal(self->instance, value_references.ptr, value_references.len, shifts.ptr);
 }
 
@@ -443,13 +452,13 @@ static fmi3Status set_fractions(WitInstance *self, wit_list_uint32_t value_refer
 
 uint8_t fmi3_wit_set_interval_fraction(WitInstance *self, wit_list_uint32_t value_references,
                                        wit_list_interval_fraction_t intervals) {
-    SAME_COUNT(intervals, value_references)
+    SAME_COUNT("set-interval-fraction", intervals, value_references)
     return (uint8_t)set_fractions(self, value_references, intervals, fmi3SetIntervalFraction);
 }
 
 uint8_t fmi3_wit_set_shift_fraction(WitInstance *self, wit_list_uint32_t value_references,
                                     wit_list_interval_fraction_t shifts) {
-    SAME_COUNT(shifts, value_references)
+    SAME_COUNT("set-shift-fraction", shifts, value_references)
     return (uint8_t)set_fractions(self, value_references, shifts, fmi3SetShiftFraction);
 }
 
@@ -457,11 +466,7 @@ uint8_t fmi3_wit_set_shift_fraction(WitInstance *self, wit_list_uint32_t value_r
    there is no C function to call: the draft's WIT keeps it for a future mapping. */
 uint8_t fmi3_wit_set_input_derivatives(WitInstance *self, wit_list_tuple_uint32_uint32_t requests, wit_list_double_t values) {
     (void)requests, (void)values;
-    static const char message[] = "set-input-derivatives: not supported: FMI 3.0 has no fmi3SetInputDerivatives";
-    const wit_string_t name = {(uint8_t *)self->name, strlen(self->name)};
-    const wit_string_t category = {(uint8_t *)"logStatusError", sizeof("logStatusError") - 1};
-    fmi3_wit_log_message(name, (uint8_t)fmi3Error, category, (wit_string_t){(uint8_t *)message, sizeof(message) - 1});
-    return (uint8_t)fmi3Error;
+    return refuse(self, "set-input-derivatives: not supported: FMI 3.0 has no fmi3SetInputDerivatives");
 }
 
 void fmi3_wit_get_output_derivatives(WitInstance *self, wit_list_tuple_uint32_uint32_t requests,
