@@ -96,7 +96,6 @@ def add_parser(commands) -> argparse.ArgumentParser:
 
 def run(args) -> int:
     """Run `pendulum-fmu judge` with the parsed arguments; returns the exit status."""
-    from ..figures._plot import plot_judgement
     from ..judging._judge import format_judgement, format_kit, judge, judge_kit, write_json
 
     if args.ssp is not None:
@@ -146,6 +145,9 @@ def run(args) -> int:
         print(format_judgement(judgement))
         judged = {args.result.name: judgement}
         figures = {args.result.name: args.plot} if args.plot else {}
+    if figures:
+        from ..figures._plot import plot_judgement  # matplotlib: loaded only to draw
+
     for title, path in figures.items():
         print(f"wrote {plot_judgement(judged[title], path, title)}")
     if args.json:

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import bisect
 import csv
+import heapq
 import itertools
 import math
 import numbers
@@ -114,6 +115,29 @@ class _TorqueFile:
         j = bisect.bisect_right(self.times, t + tolerance)
         return max(t, self.times[j - 1]) if j and self.times[j - 1] >= t - tolerance else t
 
+    def held_after(self, points: list[Fraction], step: Fraction) -> list[float]:
+        """after(latest_event_near(p, step)) of each point, the same values: the row times as
+        doubles decide each point with no row near it on a flat stretch (its value is the row's);
+        the exact methods decide the others.
+        """
+        times, torques = self.times, self.torques
+        row_doubles, doubles = np.array([float(t) for t in times]), np.array([float(p) for p in points])
+        reach = np.maximum(float(_TOLERANCE_STEPS * step), _TOLERANCE_ULPS * np.spacing(np.abs(doubles)))
+        # Widened by what the doubles may be off by (each time's rounding, the tolerance's):
+        # a few ulp, bounded here by 16.
+        reach += 16 * np.spacing(np.maximum(np.abs(doubles), reach))
+        near = np.searchsorted(row_doubles, doubles + reach, "right") > np.searchsorted(
+            row_doubles, doubles - reach, "left"
+        )
+        after = np.searchsorted(row_doubles, doubles, "right")  # times[j-1] <= p < times[j]
+        before = np.clip(after - 1, 0, len(times) - 1)
+        torque_doubles = np.array(torques)
+        sloped = torque_doubles[before] != torque_doubles[np.minimum(after, len(times) - 1)]
+        values = torque_doubles[before].tolist()
+        for k in np.flatnonzero(near | sloped).tolist():
+            values[k] = self.after(self.latest_event_near(points[k], step))
+        return values
+
 
 def _grid(start: Fraction, stop: Fraction, step: Fraction) -> list[Fraction]:
     """Start + k*step up to stop; stop itself ends a shorter last step unless it is on the grid."""
@@ -138,12 +162,13 @@ def _with_events(grid: list[Fraction], events: list[Fraction], step: Fraction) -
         j = bisect.bisect_left(grid, event)
         if min(grid[j] - event, event - grid[j - 1]) > _tolerance(event, step):
             extra.append(event)
-    return sorted(set(grid) | set(extra))
+    # The grid is sorted and no extra event is on it: merged, not sorted anew.
+    return list(heapq.merge(grid, sorted(set(extra))))
 
 
 class _Pieces:
     """The torque as pieces [start, end) on which it is u0 + rate * (t - start), the
-    communication points the signal defines, and the torque just after any time.
+    communication points the signal defines, and the torque just after each of an array of times.
     """
 
     def __init__(
@@ -153,10 +178,10 @@ class _Pieces:
         u0: list[float],
         rate: list[float],
         points: list[Fraction],
-        value_after: Callable[[Fraction], float],
+        values_after: Callable[[np.ndarray], np.ndarray],
     ):
         self.starts, self.stop, self.u0, self.rate = starts, stop, u0, rate
-        self.points, self.value_after = points, value_after
+        self.points, self.values_after = points, values_after
 
 
 def _signal_pieces(torque, start: Fraction, stop: Fraction | None, step: Fraction, ramp: bool) -> _Pieces:
@@ -176,11 +201,11 @@ def _signal_pieces(torque, start: Fraction, stop: Fraction | None, step: Fractio
                 u0,
                 rate,
                 _with_events(grid, signal.times, step),
-                lambda t: signal.after(signal.latest_event_near(t, step)),
+                lambda times: np.array([signal.after(signal.latest_event_near(_exact(t), step)) for t in times.tolist()]),
             )
         points = _with_events(grid, signal.jumps(), step)
-        held = [signal.after(signal.latest_event_near(p, step)) for p in points[:-1]]
-        return _Pieces(points[:-1], stop, held, [0.0] * len(held), points, _holding(points, held, step))
+        held = signal.held_after(points[:-1], step)
+        return _Pieces(points[:-1], stop, held, [0.0] * len(held), points, _Holding(points, held, step).values_after)
 
     if isinstance(torque, (list, tuple, np.ndarray)):
         values = [_torque(u, f"at step {k} of the array") for k, u in enumerate(torque)]
@@ -196,19 +221,47 @@ def _signal_pieces(torque, start: Fraction, stop: Fraction | None, step: Fractio
     else:
         rate = [0.0] * (len(points) - 1)
     u0 = values[: len(points) - 1]
-    return _Pieces(points[:-1], points[-1], u0, rate, points, _holding(points, u0, step))
+    return _Pieces(points[:-1], points[-1], u0, rate, points, _Holding(points, u0, step).values_after)
 
 
-def _holding(points: list[Fraction], values: list[float], step: Fraction) -> Callable[[Fraction], float]:
+class _Holding:
     """The torque just after t of a signal holding values[k] from points[k]: the step holding t
     is the one starting at the latest point at or (within the tolerance) just after t.
+
+    value_after(t) decides it in exact fractions. values_after(times) decides a whole array with
+    the points as doubles, looked up once; a time whose reach (t plus its tolerance) lies within
+    rounding of a point, where doubles cannot tell the side, is decided by value_after.
     """
 
-    def value_after(t: Fraction) -> float:
-        j = max(bisect.bisect_right(points, t + _tolerance(t, step)) - 1, 0)
-        return values[min(j, len(values) - 1)]
+    def __init__(self, points: list[Fraction], values: list[float], step: Fraction):
+        self.points, self.values, self.step = points, values, step
+        self._point_doubles = np.array([float(p) for p in points])
+        self._value_doubles = np.array(values, dtype=float)
+        self._step_tolerance = float(_TOLERANCE_STEPS * step)
 
-    return value_after
+    def value_after(self, t: Fraction) -> float:
+        """The value held just after the exact time t."""
+        j = max(bisect.bisect_right(self.points, t + _tolerance(t, self.step)) - 1, 0)
+        return self.values[min(j, len(self.values) - 1)]
+
+    def values_after(self, times: np.ndarray) -> np.ndarray:
+        """value_after of each time, read as the decimal a person wrote (_exact)."""
+        times = np.asarray(times, dtype=float)
+        tolerance = np.maximum(self._step_tolerance, _TOLERANCE_ULPS * np.spacing(np.abs(times)))
+        reach = times + tolerance
+        points = self._point_doubles
+        j = np.searchsorted(points, reach, side="right") - 1
+        below, above = points[np.clip(j, 0, len(points) - 1)], points[np.clip(j + 1, 0, len(points) - 1)]
+        # What the doubles may be off by: the decimal of t and its double, the tolerance's and the
+        # sum's roundings, each point's double; a few ulp of the largest magnitude, bounded
+        # here by 16.
+        scale = np.maximum.reduce([np.abs(times), tolerance, np.abs(reach), np.abs(below), np.abs(above)])
+        margin = 16 * np.spacing(scale)
+        near = (np.abs(reach - below) <= margin) | (np.abs(above - reach) <= margin)
+        out = self._value_doubles[np.clip(j, 0, len(self.values) - 1)]
+        for i in np.flatnonzero(near).tolist():
+            out[i] = self.value_after(_exact(times[i]))
+        return out
 
 
 def equation_of_motion(parameters: dict[str, float]) -> Callable:
@@ -300,7 +353,7 @@ def _integrate(
         else:
             out["theta"][mine], out["omega"][mine] = state
         first = last + 1
-    out["torque"] = [pieces.value_after(_exact(t)) for t in at.tolist()]
+    out["torque"] = pieces.values_after(at)
     # The end of the run reports the torque the last piece reached, as a master reads it back.
     at_end = at >= ends[-1]
     out["torque"][at_end] = pieces.u0[-1] + pieces.rate[-1] * (ends[-1] - starts[-1])
@@ -472,7 +525,7 @@ def reference_schedule(
     points = [Fraction(float(t)) for t in plan.time]
     u0, rate = plan.torque.tolist(), plan.torque_rate.tolist()
     # The schedule's points are the tools' own: no tolerance beyond rounding.
-    pieces = _Pieces(points[:-1], points[-1], u0, rate, points, _holding(points, u0, Fraction(0)))
+    pieces = _Pieces(points[:-1], points[-1], u0, rate, points, _Holding(points, u0, Fraction(0)).values_after)
     return _integrate(
         pieces,
         np.asarray(plan.time if at is None else at, dtype=float),
