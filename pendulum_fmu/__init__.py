@@ -43,6 +43,7 @@ _LAZY = {
     # judging a master's result, and the kit of scenarios to judge
     "judge": "judging._judge",
     "judge_kit": "judging._judge",
+    "judge_results": "judging._judge",
     "Judgement": "judging._judge",
     "ResultFileError": "judging._result_file",
     "write_scenarios": "scenarios._scenarios",

@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 from .._errors import InvalidInput
 from ._arguments import (
@@ -16,9 +16,6 @@ from ._arguments import (
     signal_options,
     torque_signal,
 )
-
-if TYPE_CHECKING:
-    from ..judging._judge import Judgement
 
 
 def add_parser(commands) -> argparse.ArgumentParser:
@@ -36,8 +33,9 @@ def add_parser(commands) -> argparse.ArgumentParser:
     judge.add_argument(
         "result",
         type=Path,
-        nargs="?",
-        help="the result CSV, or a folder written by pendulum-fmu scenarios holding NAME_out.csv files",
+        nargs="*",
+        help="the result CSV; several results of the same run, judged against one reference; or a "
+        "folder written by pendulum-fmu scenarios holding NAME_out.csv files",
     )
     judge.add_argument(
         "--calls",
@@ -96,8 +94,13 @@ def add_parser(commands) -> argparse.ArgumentParser:
 
 def run(args) -> int:
     """Run `pendulum-fmu judge` with the parsed arguments; returns the exit status."""
-    from ..judging._judge import format_judgement, format_kit, judge, judge_kit, write_json
-
+    results: list[Path] = args.result
+    if len(results) > 1 and (args.ssp is not None or args.calls is not None):
+        raise InvalidInput(
+            f"{'--ssp' if args.ssp is not None else '--calls'} judges one result or log at a time; "
+            f"{len(results)} results were given: judge them one by one"
+        )
+    args.result = results[0] if results else None
     if args.ssp is not None:
         return _judge_ssp(args)
 
@@ -106,10 +109,29 @@ def run(args) -> int:
         return _judge_calls(args, signal)
     if args.result is None:
         raise InvalidInput("judge needs a result file, a kit's folder, or --calls LOG")
-    is_kit = args.result.is_dir()
-    kit_files = [path for path in args.result.iterdir() if path.is_file()] if is_kit else []
+    folders = [path for path in results if path.is_dir()]
+    if folders and len(results) > 1:
+        raise InvalidInput(
+            f"{folders[0]} is a folder, judged as a scenario kit on its own: give a kit's folder alone, "
+            "or result files only"
+        )
+    if folders:
+        return _judge_kit(args, signal)
+    if signal is None:
+        raise InvalidInput(
+            "judging a result file needs the run's torque: give --torque N.m or "
+            "--torque-file F.csv (or judge a scenario kit's folder)"
+        )
+    return _judge_results(args, signal, results)
+
+
+def _judge_kit(args, signal) -> int:
+    """`judge KIT`: every NAME_out.csv beside a scenario kit's NAME.json, each its own run."""
+    from ..judging._judge import format_kit, judge_kit, write_json
+
+    kit_files = [path for path in args.result.iterdir() if path.is_file()]
     check_outputs(
-        {"--json": args.json, **({} if is_kit else {"--plot": args.plot})},
+        {"--json": args.json},
         {
             "the result": args.result,
             "--torque-file": args.torque_file,
@@ -117,42 +139,101 @@ def run(args) -> int:
             **{f"the kit's {path.name}": path for path in kit_files},
         },
     )
-    if is_kit:
-        if signal is not None:
-            raise InvalidInput(
-                f"{args.result} is a folder, judged as a scenario kit whose NAME.json "
-                "files define the runs: leave out --torque and --torque-file"
-            )
-        kit = judge_kit(args.result, tolerance=args.tol, mapping=args.mapping, fmu_path=args.fmu)
-        print(format_kit(kit))
-        judged = {name: judgement for name, judgement in kit.items() if judgement is not None}
-        verdicts: dict[str, Judgement | None] | Judgement = kit
-        figures = {name: args.plot / f"{name}.png" for name in judged} if args.plot else {}
-    else:
-        if signal is None:
-            raise InvalidInput(
-                "judging a result file needs the run's torque: give --torque N.m or "
-                "--torque-file F.csv (or judge a scenario kit's folder)"
-            )
-        verdicts = judgement = judge(
-            args.result,
-            signal,
-            start_time=args.start_time,
-            tolerance=args.tol,
-            mapping=args.mapping,
-            **signal_options(args),
+    if signal is not None:
+        raise InvalidInput(
+            f"{args.result} is a folder, judged as a scenario kit whose NAME.json "
+            "files define the runs: leave out --torque and --torque-file"
         )
-        print(format_judgement(judgement))
-        judged = {args.result.name: judgement}
-        figures = {args.result.name: args.plot} if args.plot else {}
-    if figures:
-        from ..figures._plot import plot_judgement  # matplotlib: loaded only to draw
-
-    for title, path in figures.items():
-        print(f"wrote {plot_judgement(judged[title], path, title)}")
+    kit = judge_kit(args.result, tolerance=args.tol, mapping=args.mapping, fmu_path=args.fmu)
+    print(format_kit(kit))
+    judged = {name: judgement for name, judgement in kit.items() if judgement is not None}
+    if args.plot:
+        _plot({name: (judged[name], args.plot / f"{name}.png") for name in judged})
     if args.json:
-        print(f"wrote {write_json(verdicts, args.json)}")
+        print(f"wrote {write_json(kit, args.json)}")
     return 0 if all(judgement.passed for judgement in judged.values()) else 1
+
+
+def _judge_results(args, signal, results: list[Path]) -> int:
+    """`judge RESULT [RESULT ...]`: results of one run, against one reference (JudgedRun). A
+    result that cannot be judged gets its one line and the others are judged; the exit status is
+    the worst: 2 for such a result, else 1 for a fail, else 0.
+    """
+    from ..judging._judge import JudgedRun, Judgement, format_judgement, write_json
+    from ..judging._result_file import ResultFileError
+
+    several = len(results) > 1
+    check_outputs(
+        {"--json": args.json, **({} if several else {"--plot": args.plot})},
+        {
+            **{f"the result {path}" if several else "the result": path for path in results},
+            "--torque-file": args.torque_file,
+            "--fmu": args.fmu,
+        },
+    )
+    figures = _figure_paths(args.plot, results) if args.plot else {}
+    run = JudgedRun(signal, start_time=args.start_time, tolerance=args.tol, **signal_options(args))
+    verdicts: list[Judgement | dict] = []
+    for number, path in enumerate(results):
+        try:
+            judgement = run.judge(path, args.mapping)
+        except ResultFileError as error:
+            if not several:
+                raise
+            print(f"pendulum-fmu judge: error: {error}", file=sys.stderr, flush=True)
+            verdicts.append({"result": str(path), "error": str(error)})
+            continue
+        print(("\n" if number else "") + format_judgement(judgement), flush=True)
+        verdicts.append(judgement)
+    judged = [judgement for judgement in verdicts if isinstance(judgement, Judgement)]
+    if several:
+        print(f"\n{sum(j.passed for j in judged)} of {len(results)} results pass" + _not_judged(results, judged))
+    _plot(
+        {
+            path.name: (judgement, figures[path])
+            for path, judgement in zip(results, verdicts, strict=True)
+            if isinstance(judgement, Judgement) and path in figures
+        }
+    )
+    if args.json:
+        print(f"wrote {write_json(verdicts if several else judged[0], args.json)}")
+    if len(judged) < len(results):
+        return 2
+    return 0 if all(judgement.passed for judgement in judged) else 1
+
+
+def _figure_paths(plot: Path, results: list[Path]) -> dict[Path, Path]:
+    """Where --plot draws each result: the file itself for one, else FOLDER/NAME.png for each,
+    the folder's name refused when two results would share a figure.
+    """
+    if len(results) == 1:
+        return {results[0]: plot}
+    figures = {path: plot / f"{path.stem}.png" for path in results}
+    by_figure: dict[Path, Path] = {}
+    for path, figure in figures.items():
+        if figure in by_figure:
+            raise InvalidInput(
+                f"--plot {plot}: {by_figure[figure]} and {path} would both be drawn as {figure}; "
+                "give results with different names, or judge them in two calls"
+            )
+        by_figure[figure] = path
+    return figures
+
+
+def _plot(figures: dict) -> None:
+    """Draw each judgement ({title: (judgement, path)}); matplotlib is loaded only here."""
+    if not figures:
+        return
+    from ..figures._plot import plot_judgement
+
+    for title, (judgement, path) in figures.items():
+        print(f"wrote {plot_judgement(judgement, path, title)}")
+
+
+def _not_judged(results: list[Path], judged: list) -> str:
+    """The summary line's tail: how many results could not be judged, if any."""
+    missing = len(results) - len(judged)
+    return f"; {missing} could not be judged (each error line says why)" if missing else ""
 
 
 def _judge_ssp(args) -> int:

@@ -198,30 +198,33 @@ def _integration(run: Run) -> list[np.ndarray]:
     return [_euler(run.plan, acceleration, run.theta0, run.omega0, semi)[index] for semi in (False, True)]
 
 
-def candidate_variants(
-    run: Run,
-    torque,
-    held: TorqueSchedule | None,
-    correct: np.ndarray,
-    result: np.ndarray,
-    tolerance: float,
-    start_torque: float,
-) -> dict[str, list[np.ndarray]]:
-    """{candidate: its variants at the result's times}; an empty list where it does not apply.
+def shared_variants(run: Run, torque, held: TorqueSchedule | None, start_torque: float) -> dict[str, list[np.ndarray]]:
+    """{candidate: its variants at the result's times} of every candidate whose variants do not
+    depend on the result (all but state not restored): made once for the results of a run that
+    share their times. An empty list where a candidate does not apply.
     held: for a ramp run, the same signal held over each step (schedule without ramp).
     """
     plan, ramp = run.plan, held is not None
     off_grid = _plan_index(plan, run.times, run.step_size) is None
-    wrong = np.flatnonzero(np.abs(result["theta"] - correct["theta"]) > tolerance)
     return {
         LATE: [run.integrate(p) for p in _late(plan, start_torque)],
         EARLY: [run.integrate(p) for p in _early(plan)],
         INTERPOLATED: [] if ramp else [run.integrate(p) for p in _interpolated(plan)],
         HELD: [run.integrate(held)] if held is not None else [],
         DRIFT: [run.integrate(p) for p in _drifted(torque, run.times, ramp)] if off_grid else [],
-        NOT_RESTORED: _not_restored(run, correct, int(wrong[0])) if len(wrong) else [],
         INTEGRATION: _integration(run),
     }
+
+
+def candidate_variants(
+    shared: dict[str, list[np.ndarray]], run: Run, correct: np.ndarray, result: np.ndarray, tolerance: float
+) -> dict[str, list[np.ndarray]]:
+    """{candidate: its variants at the result's times}, in DIAGNOSES' order: the shared ones
+    (shared_variants) and state not restored, which restarts where this result first disagrees.
+    """
+    wrong = np.flatnonzero(np.abs(result["theta"] - correct["theta"]) > tolerance)
+    own = {NOT_RESTORED: _not_restored(run, correct, int(wrong[0])) if len(wrong) else []}
+    return {name: own[name] if name in own else shared[name] for name in DIAGNOSES if name in own or name in shared}
 
 
 def diagnose(

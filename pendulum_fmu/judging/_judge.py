@@ -44,7 +44,7 @@ from ..oracle._reference import reference
 from ..scenarios._scenario_settings import JUDGE_TOLERANCE as DEFAULT_TOLERANCE, read_settings, settings_files
 from ..signals._time_grid import event_tolerance
 from ..signals._torque_schedule import TorqueSchedule, schedule
-from ._diagnoses import AGREES, INPUT_TIMING, Run, candidate_variants, diagnose
+from ._diagnoses import AGREES, INPUT_TIMING, Run, candidate_variants, diagnose, shared_variants
 from ._regression_tools import format_verdicts, regression_verdicts
 from ._result_file import OPTIONAL, ResultFileError, read_result
 
@@ -177,6 +177,164 @@ def _check_span(result: np.ndarray, plan: TorqueSchedule, step_size: float, sour
         )
 
 
+class JudgedRun:
+    """One run's definition, and what every result of it is judged against.
+
+    The schedule is made once. The reference and the variants of the candidate mistakes that do
+    not depend on the result (all but state not restored) are made once per set of result times
+    and kept for the next result on the same times: the results of one scenario share them.
+
+    Parameters
+    ----------
+    torque, start_time, stop_time, step_size, ramp, parameters, theta0, omega0, tolerance, fmu_path, max_steps
+        As judge() takes them.
+
+    Raises
+    ------
+    InvalidInput
+        A tolerance that is not positive and finite, or a run definition simulate() would refuse.
+    """
+
+    # Sets of result times whose reference and variants are kept (results of one scenario share
+    # one; a master whose times drift has its own per result).
+    KEPT_TIMES = 4
+
+    def __init__(
+        self,
+        torque,
+        *,
+        start_time: float = 0.0,
+        stop_time: float | None = None,
+        step_size: float = 1e-3,
+        ramp: bool = False,
+        parameters: dict | None = None,
+        theta0: float = 0.0,
+        omega0: float = 0.0,
+        tolerance: float | None = None,
+        fmu_path: str | Path | FmuModel | None = None,
+        max_steps: int | None = None,
+    ):
+        tolerance = DEFAULT_TOLERANCE if tolerance is None else tolerance
+        if not (math.isfinite(tolerance) and tolerance > 0):
+            raise InvalidInput(f"the tolerance {tolerance} must be a positive finite number (rad)")
+        self.torque, self.tolerance = torque, tolerance
+        self.start_time, self.stop_time, self.step_size, self.ramp = start_time, stop_time, step_size, ramp
+        self.theta0, self.omega0 = theta0, omega0
+        self.model = fmu_model(fmu_path)
+        self.parameters = resolve_parameters(parameters, self.model)
+        self.plan = schedule(
+            torque, start_time=start_time, stop_time=stop_time, step_size=step_size, ramp=ramp, max_steps=max_steps
+        )
+        self.held = schedule(torque, start_time=start_time, stop_time=stop_time, step_size=step_size) if ramp else None
+        self.start_torque = float(self.model.variables["torque"].start or 0.0)
+        self._kept: dict[bytes, tuple[np.ndarray, Run, dict[str, list[np.ndarray]]]] = {}
+
+    def _shared(self, times: np.ndarray) -> tuple[np.ndarray, Run, dict[str, list[np.ndarray]]]:
+        """The reference at these times, the frame of the run's variants, and the variants every
+        result on these times shares (made here the first time, kept for the next).
+        """
+        key = times.tobytes()
+        if key not in self._kept:
+            correct = reference(
+                self.torque,
+                start_time=self.start_time,
+                stop_time=self.stop_time,
+                step_size=self.step_size,
+                ramp=self.ramp,
+                parameters=self.parameters,
+                theta0=self.theta0,
+                omega0=self.omega0,
+                at=times,
+                fmu_path=self.model,
+            )
+            run = Run(self.plan, times, self.step_size, self.parameters, self.theta0, self.omega0, self.model)
+            if len(self._kept) >= self.KEPT_TIMES:
+                del self._kept[next(iter(self._kept))]
+            self._kept[key] = (correct, run, shared_variants(run, self.torque, self.held, self.start_torque))
+        return self._kept[key]
+
+    def judge(self, result, mapping: str | dict | None = None) -> Judgement:
+        """Judge one result of this run (judge() says how).
+
+        Parameters
+        ----------
+        result : str, Path or numpy.ndarray
+            A result CSV (read_result) or an array with fields time and theta (omega, alpha: optional).
+        mapping : str or dict, optional
+            The result's column names and unit factors (--map), for a CSV.
+
+        Returns
+        -------
+        Judgement
+            As judge() returns it.
+
+        Raises
+        ------
+        ResultFileError
+            A result file that cannot be read, whose times fall outside the run, or whose first
+            and last rows are not the run's start and stop (a result of part of the run).
+        InvalidInput
+            A map given with an array result, or values with which the reference fails.
+        """
+        source = str(result) if isinstance(result, (str, Path)) else "result"
+        if isinstance(result, (str, Path)):
+            result = read_result(result, mapping)
+        elif mapping:
+            raise InvalidInput(
+                "a map renames and scales a result file's columns: an array result is "
+                "judged as it is, in the fields time and theta (rad); leave out mapping"
+            )
+        _check_span(result, self.plan, self.step_size, source)
+        times = np.asarray(result["time"], dtype=float)
+        correct, run, shared = self._shared(times)
+        difference = np.abs(result["theta"] - correct["theta"])
+        raw = float(np.max(difference))
+        variants = candidate_variants(shared, run, correct, result, self.tolerance)
+        scores, best_variant, smallest_input_effect = _scores(variants, result, correct, self.tolerance)
+        if raw <= self.tolerance:
+            diagnosis, residual = AGREES, raw
+        else:
+            diagnosis, residual = diagnose(raw, self.tolerance, scores, smallest_input_effect)
+        return Judgement(
+            verdict="pass" if raw <= self.tolerance else "fail",
+            diagnosis=diagnosis,
+            residual=residual,
+            max_abs_dtheta=raw,
+            worst_time=float(times[int(np.argmax(difference))]),
+            tolerance=self.tolerance,
+            candidates=scores,
+            smallest_input_effect=smallest_input_effect,
+            result=result,
+            reference=correct,
+            explanation=best_variant.get(diagnosis) if diagnosis != AGREES else None,
+            source=source,
+            regression_tools=regression_verdicts(times, correct["theta"], result["theta"]),
+        )
+
+
+def _scores(
+    variants: dict[str, list[np.ndarray]], result: np.ndarray, correct: np.ndarray, tolerance: float
+) -> tuple[dict[str, dict | None], dict[str, np.ndarray], float | None]:
+    """Per candidate, the residual and effect of its best variant (None where it does not apply);
+    that variant; and the smallest effect above the tolerance of an input-timing variant.
+    """
+    scores: dict[str, dict | None] = {}
+    best_variant: dict[str, np.ndarray] = {}
+    timing_effects: list[float] = []
+    for name, made in variants.items():
+        if not made:
+            scores[name] = None
+            continue
+        residuals = [float(np.max(np.abs(result["theta"] - v["theta"]))) for v in made]
+        effects = [float(np.max(np.abs(v["theta"] - correct["theta"]))) for v in made]
+        if name in INPUT_TIMING:
+            timing_effects += [effect for effect in effects if effect > tolerance]
+        i = int(np.argmin(residuals))
+        best_variant[name] = made[i]
+        scores[name] = {"residual": residuals[i], "effect": effects[i]}
+    return scores, best_variant, min(timing_effects, default=None)
+
+
 def judge(
     result,
     torque,
@@ -237,25 +395,7 @@ def judge(
     >>> judgement.passed, judgement.diagnosis
     (True, 'agrees')
     """
-    tolerance = DEFAULT_TOLERANCE if tolerance is None else tolerance
-    if not (math.isfinite(tolerance) and tolerance > 0):
-        raise InvalidInput(f"the tolerance {tolerance} must be a positive finite number (rad)")
-    source = str(result) if isinstance(result, (str, Path)) else "result"
-    if isinstance(result, (str, Path)):
-        result = read_result(result, mapping)
-    elif mapping:
-        raise InvalidInput(
-            "a map renames and scales a result file's columns: an array result is "
-            "judged as it is, in the fields time and theta (rad); leave out mapping"
-        )
-    model = fmu_model(fmu_path)
-    parameters = resolve_parameters(parameters, model)
-    plan = schedule(
-        torque, start_time=start_time, stop_time=stop_time, step_size=step_size, ramp=ramp, max_steps=max_steps
-    )
-    _check_span(result, plan, step_size, source)
-    times = np.asarray(result["time"], dtype=float)
-    correct = reference(
+    return JudgedRun(
         torque,
         start_time=start_time,
         stop_time=stop_time,
@@ -264,50 +404,82 @@ def judge(
         parameters=parameters,
         theta0=theta0,
         omega0=omega0,
-        at=times,
-        fmu_path=model,
-    )
-    difference = np.abs(result["theta"] - correct["theta"])
-    raw = float(np.max(difference))
-    worst_time = float(times[int(np.argmax(difference))])
-    run = Run(plan, times, step_size, parameters, theta0, omega0, model)
-    start_torque = float(model.variables["torque"].start or 0.0)
-    held = schedule(torque, start_time=start_time, stop_time=stop_time, step_size=step_size) if ramp else None
-    variants = candidate_variants(run, torque, held, correct, result, tolerance, start_torque)
-    scores: dict[str, dict | None] = {}
-    best_variant: dict[str, np.ndarray] = {}
-    timing_effects: list[float] = []
-    for name, made in variants.items():
-        if not made:
-            scores[name] = None
-            continue
-        residuals = [float(np.max(np.abs(result["theta"] - v["theta"]))) for v in made]
-        effects = [float(np.max(np.abs(v["theta"] - correct["theta"]))) for v in made]
-        if name in INPUT_TIMING:
-            timing_effects += [effect for effect in effects if effect > tolerance]
-        i = int(np.argmin(residuals))
-        best_variant[name] = made[i]
-        scores[name] = {"residual": residuals[i], "effect": effects[i]}
-    smallest_input_effect = min(timing_effects, default=None)
-    if raw <= tolerance:
-        diagnosis, residual = AGREES, raw
-    else:
-        diagnosis, residual = diagnose(raw, tolerance, scores, smallest_input_effect)
-    return Judgement(
-        verdict="pass" if raw <= tolerance else "fail",
-        diagnosis=diagnosis,
-        residual=residual,
-        max_abs_dtheta=raw,
-        worst_time=worst_time,
         tolerance=tolerance,
-        candidates=scores,
-        smallest_input_effect=smallest_input_effect,
-        result=result,
-        reference=correct,
-        explanation=best_variant.get(diagnosis) if diagnosis != AGREES else None,
-        source=source,
-        regression_tools=regression_verdicts(times, correct["theta"], result["theta"]),
+        fmu_path=fmu_path,
+        max_steps=max_steps,
+    ).judge(result, mapping)
+
+
+def judge_results(
+    results,
+    torque,
+    *,
+    start_time: float = 0.0,
+    stop_time: float | None = None,
+    step_size: float = 1e-3,
+    ramp: bool = False,
+    parameters: dict | None = None,
+    theta0: float = 0.0,
+    omega0: float = 0.0,
+    tolerance: float | None = None,
+    mapping: str | dict | None = None,
+    fmu_path: str | Path | FmuModel | None = None,
+    max_steps: int | None = None,
+) -> list[Judgement]:
+    """Judge many results of one run, each as judge() would, making the reference once.
+
+    The results of one scenario (a regression suite's runs of it, one per master or version)
+    share their times: the reference and the candidate mistakes' variants are made for the first
+    and reused for the others (JudgedRun).
+
+    Parameters
+    ----------
+    results : iterable of str, Path or numpy.ndarray
+        The result CSVs or arrays, as judge() takes one.
+    torque, start_time, stop_time, step_size, ramp, parameters, theta0, omega0, tolerance, mapping, fmu_path, max_steps
+        As judge() takes them, the same for every result.
+
+    Returns
+    -------
+    list of Judgement
+        One per result, in their order.
+
+    Raises
+    ------
+    ResultFileError
+        The first result file that cannot be judged (judge() says which); none after it is judged.
+    InvalidInput
+        A tolerance that is not positive and finite, or a run definition simulate() would refuse.
+
+    Examples
+    --------
+    The FMU's run and one whose torque steps a millisecond late, judged against one reference:
+
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from pendulum_fmu import judge_results, simulate
+    >>> from pendulum_fmu.fmu._results import write_csv
+    >>> folder = Path(tempfile.mkdtemp())
+    >>> right = write_csv(simulate(lambda t: 0.0 if t < 0.25 else 20.0, stop_time=0.5), folder / "right.csv")
+    >>> late = write_csv(simulate(lambda t: 0.0 if t < 0.251 else 20.0, stop_time=0.5), folder / "late.csv")
+    >>> judgements = judge_results([right, late], lambda t: 0.0 if t < 0.25 else 20.0, stop_time=0.5)
+    >>> [(j.verdict, j.diagnosis) for j in judgements]
+    [('pass', 'agrees'), ('fail', 'input one step late')]
+    """
+    run = JudgedRun(
+        torque,
+        start_time=start_time,
+        stop_time=stop_time,
+        step_size=step_size,
+        ramp=ramp,
+        parameters=parameters,
+        theta0=theta0,
+        omega0=omega0,
+        tolerance=tolerance,
+        fmu_path=fmu_path,
+        max_steps=max_steps,
     )
+    return [run.judge(result, mapping) for result in results]
 
 
 def format_judgement(judgement: Judgement) -> str:
@@ -443,14 +615,16 @@ def judge_kit(
     return verdicts
 
 
-def write_json(verdicts: dict[str, Judgement | None] | Judgement, path: str | Path) -> Path:
-    """Write --json whole or not at all: one judgement's summary (Judgement.summary), or
-    {"scenarios": {name: summary or null}} for a kit.
+def write_json(verdicts: dict[str, Judgement | None] | Judgement | list[Judgement | dict], path: str | Path) -> Path:
+    """Write --json whole or not at all: one judgement's summary (Judgement.summary),
+    {"scenarios": {name: summary or null}} for a kit, or {"results": [summary, ...]} for many
+    results of one run.
 
     Parameters
     ----------
-    verdicts : Judgement or dict
-        What judge() or judge_kit() returned.
+    verdicts : Judgement, dict or list
+        What judge(), judge_kit() or judge_results() returned; a list may also hold, for a result
+        that could not be judged, {"result": its name, "error": the one line saying why}.
     path : str or Path
         The JSON file.
 
@@ -459,8 +633,11 @@ def write_json(verdicts: dict[str, Judgement | None] | Judgement, path: str | Pa
     Path
         path.
     """
+    content: dict
     if isinstance(verdicts, Judgement):
         content = verdicts.summary()
+    elif isinstance(verdicts, list):
+        content = {"results": [j.summary() if isinstance(j, Judgement) else j for j in verdicts]}
     else:
         content = {"scenarios": {name: j.summary() if j else None for name, j in verdicts.items()}}
     with replacing(path) as file:
@@ -469,4 +646,13 @@ def write_json(verdicts: dict[str, Judgement | None] | Judgement, path: str | Pa
     return Path(path)
 
 
-__all__ = ["Judgement", "format_judgement", "format_kit", "judge", "judge_kit", "write_json"]
+__all__ = [
+    "JudgedRun",
+    "Judgement",
+    "format_judgement",
+    "format_kit",
+    "judge",
+    "judge_kit",
+    "judge_results",
+    "write_json",
+]

@@ -102,6 +102,30 @@ def read_result(path: str | Path, mapping: str | dict | None = None) -> np.ndarr
     out["torque"] = np.nan
     for quantity in OPTIONAL:
         out[quantity] = np.nan
+    if _read_columns(out, data, columns):
+        return out
+    _refuse_rows(path, out, data, columns)
+    return out
+
+
+def _read_columns(out: np.ndarray, data: list, columns: dict) -> bool:
+    """Fill out's columns from the rows a column at a time; False, with nothing to trust in out,
+    when a cell is missing, not a number or not finite, or a time goes backwards (_refuse_rows
+    then finds the first such row and says what is wrong with it).
+    """
+    for quantity, (column, factor) in columns.items():
+        try:
+            values = np.array([float(row[column]) for _, row in data])
+        except (ValueError, IndexError):
+            return False
+        if not np.isfinite(values).all():
+            return False
+        out[quantity] = values * factor
+    return not np.any(np.diff(out["time"]) < 0)
+
+
+def _refuse_rows(path: Path, out: np.ndarray, data: list, columns: dict) -> None:
+    """Read the rows one by one, raising ResultFileError at the first that cannot be judged."""
     for i, (number, row) in enumerate(data):
         for quantity, (column, factor) in columns.items():
             cell = row[column].strip() if column < len(row) else ""
@@ -117,4 +141,3 @@ def read_result(path: str | Path, mapping: str | dict | None = None) -> np.ndarr
                 f"{path}:{number}: time {out['time'][i]:.17g} goes backwards (previous "
                 f"row: {out['time'][i - 1]:.17g}); a result's times must not decrease"
             )
-    return out

@@ -201,7 +201,9 @@ def _signal_pieces(torque, start: Fraction, stop: Fraction | None, step: Fractio
                 u0,
                 rate,
                 _with_events(grid, signal.times, step),
-                lambda times: np.array([signal.after(signal.latest_event_near(_exact(t), step)) for t in times.tolist()]),
+                lambda times: np.array(
+                    [signal.after(signal.latest_event_near(_exact(t), step)) for t in times.tolist()]
+                ),
             )
         points = _with_events(grid, signal.jumps(), step)
         held = signal.held_after(points[:-1], step)
