@@ -28,6 +28,7 @@ from pendulum_fmu.judging._diagnoses import (
 )
 from pendulum_fmu.judging._judge import judge
 from pendulum_fmu.judging._result_file import ResultFileError, read_result
+from pendulum_fmu.oracle._reference import reference
 from pendulum_fmu.scenarios._scenario_settings import KIT_FMU, read_settings
 from pendulum_fmu.scenarios._scenarios import write_scenarios
 
@@ -257,3 +258,81 @@ def test_fmpy_model_exchange_solvers_are_integration_errors(kit, solver):
         assert judgement.residual == 0.0 and judgement.max_abs_dtheta > 1e-4
     else:
         assert 1e-9 < judgement.max_abs_dtheta < INTEGRATION_SMALL * judgement.smallest_input_effect
+
+
+def _same_judgement(together, alone):
+    """Two judgements of one result agree in every number they report."""
+    assert together.source == alone.source
+    assert (together.verdict, together.diagnosis) == (alone.verdict, alone.diagnosis)
+    assert (together.residual, together.max_abs_dtheta, together.worst_time) == (
+        alone.residual,
+        alone.max_abs_dtheta,
+        alone.worst_time,
+    )
+    assert together.candidates == alone.candidates
+    assert together.smallest_input_effect == alone.smallest_input_effect
+    assert together.regression_tools == alone.regression_tools
+    assert np.array_equal(together.reference, alone.reference)
+
+
+def _results_of(kit, tmp_path, name, mistakes):
+    """Scenario `name` run once per mistake (None: none), each result kept under its own name."""
+    paths = []
+    for mistake in mistakes:
+        path = tmp_path / f"{name}_{mistake or 'right'}.csv"
+        path.write_bytes(run(kit, name, mistake).read_bytes())
+        paths.append(path)
+    return paths
+
+
+@pytest.mark.parametrize(
+    ("name", "mistakes"),
+    [
+        # A drifting master's times are its own: the reference and variants made for them too.
+        ("random_steps", [None, "late", "ramped", "drift", "late_once", "euler", None]),
+        ("resume", [None, "not_restored", None, "not_restored"]),
+        ("ramp", ["held", None, "early"]),
+    ],
+)
+def test_many_results_judged_together_are_judged_as_each_alone(kit, tmp_path, name, mistakes, monkeypatch):
+    from pendulum_fmu import judge_results
+    from pendulum_fmu.judging import _judge
+
+    paths = _results_of(kit, tmp_path, name, mistakes)
+    settings = read_settings(kit / f"{name}.json")
+    settings.pop("output")
+    references = []
+    monkeypatch.setattr(_judge, "reference", lambda *a, **k: references.append(k["at"]) or reference(*a, **k))
+    together = judge_results(paths, **settings)
+    monkeypatch.undo()
+    assert len(together) == len(paths)
+    # One reference per set of result times: one for all but a drifting master's.
+    assert len(references) == len({read_result(path)["time"].tobytes() for path in paths}) < len(paths)
+    for path, judgement in zip(paths, together, strict=True):
+        _same_judgement(judgement, judge(path, **settings))
+    # Each mistake named as made, the right runs passing (the ones whose diagnosis is their own).
+    named = {judgement.source: judgement.diagnosis for judgement in together}
+    expected = {mistake: diagnosis for scenario, mistake, diagnosis in WRONG_MASTERS if scenario == name}
+    for path, mistake in zip(paths, mistakes, strict=True):
+        assert named[str(path)] == (AGREES if mistake is None else expected[mistake])
+
+
+def test_the_command_judges_many_results_and_exits_with_the_worst(kit, tmp_path, capsys):
+    right, late = _results_of(kit, tmp_path, "decimal_steps", [None, "late"])
+    signal = ["--torque-file", str(kit / "decimal_steps_in.csv"), "--step-size", "0.009"]
+    assert main(["judge", str(right), str(right), *signal]) == 0
+    assert capsys.readouterr().out.endswith("\n2 of 2 results pass\n")
+
+    absent = tmp_path / "absent.csv"
+    summary = tmp_path / "many.json"
+    assert main(["judge", str(right), str(absent), str(late), *signal, "--json", str(summary)]) == 2
+    printed = capsys.readouterr()
+    # Each result's lines in the order given, the one that cannot be read said in one line.
+    assert printed.out.index(f"{right}: pass: {AGREES}") < printed.out.index(f"{late}: fail: {LATE}")
+    assert "2 of 3 results pass" not in printed.out and "1 of 3 results pass; 1 could not be judged" in printed.out
+    assert printed.err == f"pendulum-fmu judge: error: {absent}: cannot read: No such file or directory\n"
+    written = json.loads(summary.read_text())["results"]
+    assert [entry["result"] for entry in written] == [str(right), str(absent), str(late)]
+    assert written[1]["error"].startswith(f"{absent}: cannot read")
+    assert (written[0]["verdict"], written[2]["diagnosis"]) == ("pass", LATE)
+    assert main(["judge", str(right), str(late), *signal]) == 1
