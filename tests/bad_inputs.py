@@ -623,6 +623,27 @@ CASES = [
     ),
     _case("judge", "judge {files} --torque 1", 2, "is a folder, judged as a scenario kit whose NAME.json files"),
     _case(
+        "judge",
+        "judge {files}/result.csv {files}/absent.csv --torque 1 --stop-time 0.001",
+        2,
+        "absent.csv: cannot read: No such file",
+    ),
+    _case(
+        "judge", "judge {files}/result.csv {files} --torque 1", 2, "is a folder, judged as a scenario kit on its own"
+    ),
+    _case(
+        "judge",
+        "judge {files}/result.csv {files}/result_t0.csv --ssp {files}/absent.ssp",
+        2,
+        "--ssp judges one result or log at a time; 2 results were given",
+    ),
+    _case(
+        "judge",
+        "judge {files}/result.csv {files}/result.csv --torque 1 --stop-time 0.001 --plot {files}/out",
+        2,
+        "would both be drawn as {files}/out/result.png",
+    ),
+    _case(
         "scenarios",
         "scenarios --output-dir {files}/bad_number.csv/kit",
         2,
@@ -792,6 +813,7 @@ from pendulum_fmu import (
     create_closed_loop_fmu,
     default_fmu,
     judge,
+    judge_results,
     read_settings,
     reference,
     reference_schedule,
@@ -1099,6 +1121,12 @@ CALLS = [
         'judge("{files}/result.csv", 1.0, stop_time=0.001, mapping={"theta": "phi"})',
         "ResultFileError",
         "result.csv:1: no column 'phi'",
+    ),
+    Call(
+        "judge",
+        'judge_results(["{files}/result.csv", "{files}/absent.csv"], 1.0, stop_time=0.001)',
+        "ResultFileError",
+        "absent.csv: cannot read: No such file or directory",
     ),
     Call(
         "judge",

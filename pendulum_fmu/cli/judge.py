@@ -208,15 +208,16 @@ def _figure_paths(plot: Path, results: list[Path]) -> dict[Path, Path]:
     """
     if len(results) == 1:
         return {results[0]: plot}
-    figures = {path: plot / f"{path.stem}.png" for path in results}
-    by_figure: dict[Path, Path] = {}
-    for path, figure in figures.items():
-        if figure in by_figure:
+    figures: dict[Path, Path] = {}
+    for path in results:
+        figure = plot / f"{path.stem}.png"
+        drawn = next((other for other, taken in figures.items() if taken == figure), None)
+        if drawn is not None:
             raise InvalidInput(
-                f"--plot {plot}: {by_figure[figure]} and {path} would both be drawn as {figure}; "
+                f"--plot {plot}: {drawn} and {path} would both be drawn as {figure}; "
                 "give results with different names, or judge them in two calls"
             )
-        by_figure[figure] = path
+        figures[path] = figure
     return figures
 
 
