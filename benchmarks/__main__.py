@@ -16,6 +16,7 @@ from .builds import build_fmi3_fmu, build_null_fmu, build_pendulum_fmu, build_st
 from .case_cost import case_cost_rows
 from .fixed_cost import fixed_cost_rows
 from .floor import floor_rows
+from .judge_cost import judge_cost_rows
 from .own_cost import own_cost_rows
 from .peers import opensim_rows, pythonfmu_rows
 from .python_loop import python_loop_rows
@@ -35,6 +36,7 @@ PARTS = (
     "scale",
     "realtime",
     "wasm",
+    "judge",
 )
 DEFAULT_FIGURE = Path(__file__).resolve().parent / "accuracy_cost.png"
 
@@ -112,6 +114,8 @@ def main(argv=None) -> int:
                 rows += realtime_rows(pendulum, scratch)
             elif part == "wasm":
                 rows += wasm_cost_rows(build_fmi3_fmu(scratch), repetitions)
+            elif part == "judge":
+                rows += judge_cost_rows(3 if args.quick else 5)
     tables = [main_table(rows)] + ([grid] if grid else [])
     print("\n\n".join(as_text(table) for table in tables))
     if args.markdown:
