@@ -69,6 +69,21 @@ def test_the_command_lines_simulate_loads_neither_the_sweep_nor_matplotlib():
     assert theta == pytest.approx(pendulum_fmu.reference(20.0)["theta"][-1], abs=1e-9)
 
 
+def test_the_command_lines_judge_loads_matplotlib_only_to_draw(tmp_path):
+    torque = tmp_path / "torque.csv"
+    torque.write_text("time,torque\n0,20\n0.5,20\n0.5,-20\n1,-20\n")
+    result = pendulum_fmu.simulate(str(torque))
+    rows = zip(result["time"].tolist(), result["theta"].tolist(), strict=True)
+    (tmp_path / "out.csv").write_text("time,theta\n" + "".join(f"{t!r},{theta!r}\n" for t, theta in rows))
+    judged = f"main(['judge', {str(tmp_path / 'out.csv')!r}, '--torque-file', {str(torque)!r}])"
+    loaded = _loaded_after(f"from pendulum_fmu.cli import main\nprint({judged})")
+    assert "matplotlib" not in loaded["top"] and "dask" not in loaded["top"]
+    assert "pendulum_fmu.figures._plot" not in loaded["ours"]
+    # It still judged: the FMU's run agrees with the reference, exit 0.
+    assert loaded["printed"][-1] == "0", loaded["printed"]
+    assert loaded["printed"][0].startswith(f"{tmp_path / 'out.csv'}: pass: agrees (residual ")
+
+
 def test_the_names_at_the_top_are_the_api():
     from pendulum_fmu import Study, compare, default_fmu, judge, reference, run_sweep, simulate
     from pendulum_fmu.sweep.run import run_sweep as sweep_runner
