@@ -149,6 +149,7 @@ def test_wheel_carries_the_fmu_for_every_platform_built(artefacts, tmp_path):
             ("aarch64-linux", "so"),
             ("x86_64-darwin", "dylib"),
             ("aarch64-darwin", "dylib"),
+            ("wasm32-wasip2", "wasm"),
         )
     }
     # darwin64 is one universal binary of both Mac slices, as LLVM reads it.
@@ -217,8 +218,8 @@ def test_installed_package_runs_from_an_empty_folder(installed, tmp_path):
     assert (tmp_path / "Pendulum.fmu").read_bytes() == fmu.read_bytes()
     assert exported == "wrote Pendulum.fmu (binaries for aarch64-linux, darwin64, linux64, win64)\n"
     assert _run([cli, "export", "--fmi-version", "3"], cwd=tmp_path).stdout == (
-        "wrote Pendulum-fmi3.fmu (binaries for aarch64-darwin, aarch64-linux, x86_64-darwin, x86_64-linux, "
-        "x86_64-windows)\n"
+        "wrote Pendulum-fmi3.fmu (binaries for aarch64-darwin, aarch64-linux, wasm32-wasip2, x86_64-darwin, "
+        "x86_64-linux, x86_64-windows)\n"
     )
     refused = _run([cli, "export"], cwd=tmp_path, check=False)
     assert refused.returncode == 2 and refused.stderr.startswith("pendulum-fmu export: error: Pendulum.fmu exists")

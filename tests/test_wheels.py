@@ -27,7 +27,7 @@ from packaging.utils import parse_wheel_filename
 
 from benchmarks.builds import build_bare_master
 from build_wheels import LEGACY_MANYLINUX, MANYLINUX_GLIBC, WHEELS, WheelhouseError, build_wheels, check_tools, main
-from fmu_build import PLATFORMS
+from fmu_build import PLATFORMS, WASM
 from pendulum_fmu import FMU_FILES, __version__
 from pendulum_fmu.cli import main as cli
 from pendulum_fmu.oracle._reference import reference
@@ -139,7 +139,7 @@ def test_every_wheel_has_the_same_fmus_and_its_own_native_loop(wheelhouse, tmp_p
             folder
             for platform in PLATFORMS.values()
             for folder in ((platform.fmi2_folder,) if fmi_version == 2 else platform.fmi3_folders)
-        }
+        } | ({WASM} if fmi_version == 3 else set())  # the WebAssembly component: FMI 3.0 FMUs alone
 
 
 def _extracted(wheel: Path, fmu_name: str, tmp_path: Path) -> Path:
