@@ -22,8 +22,20 @@ from .python_loop import python_loop_rows
 from .realtime import realtime_rows
 from .report import as_markdown, as_text, main_table
 from .scale import scale_rows
+from .small_studies import small_study_rows
 
-PARTS = ("floor", "own-cost", "accuracy", "python-loop", "fixed-cost", "opensim", "pythonfmu", "scale", "realtime")
+PARTS = (
+    "floor",
+    "own-cost",
+    "accuracy",
+    "python-loop",
+    "fixed-cost",
+    "opensim",
+    "pythonfmu",
+    "scale",
+    "small-studies",
+    "realtime",
+)
 DEFAULT_FIGURE = Path(__file__).resolve().parent / "accuracy_cost.png"
 
 
@@ -59,6 +71,12 @@ def parse_arguments(argv):
         default=DEFAULT_FIGURE,
         metavar="FILE",
         help="where the accuracy/cost figure goes (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--before",
+        type=Path,
+        metavar="CHECKOUT",
+        help="small-studies: a checkout of another version (e.g. main's) to run side by side with this one",
     )
     return parser.parse_args(argv)
 
@@ -96,6 +114,8 @@ def main(argv=None) -> int:
                 rows += pythonfmu_rows(pendulum, scratch, repetitions)
             elif part == "scale":
                 rows += scale_rows(pendulum, args.quick) + case_cost_rows(pendulum, args.quick)
+            elif part == "small-studies":
+                rows += small_study_rows(pendulum.path, args.quick, args.before)
             elif part == "realtime":
                 rows += realtime_rows(pendulum, scratch)
     tables = [main_table(rows)] + ([grid] if grid else [])

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from .._errors import InvalidInput
 from .._stop_signals import STOPPING_SIGNALS, Stopped
-from ..signals._time_grid import DEFAULT_MAX_CASES
+from ..signals._time_grid import BREAK_EVEN_STEPS, DEFAULT_MAX_CASES, RUN_IN
 from ._arguments import add_fmu_argument, assignment, float_number, output_location, positive_int
 
 
@@ -119,7 +119,17 @@ def _add_cluster_arguments(sweep: argparse.ArgumentParser) -> None:
             metavar="PEM",
             help=f"{what}, for --scheduler tls://... (default: dask's configuration, distributed.comm.tls.*)",
         )
-    sweep.add_argument("--workers", type=int, default=None, help="local cluster workers (default: 2)")
+    sweep.add_argument(
+        "--workers", type=int, default=None, help="local cluster workers (default: 2; given, a cluster runs the study)"
+    )
+    sweep.add_argument(
+        "--run-in",
+        choices=RUN_IN,
+        default="auto",
+        help="where the study runs: auto (this process below about "
+        f"{BREAK_EVEN_STEPS / 1e6:g} million steps in all, without --scheduler or --workers; else dask), "
+        "process, or cluster (a local one without --scheduler) (default: %(default)s)",
+    )
 
 
 def _security(args):
@@ -167,6 +177,7 @@ def run(args) -> int:
             connect_timeout=args.connect_timeout,
             max_cases=args.max_cases,
             security=_security(args),
+            run_in=args.run_in,
         )
     except Stopped as stopped:
         what = STOPPING_SIGNALS[signal.Signals(stopped.signal_number)]

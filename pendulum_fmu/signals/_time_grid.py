@@ -36,6 +36,15 @@ DEFAULT_MAX_STEPS = 10_000_000
 # the command line's help reads it without loading the sweep.
 DEFAULT_MAX_CASES = 1_000_000
 
+# Where run_sweep runs a study (sweep/here.py): chosen by its size, the calling process, a dask
+# cluster. A study of fewer steps (cases times steps per case) than BREAK_EVEN_STEPS still to run
+# takes less time in the calling process than on a local cluster of two workers, whose start is
+# then more than its workers save. Measured by `python -m benchmarks.small_studies` (studies in
+# process and on a cluster at two sizes, where the two lines cross): BREAK_EVEN on the 2-core VM;
+# rounded down, since a machine with more cores crosses sooner. Here for the same reason.
+RUN_IN = ("auto", "process", "cluster")
+BREAK_EVEN_STEPS = 20_000_000
+
 
 # Runs needing less memory than this are not checked against what the machine has left: reading
 # it (/proc/meminfo) costs more than such a run, which no machine that runs Python lacks.

@@ -31,7 +31,8 @@ The package, in the order a run goes through it:
 
     study.py   Study, what goes in (the cases, times, outputs, FMU), and SweepResult, what comes out
     grid.py    the cases: sweep_grid's every combination, or a list of dicts, checked
-    run.py     run_sweep: the folder locked, the chunks run on dask, the figure drawn
+    run.py     run_sweep: the folder locked, the chunks run (on dask, or here), the figure drawn
+    here.py    where a study runs: a small one in the calling process, chunk by chunk
     client.py  the dask client, the chunks submitted and gathered, the progress line
     security.py  who can reach the cluster: the local cluster's certificates, the client's TLS
     worker.py  a chunk on a worker: its cases through the native loop, its two parts written

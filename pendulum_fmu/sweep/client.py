@@ -288,6 +288,18 @@ class Totals:
     bytes: int = 0
     worker_cpu_seconds: float = 0.0
     worker_stepping_seconds: float = 0.0
+    chunks: int = 0
+
+    def add(self, result: tuple, bar) -> None:
+        """Count a chunk's result (run_chunk's tuple) and advance the bar by its cases."""
+        _, count, failed, written, cpu, stepping = result
+        self.failed += failed
+        self.bytes += written
+        self.worker_cpu_seconds += cpu
+        self.worker_stepping_seconds += stepping
+        self.chunks += 1
+        bar.set_postfix_str(f"{self.failed} failed", refresh=False)
+        bar.update(count)
 
 
 def run_chunks(client, task: Task, chunks: Iterable[tuple[int, int, dict]], bar) -> Totals:
@@ -329,13 +341,8 @@ def run_chunks(client, task: Task, chunks: Iterable[tuple[int, int, dict]], bar)
             results = client.gather(ran)
         except OSError:  # the scheduler went away since: reported as when that comes first
             raise CancelledError("scheduler-connection-lost") from None  # as dask's cancellation says it
-        for _, count, failed, written, cpu, stepping in results:
-            totals.failed += failed
-            totals.bytes += written
-            totals.worker_cpu_seconds += cpu
-            totals.worker_stepping_seconds += stepping
-            bar.set_postfix_str(f"{totals.failed} failed", refresh=False)
-            bar.update(count)
+        for result in results:
+            totals.add(result, bar)
         for future in batch:
             if future.status != "finished":
                 future.result()  # raises what the chunk's run raised
