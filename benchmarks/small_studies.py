@@ -54,16 +54,18 @@ from pendulum_fmu.sweep.client import dask_client
 fmu, torques, stop_time = sys.argv[1], json.loads(sys.argv[2]), float(sys.argv[3])
 folder = tempfile.mkdtemp(prefix="pendulum-small-studies-")
 
-def study(cases, name):
+def study(cases, name, **options):
     started = time.perf_counter()
     run_sweep(Study(sweep_grid(torques[:cases]), stop_time=stop_time, fmu_path=fmu),
-              output_dir=os.path.join(folder, name), progress=False)
+              output_dir=os.path.join(folder, name), progress=False, **options)
     return time.perf_counter() - started
 
 study(1, "warm")
 with dask_client(None, 2, 30.0):  # dask's imports, in a checkout whose small studies need none
     pass
 seconds = {"api 1": study(1, "one"), "api 10": study(10, "ten")}
+if sys.argv[4] == "this":  # a version with the option
+    seconds["api 10 no figure"] = study(10, "ten without", figure=False)
 started = time.perf_counter()
 for torque in torques:
     simulate(torque, stop_time=stop_time, fmu_path=fmu)
@@ -83,10 +85,11 @@ for torque in json.loads(sys.argv[2]):
 
 
 def _wall(command: list[str], checkout: Path) -> tuple[float, str]:
-    """(seconds, stdout) of a command run with the checkout's package first on the path."""
-    environment = {**os.environ, "PYTHONPATH": str(checkout)}
+    """(seconds, stdout) of a command run in the checkout, whose package is then the first on
+    the path (python -m and -c put the working directory before PYTHONPATH).
+    """
     started = time.perf_counter()
-    run = subprocess.run(command, env=environment, capture_output=True, text=True, timeout=600, check=False)
+    run = subprocess.run(command, cwd=checkout, capture_output=True, text=True, timeout=600, check=False)
     seconds = time.perf_counter() - started
     if run.returncode != 0:
         raise RuntimeError(f"{' '.join(command[:4])} ... failed in {checkout}: {run.stderr.strip()[-400:]}")
@@ -94,15 +97,19 @@ def _wall(command: list[str], checkout: Path) -> tuple[float, str]:
 
 
 def one_round(checkout: Path, fmu: Path, scratch: Path) -> dict[str, float]:
-    """Seconds of every contender once, with the checkout's package."""
+    """Seconds of every contender once, with the checkout's package (this one's: with --no-figure too)."""
+    this = "this" if checkout == REPOSITORY else "other"
     arguments = [str(fmu), json.dumps(TORQUES), str(STOP_TIME)]
-    seconds = json.loads(_wall([sys.executable, "-c", WARM_PROCESS, *arguments], checkout)[1])
+    seconds = json.loads(_wall([sys.executable, "-c", WARM_PROCESS, *arguments, this], checkout)[1])
     seconds["loop process"] = _wall([sys.executable, "-c", LOOP, *arguments], checkout)[0]
-    for cases in (1, 10):
+    studies = {"command 1": (1, []), "command 10": (10, [])}
+    if this == "this":
+        studies["command 10 no figure"] = (10, ["--no-figure"])
+    for name, (cases, extra) in studies.items():
         folder = tempfile.mkdtemp(dir=scratch)
-        command = [sys.executable, "-m", "pendulum_fmu", "sweep", "--torque", *map(str, TORQUES[:cases])]
+        command = [sys.executable, "-m", "pendulum_fmu", "sweep", "--torque", *map(str, TORQUES[:cases]), *extra]
         options = ["--stop-time", str(STOP_TIME), "--fmu", str(fmu), "--output-dir", f"{folder}/study"]
-        seconds[f"command {cases}"] = _wall(command + options, checkout)[0]
+        seconds[name] = _wall(command + options, checkout)[0]
     return seconds
 
 
@@ -173,10 +180,12 @@ def small_study_rows(fmu: Path, quick: bool, before: Path | None = None) -> list
         cases, steps, studies = break_even(fmu, Path(scratch), 3)
     for seconds in medians.values():
         seconds["ratio"] = seconds["command 10"] / seconds["loop process"]
+        if "command 10 no figure" in seconds:
+            seconds["ratio no figure"] = seconds["command 10 no figure"] / seconds["loop process"]
     after = medians["after"]
 
     def value(key: str, unit: str = " s") -> str:
-        return " -> ".join(f"{seconds[key]:.2f}{unit}" for seconds in medians.values())
+        return " -> ".join(f"{seconds[key]:.2f}{unit}" if key in seconds else "-" for seconds in medians.values())
 
     def study(where: str, size: int) -> str:
         return _cell(studies[f"{where} {size}"])
@@ -199,8 +208,17 @@ def small_study_rows(fmu: Path, quick: bool, before: Path | None = None) -> list
             f"<= {LOOP_TARGET:g}",
             after["ratio"] <= LOOP_TARGET,
         ),
+        Row(PART, "10-case study, `pendulum-fmu sweep --no-figure`, end to end", value("command 10 no figure")),
+        Row(
+            PART,
+            "the same / the loop's process",
+            value("ratio no figure", ""),
+            f"<= {LOOP_TARGET:g}",
+            after["ratio no figure"] <= LOOP_TARGET,
+        ),
         Row(PART, "1-case study, run_sweep in a process that ran one", value("api 1")),
         Row(PART, "10-case study, run_sweep in a process that ran one", value("api 10")),
+        Row(PART, "the same, figure=False", value("api 10 no figure")),
         Row(PART, "the 10 cases' simulate() loop, in that process", value("loop warm")),
         Row(PART, "the local cluster of 2 workers, TLS included: start and close", value("cluster")),
         Row(

@@ -4,17 +4,19 @@ signal, resumable; and the rule that chooses where a study runs.
 """
 
 import json
+import os
 import signal
 import subprocess
 import time
 
 import numpy as np
+import psutil
 import pytest
 from test_sweep import OUTPUTS, STEP_SIZE, STOP_TIME, _assert_every_case_once, _exact, _sweep_command, _table
 
 from pendulum_fmu._errors import InvalidInput
 from pendulum_fmu.signals._time_grid import BREAK_EVEN_STEPS
-from pendulum_fmu.sweep import Study, run_sweep, sweep_grid
+from pendulum_fmu.sweep import Study, close_kept_clusters, run_sweep, sweep_grid
 from pendulum_fmu.sweep.here import runs_here
 
 
@@ -22,6 +24,13 @@ from pendulum_fmu.sweep.here import runs_here
 def _built_fmu(fmu, monkeypatch):
     """Every study here runs the FMU built for this session."""
     monkeypatch.setattr("pendulum_fmu.default_fmu", lambda: fmu)
+
+
+def _running(pid: int) -> bool:
+    try:
+        return psutil.Process(pid).status() != psutil.STATUS_ZOMBIE
+    except psutil.NoSuchProcess:
+        return False
 
 
 def _files(folder) -> list[str]:
@@ -136,3 +145,38 @@ def test_a_signal_stops_a_study_in_the_process_and_resume_finishes_it(tmp_path, 
     assert resumed.returncode == 0, resumed.stderr
     assert f"({60 - len(written)} of 60 chunks run;" in resumed.stdout
     _assert_every_case_once(tmp_path, torques, 120.0, stride=1000)
+
+
+def test_a_kept_cluster_serves_the_next_studies_and_goes_with_one_that_stops(tmp_path, monkeypatch):
+    from pendulum_fmu.sweep import client
+
+    torques = [1.0, 2.0, 3.0]
+    study = Study(sweep_grid(torques), stop_time=0.05)
+    options = {"run_in": "cluster", "workers": 1, "keep_cluster": True, "progress": False}
+    try:
+        run_sweep(study, output_dir=tmp_path / "first", **options)
+        kept = client._kept[1][0]
+        workers = kept.run(os.getpid)
+        run_sweep(study, output_dir=tmp_path / "second", **options)
+        assert client._kept[1][0] is kept and kept.run(os.getpid) == workers  # the same processes
+        for folder in ("first", "second"):
+            _assert_every_case_once(tmp_path / folder, torques, 0.05, sample=3)
+
+        def stopped(*arguments):
+            raise KeyboardInterrupt
+
+        monkeypatch.setattr("pendulum_fmu.sweep.run.run_chunks", stopped)
+        with pytest.raises(KeyboardInterrupt):
+            run_sweep(study, output_dir=tmp_path / "third", **options)
+        assert client._kept == {}
+        deadline = time.monotonic() + 30
+        while any(_running(pid) for pid in workers.values()):  # the cluster is down
+            assert time.monotonic() < deadline
+            time.sleep(0.1)
+        monkeypatch.undo()
+        run_sweep(study, output_dir=tmp_path / "fourth", **options)  # a new one, kept in turn
+        assert close_kept_clusters(2) == 0 and close_kept_clusters() == 1 and client._kept == {}
+    finally:
+        close_kept_clusters()
+    with pytest.raises(InvalidInput, match="keep_cluster keeps a local cluster"):
+        run_sweep(study, output_dir=tmp_path / "fifth", scheduler="tcp://127.0.0.1:1", keep_cluster=True)

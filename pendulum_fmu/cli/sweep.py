@@ -77,6 +77,12 @@ def add_parser(commands) -> argparse.ArgumentParser:
         default="parquet",
         help="file format of the tables (default: %(default)s; csv for small studies)",
     )
+    sweep.add_argument(
+        "--no-figure",
+        dest="figure",
+        action="store_false",
+        help="write no sweep.png (a small study then takes about half as long)",
+    )
     again = sweep.add_mutually_exclusive_group()
     again.add_argument(
         "--resume", action="store_true", help="run only the chunks a previous run of the same study did not write"
@@ -178,6 +184,7 @@ def run(args) -> int:
             max_cases=args.max_cases,
             security=_security(args),
             run_in=args.run_in,
+            figure=args.figure,
         )
     except Stopped as stopped:
         what = STOPPING_SIGNALS[signal.Signals(stopped.signal_number)]
@@ -210,7 +217,7 @@ def run(args) -> int:
         )
     )
     for path in (result.trajectories, result.cases_table, result.figure):
-        if path is not None:  # no trajectories with --outputs none
+        if path is not None:  # no trajectories with --outputs none, no figure with --no-figure
             print(f"wrote {path}")
     if result.failed:
         # The other cases ran and are written; a script still learns that some did not.

@@ -13,7 +13,7 @@ A study goes to an output directory, a local path or any fsspec URL every worker
     cases/part-000000.parquet         per chunk, one row per case: case, its values, final_theta,
                                       final_omega, final_alpha, max_abs_theta, status ("ok" or
                                       "failed") and message (why the FMU refused the case)
-    sweep.png                         the figure
+    sweep.png                         the figure (unless run_sweep is asked for none)
     .sweep.lock                       there while a run writes a local folder: a second run is refused
     */_part-000000.<run>.staged       a chunk's part as its worker wrote it, before the run's client
                                       moves it into place: hidden from the readers, removed when
@@ -42,6 +42,7 @@ The package, in the order a run goes through it:
 May import: figures/, fmu/, signals/ and the basics.
 """
 
+from .client import close_kept_clusters
 from .grid import Grid, sweep_grid
 from .run import DEFAULT_MAX_CASES, run_sweep
 from .security import tls_files
@@ -65,6 +66,7 @@ __all__ = [
     "Grid",
     "Study",
     "SweepResult",
+    "close_kept_clusters",
     "run_sweep",
     "sweep_grid",
     "tls_files",

@@ -30,8 +30,12 @@ def runs_here(run_in: str, scheduler: str | None, workers: int | None, steps: in
     return steps < BREAK_EVEN_STEPS
 
 
-def check_place(run_in: str, scheduler: str | None, workers: int | None) -> None:
-    """run_in is one of RUN_IN, and "process" comes with no scheduler nor worker count; else one line."""
+def check_place(run_in: str, scheduler: str | None, workers: int | None, keep_cluster: bool = False) -> None:
+    """run_in is one of RUN_IN, "process" comes with no scheduler nor worker count, and
+    keep_cluster with no scheduler; else one line.
+    """
+    if keep_cluster and scheduler is not None:
+        raise InvalidInput("keep_cluster keeps a local cluster; a scheduler's cluster is kept by whoever started it")
     if run_in not in RUN_IN:
         raise InvalidInput(f"run_in {run_in!r}: choose {', '.join(RUN_IN)}")
     if run_in == "process" and (scheduler is not None or workers is not None):

@@ -43,6 +43,8 @@ def run_sweep(
     max_cases: int = DEFAULT_MAX_CASES,
     security: Security | None = None,
     run_in: str = "auto",
+    keep_cluster: bool = False,
+    figure: bool = True,
 ) -> SweepResult:
     """Run every case of a study, on dask or, when it is small, in this process, into output_dir.
 
@@ -88,6 +90,14 @@ def run_sweep(
         else on dask; "process" in this process whatever its size; "cluster" on dask (a local
         cluster without a scheduler) whatever its size. The files are the same either way, and
         either resumes what the other began.
+    keep_cluster : bool, optional
+        Keep the local cluster this study starts (or one an earlier study kept, of as many
+        workers) for the next studies of this process, instead of closing it: a notebook running
+        many studies on a cluster pays its start once. Closed when the process exits, by
+        close_kept_clusters(), or when a study on it stops (Ctrl-C, an error).
+    figure : bool, optional
+        Draw sweep.png. Without it a small study costs about half as much (matplotlib's import
+        and the drawing are most of what it costs in a process of its own).
 
     Returns
     -------
@@ -100,8 +110,8 @@ def run_sweep(
     InvalidInput
         More cases than max_cases, workers with a scheduler, security without one, a bad workers
         count or connect timeout, resume and overwrite together, an unknown run_in or "process"
-        with a scheduler or workers, or TLS files that are no certificates; all before anything
-        starts.
+        with a scheduler or workers, keep_cluster with a scheduler, or TLS files that are no
+        certificates; all before anything starts.
     StudyExists
         output_dir holds a study and neither resume (for the same study) nor overwrite was
         given; before anything starts.
@@ -135,7 +145,7 @@ def run_sweep(
     if not isinstance(output_dir, str | os.PathLike):
         raise WrongType(f"output_dir is a folder's path or an fsspec URL, not {output_dir!r}")
     _check_options(len(study.cases), max_cases, scheduler, workers, connect_timeout, resume, overwrite, security)
-    check_place(run_in, scheduler, workers)
+    check_place(run_in, scheduler, workers, keep_cluster)
     url = str(output_dir)
     target = Store(*_file_system(url), format=study.format)
     fmu = str(fmu_file(study.fmu_path).resolve())
@@ -167,7 +177,7 @@ def run_sweep(
                 with (
                     contextlib.nullcontext()
                     if here
-                    else dask_client(scheduler, workers, connect_timeout, security) as client
+                    else dask_client(scheduler, workers, connect_timeout, security, keep_cluster) as client
                 ):
                     store.start(definition, chunk_cases, task.run)
                     try:
@@ -180,7 +190,8 @@ def run_sweep(
                 store.remove_unfinished()
             drawing = time.perf_counter()
             table = store.read_cases(study.names)
-            draw(store, table, study.names, study.outputs, fmu, f"{store.root}/sweep.png")
+            if figure:
+                draw(store, table, study.names, study.outputs, fmu, f"{store.root}/sweep.png")
             drawn = time.perf_counter()
             if store is not target:
                 target.replace_with(store)
@@ -193,7 +204,7 @@ def run_sweep(
         output_dir=where(""),
         trajectories=where("trajectories") if study.outputs else None,
         cases_table=where("cases"),
-        figure=where("sweep.png"),
+        figure=where("sweep.png") if figure else None,
         cases=len(study.cases),
         failed=int(np.sum(table["status"].to_numpy(zero_copy_only=False) == "failed")),
         chunks=math.ceil(len(study.cases) / chunk_cases),

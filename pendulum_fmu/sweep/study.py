@@ -184,7 +184,7 @@ class SweepResult:
     # A folder of a file per chunk: case, time and the outputs kept; None with no outputs.
     trajectories: Path | str | None
     cases_table: Path | str  # a folder of a file per chunk: a row per case (its values, summaries, status)
-    figure: Path | str  # sweep.png
+    figure: Path | str | None  # sweep.png; None where run_sweep was asked for none
     cases: int
     failed: int  # cases the FMU refused; their status and message are in the cases table
     chunks: int
