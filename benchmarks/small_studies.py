@@ -184,42 +184,29 @@ def small_study_rows(fmu: Path, quick: bool, before: Path | None = None) -> list
             seconds["ratio no figure"] = seconds["command 10 no figure"] / seconds["loop process"]
     after = medians["after"]
 
-    def value(key: str, unit: str = " s") -> str:
-        return " -> ".join(f"{seconds[key]:.2f}{unit}" if key in seconds else "-" for seconds in medians.values())
+    def value(key: str, unit: str = " s", scale: float = 1.0) -> str:
+        return " -> ".join(
+            f"{seconds[key] * scale:.2f}{unit}" if key in seconds else "-" for seconds in medians.values()
+        )
+
+    def held(measure: str, key: str, target: float, unit: str = "") -> Row:
+        return Row(PART, measure, value(key, unit), f"<= {target:g}{unit}", after[key] <= target)
 
     def study(where: str, size: int) -> str:
         return _cell(studies[f"{where} {size}"])
 
     return [
         Row(PART, f"median of {repetitions}, load average {load:.1f} before", " -> ".join(medians)),
-        Row(
-            PART,
-            "1-case study, `pendulum-fmu sweep`, end to end",
-            value("command 1"),
-            f"< {STUDY_TARGET:g} s",
-            after["command 1"] < STUDY_TARGET,
-        ),
+        held("1-case study, `pendulum-fmu sweep`, end to end", "command 1", STUDY_TARGET, " s"),
         Row(PART, "10-case study, `pendulum-fmu sweep`, end to end", value("command 10")),
         Row(PART, "the 10 cases' simulate() loop, a fresh process, end to end", value("loop process")),
-        Row(
-            PART,
-            "10-case study by the command / the loop's process",
-            value("ratio", ""),
-            f"<= {LOOP_TARGET:g}",
-            after["ratio"] <= LOOP_TARGET,
-        ),
+        held("10-case study by the command / the loop's process", "ratio", LOOP_TARGET),
         Row(PART, "10-case study, `pendulum-fmu sweep --no-figure`, end to end", value("command 10 no figure")),
-        Row(
-            PART,
-            "the same / the loop's process",
-            value("ratio no figure", ""),
-            f"<= {LOOP_TARGET:g}",
-            after["ratio no figure"] <= LOOP_TARGET,
-        ),
+        held("the same / the loop's process", "ratio no figure", LOOP_TARGET),
         Row(PART, "1-case study, run_sweep in a process that ran one", value("api 1")),
         Row(PART, "10-case study, run_sweep in a process that ran one", value("api 10")),
         Row(PART, "the same, figure=False", value("api 10 no figure")),
-        Row(PART, "the 10 cases' simulate() loop, in that process", value("loop warm")),
+        Row(PART, "the 10 cases' simulate() loop, in that process", value("loop warm", " ms", 1e3)),
         Row(PART, "the local cluster of 2 workers, TLS included: start and close", value("cluster")),
         Row(
             PART,

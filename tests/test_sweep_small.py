@@ -14,6 +14,7 @@ import psutil
 import pytest
 from test_sweep import OUTPUTS, STEP_SIZE, STOP_TIME, _assert_every_case_once, _exact, _sweep_command, _table
 
+from pendulum_fmu import simulate
 from pendulum_fmu._errors import InvalidInput
 from pendulum_fmu.signals._time_grid import BREAK_EVEN_STEPS
 from pendulum_fmu.sweep import Study, close_kept_clusters, run_sweep, sweep_grid
@@ -180,3 +181,15 @@ def test_a_kept_cluster_serves_the_next_studies_and_goes_with_one_that_stops(tmp
         close_kept_clusters()
     with pytest.raises(InvalidInput, match="keep_cluster keeps a local cluster"):
         run_sweep(study, output_dir=tmp_path / "fifth", scheduler="tcp://127.0.0.1:1", keep_cluster=True)
+
+
+def test_no_figure_writes_the_tables_alone_and_names_only_them(tmp_path, capsys):
+    from pendulum_fmu.cli import main
+
+    command = ["sweep", "--torque", "2", "4", "--stop-time", "0.1", "--no-figure", "--output-dir", str(tmp_path)]
+    assert main(command) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[1:] == [f"wrote {tmp_path / 'trajectories'}", f"wrote {tmp_path / 'cases'}"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cases", "study.json", "trajectories"]
+    final_theta = [simulate(torque, stop_time=0.1)["theta"][-1] for torque in (2.0, 4.0)]
+    assert _table(tmp_path / "cases")["final_theta"].tolist() == final_theta
