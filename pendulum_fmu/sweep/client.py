@@ -21,6 +21,7 @@ import time
 from collections.abc import Iterable
 from concurrent.futures import CancelledError
 from dataclasses import dataclass
+from typing import Any
 
 from .._errors import InvalidInput, PendulumFmuError
 from .security import client_security, run_certificates
@@ -100,7 +101,7 @@ def dask_client(scheduler: str | None, workers: int | None, connect_timeout: flo
 
 # The local clusters kept for the next studies of this process, by their workers: each one's
 # client, and the stack that closes the two.
-_kept: dict[int, tuple[object, contextlib.ExitStack]] = {}
+_kept: dict[int, tuple[Any, contextlib.ExitStack]] = {}  # a distributed.Client, not imported here
 
 
 @contextlib.contextmanager
