@@ -40,9 +40,9 @@ DEFAULT_MAX_CASES = 1_000_000
 # cluster. A study of fewer steps (cases times steps per case) than BREAK_EVEN_STEPS still to run
 # takes less time in the calling process than on a local cluster of two workers, whose start is
 # then more than its workers save. Measured by `python -m benchmarks.small_studies` (studies in
-# the process and on a cluster at two sizes, where the two lines cross): 25, 105 and 248 million
-# steps in three runs on the loaded 2-core VM; the lowest, rounded down, as a machine with more
-# cores crosses sooner. Here beside the other size limits, for the same reason.
+# the process and on a cluster at two sizes, where the two lines cross): 25, 40, 105, 248 and 322
+# million steps in five runs on the loaded 2-core VM; the lowest, rounded down, for a quieter
+# machine, whose two workers gain more. Here beside the other size limits, for the same reason.
 RUN_IN = ("auto", "process", "cluster")
 BREAK_EVEN_STEPS = 20_000_000
 
