@@ -1,4 +1,5 @@
-"""Parameter studies on dask.distributed: workers simulate chunks of cases and write them.
+"""Parameter studies on dask.distributed: workers simulate chunks of cases and write them (a
+small study's chunks the calling process runs itself, here.py).
 
     from pendulum_fmu.sweep import Study, run_sweep, sweep_grid
 
