@@ -12,7 +12,7 @@ import tempfile
 from pathlib import Path
 
 from .accuracy_cost import accuracy_cost_rows
-from .builds import build_null_fmu, build_pendulum_fmu, build_step_master
+from .builds import build_fmi3_fmu, build_null_fmu, build_pendulum_fmu, build_step_master
 from .case_cost import case_cost_rows
 from .fixed_cost import fixed_cost_rows
 from .floor import floor_rows
@@ -23,6 +23,7 @@ from .realtime import realtime_rows
 from .report import as_markdown, as_text, main_table
 from .scale import scale_rows
 from .small_studies import small_study_rows
+from .wasm_cost import wasm_cost_rows
 
 PARTS = (
     "floor",
@@ -35,6 +36,7 @@ PARTS = (
     "scale",
     "small-studies",
     "realtime",
+    "wasm",
 )
 DEFAULT_FIGURE = Path(__file__).resolve().parent / "accuracy_cost.png"
 
@@ -118,6 +120,8 @@ def main(argv=None) -> int:
                 rows += small_study_rows(pendulum.path, args.quick, args.before)
             elif part == "realtime":
                 rows += realtime_rows(pendulum, scratch)
+            elif part == "wasm":
+                rows += wasm_cost_rows(build_fmi3_fmu(scratch), repetitions)
     tables = [main_table(rows)] + ([grid] if grid else [])
     print("\n\n".join(as_text(table) for table in tables))
     if args.markdown:

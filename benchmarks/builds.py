@@ -46,6 +46,13 @@ def build_pendulum_fmu(out_dir: Path) -> BuiltFmu:
     return unzipped(build_fmu(out_dir / "Pendulum.fmu", platforms=("linux64",)), out_dir)
 
 
+def build_fmi3_fmu(out_dir: Path) -> Path:
+    """The FMI 3.0 FMU as pendulum-fmu build makes it: every binary this machine builds, the
+    WebAssembly one among them (the wasm part runs its native and its wasm binary side by side).
+    """
+    return build_fmu(out_dir / "Pendulum-fmi3.fmu", fmi_version=3)
+
+
 def build_null_fmu(out_dir: Path) -> BuiltFmu:
     """Build null_fmu/ with the pendulum's compiler flags (its CMakeLists.txt includes
     cmake/flags.cmake) and zip it as NullFmu.fmu.

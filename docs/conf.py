@@ -7,7 +7,8 @@ Built by the one command the README names (from the repository root):
 ``-W`` turns every warning into an error, as CI (.ci/run) builds it. The pages are the Markdown
 files of this folder (MyST), the API reference comes from the numpydoc docstrings (autodoc,
 autosummary), the command line from the parser (sphinx-argparse), and the examples page from
-running examples/*.py during the build (_ext/example_pages.py).
+running examples/*.py during the build (_ext/example_pages.py), and the wasm page's scripts
+from the FMU's wasm binary (_ext/wasm_page.py: Node and `npm ci --prefix web` needed).
 """
 
 import importlib
@@ -31,6 +32,7 @@ extensions = [
     "sphinx.ext.autosummary",
     "sphinxarg.ext",
     "example_pages",
+    "wasm_page",
 ]
 
 source_suffix = {".md": "markdown", ".rst": "restructuredtext"}

@@ -13,6 +13,7 @@ each of which imports only those listed before it:
 - binaries.py: one binary through CMake (CMakeLists.txt, cmake/): the FMU's library, the native
   loop; macho.py merges the two macOS slices into one universal binary;
 - documentation.py: the FMU's documentation/index.html;
+- wasm_component.py: the FMI 3.0 FMU's WebAssembly component and FMI-LS-WASM's manifest;
 - fmu_file.py: an FMU file, its binaries, sources and documentation zipped (build_fmu,
   build_pid_controller).
 - release_files.py: the sdist's tar.gz and the wheel's files, the same bytes from one commit
@@ -20,7 +21,8 @@ each of which imports only those listed before it:
 
 model_variables.py writes the C code's value references, names and start values from the
 model's modelDescription.xml, so the XML stays the single source of truth; fmi3.py generates the
-FMI 3.0 description from the FMI 2.0 one.
+FMI 3.0 description from the FMI 2.0 one; wasm_glue.py the WebAssembly component's canonical-ABI
+glue from its WIT world (both run by CMake, standard library only).
 
 Builds only ever run from a source tree (a clone or the sdist): an installed package carries the
 built FMU as package data instead (see pendulum_fmu.default_fmu).
@@ -35,6 +37,8 @@ from .macho import MachOError, merge_universal
 from .model_variables import ModelDescriptionError, generate_variables
 from .platforms import (
     PLATFORMS,
+    WASM,
+    WASM_TARGET,
     ZIG,
     ZIG_GLIBC,
     ZIG_PACKAGE,
@@ -43,6 +47,8 @@ from .platforms import (
     available_platforms,
     check_platforms,
     check_toolchain,
+    check_wasm_toolchain,
+    find_wasm_tools,
     find_zig,
 )
 from .sources import (
@@ -87,6 +93,8 @@ __all__ = [
     "ROOT",
     "SOURCE_DIR",
     "TOOLCHAINS",
+    "WASM",
+    "WASM_TARGET",
     "ZIG",
     "ZIG_GLIBC",
     "ZIG_PACKAGE",
@@ -104,9 +112,11 @@ __all__ = [
     "build_pid_controller",
     "check_platforms",
     "check_toolchain",
+    "check_wasm_toolchain",
     "cmake_build",
     "compile_native_loop",
     "documentation_html",
+    "find_wasm_tools",
     "find_zig",
     "fmu_is_stale",
     "generate_variables",

@@ -27,6 +27,9 @@ from .sources import ROOT
 
 # What a build's inputs are, for whether the tree differs from its commit.
 BUILD_INPUTS = ("fmu_src", "modelDescription.xml", "CMakeLists.txt", "cmake", "fmu_build")
+# What marks the line of link.txt that links: a shared library's flag, or the WebAssembly core
+# module's (a reactor, cmake/wasm.cmake).
+LINKS = ("-shared", "-dynamiclib", "-mexec-model=reactor")
 # What an sdist carries in place of .git, at its top: source_record() as JSON.
 SOURCE_RECORD_FILE = "source_commit.json"
 
@@ -146,7 +149,7 @@ def toolchain(build: Path, cmake_target: str) -> dict:
     [link] = [
         words
         for words in map(shlex.split, (folder / "link.txt").read_text().splitlines())
-        if words and words[0] == first[0] and any(word in words for word in ("-shared", "-dynamiclib"))
+        if words and words[0] == first[0] and any(word in words for word in LINKS)
     ]
     listed = [word for path in sorted(folder.glob("objects*.rsp")) for word in shlex.split(path.read_text())]
     exports = sorted(build.glob(f"{cmake_target}.exports.map"))

@@ -23,7 +23,7 @@ from . import fmi3
 from .binaries import cmake_build, merged_binary
 from .build_record import source_commit, source_date_epoch, toolchain
 from .documentation import documentation_html
-from .platforms import PLATFORMS, available_platforms, check_platforms, check_toolchain
+from .platforms import PLATFORMS, WASM, available_platforms, check_platforms, check_toolchain, check_wasm_toolchain
 from .sources import (
     CHECKOUT_CONTROLLER,
     DEFAULT_FMU,
@@ -36,6 +36,7 @@ from .sources import (
     copy_sources,
     write_variables,
 )
+from .wasm_component import MANIFEST, MANIFEST_ENTRY, wasm_component
 
 
 def _stamped_model_description(xml: Path, fmi_version: int = 2) -> str:
@@ -49,6 +50,15 @@ def _stamped_model_description(xml: Path, fmi_version: int = 2) -> str:
     return text
 
 
+def _check_toolchains(platforms: tuple[str, ...], fmi_version: int, linux_glibc: str | None) -> None:
+    """BuildError naming what to install unless every platform's tools are here."""
+    for name in platforms:
+        if name == WASM:
+            check_wasm_toolchain(fmi_version)
+        else:
+            check_toolchain(PLATFORMS[name], fmi_version, linux_glibc)
+
+
 def _binaries(
     platforms: tuple[str, ...], tmp: Path, definitions: dict, identifier: str, fmi_version: int, linux_glibc
 ) -> tuple[dict[str, Path], dict[str, list]]:
@@ -58,6 +68,11 @@ def _binaries(
     binaries: dict[str, Path] = {}
     toolchains: dict[str, list] = {}
     for name in platforms:
+        if name == WASM:
+            component, made_component = wasm_component(tmp / name, definitions)
+            binaries[f"binaries/{WASM}/{component.name}"] = component
+            toolchains[f"binaries/{WASM}/{component.name}"] = [made_component]
+            continue
         platform = PLATFORMS[name]
         slices = {
             target.name: cmake_build(target, tmp / name / target.name, "fmu", definitions, linux_glibc=linux_glibc)
@@ -94,6 +109,8 @@ def _write_fmu(
         **{f"sources/{source.name}": source.read_bytes() for source in sorted(sources.iterdir())},
         "documentation/index.html": documentation_html(model_description, fmi_version).encode(),
     }
+    if any(name.startswith(f"binaries/{WASM}/") for name in binaries):
+        entries[MANIFEST_ENTRY] = MANIFEST.encode()
     epoch = source_date_epoch()
     record = {
         "format": RECORD_FORMAT,
@@ -128,9 +145,10 @@ def build_fmu(
     model_description_file : Path
         The model's FMI 2.0 modelDescription.xml, the source of its variables.
     platforms : tuple of str, optional
-        FMI 2.0 platform folder names (keys of PLATFORMS). None builds every platform whose
-        tools are present and warns (PlatformSkipped) about each other one; a platform named
-        here must build.
+        FMI 2.0 platform folder names (keys of PLATFORMS), and for FMI 3.0 WASM
+        ("wasm32-wasip2": the WebAssembly component and FMI-LS-WASM's manifest). None builds
+        every platform whose tools are present and warns (PlatformSkipped) about each other one;
+        a platform named here must build.
     fmi_version : int
         2, or 3 for the FMI 3.0 FMU from the same sources: its model description and
         sources/buildDescription.xml are generated from the FMI 2.0 one (fmi3.py), its binaries
@@ -163,8 +181,7 @@ def build_fmu(
         platforms = available_platforms(fmi_version, linux_glibc)
     check_platforms(platforms)
     check_writable(out_file)  # before the compilers run
-    for name in platforms:
-        check_toolchain(PLATFORMS[name], fmi_version, linux_glibc)
+    _check_toolchains(platforms, fmi_version, linux_glibc)
     model_dir = Path(model_dir)
     model_description = read_model_description(str(model_description_file))
     identifier = model_description.coSimulation.modelIdentifier

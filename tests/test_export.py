@@ -5,7 +5,8 @@ import zipfile
 
 import pytest
 
-from fmu_build import available_platforms
+from fmu_build import WASM, available_platforms
+from fmu_build.wasm_component import MANIFEST_ENTRY
 from pendulum_fmu import default_fmu
 from pendulum_fmu.cli import main
 from pendulum_fmu.fmu._export import FmuExists, export_fmu
@@ -65,10 +66,14 @@ def test_export_of_the_fmi3_fmu_lists_its_platform_folders(tmp_path, monkeypatch
     monkeypatch.chdir(tmp_path)
     exported = export_fmu(fmi_version=3)
     assert exported.path.name == "Pendulum-fmi3.fmu" and exported.path.read_bytes() == default_fmu(3).read_bytes()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        wasm = (WASM,) if WASM in available_platforms(3) else ()  # the WebAssembly component: zig, wasm-tools
     assert exported.platforms == tuple(
-        sorted(folder for platform in built_platforms for folder in FMI3_FOLDERS[platform])
+        sorted([*(folder for platform in built_platforms for folder in FMI3_FOLDERS[platform]), *wasm])
     )
     with zipfile.ZipFile(exported.path) as fmu:
         assert b'fmiVersion="3.0"' in fmu.read("modelDescription.xml")
+        assert (MANIFEST_ENTRY in fmu.namelist()) == bool(wasm)
     other = export_fmu(tmp_path / "sub" / "P.fmu", fmi_version=3)
     assert other.path == tmp_path / "sub" / "P.fmu" and other.platforms == exported.platforms

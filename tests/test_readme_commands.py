@@ -36,6 +36,7 @@ DOCS_PAGES = tuple(
         "install",
         "fmu",
         "fmi3",
+        "wasm",
         "torque_signals",
         "python_api",
         "command_line",
@@ -201,18 +202,22 @@ def copy_of_the_clone(root: Path, target: Path) -> Path:
     """The clone at root copied to target as its commands meet it fresh.
 
     The copy holds neither the build's outputs nor what the documents' commands wrote into the
-    clone; its `.venv` stands for the set-up (this interpreter's environment).
+    clone; its `.venv` stands for the set-up (this interpreter's environment), its
+    `web/node_modules` for `npm ci --prefix web` (the clone's).
     """
     left_out = command_outputs((root / ".gitignore").read_text(encoding="utf-8"))
 
     def ignored(folder, names):
         at_top = Path(folder) == root
         return shutil.ignore_patterns(
-            ".venv", ".git", "dist", "build", "out", "__pycache__", "*.egg-info", ".pytest_cache"
+            ".venv", ".git", "dist", "build", "out", "__pycache__", "*.egg-info", ".pytest_cache", "node_modules"
         )(folder, names) | {name for name in names if at_top and name in left_out}
 
     shutil.copytree(root, target, symlinks=True, ignore=ignored)
     (target / ".venv").symlink_to(sys.prefix, target_is_directory=True)
+    # jco for the docs build's wasm page: the clone's install stands for `npm ci --prefix web`.
+    if (root / "web" / "node_modules").is_dir():
+        (target / "web" / "node_modules").symlink_to(root / "web" / "node_modules", target_is_directory=True)
     return target
 
 

@@ -25,4 +25,19 @@ const char *escape_text(char *out, size_t size, const char *text);
    bytes) saying which. */
 FILE *record_file_open(const char *name, const char *marker, char *why, size_t why_size);
 
+/* What a master can do when record_file_open refuses: name another file, or, in the WebAssembly
+   binary, which has no files, read the record from the logger. */
+#if defined(__wasm__)
+#define RECORD_FILE_ADVICE "switch on the log category logCalls: the record goes to the logger"
+#else
+#define RECORD_FILE_ADVICE "name a new file, or one of its records"
+#endif
+
+/* Appends one line (line and a newline) to a record file record_file_open opened, flushed at
+   once, so that the record is whole up to a master's crash. */
+void record_file_append(FILE *file, const char *line);
+
+/* Closes a record file record_file_open opened. */
+void record_file_close(FILE *file);
+
 #endif

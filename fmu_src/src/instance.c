@@ -64,18 +64,14 @@ void instance_record_call(const Instance *instance, const char *function, double
     char line[RECORD_LINE_SIZE];
     snprintf(line, sizeof(line), CALL_RECORD_MARKER " instance=\"%s\" %s(%s) time=%.17g->%.17g status=%s",
              name, function, arguments, time_before, instance->data.time, status_names[status]);
-    if (instance->record_file) {
-        /* Flushed per line, so that the record is whole up to a master's crash. */
-        fprintf(instance->record_file, "%s\n", line);
-        fflush(instance->record_file);
-    }
+    if (instance->record_file) record_file_append(instance->record_file, line);
     instance_log(instance, STATUS_OK, LOG_CALLS, "%s", line);
 }
 
 #ifdef VR_CALLRECORDFILE
 /* Closes the record file there is, and opens the one `name` names (none when empty). */
 static Status record_to_file(Instance *instance, const char *function, const char *name) {
-    if (instance->record_file) fclose(instance->record_file);
+    if (instance->record_file) record_file_close(instance->record_file);
     instance->record_file = NULL;
     instance->log_categories &= ~RECORD_TO_FILE;
     strcpy(instance->record_file_name, name);
@@ -85,8 +81,8 @@ static Status record_to_file(Instance *instance, const char *function, const cha
     if (!instance->record_file) {
         char escaped[ESCAPED_SIZE(MAX_RECORD_FILE_NAME)];
         instance_log(instance, STATUS_WARNING, LOG_STATUS_WARNING,
-                     "%s: callRecordFile \"%s\" %s: the FMU writes no record file (name a new file, "
-                     "or one of its records)", function, escape_text(escaped, sizeof(escaped), name), why);
+                     "%s: callRecordFile \"%s\" %s: the FMU writes no record file (" RECORD_FILE_ADVICE ")",
+                     function, escape_text(escaped, sizeof(escaped), name), why);
         return STATUS_WARNING;
     }
     instance->log_categories |= RECORD_TO_FILE;
@@ -251,7 +247,7 @@ Instance *instance_create(const char *function, const char *name, const char *to
 void instance_free(Instance *instance) {
     if (!instance) return; /* both standards: freeing NULL is ignored */
     instance_free_states(instance);
-    if (instance->record_file) fclose(instance->record_file);
+    if (instance->record_file) record_file_close(instance->record_file);
     free(instance);
 }
 

@@ -44,11 +44,28 @@ const char *escape_text(char *out, size_t size, const char *text) {
     return out;
 }
 
+#if !defined(__wasm__)
 static int starts_with_marker(const char *head, size_t read, const char *marker) {
     return read == strlen(marker) && memcmp(head, marker, read) == 0;
 }
+#endif
 
-#ifdef _WIN32
+#if defined(__wasm__)
+/* A WebAssembly component of the FMU imports nothing but the FMI callbacks (no WASI file system),
+   so it has no file to open: the record goes to the logger alone (category logCalls,
+   RECORD_FILE_ADVICE). Nothing is ever opened, so nothing is ever written or closed, and no file
+   function is linked in. */
+FILE *record_file_open(const char *name, const char *marker, char *why, size_t why_size) {
+    (void)name, (void)marker;
+    snprintf(why, why_size, "cannot be opened: the WebAssembly binary has no files");
+    return NULL;
+}
+
+void record_file_append(FILE *file, const char *line) { (void)file, (void)line; }
+
+void record_file_close(FILE *file) { (void)file; }
+
+#elif defined(_WIN32)
 #include <fcntl.h>
 #include <io.h>
 #include <stdint.h>
@@ -160,4 +177,13 @@ FILE *record_file_open(const char *name, const char *marker, char *why, size_t w
     }
     return stream;
 }
+#endif
+
+#if !defined(__wasm__)
+void record_file_append(FILE *file, const char *line) {
+    fprintf(file, "%s\n", line);
+    fflush(file);
+}
+
+void record_file_close(FILE *file) { fclose(file); }
 #endif

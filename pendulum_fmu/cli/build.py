@@ -49,8 +49,9 @@ def add_parser(commands) -> argparse.ArgumentParser:
         "--platforms",
         type=_platforms,
         default=None,
-        help=f"comma-separated, among {', '.join(PLATFORMS)} (default: every one "
-        "whose compiler is installed; the others are skipped with a note)",
+        help=f"comma-separated, among {', '.join(PLATFORMS)} and, for FMI 3.0, {tool.WASM} (the "
+        "WebAssembly component) (default: every one whose compiler is installed; the others are skipped "
+        "with a note)",
     )
     build.add_argument(
         "--linux-glibc",

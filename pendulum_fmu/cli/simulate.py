@@ -6,6 +6,7 @@ import argparse
 
 import numpy as np
 
+from ..fmu import WASM_PLATFORM
 from ._arguments import (
     add_signal_arguments,
     check_outputs,
@@ -34,6 +35,13 @@ def add_parser(commands) -> argparse.ArgumentParser:
         default=None,
         help="relative tolerance of the FMU's integrator (default: 1e-10)",
     )
+    simulate.add_argument(
+        "--platform",
+        choices=[WASM_PLATFORM],
+        default=None,
+        help="run the FMU's WebAssembly binary (FMI 3.0, FMI-LS-WASM) through wasmtime instead of "
+        "this machine's native one",
+    )
     simulate.add_argument("--output", type=output_path, help="write time,torque,theta,omega,alpha CSV")
     simulate.add_argument("--plot", type=output_path, help="write a PNG of theta and omega")
     simulate.set_defaults(run=run)
@@ -49,7 +57,7 @@ def run(args) -> int:
     check_outputs(
         {"--output": args.output, "--plot": args.plot}, {"--torque-file": args.torque_file, "--fmu": args.fmu}
     )
-    run = simulate(torque_signal(args), tolerance=args.tolerance, **signal_options(args))
+    run = simulate(torque_signal(args), tolerance=args.tolerance, platform=args.platform, **signal_options(args))
     last = run[-1]
     # The fields and units of the FMU that ran, --fmu's or the default one: its outputs, as many
     # as it has, after time and torque.

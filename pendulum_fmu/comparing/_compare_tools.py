@@ -33,9 +33,9 @@ import numpy as np
 
 from .._errors import InvalidInput, Skipped, WrongType
 from ..engines import MODES, check_mode
-from ..fmu import _results as results
+from ..fmu import WASM_PLATFORM, _results as results
 from ..fmu._model import FmuModel, fmu_model
-from ..fmu._simulate import simulate_plan
+from ..fmu._simulate import resolve_parameters, simulate_plan
 from ..oracle._reference import reference_schedule
 from ..signals._torque_schedule import TorqueSchedule
 
@@ -99,10 +99,23 @@ def run_fmu(
     omega0: float = 0.0,
     mode: str = "accurate",
     fmu_path: str | Path | FmuModel | None = None,
+    platform: str | None = None,
 ) -> np.ndarray:
-    """The project's FMU (the checkout's, or fmu_path) through fmpy; ramps are passed on."""
+    """The project's FMU (the checkout's, or fmu_path) through fmpy; ramps are passed on.
+    platform: its binary, as simulate's (the wasm tool's: WASM_PLATFORM).
+    """
     check_mode(mode, "fmu")
-    return simulate_plan(plan, parameters=parameters, theta0=theta0, omega0=omega0, fmu_path=fmu_path)
+    if platform:
+        # A set the FMU refuses, in its words as every tool says them, before the binary is looked for.
+        resolve_parameters(parameters, fmu_path)
+    return simulate_plan(
+        plan, parameters=parameters, theta0=theta0, omega0=omega0, fmu_path=fmu_path, platform=platform
+    )
+
+
+# The wasm tool: the FMU's WebAssembly binary through wasmtime, fmu_path's (FMI 3.0) or the
+# checkout's FMI 3.0 FMU; the torque held over each step.
+run_wasm = partial(run_fmu, platform=WASM_PLATFORM)
 
 
 def run_reference(
@@ -141,6 +154,7 @@ KINDS = {
     "mujoco": Kind("pendulum_fmu.engines.mujoco:run", "mujoco", "mujoco", MODES),
     "drake": Kind("pendulum_fmu.engines.drake:run", "pydrake", "drake", MODES),
     "pybullet": Kind("pendulum_fmu.engines.pybullet:run", "pybullet", "pybullet", MODES),
+    "wasm": Kind("pendulum_fmu.comparing._compare_tools:run_wasm", "wasmtime", "wasm"),
 }
 # The tools compare runs when none are named: of these, the ones installed here.
 DEFAULT_TOOLS = ("fmu", "reference", "opensim")
@@ -159,7 +173,7 @@ class ToolInfo:
     Attributes
     ----------
     name : str
-        The tool's name: fmu, reference, opensim, mujoco, drake or pybullet.
+        The tool's name: fmu, reference, opensim, mujoco, drake, pybullet or wasm.
     installed : bool
         Whether its Python package can be imported here.
     labels : tuple of str
@@ -186,7 +200,8 @@ def list_tools() -> list[ToolInfo]:
     Returns
     -------
     list of ToolInfo
-        fmu, reference, then the engines: opensim, mujoco, drake, pybullet.
+        fmu, reference, the engines (opensim, mujoco, drake, pybullet), then wasm: the FMU's
+        WebAssembly binary.
 
     Raises
     ------

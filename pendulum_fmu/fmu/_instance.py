@@ -223,7 +223,8 @@ def open_fmu(
 
 def instantiated(model: FmuModel, instance_name: str) -> FmuInstance:
     """An instantiated FmuInstance of a model, not yet initialized (see open_fmu)."""
-    _ = model.pendulum_variables  # FmuFileError when it is no pendulum FMU this machine runs
+    _ = model.pendulum_variables  # FmuFileError when it is no pendulum FMU
+    model.binary()  # FmuFileError when it has no binary this machine loads
     folder, description, fmi_version = model.folder, model.description, model.fmi_version
     messages = MessageLog(fmi_version)
     arguments = dict(

@@ -22,7 +22,8 @@ import fmpy
 from fmpy import extract, read_model_description
 
 from .._errors import InvalidInput, MissingFile, WrongType
-from .._received_files import check_fmu
+from .._received_files import open_fmu
+from . import WASM_PLATFORM
 
 # The start values a user gives, and the FMU's variables they start.
 START_VALUES = {"theta0": "theta", "omega0": "omega"}
@@ -120,7 +121,7 @@ class FmuModel:
         ------
         FmuFileError
             Not a pendulum (no torque, theta, omega or alpha), no Co-Simulation interface, or no
-            binary for this platform.
+            binary for this platform nor a WebAssembly one (binary() says which).
         """
         description, path = self.description, self.path
         missing = [name for name in PENDULUM_VARIABLES if name not in self.variables]
@@ -134,14 +135,52 @@ class FmuModel:
             raise FmuFileError(
                 f"{path} has no Co-Simulation interface, which this package runs: export it for Co-Simulation"
             )
-        folder = fmpy.platform_tuple if self.fmi_version == 3 else fmpy.platform
-        binary = f"binaries/{folder}/{description.coSimulation.modelIdentifier}{fmpy.sharedLibraryExtension}"
-        if binary not in self._archive_names:
-            raise FmuFileError(
-                f"{path} has no binary for this platform ({binary}): build it here with "
-                "pendulum-fmu build, or give an FMU built for this platform"
-            )
+        if self.binary(WASM_PLATFORM, refuse=False) is None:
+            self.binary()
         return self.variables
+
+    def binary(self, platform: str | None = None, *, refuse: bool = True) -> str | None:
+        """The archive name of the FMU's Co-Simulation binary for a platform.
+
+        Parameters
+        ----------
+        platform : str, optional
+            None: this machine's (fmpy's platform folder); WASM_PLATFORM: the WebAssembly
+            component of FMI-LS-WASM (FMI 3.0 only).
+        refuse : bool, optional
+            Raise when the FMU has no such binary (else return None).
+
+        Returns
+        -------
+        str or None
+            Such as binaries/x86_64-linux/Pendulum.so, or binaries/wasm32-wasip2/Pendulum.wasm.
+
+        Raises
+        ------
+        FmuFileError
+            No such binary in the FMU (when refuse), naming the one it lacks and what to do.
+        """
+        identifier = self.description.coSimulation.modelIdentifier
+        if platform == WASM_PLATFORM:
+            name = f"binaries/{WASM_PLATFORM}/{identifier}.wasm"
+            advice = "give the FMI 3.0 FMU that carries it (pendulum-fmu export --fmi-version 3)"
+            if self.fmi_version != 3:
+                name, advice = "", "a WebAssembly binary is FMI 3.0 only: give the FMI 3.0 FMU"
+        else:
+            folder = fmpy.platform_tuple if self.fmi_version == 3 else fmpy.platform
+            name = f"binaries/{folder}/{identifier}{fmpy.sharedLibraryExtension}"
+            advice = "build it here with pendulum-fmu build, or give an FMU built for this platform"
+            if self.binary(WASM_PLATFORM, refuse=False):
+                advice = (
+                    f"run its WebAssembly binary instead: --platform {WASM_PLATFORM} "
+                    f"(platform={WASM_PLATFORM!r} in Python)"
+                )
+        if name in self._archive_names:
+            return name
+        if not refuse:
+            return None
+        what = "this platform" if platform is None else platform
+        raise FmuFileError(f"{self.path} has no binary for {what}{f' ({name})' if name else ''}: {advice}")
 
     @cached_property
     def default_parameters(self) -> dict[str, float]:
@@ -203,9 +242,8 @@ def _read(path: str, version: tuple, shown: str) -> FmuModel:
     user gave it, for the messages.
     """
     try:
-        with zipfile.ZipFile(path) as archive:
+        with open_fmu(path, shown, FmuFileError) as archive:  # before fmpy parses and unpacks it
             names = frozenset(archive.namelist())
-            check_fmu(archive, shown, FmuFileError)  # before fmpy parses it and unpacks it (FmuModel.folder)
     except (zipfile.BadZipFile, OSError):
         raise FmuFileError(
             f"{shown} is not an FMU (an FMU is a zip archive with a modelDescription.xml): check the path"

@@ -21,7 +21,7 @@ import numpy as np
 from .. import default_fmu
 from .._errors import InvalidInput
 from ..signals._torque_schedule import TorqueSchedule, TorqueSignal, schedule
-from . import _native_loop as cs_loop, _results as results
+from . import WASM_PLATFORM, _native_loop as cs_loop, _results as results
 from ._instance import FmuError, FmuInstance, initialize, instantiated, open_fmu
 from ._model import FmuModel, file_version, fmu_file, fmu_model
 from ._parameters import merged_with, start_value
@@ -88,11 +88,8 @@ def run_schedule_python(slave: FmuInstance, plan: TorqueSchedule) -> np.ndarray:
     """
     dll, messages, fmi3 = slave.dll, slave.messages, slave.fmi_version == 3
     ramped = bool(np.any(plan.torque_rate))
-    if fmi3 and ramped:
-        raise InvalidInput(
-            "FMI 3.0 has no input derivatives, so an FMI 3.0 FMU cannot ramp the "
-            "torque: hold it over each step (no --ramp), or use the FMI 2.0 FMU"
-        )
+    if fmi3:
+        check_held(plan)
     names = (
         ("fmi3SetFloat64", "fmi3GetFloat64", None, "fmi3DoStep")
         if fmi3
@@ -158,6 +155,17 @@ def run_schedule_python(slave: FmuInstance, plan: TorqueSchedule) -> np.ndarray:
     return _result(plan, recorded_names, np.frombuffer(rows).reshape(-1, count))
 
 
+def check_held(plan: TorqueSchedule) -> None:
+    """InvalidInput when the schedule ramps the torque, which an FMI 3.0 FMU cannot (it has no
+    input derivatives).
+    """
+    if np.any(plan.torque_rate):
+        raise InvalidInput(
+            "FMI 3.0 has no input derivatives, so an FMI 3.0 FMU cannot ramp the "
+            "torque: hold it over each step (no --ramp), or use the FMI 2.0 FMU"
+        )
+
+
 def simulate(
     torque: TorqueSignal = 20.0,
     *,
@@ -171,6 +179,7 @@ def simulate(
     tolerance: float | None = None,
     fmu_path: str | Path | None = None,
     max_steps: int | None = None,
+    platform: str | None = None,
 ) -> np.ndarray:
     """Simulate the pendulum FMU under a torque signal, one communication step at a time.
 
@@ -199,10 +208,14 @@ def simulate(
     tolerance : float, optional
         Relative tolerance of the FMU's integrator (None: the FMU's 1e-10).
     fmu_path : str or Path, optional
-        The FMU to run (default: pendulum_fmu.default_fmu()); its own parameters apply.
+        The FMU to run (default: pendulum_fmu.default_fmu(); for platform "wasm32-wasip2" the
+        package's FMI 3.0 FMU stands for it); its own parameters apply.
     max_steps : int, optional
         The longest run accepted (default _time_grid.DEFAULT_MAX_STEPS); a longer one, or
         one that would not fit in memory, is refused before anything is allocated.
+    platform : {None, "wasm32-wasip2"}, optional
+        The FMU's binary to run: None, this machine's native one; "wasm32-wasip2", the
+        WebAssembly one an FMI 3.0 FMU carries (FMI-LS-WASM), through wasmtime (the wasm extra).
 
     Returns
     -------
@@ -220,6 +233,8 @@ def simulate(
         The FMU refused the parameters or a step; the message carries what it logged.
     MissingFile
         No FMU at fmu_path.
+    MissingDependency
+        platform "wasm32-wasip2" without the wasmtime package.
 
     Examples
     --------
@@ -236,7 +251,13 @@ def simulate(
         torque, start_time=start_time, stop_time=stop_time, step_size=step_size, ramp=ramp, max_steps=max_steps
     )
     return simulate_plan(
-        plan, parameters=parameters, theta0=theta0, omega0=omega0, tolerance=tolerance, fmu_path=fmu_path
+        plan,
+        parameters=parameters,
+        theta0=theta0,
+        omega0=omega0,
+        tolerance=tolerance,
+        fmu_path=fmu_path,
+        platform=platform,
     )
 
 
@@ -248,9 +269,10 @@ def simulate_plan(
     omega0: float = 0.0,
     tolerance: float | None = None,
     fmu_path: str | Path | FmuModel | None = None,
+    platform: str | None = None,
 ) -> np.ndarray:
-    """A schedule through this thread's Simulator of the FMU (see simulate)."""
-    runner = simulator(fmu_path)
+    """A schedule through this thread's Simulator of the FMU's binary for platform (see simulate)."""
+    runner = simulator(fmu_path, platform)
     try:
         return runner.run(plan, parameters=parameters, theta0=theta0, omega0=omega0, tolerance=tolerance)
     except FmuError:
@@ -283,7 +305,11 @@ def _refusal(model: FmuModel, items: tuple) -> str | None:
     per model (a file rebuilt or replaced is another model) and set of parameters.
     """
     try:
-        slave = open_fmu(model, parameters=dict(items))
+        if model.binary(refuse=False) is None and model.binary(WASM_PLATFORM, refuse=False):
+            slave = _wasm().instantiated(model, "pendulum")  # an FMU that carries only that one
+            initialize(slave, parameters=dict(items))
+        else:
+            slave = open_fmu(model, parameters=dict(items))
     except FmuError as error:
         # "initialization failed: [ERROR] fmi2ExitInitializationMode: mass must be > 0"
         return f"the FMU refuses the parameters: {str(error).rsplit(': ', 1)[-1]}"
@@ -297,16 +323,20 @@ class Simulator:
     initialization with the run's parameters, start values and tolerance, which leaves it as a
     fresh instance would be, so the numbers are a fresh instance's bit for bit.
 
-    One thread at a time: simulator() keeps one per thread and FMU file. The native loop restarts
-    and steps it in one call (FMI 2.0); else (FMI 3.0, or no native loop) fmpy's calls do.
+    One thread at a time: simulator() keeps one per thread, FMU file and platform. The native loop
+    restarts and steps it in one call (FMI 2.0); else (FMI 3.0, or no native loop) fmpy's calls
+    do; the WebAssembly binary (platform "wasm32-wasip2") is stepped through wasmtime (_wasm.py).
     """
 
     # Also names the restart's start values, in this order.
     START_STATES = ("theta", "omega")
 
-    def __init__(self, fmu_path: Path, version: tuple):
+    def __init__(self, fmu_path: Path, version: tuple, platform: str | None = None):
         self.fmu_path, self.version = fmu_path, version
-        self.slave = instantiated(fmu_model(fmu_path), "pendulum")
+        model = fmu_model(fmu_path)
+        wasm = platform == WASM_PLATFORM
+        self.slave = _wasm().instantiated(model, "pendulum") if wasm else instantiated(model, "pendulum")
+        self.loop = _wasm().run_schedule if wasm else None
         self.defaults = dict(self.slave.model.default_parameters)
         self.stepper = (
             _stepper(self.slave, (*self.defaults, *self.START_STATES)) if cs_loop.drives(self.slave) else None
@@ -338,11 +368,25 @@ class Simulator:
                 tolerance=tolerance,
                 start_time=float(plan.time[0]),
             )
-            return run_schedule_python(self.slave, plan)
+            if self.loop is None:
+                return run_schedule_python(self.slave, plan)
+            check_held(plan)
+            return _result(plan, self.slave.model.recorded, self.loop(self.slave, plan))
         return _stepped(self.stepper, plan, self.slave.model.recorded, start_values=start, tolerance=tolerance)
 
     def close(self) -> None:
         self.slave.freeInstance()
+
+
+# What simulate's platform takes: this machine's native binary, or the WebAssembly one.
+PLATFORMS = (None, WASM_PLATFORM)
+
+
+def _wasm():
+    """The _wasm module, imported when the WebAssembly binary is asked for (it needs wasmtime)."""
+    from . import _wasm
+
+    return _wasm
 
 
 # Simulators a thread keeps, the least recently used dropped first (each holds an instance).
@@ -350,20 +394,24 @@ SIMULATORS_PER_THREAD = 8
 _simulators = threading.local()
 
 
-@lru_cache(maxsize=1)
-def _default_fmu() -> Path:
-    """default_fmu(), looked up once per process (in a checkout: rebuilt then if stale)."""
-    return default_fmu()
+@lru_cache(maxsize=2)
+def _default_fmu(fmi_version: int = 2) -> Path:
+    """default_fmu(fmi_version), looked up once per process (in a checkout: rebuilt then if stale)."""
+    return default_fmu(fmi_version)
 
 
-def simulator(fmu_path: str | Path | FmuModel | None = None) -> Simulator:
-    """The Simulator of an FMU file kept by the calling thread, made on first use and again
-    whenever the file is rebuilt or replaced (its file_version changes).
+def simulator(fmu_path: str | Path | FmuModel | None = None, platform: str | None = None) -> Simulator:
+    """The Simulator of an FMU file's binary kept by the calling thread, made on first use and
+    again whenever the file is rebuilt or replaced (its file_version changes).
 
     Parameters
     ----------
     fmu_path
-        The FMU file or its model; None: pendulum_fmu.default_fmu(), looked up once per process.
+        The FMU file or its model; None: pendulum_fmu.default_fmu(), looked up once per process
+        (for the WebAssembly binary, which is FMI 3.0 only, the package's FMI 3.0 FMU stands for
+        it, given or not).
+    platform : {None, "wasm32-wasip2"}
+        Which binary: this machine's native one, or the WebAssembly one (see simulate).
 
     Returns
     -------
@@ -374,19 +422,29 @@ def simulator(fmu_path: str | Path | FmuModel | None = None) -> Simulator:
     ------
     MissingFile
         When there is no such file.
+    InvalidInput
+        A platform other than those.
     """
+    if platform not in PLATFORMS:
+        raise InvalidInput(
+            f"platform {platform!r} is none the package runs: None (this machine's binary) or {WASM_PLATFORM!r}"
+        )
     path = _default_fmu() if fmu_path is None else fmu_file(fmu_path)
+    if platform and path.resolve() == _default_fmu().resolve():
+        # The package's FMU, whose WebAssembly binary its FMI 3.0 file carries (same sources,
+        # same numbers: docs/fmi3.md); compare hands every tool the FMI 2.0 file it resolved.
+        path = _default_fmu(3)
     version = file_version(path)
     kept = getattr(_simulators, "kept", None)
     if kept is None:
         kept = _simulators.kept = OrderedDict()
-    key = os.fspath(path)
+    key = (os.fspath(path), platform)
     current = kept.pop(key, None)
     if current is not None and current.version != version:
         current.close()
         current = None
     if current is None:
-        current = Simulator(Path(path), version)
+        current = Simulator(Path(path), version, platform)
         while len(kept) >= SIMULATORS_PER_THREAD:
             kept.popitem(last=False)[1].close()
     kept[key] = current

@@ -21,7 +21,7 @@ from xml.etree import ElementTree
 from .. import default_fmu
 from .._atomic_files import replacing
 from .._errors import InvalidInput, MissingFile, PendulumFmuError
-from .._received_files import check_archive, check_fmu, check_xml
+from .._received_files import check_xml, open_archive, open_fmu
 from ..fmu._simulate import resolve_parameters
 from ._closed_loop import WIRES, controller_defaults, controller_fmu
 
@@ -402,12 +402,10 @@ def read_ssp(path: str | os.PathLike) -> SspSettings:
     if not path.is_file():
         raise MissingFile(f"no SSP at {path}: write one with `pendulum-fmu export-ssp {path}`")
     try:
-        with zipfile.ZipFile(path) as archive:
-            check_archive(archive, str(path), SspFileError)  # before any entry is read
+        with open_archive(path, str(path), SspFileError) as archive:  # before any entry is read
             for name in archive.namelist():  # the FMUs a master will unpack
                 if name.endswith(".fmu"):
-                    with zipfile.ZipFile(archive.open(name)) as fmu:
-                        check_fmu(fmu, f"{path}'s {name}", SspFileError)
+                    open_fmu(archive.open(name), f"{path}'s {name}", SspFileError).close()
             ssd = _parsed(archive, "SystemStructure.ssd")
             bindings = {
                 _attribute(c, ".", "name"): _attribute(c, "ssd:ParameterBindings/ssd:ParameterBinding", "source")
