@@ -23,6 +23,7 @@ from .python_loop import python_loop_rows
 from .realtime import realtime_rows
 from .report import as_markdown, as_text, main_table
 from .scale import scale_rows
+from .small_studies import small_study_rows
 from .wasm_cost import wasm_cost_rows
 
 PARTS = (
@@ -34,6 +35,7 @@ PARTS = (
     "opensim",
     "pythonfmu",
     "scale",
+    "small-studies",
     "realtime",
     "wasm",
     "judge",
@@ -74,6 +76,12 @@ def parse_arguments(argv):
         metavar="FILE",
         help="where the accuracy/cost figure goes (default: %(default)s)",
     )
+    parser.add_argument(
+        "--before",
+        type=Path,
+        metavar="CHECKOUT",
+        help="small-studies: a checkout of another version (e.g. main's) to run side by side with this one",
+    )
     return parser.parse_args(argv)
 
 
@@ -110,6 +118,8 @@ def main(argv=None) -> int:
                 rows += pythonfmu_rows(pendulum, scratch, repetitions)
             elif part == "scale":
                 rows += scale_rows(pendulum, args.quick) + case_cost_rows(pendulum, args.quick)
+            elif part == "small-studies":
+                rows += small_study_rows(pendulum.path, args.quick, args.before)
             elif part == "realtime":
                 rows += realtime_rows(pendulum, scratch)
             elif part == "wasm":

@@ -36,6 +36,7 @@ CLIENT_MEMORY_TARGET = 500e6  # bytes, for 100,000 cases
 RATE_TARGET = 1000  # cases/s per worker
 EFFICIENCY_TARGET = 0.85
 FIGURE_TARGET = 5.0  # s for 100,000 cases
+STARTUP_SHARE_TARGET = 0.05  # of a study whose efficiency counts (issue 42)
 
 
 def free_port() -> int:
@@ -152,13 +153,16 @@ def measure_client(
         return usage.ru_utime + usage.ru_stime
 
     # A small study first: the workers import the package and unzip the FMU once in their lives,
-    # and this process imports what drawing needs; neither is a cost per case.
-    sweep.run_sweep(
-        sweep.Study(sweep.sweep_grid([1.0, 2.0]), stop_time=0.01, fmu_path=fmu),
-        output_dir=f"{output_dir}/warm-up",
-        scheduler=address,
-        progress=False,
-    )
+    # and this process imports what drawing needs; neither is a cost per case. Then the same
+    # again, whose seconds are what a study costs besides its cases (connecting, submitting,
+    # committing, the figure).
+    for name in ("warm-up", "fixed"):
+        fixed = sweep.run_sweep(
+            sweep.Study(sweep.sweep_grid([1.0, 2.0]), stop_time=0.01, fmu_path=fmu),
+            output_dir=f"{output_dir}/{name}",
+            scheduler=address,
+            progress=False,
+        )
     others_before = [_cpu_times(pid) for pid in others]
     before = cpu()
     chosen = {} if outputs is None else {"outputs": outputs}
@@ -177,6 +181,7 @@ def measure_client(
         json.dumps(
             {
                 "seconds": result.seconds,
+                "fixed_seconds": fixed.seconds,
                 "cpu": client_cpu,
                 "figure": result.figure_seconds,
                 "bytes": result.bytes,
@@ -269,14 +274,19 @@ def _cpu_seconds(pid: int) -> float:
     return sum(_cpu_times(pid))
 
 
-def scale_rows(fmu: BuiltFmu, quick: bool, cases: int | None = None) -> list[Row]:
+def scale_rows(fmu: BuiltFmu, quick: bool, cases: int | None = None, per_worker: bool = False) -> list[Row]:
     """The part's rows; cases: of each 3-s study (default 1024 quick, else 4096), more where the
-    cores are many, so that 16 workers each run more than a few chunks' worth.
+    cores are many, so that 16 workers each run more than a few chunks' worth. per_worker: cases
+    is per worker instead, each worker count's study as many times larger (every study then lasts
+    about as long, and so can be long enough at 16 workers for its start-up not to count
+    without taking 16 times as long at 1), and each control process runs as many cases.
     """
-    cases = cases or (1024 if quick else 4096)
+    per_count = cases or (1024 if quick else 4096)
     rounds = 1 if quick else 3
     worker_counts = [n for n in (1, 2, 4, 8, 16) if n <= (os.cpu_count() or 1)]
+    studies = {workers: per_count * workers if per_worker else per_count for workers in worker_counts}
     rows = [Row(PART, "machine", _load())]
+    control_cases = per_count if per_worker else 200
     # Every cluster runs at once and the rounds alternate between them, so that a change in the
     # machine's speed (other jobs on a shared VM) falls on every worker count alike.
     with contextlib.ExitStack() as clusters:
@@ -285,14 +295,17 @@ def scale_rows(fmu: BuiltFmu, quick: bool, cases: int | None = None) -> list[Row
         for _ in range(rounds):
             for workers, (address, processes) in handles.items():
                 scheduler_cpu = _cpu_seconds(processes[0].pid)
-                runs[workers].append(_study(address, cases, 3.0, fmu))
+                runs[workers].append(_study(address, studies[workers], 3.0, fmu))
                 runs[workers][-1]["scheduler_cpu"] = _cpu_seconds(processes[0].pid) - scheduler_cpu
     results = {workers: _median_study(runs[workers]) for workers in worker_counts}
-    rates = {workers: cases / result["seconds"] for workers, result in results.items()}
+    rates = {workers: studies[workers] / result["seconds"] for workers, result in results.items()}
     # The figure is a fixed cost of a study (about a second), whatever its size or workers.
-    running_rates = {workers: cases / (result["seconds"] - result["figure"]) for workers, result in results.items()}
-    worker_cpu = {workers: result["worker_cpu"] / cases for workers, result in results.items()}
+    running_rates = {
+        workers: studies[workers] / (result["seconds"] - result["figure"]) for workers, result in results.items()
+    }
+    worker_cpu = {workers: result["worker_cpu"] / studies[workers] for workers, result in results.items()}
     for workers, result in results.items():
+        cases = studies[workers]
         stepping = result["worker_stepping"] / cases
         label = f"{workers} worker(s), {cases} 3-s cases, median of {rounds}"
         per_worker = rates[workers] / workers
@@ -319,12 +332,21 @@ def scale_rows(fmu: BuiltFmu, quick: bool, cases: int | None = None) -> list[Row
                 f"{label}: the same without the figure ({result['figure']:.2f} s): cases/s, efficiency",
                 f"{running_rates[workers]:.0f}, {running_efficiency:.0%}",
             ),
+            Row(
+                PART,
+                f"{label}: a 2-case study's seconds on the warm cluster (what a study costs besides "
+                "its cases) / this one's",
+                f"{result['fixed_seconds'] / result['seconds']:.1%}",
+                f"< {STARTUP_SHARE_TARGET:.0%}",
+                result["fixed_seconds"] / result["seconds"] < STARTUP_SHARE_TARGET,
+            ),
             *(
                 [
                     Row(
                         PART,
-                        f"control: {workers} plain processes running simulate() (no dask, no files), speed-up over one",
-                        f"{_control_speedup(fmu, workers):.2f} of {workers}",
+                        f"control: {workers} plain processes running simulate() (no dask, no files), "
+                        f"{control_cases} cases each, speed-up over one",
+                        f"{_control_speedup(fmu, workers, control_cases):.2f} of {workers}",
                     )
                 ]
                 if workers > 1

@@ -54,6 +54,7 @@ _LAZY = {
     "Study": "sweep",
     "SweepResult": "sweep",
     "tls_files": "sweep",
+    "close_kept_clusters": "sweep",
     # what a user hands on: the FMU, the closed loop, the SSP
     "export_fmu": "fmu._export",
     "create_closed_loop_fmu": "ssp._closed_loop",

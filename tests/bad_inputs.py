@@ -471,6 +471,12 @@ CASES = [
     ),
     _case(
         "sweep",
+        "sweep --torque 5 --run-in process --workers 2 --output-dir {files}/out",
+        2,
+        "run_in 'process' (--run-in process) runs the study in this process: give it no scheduler",
+    ),
+    _case(
+        "sweep",
         "sweep --torque 1 2 3 4 5 6 7 8 9 10 --set mass=1,2,3,4,5,6,7,8,9,10 "
         "--set length=1,2,3,4,5,6,7,8,9,10 --max-cases 999 --output-dir {files}/out",
         2,

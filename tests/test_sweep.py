@@ -1194,6 +1194,8 @@ def test_ctrl_c_to_the_process_group_is_one_line_whenever_it_comes(tmp_path, del
             "600",
             "--outputs",
             "none",
+            "--run-in",
+            "cluster",
         ),
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from .._errors import InvalidInput
 from .._stop_signals import STOPPING_SIGNALS, Stopped
-from ..signals._time_grid import DEFAULT_MAX_CASES
+from ..signals._time_grid import BREAK_EVEN_STEPS, DEFAULT_MAX_CASES, RUN_IN
 from ._arguments import add_fmu_argument, assignment, float_number, output_location, positive_int
 
 
@@ -77,6 +77,12 @@ def add_parser(commands) -> argparse.ArgumentParser:
         default="parquet",
         help="file format of the tables (default: %(default)s; csv for small studies)",
     )
+    sweep.add_argument(
+        "--no-figure",
+        dest="figure",
+        action="store_false",
+        help="write no sweep.png (a small study then takes about half as long)",
+    )
     again = sweep.add_mutually_exclusive_group()
     again.add_argument(
         "--resume", action="store_true", help="run only the chunks a previous run of the same study did not write"
@@ -119,7 +125,17 @@ def _add_cluster_arguments(sweep: argparse.ArgumentParser) -> None:
             metavar="PEM",
             help=f"{what}, for --scheduler tls://... (default: dask's configuration, distributed.comm.tls.*)",
         )
-    sweep.add_argument("--workers", type=int, default=None, help="local cluster workers (default: 2)")
+    sweep.add_argument(
+        "--workers", type=int, default=None, help="local cluster workers (default: 2; given, a cluster runs the study)"
+    )
+    sweep.add_argument(
+        "--run-in",
+        choices=RUN_IN,
+        default="auto",
+        help="where the study runs: auto (this process below about "
+        f"{BREAK_EVEN_STEPS / 1e6:g} million steps in all, without --scheduler or --workers; else dask), "
+        "process, or cluster (a local one without --scheduler) (default: %(default)s)",
+    )
 
 
 def _security(args):
@@ -167,6 +183,8 @@ def run(args) -> int:
             connect_timeout=args.connect_timeout,
             max_cases=args.max_cases,
             security=_security(args),
+            run_in=args.run_in,
+            figure=args.figure,
         )
     except Stopped as stopped:
         what = STOPPING_SIGNALS[signal.Signals(stopped.signal_number)]
@@ -199,7 +217,7 @@ def run(args) -> int:
         )
     )
     for path in (result.trajectories, result.cases_table, result.figure):
-        if path is not None:  # no trajectories with --outputs none
+        if path is not None:  # no trajectories with --outputs none, no figure with --no-figure
             print(f"wrote {path}")
     if result.failed:
         # The other cases ran and are written; a script still learns that some did not.

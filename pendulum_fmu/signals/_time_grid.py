@@ -36,6 +36,16 @@ DEFAULT_MAX_STEPS = 10_000_000
 # the command line's help reads it without loading the sweep.
 DEFAULT_MAX_CASES = 1_000_000
 
+# Where run_sweep runs a study (sweep/here.py): chosen by its size, the calling process, a dask
+# cluster. A study of fewer steps (cases times steps per case) than BREAK_EVEN_STEPS still to run
+# takes less time in the calling process than on a local cluster of two workers, whose start is
+# then more than its workers save. Measured by `python -m benchmarks.small_studies` (studies in
+# the process and on a cluster at two sizes, where the two lines cross): 25, 40, 105, 248 and 322
+# million steps in five runs on the loaded 2-core VM; the lowest, rounded down, for a quieter
+# machine, whose two workers gain more. Here beside the other size limits, for the same reason.
+RUN_IN = ("auto", "process", "cluster")
+BREAK_EVEN_STEPS = 20_000_000
+
 
 # Runs needing less memory than this are not checked against what the machine has left: reading
 # it (/proc/meminfo) costs more than such a run, which no machine that runs Python lacks.

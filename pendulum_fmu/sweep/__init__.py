@@ -1,4 +1,5 @@
-"""Parameter studies on dask.distributed: workers simulate chunks of cases and write them.
+"""Parameter studies on dask.distributed: workers simulate chunks of cases and write them (a
+small study's chunks the calling process runs itself, here.py).
 
     from pendulum_fmu.sweep import Study, run_sweep, sweep_grid
 
@@ -13,7 +14,7 @@ A study goes to an output directory, a local path or any fsspec URL every worker
     cases/part-000000.parquet         per chunk, one row per case: case, its values, final_theta,
                                       final_omega, final_alpha, max_abs_theta, status ("ok" or
                                       "failed") and message (why the FMU refused the case)
-    sweep.png                         the figure
+    sweep.png                         the figure (unless run_sweep is asked for none)
     .sweep.lock                       there while a run writes a local folder: a second run is refused
     */_part-000000.<run>.staged       a chunk's part as its worker wrote it, before the run's client
                                       moves it into place: hidden from the readers, removed when
@@ -31,7 +32,8 @@ The package, in the order a run goes through it:
 
     study.py   Study, what goes in (the cases, times, outputs, FMU), and SweepResult, what comes out
     grid.py    the cases: sweep_grid's every combination, or a list of dicts, checked
-    run.py     run_sweep: the folder locked, the chunks run on dask, the figure drawn
+    run.py     run_sweep: the folder locked, the chunks run (on dask, or here), the figure drawn
+    here.py    where a study runs: a small one in the calling process, chunk by chunk
     client.py  the dask client, the chunks submitted and gathered, the progress line
     security.py  who can reach the cluster: the local cluster's certificates, the client's TLS
     worker.py  a chunk on a worker: its cases through the native loop, its two parts written
@@ -41,6 +43,7 @@ The package, in the order a run goes through it:
 May import: figures/, fmu/, signals/ and the basics.
 """
 
+from .client import close_kept_clusters
 from .grid import Grid, sweep_grid
 from .run import DEFAULT_MAX_CASES, run_sweep
 from .security import tls_files
@@ -64,6 +67,7 @@ __all__ = [
     "Grid",
     "Study",
     "SweepResult",
+    "close_kept_clusters",
     "run_sweep",
     "sweep_grid",
     "tls_files",

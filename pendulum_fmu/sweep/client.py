@@ -7,8 +7,10 @@ So the client's memory and its work per case stay small however large the study.
 
 from __future__ import annotations
 
+import atexit
 import contextlib
 import logging
+import numbers
 import queue
 import re
 import signal
@@ -19,8 +21,9 @@ import time
 from collections.abc import Iterable
 from concurrent.futures import CancelledError
 from dataclasses import dataclass
+from typing import Any
 
-from .._errors import PendulumFmuError
+from .._errors import InvalidInput, PendulumFmuError
 from .security import client_security, run_certificates
 from .worker import Task, run_chunk
 
@@ -55,14 +58,19 @@ class SchedulerLost(PendulumFmuError, ConnectionError):
 
 
 @contextlib.contextmanager
-def dask_client(scheduler: str | None, workers: int | None, connect_timeout: float, security=None):
-    """A dask client: on a local cluster of `workers` processes started (and closed) here, which
-    only holders of its run's certificates can reach (security.py), or on the scheduler at an
-    address, connecting with security (a distributed.security.Security; None: dask's
-    configuration's), refused within connect_timeout when it does not answer.
+def dask_client(scheduler: str | None, workers: int | None, connect_timeout: float, security=None, keep=False):
+    """A dask client: on a local cluster of `workers` processes started (and closed) here, or
+    kept for the next study in the process where keep (see kept_client), which only holders of
+    its run's certificates can reach (security.py); or on the scheduler at an address,
+    connecting with security (a distributed.security.Security; None: dask's configuration's),
+    refused within connect_timeout when it does not answer.
     """
     from dask.distributed import Client
 
+    if scheduler is None and keep:
+        with kept_client(workers or 2) as client:
+            yield client
+        return
     if scheduler is None:
         with contextlib.ExitStack() as stack:
             cluster = _local_cluster(stack, workers or 2)
@@ -89,6 +97,69 @@ def dask_client(scheduler: str | None, workers: int | None, connect_timeout: flo
         )
     with _quiet(logging.getLogger("distributed.client")), client:
         yield client
+
+
+# The local clusters kept for the next studies of this process, by their workers: each one's
+# client, and the stack that closes the two.
+_kept: dict[int, tuple[Any, contextlib.ExitStack]] = {}  # a distributed.Client, not imported here
+
+
+@contextlib.contextmanager
+def kept_client(workers: int):
+    """A client of the local cluster of `workers` processes kept for this process's studies:
+    started by the first study that asks for it, closed by close_kept_clusters (at the latest
+    when the process exits). A study that does not end well (Ctrl-C, an error) closes it, so that
+    none of its chunks still running is left on the workers of the next study.
+    """
+    from dask.distributed import Client
+
+    if workers in _kept and _kept[workers][0].status != "running":  # closed under it (a lost worker, a test)
+        close_kept_clusters(workers)
+    if workers not in _kept:
+        atexit.unregister(close_kept_clusters)  # registered once, however many clusters
+        atexit.register(close_kept_clusters)
+        with contextlib.ExitStack() as stack:
+            cluster = _local_cluster(stack, workers)
+            _kept[workers] = (stack.enter_context(Client(cluster)), stack.pop_all())
+    try:
+        yield _kept[workers][0]
+    except BaseException:
+        _kept.pop(workers)[1].close()
+        raise
+
+
+def close_kept_clusters(workers: int | None = None) -> int:
+    """Close the local clusters that run_sweep(..., keep_cluster=True) kept for this process.
+
+    They close when the process exits; this frees their processes sooner.
+
+    Parameters
+    ----------
+    workers : int, optional
+        Close only the cluster kept with this many workers (default: every one).
+
+    Returns
+    -------
+    int
+        How many clusters were closed (none were kept: 0).
+
+    Raises
+    ------
+    InvalidInput
+        workers that is not a positive integer.
+
+    Examples
+    --------
+    >>> from pendulum_fmu import close_kept_clusters
+    >>> close_kept_clusters()
+    0
+    """
+    if workers is not None and (not isinstance(workers, numbers.Integral) or workers < 1):
+        raise InvalidInput(f"workers must be a positive integer, got {workers!r}")
+    closing = [count for count in _kept if workers in (None, count)]
+    for count in closing:
+        _kept.pop(count)[1].close()
+    return len(closing)
 
 
 def _local_cluster(stack: contextlib.ExitStack, workers: int):
@@ -288,6 +359,18 @@ class Totals:
     bytes: int = 0
     worker_cpu_seconds: float = 0.0
     worker_stepping_seconds: float = 0.0
+    chunks: int = 0
+
+    def add(self, result: tuple, bar) -> None:
+        """Count a chunk's result (run_chunk's tuple) and advance the bar by its cases."""
+        _, count, failed, written, cpu, stepping = result
+        self.failed += failed
+        self.bytes += written
+        self.worker_cpu_seconds += cpu
+        self.worker_stepping_seconds += stepping
+        self.chunks += 1
+        bar.set_postfix_str(f"{self.failed} failed", refresh=False)
+        bar.update(count)
 
 
 def run_chunks(client, task: Task, chunks: Iterable[tuple[int, int, dict]], bar) -> Totals:
@@ -329,13 +412,8 @@ def run_chunks(client, task: Task, chunks: Iterable[tuple[int, int, dict]], bar)
             results = client.gather(ran)
         except OSError:  # the scheduler went away since: reported as when that comes first
             raise CancelledError("scheduler-connection-lost") from None  # as dask's cancellation says it
-        for _, count, failed, written, cpu, stepping in results:
-            totals.failed += failed
-            totals.bytes += written
-            totals.worker_cpu_seconds += cpu
-            totals.worker_stepping_seconds += stepping
-            bar.set_postfix_str(f"{totals.failed} failed", refresh=False)
-            bar.update(count)
+        for result in results:
+            totals.add(result, bar)
         for future in batch:
             if future.status != "finished":
                 future.result()  # raises what the chunk's run raised

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import math
 import numbers
 import os
@@ -20,6 +21,7 @@ from ..signals._time_grid import DEFAULT_MAX_CASES
 from .client import SchedulerLost, Totals, dask_client, progress_bar, run_chunks
 from .figure import draw
 from .grid import columns
+from .here import check_place, run_chunks_here, runs_here
 from .store import Held, Store, StudyExists
 from .study import Study, SweepResult
 from .worker import Task
@@ -40,8 +42,11 @@ def run_sweep(
     progress: bool = True,
     max_cases: int = DEFAULT_MAX_CASES,
     security: Security | None = None,
+    run_in: str = "auto",
+    keep_cluster: bool = False,
+    figure: bool = True,
 ) -> SweepResult:
-    """Run every case of a study on dask; the workers write it into output_dir.
+    """Run every case of a study, on dask or, when it is small, in this process, into output_dir.
 
     output_dir receives study.json, trajectories/ and cases/ (a Parquet or CSV file per chunk of
     cases) and sweep.png; see the package's doc. A case the FMU refuses is recorded with its
@@ -62,11 +67,12 @@ def run_sweep(
         the old study stays as it was. Without resume or overwrite, a folder that holds a study,
         finished or not, is refused.
     scheduler : str, optional
-        The address of a running dask.distributed scheduler. Without one a local cluster of
-        `workers` processes runs for this call; its workers are spawned, so a script calling
-        this needs the ``if __name__ == "__main__":`` guard.
+        The address of a running dask.distributed scheduler. Without one, a study of fewer than
+        here.BREAK_EVEN_STEPS steps in all runs in this process, and a larger one on a local
+        cluster of `workers` processes started for this call; its workers are spawned, so a
+        script calling this needs the ``if __name__ == "__main__":`` guard.
     workers : int, optional
-        Processes of the local cluster (default 2).
+        Processes of the local cluster (default 2); given, the study runs on one whatever its size.
     connect_timeout : float, optional
         Seconds the scheduler has to answer.
     progress : bool, optional
@@ -78,6 +84,20 @@ def run_sweep(
         client's certificate and key, e.g. security.tls_files(ca_file, cert, key). Without it,
         dask's configuration's (distributed.comm.tls.*). The local cluster makes its own, which
         only this run holds.
+    run_in : {"auto", "process", "cluster"}, optional
+        Where the study runs: "auto" in this process when it has fewer than
+        here.BREAK_EVEN_STEPS steps still to run and neither scheduler nor workers is given,
+        else on dask; "process" in this process whatever its size; "cluster" on dask (a local
+        cluster without a scheduler) whatever its size. The files are the same either way, and
+        either resumes what the other began.
+    keep_cluster : bool, optional
+        Keep the local cluster this study starts (or one an earlier study kept, of as many
+        workers) for the next studies of this process, instead of closing it: a notebook running
+        many studies on a cluster pays its start once. Closed when the process exits, by
+        close_kept_clusters(), or when a study on it stops (Ctrl-C, an error).
+    figure : bool, optional
+        Draw sweep.png. Without it a small study costs about half as much (matplotlib's import
+        and the drawing are most of what it costs in a process of its own).
 
     Returns
     -------
@@ -89,7 +109,8 @@ def run_sweep(
     ------
     InvalidInput
         More cases than max_cases, workers with a scheduler, security without one, a bad workers
-        count or connect timeout, resume and overwrite together, or TLS files that are no
+        count or connect timeout, resume and overwrite together, an unknown run_in or "process"
+        with a scheduler or workers, keep_cluster with a scheduler, or TLS files that are no
         certificates; all before anything starts.
     StudyExists
         output_dir holds a study and neither resume (for the same study) nor overwrite was
@@ -124,6 +145,7 @@ def run_sweep(
     if not isinstance(output_dir, str | os.PathLike):
         raise WrongType(f"output_dir is a folder's path or an fsspec URL, not {output_dir!r}")
     _check_options(len(study.cases), max_cases, scheduler, workers, connect_timeout, resume, overwrite, security)
+    check_place(run_in, scheduler, workers, keep_cluster)
     url = str(output_dir)
     target = Store(*_file_system(url), format=study.format)
     fmu = str(fmu_file(study.fmu_path).resolve())
@@ -148,12 +170,18 @@ def run_sweep(
             stride=study.stride,
             run=uuid.uuid4().hex,
         )
+        pending = _pending_cases(store, len(study.cases), chunk_cases)
+        here = runs_here(run_in, scheduler, workers, sum(pending.values()) * (study.points - 1))
         try:
             try:
-                with dask_client(scheduler, workers, connect_timeout, security) as client:
+                with (
+                    contextlib.nullcontext()
+                    if here
+                    else dask_client(scheduler, workers, connect_timeout, security, keep_cluster) as client
+                ):
                     store.start(definition, chunk_cases, task.run)
                     try:
-                        totals, chunks, chunks_run = _run_pending(client, task, study, chunk_cases, progress)
+                        totals = _run_pending(client, task, study, chunk_cases, pending, progress)
                     except CancelledError as error:  # this run cancels none: the cluster did
                         raise _lost(scheduler, error, url, overwrite) from None
             finally:
@@ -162,7 +190,8 @@ def run_sweep(
                 store.remove_unfinished()
             drawing = time.perf_counter()
             table = store.read_cases(study.names)
-            draw(store, table, study.names, study.outputs, fmu, f"{store.root}/sweep.png")
+            if figure:
+                draw(store, table, study.names, study.outputs, fmu, f"{store.root}/sweep.png")
             drawn = time.perf_counter()
             if store is not target:
                 target.replace_with(store)
@@ -175,35 +204,43 @@ def run_sweep(
         output_dir=where(""),
         trajectories=where("trajectories") if study.outputs else None,
         cases_table=where("cases"),
-        figure=where("sweep.png"),
+        figure=where("sweep.png") if figure else None,
         cases=len(study.cases),
         failed=int(np.sum(table["status"].to_numpy(zero_copy_only=False) == "failed")),
-        chunks=chunks,
-        chunks_run=chunks_run,
+        chunks=math.ceil(len(study.cases) / chunk_cases),
+        chunks_run=len(pending),
         bytes=totals.bytes,
         seconds=time.perf_counter() - started,
         figure_seconds=drawn - drawing,
         worker_cpu_seconds=totals.worker_cpu_seconds,
         worker_stepping_seconds=totals.worker_stepping_seconds,
+        ran_in="process" if here else "cluster",
     )
 
 
-def _run_pending(client, task: Task, study: Study, chunk_cases: int, progress: bool) -> tuple[Totals, int, int]:
-    """Run, with the progress line, the chunks of the study that task.store does not hold done:
-    (what they reported, the study's chunks, the chunks run).
+def _pending_cases(store: Store, cases: int, chunk_cases: int) -> dict[int, int]:
+    """{index: cases} of the study's chunks that the store does not hold done."""
+    done = store.done_chunks()
+    return {
+        index: min(chunk_cases, cases - index * chunk_cases)
+        for index in range(math.ceil(cases / chunk_cases))
+        if index not in done
+    }
+
+
+def _run_pending(client, task: Task, study: Study, chunk_cases: int, pending: dict[int, int], progress: bool) -> Totals:
+    """Run, with the progress line, the pending chunks of the study: on the dask client's
+    cluster, or in this process where client is None.
     """
     cases = study.cases
-    chunks = range(math.ceil(len(cases) / chunk_cases))
-    done = task.store.done_chunks()
-    pending = [index for index in chunks if index not in done]
-    finished = sum(min(chunk_cases, len(cases) - i * chunk_cases) for i in done)
-    starts = {index: index * chunk_cases for index in pending}  # each chunk's first case
     values = (
-        (index, start, columns(cases, study.names, start, min(len(cases), start + chunk_cases)))
-        for index, start in starts.items()
+        (index, index * chunk_cases, columns(cases, study.names, index * chunk_cases, index * chunk_cases + count))
+        for index, count in pending.items()
     )
-    with progress_bar(len(cases), finished, progress) as bar:
-        return run_chunks(client, task, values, bar), len(chunks), len(pending)
+    with progress_bar(len(cases), len(cases) - sum(pending.values()), progress) as bar:
+        if client is None:
+            return run_chunks_here(task, values, bar)
+        return run_chunks(client, task, values, bar)
 
 
 def _locate(target: Store, url: str):

@@ -176,15 +176,15 @@ class SweepResult:
     >>> from pendulum_fmu import Study, run_sweep, sweep_grid
     >>> folder = Path(tempfile.mkdtemp())
     >>> result = run_sweep(Study(sweep_grid([5, 10]), stop_time=0.1), output_dir=folder, workers=1, progress=False)
-    >>> result.cases, result.failed, result.trajectories == folder / "trajectories"
-    (2, 0, True)
+    >>> result.cases, result.failed, result.trajectories == folder / "trajectories", result.ran_in
+    (2, 0, True, 'cluster')
     """
 
     output_dir: Path | str
     # A folder of a file per chunk: case, time and the outputs kept; None with no outputs.
     trajectories: Path | str | None
     cases_table: Path | str  # a folder of a file per chunk: a row per case (its values, summaries, status)
-    figure: Path | str  # sweep.png
+    figure: Path | str | None  # sweep.png; None where run_sweep was asked for none
     cases: int
     failed: int  # cases the FMU refused; their status and message are in the cases table
     chunks: int
@@ -194,3 +194,4 @@ class SweepResult:
     figure_seconds: float  # of them, reading the cases table and drawing
     worker_cpu_seconds: float  # the workers spent on this run's chunks
     worker_stepping_seconds: float  # of them, running the cases through the FMU
+    ran_in: str  # "process" (this one) or "cluster" (dask's: local or at the scheduler's address)
