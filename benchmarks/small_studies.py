@@ -22,6 +22,7 @@ is the number of cases (and steps) below which the process is quicker: what BREA
 from __future__ import annotations
 
 import argparse
+import datetime
 import json
 import os
 import subprocess
@@ -31,7 +32,7 @@ import time
 from pathlib import Path
 
 from .builds import build_pendulum_fmu
-from .report import Row
+from .report import Row, cpu_model
 from .timing import interleaved, median
 
 PART = "small studies"
@@ -168,9 +169,9 @@ def _cell(seconds: float) -> str:
     return f"{seconds:.2f} s"
 
 
-def small_study_rows(fmu: Path, quick: bool, before: Path | None = None) -> list[Row]:
-    """The rows of the table: each contender's median, before and after where a checkout is
-    given; the targets; the break-even.
+def measured(fmu: Path, quick: bool, before: Path | None = None) -> dict:
+    """Each checkout's medians ({"before": ..., "after": ...}, "after" alone without before), the
+    break-even (cases, steps, the four studies' seconds), the rounds and the load average before.
     """
     repetitions = 3 if quick else 5
     load = os.getloadavg()[0]
@@ -182,6 +183,29 @@ def small_study_rows(fmu: Path, quick: bool, before: Path | None = None) -> list
         seconds["ratio"] = seconds["command 10"] / seconds["loop process"]
         if "command 10 no figure" in seconds:
             seconds["ratio no figure"] = seconds["command 10 no figure"] / seconds["loop process"]
+    return {"medians": medians, "break even": (cases, steps, studies), "repetitions": repetitions, "load": load}
+
+
+def _break_even_text(figures: dict) -> tuple[str, str]:
+    """(the four studies' seconds, where the process stops paying) as the table gives them."""
+    cases, steps, studies = figures["break even"]
+    seconds = ", ".join(
+        _cell(studies[f"{where} {size}"]) for where in ("process", "cluster") for size in (SMALL, LARGE)
+    )
+    crossing = (
+        f"{cases:,.0f} cases = {steps / 1e6:,.1f} million steps"
+        if cases < float("inf")
+        else "none: the cluster ran a case no faster than the process"
+    )
+    return seconds, crossing
+
+
+def small_study_rows(fmu: Path, quick: bool, before: Path | None = None) -> list[Row]:
+    """The rows of `python -m benchmarks`' table: each contender's median, before and after where
+    a checkout is given; the targets; the break-even.
+    """
+    figures = measured(fmu, quick, before)
+    medians = figures["medians"]
     after = medians["after"]
 
     def value(key: str, unit: str = " s", scale: float = 1.0) -> str:
@@ -192,11 +216,11 @@ def small_study_rows(fmu: Path, quick: bool, before: Path | None = None) -> list
     def held(measure: str, key: str, target: float, unit: str = "") -> Row:
         return Row(PART, measure, value(key, unit), f"<= {target:g}{unit}", after[key] <= target)
 
-    def study(where: str, size: int) -> str:
-        return _cell(studies[f"{where} {size}"])
-
+    seconds, crossing = _break_even_text(figures)
     return [
-        Row(PART, f"median of {repetitions}, load average {load:.1f} before", " -> ".join(medians)),
+        Row(
+            PART, f"median of {figures['repetitions']}, load average {figures['load']:.1f} before", " -> ".join(medians)
+        ),
         held("1-case study, `pendulum-fmu sweep`, end to end", "command 1", STUDY_TARGET, " s"),
         Row(PART, "10-case study, `pendulum-fmu sweep`, end to end", value("command 10")),
         Row(PART, "the 10 cases' simulate() loop, a fresh process, end to end", value("loop process")),
@@ -209,27 +233,89 @@ def small_study_rows(fmu: Path, quick: bool, before: Path | None = None) -> list
         Row(PART, "the 10 cases' simulate() loop, in that process", value("loop warm", " ms", 1e3)),
         Row(PART, "the local cluster of 2 workers, TLS included: start and close", value("cluster")),
         Row(
-            PART,
-            f"break-even: studies of {SMALL} and {LARGE} 3-s cases in the process ({study('process', SMALL)}, "
-            f"{study('process', LARGE)}) and on a local cluster of 2 ({study('cluster', SMALL)}, "
-            f"{study('cluster', LARGE)}), medians of 3",
-            f"{cases:,.0f} cases = {steps / 1e6:,.1f} million steps"
-            if cases < float("inf")
-            else "none: the cluster ran a case no faster than the process",
+            PART, f"break-even: {SMALL} and {LARGE} cases in the process, then on a cluster of 2 ({seconds})", crossing
         ),
     ]
 
 
-def main() -> None:
-    from .report import as_text, main_table
+# What the command prints, and docs/sweeps.md holds (tests/readme_figures.py keeps the two in
+# step): each cell pair is "before | now", "-" where a version has no such figure.
+TEMPLATE = """Measured by `.venv/bin/python -m benchmarks.small_studies --before CHECKOUT` on {date}, {before}
+against this version, taking turns, on {machine} (load average {load} before); 3-s cases at 1 ms
+steps, all outputs written as Parquet, medians of {repetitions}:
 
+| measure | before | now | target |
+| --- | --- | --- | --- |
+| 1-case study, `pendulum-fmu sweep`, end to end | {command_1} | <= 1.5 s: {command_1_held} |
+| 10-case study, `pendulum-fmu sweep`, end to end | {command_10} | |
+| the 10 cases' `simulate()` loop, a fresh process, end to end | {loop_process} | |
+| 10-case study by the command / the loop's process | {ratio} | <= 2: {ratio_held} |
+| 10-case study, `pendulum-fmu sweep --no-figure`, end to end | {command_10_no_figure} | |
+| the same / the loop's process | {ratio_no_figure} | <= 2: {ratio_no_figure_held} |
+| 1-case study, `run_sweep` in a process that ran one | {api_1} | |
+| 10-case study, `run_sweep` in a process that ran one | {api_10} | |
+| the same, `figure=False` | {api_10_no_figure} | |
+| the 10 cases' `simulate()` loop, in that process | {loop_warm} | |
+| the local cluster of 2 workers, TLS included: start and close (the same code) | {cluster} | |
+| break-even ({small} and {large} cases in the process, then on a cluster: {break_even_seconds}) | - | {break_even} | |
+"""
+
+
+def _revision(checkout: Path) -> str:
+    found = subprocess.run(["git", "-C", str(checkout), "rev-parse", "--short", "HEAD"], capture_output=True, text=True)
+    return f"the checkout {checkout} ({found.stdout.strip() or 'no git revision'})"
+
+
+def template_figures(figures: dict, before: Path | None) -> dict[str, str]:
+    """The figures of TEMPLATE from measured()'s."""
+    medians = figures["medians"]
+    after = medians["after"]
+    earlier = medians.get("before", {})
+
+    def pair(key: str, unit: str = " s", scale: float = 1.0, digits: int = 2) -> str:
+        return " | ".join(
+            f"{seconds[key] * scale:.{digits}f}{unit}" if key in seconds else "-" for seconds in (earlier, after)
+        )
+
+    def held(key: str, target: float) -> str:
+        return "met" if after[key] <= target else "missed"
+
+    seconds, crossing = _break_even_text(figures)
+    return {
+        "date": datetime.date.today().isoformat(),
+        "before": "no other version" if before is None else _revision(before),
+        "machine": f"{cpu_model()}, {os.cpu_count()} cores",
+        "load": f"{figures['load']:.1f}",
+        "repetitions": str(figures["repetitions"]),
+        "command_1": pair("command 1"),
+        "command_1_held": held("command 1", STUDY_TARGET),
+        "command_10": pair("command 10"),
+        "loop_process": pair("loop process"),
+        "ratio": pair("ratio", ""),
+        "ratio_held": held("ratio", LOOP_TARGET),
+        "command_10_no_figure": pair("command 10 no figure"),
+        "ratio_no_figure": pair("ratio no figure", ""),
+        "ratio_no_figure_held": held("ratio no figure", LOOP_TARGET),
+        "api_1": pair("api 1"),
+        "api_10": pair("api 10"),
+        "api_10_no_figure": pair("api 10 no figure"),
+        "loop_warm": pair("loop warm", " ms", 1e3, 1),
+        "cluster": pair("cluster"),
+        "small": f"{SMALL:,}",
+        "large": f"{LARGE:,}",
+        "break_even_seconds": seconds,
+        "break_even": crossing,
+    }
+
+
+def main() -> None:
     parser = argparse.ArgumentParser(prog="python -m benchmarks.small_studies", description=__doc__.splitlines()[0])
     parser.add_argument("--before", type=Path, metavar="CHECKOUT", help="a checkout to compare with (e.g. main's)")
     parser.add_argument("--quick", action="store_true", help="3 rounds instead of 5")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory(prefix="pendulum-small-studies-fmu-") as scratch:
         fmu = build_pendulum_fmu(Path(scratch)).path
-        print(as_text(main_table(small_study_rows(fmu, args.quick, args.before))))
+        print(TEMPLATE.format(**template_figures(measured(fmu, args.quick, args.before), args.before)), end="")
 
 
 if __name__ == "__main__":
