@@ -121,19 +121,42 @@ export function fmiCallbacks(log) {
   };
 }
 
+/** What the FMU logged, as the end of an error's message. */
+const logged = (messages) => (messages.length ? `: ${messages.join("; ")}` : "");
+
 function checked(status, what, messages) {
-  if (status !== "ok" && status !== "warning") {
-    throw new Error(`${what} returned ${status}${messages.length ? `: ${messages.join("; ")}` : ""}`);
-  }
+  if (status !== "ok" && status !== "warning") throw new Error(`${what} returned ${status}${logged(messages)}`);
 }
 
 function call(what, messages, thunk) {
   try {
     return thunk();
   } catch (error) {
-    const status = error?.payload ?? error?.message ?? error;
-    throw new Error(`${what} returned ${status}${messages.length ? `: ${messages.join("; ")}` : ""}`);
+    throw new Error(`${what} returned ${error?.payload ?? error?.message ?? error}${logged(messages)}`);
   }
+}
+
+/**
+ * The instance (either kind) initialized over the plan's time, with the result's empty columns
+ * and the value references a run sets and reads.
+ */
+function initialized(instance, fmu, time, messages) {
+  if (!instance) throw new Error(`the FMU refused to instantiate${logged(messages)}`);
+  checked(instance.enterInitializationMode(undefined, time[0], time[time.length - 1]), "enterInitializationMode", messages);
+  checked(instance.exitInitializationMode(), "exitInitializationMode", messages);
+  return {
+    torqueVr: new Uint32Array([fmu.valueReferences.torque]),
+    recordedVrs: new Uint32Array(RECORDED.map((name) => fmu.valueReferences[name])),
+    columns: Object.fromEntries(RESULT_COLUMNS.map((name) => [name, new Float64Array(time.length)])),
+  };
+}
+
+/** The run's columns, its time filled in, once the instance is terminated and dropped. */
+function finished(instance, columns, time) {
+  columns.time.set(time);
+  instance.terminate();
+  instance[Symbol.dispose]?.();
+  return columns;
 }
 
 /**
@@ -146,13 +169,8 @@ export function runCoSimulation(exports, fmu, plan, messages = []) {
   const instance = CoSimulationInstance.instantiateCoSimulation(
     "pendulum", fmu.instantiationToken, "", false, false, false, false, new Uint32Array(0)
   );
-  if (!instance) throw new Error(`the FMU refused to instantiate${messages.length ? `: ${messages.join("; ")}` : ""}`);
-  const torqueVr = new Uint32Array([fmu.valueReferences.torque]);
-  const recordedVrs = new Uint32Array(RECORDED.map((name) => fmu.valueReferences[name]));
   const { time } = plan;
-  checked(instance.enterInitializationMode(undefined, time[0], time[time.length - 1]), "enterInitializationMode", messages);
-  checked(instance.exitInitializationMode(), "exitInitializationMode", messages);
-  const columns = Object.fromEntries(RESULT_COLUMNS.map((name) => [name, new Float64Array(time.length)]));
+  const { torqueVr, recordedVrs, columns } = initialized(instance, fmu, time, messages);
   const record = (k) => {
     const values = call("getFloat64", messages, () => instance.getFloat64(recordedVrs));
     RECORDED.forEach((name, i) => (columns[name][k] = values[i]));
@@ -165,10 +183,7 @@ export function runCoSimulation(exports, fmu, plan, messages = []) {
     call(`doStep at t = ${time[k]}`, messages, () => instance.doStep(time[k], time[k + 1] - time[k], true));
   }
   record(time.length - 1);
-  columns.time.set(time);
-  instance.terminate();
-  instance[Symbol.dispose]?.();
-  return columns;
+  return finished(instance, columns, time);
 }
 
 /** The state a classic Runge-Kutta step of size h reaches from x at t, derivatives(t, x) at each stage. */
@@ -188,12 +203,8 @@ export function rungeKuttaStep(derivatives, t, x, h) {
 export function runModelExchange(exports, fmu, plan, substeps, messages = []) {
   const { ModelExchangeInstance } = exports.modelExchange;
   const instance = ModelExchangeInstance.instantiateModelExchange("pendulum", fmu.instantiationToken, "", false, false);
-  if (!instance) throw new Error(`the FMU refused to instantiate${messages.length ? `: ${messages.join("; ")}` : ""}`);
-  const torqueVr = new Uint32Array([fmu.valueReferences.torque]);
-  const recordedVrs = new Uint32Array(RECORDED.map((name) => fmu.valueReferences[name]));
   const { time } = plan;
-  checked(instance.enterInitializationMode(undefined, time[0], time[time.length - 1]), "enterInitializationMode", messages);
-  checked(instance.exitInitializationMode(), "exitInitializationMode", messages);
+  const { torqueVr, recordedVrs, columns } = initialized(instance, fmu, time, messages);
   call("updateDiscreteStates", messages, () => instance.updateDiscreteStates());
   checked(instance.enterContinuousTimeMode(), "enterContinuousTimeMode", messages);
   let states = Array.from(call("getContinuousStates", messages, () => instance.getContinuousStates()));
@@ -202,7 +213,6 @@ export function runModelExchange(exports, fmu, plan, substeps, messages = []) {
     checked(instance.setContinuousStates(new Float64Array(x)), `setContinuousStates at t = ${t}`, messages);
     return Array.from(call(`getContinuousStateDerivatives at t = ${t}`, messages, () => instance.getContinuousStateDerivatives()));
   };
-  const columns = Object.fromEntries(RESULT_COLUMNS.map((name) => [name, new Float64Array(time.length)]));
   const record = (k) => {
     derivatives(time[k], states); // the outputs at the point, from its time and state
     const values = call("getFloat64", messages, () => instance.getFloat64(recordedVrs));
@@ -219,10 +229,7 @@ export function runModelExchange(exports, fmu, plan, substeps, messages = []) {
     }
   }
   record(time.length - 1);
-  columns.time.set(time);
-  instance.terminate();
-  instance[Symbol.dispose]?.();
-  return columns;
+  return finished(instance, columns, time);
 }
 
 /** A result as the CSV `pendulum-fmu judge` reads: a header, then a row per point (round-trip digits). */
