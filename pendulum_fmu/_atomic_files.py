@@ -53,11 +53,16 @@ def _streamed(path: Path) -> bool:
     return not (stat.S_ISREG(mode) or stat.S_ISDIR(mode))
 
 
-def _final(path: Path) -> Path:
-    """The file a write to path replaces: the one a symbolic link leads to (so the link stays a
-    link), else path itself.
+def _refuse_link(path: Path) -> None:
+    """CannotWrite when path is a symbolic link that does not lead to a stream: an output is
+    never written through a link, which anyone who can write the folder may have planted where
+    the output is named (a run would replace the user's ~/.bashrc, or, as root, /etc/passwd).
     """
-    return Path(os.path.realpath(path)) if path.is_symlink() else path
+    if path.is_symlink():
+        raise CannotWrite(
+            f"cannot write {path}: it is a symbolic link (to {os.readlink(path)}), which outputs "
+            "are never written through; name the file itself, or remove the link"
+        )
 
 
 def _longest_name(folder: Path) -> int:
@@ -169,7 +174,7 @@ def _check_writable(path: Path) -> None:
         if not os.access(path, os.W_OK):
             raise CannotWrite(f"cannot write {path}: permission denied; choose another output path")
         return
-    path = _final(path)
+    _refuse_link(path)
     made = [folder for folder in (path.parent, *path.parent.parents) if not folder.exists()]
     try:
         descriptor, temporary = _temporary_beside(path, f".partial{path.suffix}")
@@ -208,7 +213,7 @@ def replacing_path(path: str | os.PathLike):
     if _streamed(path):
         yield path
         return
-    path = _final(path)
+    _refuse_link(path)
     descriptor, temporary = _temporary_beside(path, f".partial{path.suffix}")
     os.close(descriptor)
     try:

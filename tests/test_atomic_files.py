@@ -3,6 +3,7 @@ nothing can be written to is refused before the work, naming the user's path.
 """
 
 import os
+import subprocess
 import sys
 
 import fsspec
@@ -108,23 +109,40 @@ def test_a_named_pipe_is_written_into_and_stays_a_pipe(tmp_path):
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="symbolic links need privileges on Windows")
-def test_a_link_keeps_leading_to_the_file_it_names_which_is_replaced(tmp_path):
+def test_an_output_is_never_written_through_a_link(tmp_path):
+    # Before, a link named as an output had the file it leads to replaced: `judge --plot j.png`
+    # with j.png a link to /etc/passwd, run as root, wrote a PNG over it.
     (tmp_path / "results").mkdir()
     real = tmp_path / "results" / "run.csv"
     real.write_text("old\n")
-    os.chmod(real, 0o640)
     link = tmp_path / "latest.csv"
     link.symlink_to(real)
-    check_writable(link)
-    with replacing(link) as file:
-        file.write("new\n")
-    assert link.is_symlink() and os.readlink(link) == str(real) and real.read_text() == "new\n"
-    assert oct(os.stat(real).st_mode & 0o777) == oct(0o640), "the replaced file keeps its permissions"
     dangling = tmp_path / "next.csv"
     dangling.symlink_to(tmp_path / "results" / "next_run.csv")
-    with replacing(dangling) as file:
-        file.write("first\n")
-    assert dangling.is_symlink() and (tmp_path / "results" / "next_run.csv").read_text() == "first\n"
+    for named in (link, dangling):
+        with pytest.raises(CannotWrite, match=f"cannot write {named}: it is a symbolic link .*never written through"):
+            check_writable(named)
+        with pytest.raises(CannotWrite, match="it is a symbolic link"), replacing(named) as file:
+            file.write("new\n")
+    assert real.read_text() == "old\n" and not (tmp_path / "results" / "next_run.csv").exists()
+    assert link.is_symlink() and dangling.is_symlink()
+    assert sorted(p.name for p in tmp_path.rglob("*")) == ["latest.csv", "next.csv", "results", "run.csv"]
+
+
+def test_the_command_refuses_a_link_as_its_output_and_leaves_what_it_leads_to(tmp_path):
+    settings = tmp_path / "bashrc"
+    settings.write_text("echo my settings\n")
+    (tmp_path / "out.png").symlink_to(settings)
+    done = subprocess.run(
+        [sys.executable, "-m", "pendulum_fmu", "simulate", "--torque", "1", "--stop-time", "0.01", "--plot", "out.png"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert done.returncode == 2 and done.stderr.count("\n") == 1
+    assert "out.png: it is a symbolic link" in done.stderr
+    assert settings.read_text() == "echo my settings\n"
 
 
 def test_a_name_as_long_as_the_file_system_allows_is_written_and_a_longer_one_refused(tmp_path):
