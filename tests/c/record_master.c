@@ -40,7 +40,11 @@ int main(int argc, char **argv) {
     const fmi2CallbackFunctions callbacks = {logger, NULL, NULL, NULL, NULL};
     fmi2Component fmu = fmi2Instantiate(argv[3], fmi2CoSimulation, argv[2], "", &callbacks,
                                         fmi2False, fmi2False);
-    if (!fmu) return 1;
+    if (!fmu) {
+        /* Said, so that a refused instantiation is told apart from wine failing to start. */
+        fprintf(stderr, "fmi2Instantiate returned NULL\n");
+        return 1;
+    }
     const fmi2ValueReference reference = VR_CALL_RECORD_FILE;
     const fmi2String file = argv[4];
     printf("fmi2SetString: %d\n", (int)fmi2SetString(fmu, &reference, 1, &file));
