@@ -1,14 +1,22 @@
 """csv-compare's tube and the FMI cross-check's band (pendulum_fmu/judging/_regression_tools.py).
 
-Against the tube's definition evaluated plainly, hand-checkable steps, and a one-step-late master
-that the tube passes while the judge names it late.
+Against the tube's definition evaluated plainly, the band against fmpy's own function,
+hand-checkable steps, and a one-step-late master that the tube passes while the judge names it
+late.
 """
+
+import warnings
 
 import numpy as np
 import pytest
 
 from pendulum_fmu import judge, simulate
-from pendulum_fmu.judging._regression_tools import cross_check_band, csv_compare_tube, tube_envelopes
+from pendulum_fmu.judging._regression_tools import (
+    CROSS_CHECK_OUTSIDE_SHARE,
+    cross_check_band,
+    csv_compare_tube,
+    tube_envelopes,
+)
 
 
 def brute_force_envelopes(t_ref, y_ref, at, half_width, half_height):
@@ -83,6 +91,35 @@ def test_a_constant_reference_takes_its_magnitude_as_its_range():
     # funnel's tubeSize.c: a range of zero falls back to |max|: +-0.002 * 3 around 3.
     assert csv_compare_tube(TIME, np.full_like(TIME, 3.0), TIME, np.full_like(TIME, 3.0059)).passed
     assert not csv_compare_tube(TIME, np.full_like(TIME, 3.0), TIME, np.full_like(TIME, 3.0061)).passed
+
+
+def fmpy_band_outside(t_ref, y_ref, t, y) -> int:
+    """The outliers fmpy.cross_check.validate_signal finds, over the reference's span."""
+    from fmpy.cross_check import validate_signal
+
+    with warnings.catch_warnings():  # fmpy imports scipy.ndimage.filters, deprecated in scipy 1.x
+        warnings.simplefilter("ignore", DeprecationWarning)
+        return int(np.count_nonzero(validate_signal(t, y, t_ref, y_ref, t_ref[0], t_ref[-1])[3]))
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_cross_check_band_finds_the_outliers_fmpys_function_finds(seed):
+    # Random references (repeated times, flat ones, one of zeros among them) and results near the
+    # band's edges, on their own time grids, partly outside the reference's span.
+    rng = np.random.default_rng(seed)
+    t_ref = np.sort(rng.uniform(0.0, 10.0, rng.integers(30, 3000)))
+    t_ref[rng.integers(1, len(t_ref), 5)] = t_ref[rng.integers(0, len(t_ref) - 1, 5)]
+    t_ref = np.sort(t_ref)
+    y_ref = np.cumsum(rng.normal(size=len(t_ref))) * [1.0, 0.0, 1e-9, 3.0][seed % 4]
+    if seed % 4 == 3:
+        y_ref[:] = 3.0
+    t = np.sort(rng.uniform(-1.0, 11.0, rng.integers(50, 4000)))
+    y = np.interp(t, t_ref, y_ref) + rng.normal(scale=0.3 * (np.ptp(y_ref) or 1.0), size=len(t))
+    verdict = cross_check_band(t_ref, y_ref, t, y)
+    expected = fmpy_band_outside(t_ref, y_ref, t, y)
+    assert verdict.outside == expected
+    assert verdict.passed == (expected <= CROSS_CHECK_OUTSIDE_SHARE * len(t))
+    assert 0 < expected < len(t)  # near the edges: some points in, some out
 
 
 def test_cross_check_band_passes_a_late_step_and_fails_one_two_seconds_late():

@@ -1,4 +1,4 @@
-"""The independent oracle: a torque signal as docs/signals.md defines it, through scipy.
+"""The independent oracle: a torque signal as docs/signals.md defines it, integrated on its own.
 
 `reference()` shares no code with the path that feeds the tools (`torque_schedule.schedule`)
 beyond its checks of what it is given (a file that is no signal, a run length, refused in the
@@ -9,8 +9,9 @@ does not carry the user's signal to the tools then shows as a difference between
 oracle. `reference_schedule()` integrates a given schedule, to
 judge a tool on exactly the torques it was fed.
 
-Both integrate the equation of motion with solve_ivp (DOP853, rtol = atol = 1e-12) over pieces
-on which the torque is linear (held or ramped), restarting at every piece boundary.
+Both integrate the equation of motion by its Taylor series (_taylor.py, rtol = atol = 1e-14 a
+step) over pieces on which the torque is linear (held or ramped), restarting at every piece
+boundary.
 """
 
 from __future__ import annotations
@@ -21,12 +22,11 @@ import heapq
 import itertools
 import math
 import numbers
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from fractions import Fraction
 from pathlib import Path
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from .._errors import InvalidInput, WrongType
 from ..fmu import _results as results
@@ -35,6 +35,7 @@ from ..fmu._simulate import resolve_parameters
 from ..signals._time_grid import step_count
 from ..signals._torque_csv import read_torque_csv
 from ..signals._torque_schedule import TorqueSchedule
+from ._taylor import Diverged, integrate_piece
 
 # docs/signals.md: an event within max(1e-9 step, 64 ulp of its time) of a communication point
 # is that point. Written again here on purpose: the oracle must not borrow the schedule's code.
@@ -64,7 +65,7 @@ def _torque(value, where: str) -> float:
     return float(value)
 
 
-def _tolerance(time: Fraction, step: Fraction) -> Fraction:
+def _tolerance(time: Fraction | float, step: Fraction) -> Fraction:
     return max(_TOLERANCE_STEPS * step, Fraction(_TOLERANCE_ULPS * math.ulp(float(time))))
 
 
@@ -173,11 +174,11 @@ class _Pieces:
 
     def __init__(
         self,
-        starts: list[Fraction],
-        stop: Fraction,
+        starts: Sequence[Fraction | float],
+        stop: Fraction | float,
         u0: list[float],
         rate: list[float],
-        points: list[Fraction],
+        points: Sequence[Fraction | float],
         values_after: Callable[[np.ndarray], np.ndarray],
     ):
         self.starts, self.stop, self.u0, self.rate = starts, stop, u0, rate
@@ -235,7 +236,7 @@ class _Holding:
     rounding of a point, where doubles cannot tell the side, is decided by value_after.
     """
 
-    def __init__(self, points: list[Fraction], values: list[float], step: Fraction):
+    def __init__(self, points: Sequence[Fraction | float], values: list[float], step: Fraction):
         self.points, self.values, self.step = points, values, step
         self._point_doubles = np.array([float(p) for p in points])
         self._value_doubles = np.array(values, dtype=float)
@@ -280,14 +281,22 @@ def equation_of_motion(parameters: dict[str, float]) -> Callable:
     callable
         acceleration(theta, omega, torque).
     """
-    inverse_inertia = 1.0 / total_inertia(parameters)
-    gravity_moment = parameters["mass"] * parameters["gravity"] * parameters["length"]
-    damping = parameters["damping"]
+    gravity_moment, damping, inverse_inertia = _model(parameters)
 
     def acceleration(theta, omega, u):
         return (u - gravity_moment * np.sin(theta) - damping * omega) * inverse_inertia
 
     return acceleration
+
+
+def _model(parameters: dict[str, float]) -> tuple[float, float, float]:
+    """mass*gravity*length, damping and 1/total inertia: the equation's three constants."""
+    with np.errstate(over="ignore"):  # values past the largest double fail where they are used
+        return (
+            parameters["mass"] * parameters["gravity"] * parameters["length"],
+            parameters["damping"],
+            1.0 / total_inertia(parameters),
+        )
 
 
 def _integrate(
@@ -299,15 +308,15 @@ def _integrate(
     rtol: float,
     atol: float,
     fmu_path: Fmu,
-    method: str = "DOP853",
-    max_step: float = np.inf,
 ) -> np.ndarray:
     theta0, omega0 = start_value("theta0", theta0, "rad"), start_value("omega0", omega0, "rad/s")
     for name, value in (("rtol", rtol), ("atol", atol)):
         if not (isinstance(value, numbers.Real) and 0 < value < math.inf):
-            raise InvalidInput(f"{name} {value!r} must be a positive finite number (solve_ivp's tolerance)")
+            raise InvalidInput(
+                f"{name} {value!r} must be a positive finite number (a tolerance of the reference's integrator)"
+            )
     parameters = resolve_parameters(parameters, fmu_path)
-    acceleration = equation_of_motion(parameters)
+    acceleration, model = equation_of_motion(parameters), _model(parameters)
     starts = [float(s) for s in pieces.starts]
     ends = [*starts[1:], float(pieces.stop)]
     # Each reported time belongs to the first piece that reaches it (a time a rounding past the
@@ -315,11 +324,11 @@ def _integrate(
     owner = np.minimum(np.searchsorted(ends, at, side="left"), len(ends) - 1)
     out = results.empty(len(at))
     out["time"] = at
-    state = np.array([theta0, omega0], dtype=float)
+    theta, omega = float(theta0), float(omega0)
     first = 0
     while first < len(starts):
-        # Merge pieces that continue one another (the same held torque), so solve_ivp restarts
-        # only where the torque changes.
+        # Merge pieces that continue one another (the same held torque), so that the series
+        # restarts only where the torque changes.
         last = first
         while (
             last + 1 < len(starts)
@@ -330,30 +339,15 @@ def _integrate(
             last += 1
         t0, t1, u0, rate = starts[first], ends[last], pieces.u0[first], pieces.rate[first]
         mine = np.flatnonzero((owner >= first) & (owner <= last))
-        if t1 > t0:
-            report = np.clip(at[mine], t0, t1)
-            times = np.unique(np.append(report, t1))  # solve_ivp wants them strictly increasing
-            # Values the FMU would refuse (mass*gravity*length past the largest double) make
-            # the derivative inf or NaN: solve_ivp then fails, and that failure is the error to
-            # show, not numpy's warnings on the way to it.
-            with np.errstate(over="ignore", invalid="ignore"):
-                solution = solve_ivp(
-                    lambda t, y, u0=u0, rate=rate, t0=t0: (y[1], acceleration(y[0], y[1], u0 + rate * (t - t0))),
-                    (t0, t1),
-                    state,
-                    method=method,
-                    rtol=rtol,
-                    atol=atol,
-                    t_eval=times,
-                    max_step=max_step,
-                )
-            if not solution.success:
-                raise _failed(solution.message, t0, parameters, theta0, omega0, pieces)
-            row = np.searchsorted(times, report)
-            out["theta"][mine], out["omega"][mine] = solution.y[0, row], solution.y[1, row]
-            state = solution.y[:, -1].copy()
-        else:
-            out["theta"][mine], out["omega"][mine] = state
+        report = np.clip(at[mine], t0, t1)
+        order = np.argsort(report, kind="stable")
+        try:
+            thetas, omegas, theta, omega = integrate_piece(
+                theta, omega, (t0, t1), (u0, rate), model, (rtol, atol), report[order].tolist()
+            )
+        except Diverged as error:
+            raise _failed(str(error), t0, parameters, theta0, omega0, pieces) from None
+        out["theta"][mine[order]], out["omega"][mine[order]] = thetas, omegas
         first = last + 1
     out["torque"] = pieces.values_after(at)
     # The end of the run reports the torque the last piece reached, as a master reads it back.
@@ -392,14 +386,12 @@ def reference(
     theta0: float = 0.0,
     omega0: float = 0.0,
     at: np.ndarray | None = None,
-    rtol: float = 1e-12,
-    atol: float = 1e-12,
+    rtol: float = 1e-14,
+    atol: float = 1e-14,
     fmu_path: Fmu = None,
-    method: str = "DOP853",
-    max_step: float = np.inf,
 ) -> np.ndarray:
-    """The trajectory under a signal as docs/signals.md defines it, through scipy's solve_ivp
-    (DOP853 by default): the independent oracle, which reads the signal itself.
+    """The trajectory under a signal as docs/signals.md defines it, integrated by the pendulum's
+    Taylor series: the independent oracle, which reads the signal itself.
 
     Parameters
     ----------
@@ -413,12 +405,8 @@ def reference(
     at : numpy.ndarray, optional
         The times to report, in s (default: the signal's communication points).
     rtol, atol : float, optional
-        solve_ivp's tolerances.
-    method : str, optional
-        solve_ivp's method (another one checks this one).
-    max_step : float, optional
-        solve_ivp's bound on its steps in s, which takes it below the error its tolerance alone
-        reaches.
+        The integrator's tolerances: the terms each step leaves out of the series stay below
+        atol + rtol * max(|theta|, |omega|).
     fmu_path : str or Path, optional
         The FMU whose parameters and defaults apply (default: pendulum_fmu.default_fmu()).
 
@@ -431,7 +419,7 @@ def reference(
     ------
     InvalidInput
         A signal the reference cannot read, parameters the FMU refuses, or values with which
-        solve_ivp fails (mass*gravity*length past the largest double, say).
+        the series does not converge (mass*gravity*length past the largest double, say).
 
     Examples
     --------
@@ -456,9 +444,7 @@ def reference(
     pieces = _signal_pieces(torque, start, stop, step, ramp)
     if at is None:
         at = np.array([float(t) for t in pieces.points])
-    return _integrate(
-        pieces, _times(at, pieces, step), parameters, theta0, omega0, rtol, atol, fmu_path, method, max_step
-    )
+    return _integrate(pieces, _times(at, pieces, step), parameters, theta0, omega0, rtol, atol, fmu_path)
 
 
 def _times(at, pieces: _Pieces, step: Fraction) -> np.ndarray:
@@ -483,8 +469,8 @@ def reference_schedule(
     theta0: float = 0.0,
     omega0: float = 0.0,
     at: np.ndarray | None = None,
-    rtol: float = 1e-12,
-    atol: float = 1e-12,
+    rtol: float = 1e-14,
+    atol: float = 1e-14,
     fmu_path: Fmu = None,
 ) -> np.ndarray:
     """Integrate exactly the torques of a schedule, reported at its communication points (or at
@@ -511,7 +497,7 @@ def reference_schedule(
         plan is no TorqueSchedule.
     InvalidInput
         Parameters the FMU refuses, times in `at` outside the run, or values with which
-        solve_ivp fails.
+        the series does not converge.
 
     Examples
     --------
@@ -524,7 +510,9 @@ def reference_schedule(
     """
     if not isinstance(plan, TorqueSchedule):
         raise WrongType(f"plan is a TorqueSchedule (torque_schedule.schedule(...)), not a {type(plan).__name__}")
-    points = [Fraction(float(t)) for t in plan.time]
+    # Doubles, compared with exact times exactly where it matters (a Fraction and a float compare
+    # by value): converting 3000 points to fractions would cost more than the integration.
+    points = plan.time.tolist()
     u0, rate = plan.torque.tolist(), plan.torque_rate.tolist()
     # The schedule's points are the tools' own: no tolerance beyond rounding.
     pieces = _Pieces(points[:-1], points[-1], u0, rate, points, _Holding(points, u0, Fraction(0)).values_after)
