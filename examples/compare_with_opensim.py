@@ -1,4 +1,4 @@
-"""One step-wise torque signal through the FMU, the scipy reference and OpenSim 4.6, with the
+"""One step-wise torque signal through the FMU, the independent reference and OpenSim 4.6, with the
 table of differences and the comparison figure (needs pip install -e ".[opensim]").
 Exits 1 when two tools differ by more than --tol.
 """

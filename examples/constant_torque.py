@@ -1,5 +1,5 @@
 """The tutorial's constant torque (20 N.m), without and with gravity: the FMU against the
-analytic parabola and the scipy reference, in the tutorial's figures.
+analytic parabola and the independent reference, in the tutorial's figures.
 """
 
 import argparse
@@ -16,14 +16,14 @@ def run(torque=20.0, stop_time=3.0, step_size=1e-3, output_dir="out/constant_tor
         arguments = dict(stop_time=stop_time, step_size=step_size, parameters={"gravity": gravity})
         fmu, oracle = simulate(torque, **arguments), reference(torque, **arguments)
         print(
-            f"{title}: max |theta_fmu - theta_scipy| = {np.max(np.abs(fmu['theta'] - oracle['theta'])):.2e} rad, "
+            f"{title}: max |theta_fmu - theta_reference| = {np.max(np.abs(fmu['theta'] - oracle['theta'])):.2e} rad, "
             f"theta({stop_time:g} s) = {fmu['theta'][-1]:.10f} rad"
         )
         if gravity == 0.0:
             parabola = 0.5 * torque / total_inertia(fmu_model().default_parameters) * fmu["time"] ** 2
             print(f"  against theta = tau t^2 / (2 I): {np.max(np.abs(fmu['theta'] - parabola)):.2e} rad")
         figure = plot_overlay(
-            {"FMU": fmu, "Rigid-body ODE (scipy)": oracle},
+            {"FMU": fmu, "Rigid-body ODE (reference)": oracle},
             f"{output_dir}/{title.lower().replace(' ', '_')}.png",
             rf"Constant Torque $\tau = {torque:g}$ N.m — {title}",
         )

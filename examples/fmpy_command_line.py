@@ -1,5 +1,5 @@
 """The FMU under fmpy's own command line: write a step-wise torque CSV in fmpy's convention (a
-repeated time marks a step), run `fmpy simulate`, and check the result against scipy.
+repeated time marks a step), run `fmpy simulate`, and check the result against the reference.
 """
 
 import argparse
@@ -13,7 +13,7 @@ from pendulum_fmu import default_fmu, reference, schedule, write_torque_csv
 
 
 def run(stop_time=3.0, output_dir="out/fmpy_command_line"):
-    """Largest |theta - scipy's| in rad, at the times fmpy simulate wrote, for a three-level torque."""
+    """Largest |theta - the reference's| in rad, at the times fmpy simulate wrote, for a three-level torque."""
     output_dir = Path(output_dir)
     plan = schedule(
         lambda t: 20.0 if t < stop_time / 3 else (-10.0 if t < 2 * stop_time / 3 else 5.0),
@@ -44,7 +44,7 @@ def run(stop_time=3.0, output_dir="out/fmpy_command_line"):
     first = np.unique(result["time"], return_index=True)[1]
     oracle = reference(torque_csv, stop_time=stop_time, at=result["time"][first])
     difference = np.max(np.abs(result["theta"][first] - oracle["theta"]))
-    print(f"fmpy simulate against scipy: max |dtheta| = {difference:.2e} rad over {len(first)} points")
+    print(f"fmpy simulate against the reference: max |dtheta| = {difference:.2e} rad over {len(first)} points")
     return difference
 
 

@@ -64,7 +64,7 @@ def test_the_command_lines_simulate_loads_neither_the_sweep_nor_matplotlib():
     assert "matplotlib" not in loaded["top"] and "dask" not in loaded["top"]
     assert not [name for name in loaded["ours"] if name.startswith("pendulum_fmu.sweep")]
     assert "pendulum_fmu.figures._plot" not in loaded["ours"]
-    # It still simulated: the final angle it printed against the scipy reference.
+    # It still simulated: the final angle it printed against the reference.
     theta = float(loaded["printed"][0].split("theta = ")[1].split(" rad")[0])
     assert theta == pytest.approx(pendulum_fmu.reference(20.0)["theta"][-1], abs=1e-9)
 
@@ -90,7 +90,7 @@ def test_the_names_at_the_top_are_the_api():
 
     assert run_sweep is sweep_runner and Study.__name__ == "Study" and callable(default_fmu)
     assert callable(compare) and callable(judge)
-    # The FMU through fmpy against the independent scipy reference, both by their top names.
+    # The FMU through fmpy against the independent reference, both by their top names.
     run, oracle = simulate(20.0, stop_time=1.0), reference(20.0, stop_time=1.0)
     assert np.max(np.abs(run["theta"] - oracle["theta"])) < 1e-9
     assert set(pendulum_fmu.__all__) <= set(dir(pendulum_fmu))

@@ -235,7 +235,7 @@ def test_compare_on_a_plain_install_runs_the_tools_installed_and_says_which_it_s
     )
     with open(tmp_path / "differences.csv", newline="") as file:
         rows = list(csv.DictReader(file))
-    # The FMU ran, and against the scipy reference it agrees to the default tolerance.
+    # The FMU ran, and against the reference it agrees to the default tolerance.
     assert [(row["tool"], row["against"]) for row in rows] == [("fmu", "reference")]
     assert 0 < float(rows[0]["theta_max"]) < 1e-9
 
@@ -250,7 +250,7 @@ def test_the_default_tools_leave_out_what_is_not_installed_with_a_warning(monkey
 def test_a_tool_asked_for_an_output_it_cannot_compute_says_so(tool, renamed_fmu):
     """An output added to the set a tool is asked for (energy, which no tool computes) comes back
     as a NaN column with a one-line warning naming the tool, never zeros; the outputs it does
-    compute stay the same numbers, checked against scipy's.
+    compute stay the same numbers, checked against the reference's.
     """
     if tool == "mujoco":
         pytest.importorskip("mujoco")

@@ -1,5 +1,5 @@
 """pendulum-fmu cross-check: the FMI cross-check layout, passed by fmpy's validator, with
-reference results that fmpy reproduces from the input file alone and that agree with scipy.
+reference results that fmpy reproduces from the input file alone and that agree with the reference.
 """
 
 import shutil
@@ -37,7 +37,7 @@ def test_layout_has_every_file_under_one_megabyte(repository):
     assert options["RelTol"] > 0
 
 
-def test_reference_results_agree_with_fmpy_and_scipy_and_pass_fmpys_validator(repository, tmp_path):
+def test_reference_results_agree_with_fmpy_and_the_oracle_and_pass_fmpys_validator(repository, tmp_path):
     folder = _model_dir(repository)
     options = read_ref_opt_file(str(folder / "Pendulum_ref.opt"))
     inputs, expected = read_csv(str(folder / "Pendulum_in.csv")), read_csv(str(folder / "Pendulum_ref.csv"))
@@ -59,7 +59,7 @@ def test_reference_results_agree_with_fmpy_and_scipy_and_pass_fmpys_validator(re
     for name in ("theta", "omega"):
         assert np.array_equal(by_fmpy[name], expected[name])  # the same binary, the same steps
 
-    # scipy's DOP853 holding, over each step, the input's value at the step's start.
+    # The reference holding, over each step, the input's value at the step's start.
     table = read_torque_csv(folder / "Pendulum_in.csv")
     oracle = reference(table.value_after, stop_time=options["StopTime"], step_size=options["StepSize"])
     assert np.max(np.abs(oracle["theta"] - expected["theta"])) < 1e-8

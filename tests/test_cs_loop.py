@@ -1,4 +1,4 @@
-"""The native co-simulation loop against the Python loop, bit for bit, and against scipy; its
+"""The native co-simulation loop against the Python loop, bit for bit, and against the reference; its
 failures and its restarts.
 """
 
@@ -40,7 +40,7 @@ def test_native_loop_matches_the_python_loop_bit_for_bit(fmu, ramp):
     native, python = runs
     for name in native.dtype.names:
         assert np.array_equal(native[name], python[name]), name
-    # And both are the physics: the scipy oracle of the same schedule.
+    # And both are the physics: the oracle of the same schedule.
     oracle = reference_schedule(plan, theta0=0.2, parameters={"damping": 1.5})
     assert np.max(np.abs(native["theta"] - oracle["theta"])) < 1e-9
 

@@ -1,7 +1,7 @@
-"""MuJoCo, Drake and PyBullet against the scipy reference: accuracy, defaults, traps, parameters.
+"""MuJoCo, Drake and PyBullet against the reference: accuracy, defaults, traps, parameters.
 
 Each engine is skipped when its package is not installed. The random step signal is made here
-from numpy's generator; the reference is pendulum_fmu.reference (scipy DOP853 at 1e-12), which
+from numpy's generator; the reference is pendulum_fmu.reference (its Taylor series), which
 shares no code with the adapters.
 """
 

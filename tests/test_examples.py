@@ -47,7 +47,7 @@ def test_closed_loop_pd_settles_and_follows_the_applied_torques():
     time, theta, omega, torque = example.run(stop_time=3.0)
     assert abs(theta[-1] - 0.5) < 2e-3
     assert example.settling_time(time, theta, 0.5) < 2.5
-    # The same torque sequence through scipy gives the same trajectory.
+    # The same torque sequence through the reference gives the same trajectory.
     oracle = reference_schedule(TorqueSchedule(time=time, torque=torque, torque_rate=np.zeros_like(torque)))
     assert np.max(np.abs(theta - oracle["theta"])) < 1e-10
     assert np.max(np.abs(omega - oracle["omega"])) < 1e-10

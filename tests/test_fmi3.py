@@ -126,7 +126,7 @@ def test_co_simulation_gives_exactly_the_fmi2_numbers(fmu, fmu3, gravity):
     )
 
 
-def test_variable_steps_match_fmi2_and_scipy(fmu, fmu3):
+def test_variable_steps_match_fmi2_and_the_reference(fmu, fmu3):
     steps = np.tile([1e-3, 7e-3, 0.05, 2.5e-4, 0.1], 12)
     time = np.concatenate([[0.0], np.cumsum(steps)])
     plan = TorqueSchedule(time=time, torque=30.0 * np.sin(3.0 * time[:-1]), torque_rate=np.zeros(len(steps)))
@@ -249,7 +249,7 @@ def test_directional_derivatives_match_finite_differences(fmu, fmu3, tmp_path, v
 
 
 @pytest.mark.parametrize("gravity", [0.0, 9.81])
-def test_model_exchange_cvode_at_default_tolerance_within_1e6_of_scipy(fmu3, gravity):
+def test_model_exchange_cvode_at_default_tolerance_within_1e6_of_the_reference(fmu3, gravity):
     torque = np.array([(0.0, 20.0), (3.0, 20.0)], dtype=[("time", "f8"), ("torque", "f8")])
     result = simulate_fmu(
         str(fmu3),

@@ -1,4 +1,4 @@
-"""The FMU driven by fmpy, against analytic solutions and scipy."""
+"""The FMU driven by fmpy, against analytic solutions and the reference."""
 
 import ctypes
 import subprocess
@@ -71,7 +71,7 @@ def test_gravity_off_is_the_exact_parabola(fmu):
     assert np.max(np.abs(result["alpha"] - 20.0 / I_TOTAL)) < 1e-14
 
 
-def test_gravity_on_matches_scipy(fmu):
+def test_gravity_on_matches_the_reference(fmu):
     result = simulate(20.0, fmu_path=fmu)
     expected = reference(20.0)
     assert np.max(np.abs(result["theta"] - expected["theta"])) < 1e-10
@@ -109,7 +109,7 @@ def test_ramped_torque_is_the_exact_cubic(fmu):
     assert np.max(np.abs(result["torque"] - (5 + 10 * t))) < 1e-12
 
 
-def test_ramped_torque_with_gravity_matches_scipy(fmu):
+def test_ramped_torque_with_gravity_matches_the_reference(fmu):
     # 20 ms steps at the default 1e-10 drift by ~3e-13 a step; ask for what the test checks.
     def signal(t):
         return 40 * np.cos(3 * t)

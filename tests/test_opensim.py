@@ -1,4 +1,4 @@
-"""OpenSim 4.6 running the tutorial's model agrees with the FMU and scipy."""
+"""OpenSim 4.6 running the tutorial's model agrees with the FMU and the reference."""
 
 import re
 

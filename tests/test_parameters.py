@@ -1,7 +1,7 @@
 """One validation: every tool refuses a parameter set the FMU refuses, with the FMU's own words.
 
 The physical checks live once, in the FMU's model.c; simulate.resolve_parameters asks the FMU,
-and the scipy reference, OpenSim and the engines all go through it.
+and the reference, OpenSim and the engines all go through it.
 """
 
 import importlib.util

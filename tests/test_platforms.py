@@ -196,7 +196,7 @@ def test_each_platforms_binary_writes_its_record_only_into_a_record_of_its_own(e
         assert "is a symbolic link" in run("link.log")
 
 
-# linux64 too: there the master of each FMI version checks the other's, and scipy, with no cross tools.
+# linux64 too: there the master of each FMI version checks the other's, and the reference, with no cross tools.
 @pytest.mark.parametrize("platform", ["linux64", *CROSS])
 @EACH_FMI_VERSION
 def test_binary_on_its_platform_matches_linux64_in_both_fmi_versions(every_platform, fmi_version, platform):
@@ -205,7 +205,7 @@ def test_binary_on_its_platform_matches_linux64_in_both_fmi_versions(every_platf
     # Both versions are the same plumbing and model behind other entry points, so the same numbers.
     for version, build in every_platform.items():
         assert np.max(np.abs(run - _theta_by_step_master(build, "linux64"))) <= 1e-15, version
-    # And the pendulum: scipy's DOP853 at 1e-12 on the same held torque.
+    # And the pendulum: the reference on the same held torque.
     expected = reference(20.0, stop_time=STEPS * STEP_SIZE, step_size=STEP_SIZE)["theta"]
     assert np.max(np.abs(run - expected)) < 1e-9
 
@@ -534,7 +534,7 @@ def test_zig_stands_in_for_a_missing_cross_gcc_with_the_gcc_builds_theta(
         # zig's DLL takes sin and cos from zig's own mingw-w64 runtime and pow from the UCRT (here
         # wine's), which round differently from glibc in the last bit now and then; the mingw
         # build's sin, cos and pow happen to give glibc's bits on this case. So: the tolerance of
-        # test_binary_on_its_platform_matches_linux64_in_both_fmi_versions, and scipy's pendulum.
+        # test_binary_on_its_platform_matches_linux64_in_both_fmi_versions, and the reference's pendulum.
         assert np.max(np.abs(run - gcc)) <= 1e-15
         expected = reference(20.0, stop_time=STEPS * STEP_SIZE, step_size=STEP_SIZE)["theta"]
         assert np.max(np.abs(run - expected)) < 1e-9

@@ -1,4 +1,4 @@
-"""Parameter studies on dask: the written study against simulate() and the analytic and scipy
+"""Parameter studies on dask: the written study against simulate() and the analytic and Taylor
 references, resume, failures, fsspec URLs, a cluster of separate processes, signals and
 concurrent runs, and the studies refused before anything starts.
 """

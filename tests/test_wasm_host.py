@@ -1,6 +1,6 @@
 """The FMU's WebAssembly binary (wasm32-wasip2, FMI-LS-WASM) run by the package through wasmtime:
 the numbers of its native FMI 3.0 binary, Co-Simulation and Model Exchange, on the seed case and the
-quick start's jump; the scipy reference's; the same commands; one-line refusals.
+quick start's jump; the reference's; the same commands; one-line refusals.
 """
 
 import sys
@@ -70,7 +70,7 @@ def test_co_simulation_is_the_native_binary_to_1e_12(wasm_fmu, jump, signal):
     assert np.array_equal(ours["time"], native["time"]) and np.array_equal(ours["torque"], native["torque"])
     assert np.max(np.abs(ours["theta"] - native["theta"])) <= 1e-12
     assert np.max(np.abs(ours["omega"] - native["omega"])) <= 1e-12
-    # And the independent scipy reference, as the native binary is held to it (test_fmi3.py).
+    # And the independent reference, as the native binary is held to it (test_fmi3.py).
     plan = schedule(torque, stop_time=3.0, step_size=1e-3)
     assert np.max(np.abs(ours["theta"] - reference_schedule(plan)["theta"])) < 1e-9
 

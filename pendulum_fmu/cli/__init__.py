@@ -49,7 +49,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="pendulum-fmu",
         description="A torque-driven pendulum as an FMI 2.0 (or 3.0) FMU: build it, "
-        "simulate it, and compare it with scipy and OpenSim.",
+        "simulate it, and compare it with an independent reference and OpenSim.",
     )
     parser.add_argument("--version", action="version", version=f"pendulum-fmu {__version__}")
     parser.add_argument(

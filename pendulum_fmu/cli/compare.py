@@ -13,7 +13,7 @@ def add_parser(commands) -> argparse.ArgumentParser:
         "compare",
         help="run one torque signal through several tools",
         description="Run one torque signal through the FMU and OpenSim "
-        "and judge each against the independent scipy "
+        "and judge each against the independent "
         "reference, which reads the signal itself: write "
         "trajectories, a table of max and RMS differences "
         "(and of the torque each tool received against the "

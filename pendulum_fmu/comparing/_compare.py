@@ -46,7 +46,7 @@ def run_tools(
 ) -> dict[str, np.ndarray]:
     """{tool label: result array} for the same schedule, parameters and start values; tools as
     --tools gives them (see _compare_tools.py), mapping the --map of other FMUs. "reference" here is
-    reference_schedule: the schedule's own torques through scipy.
+    reference_schedule: the schedule's own torques, integrated on their own.
     """
     model = fmu_model(fmu_path)  # read once, passed to every tool
     parsed = parse_tools(tools, mapping=mapping, fmu_path=model)

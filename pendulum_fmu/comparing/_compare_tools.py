@@ -127,7 +127,7 @@ def run_reference(
     mode: str = "accurate",
     fmu_path: str | Path | FmuModel | None = None,
 ) -> np.ndarray:
-    """The schedule's own torques through scipy (_reference.py); fmu_path's defaults apply."""
+    """The schedule's own torques through the reference (_reference.py); fmu_path's defaults apply."""
     check_mode(mode, "reference")
     return reference_schedule(plan, parameters=parameters, theta0=theta0, omega0=omega0, fmu_path=fmu_path)
 

@@ -1,6 +1,6 @@
 """The OpenSim pendulum tutorial end to end, as `pendulum-fmu demo` runs it.
 
-Gravity off and on, the FMU against the scipy reference (and OpenSim when installed), with the
+Gravity off and on, the FMU against the independent reference (and OpenSim when installed), with the
 error table of each; the two runs overlaid; and the tutorial's parameter study on a local dask
 cluster. It prints what it finds and writes the figures and tables into one folder.
 """

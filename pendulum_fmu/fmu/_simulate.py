@@ -288,7 +288,7 @@ def resolve_parameters(
     fmu_path is the FMU: a path, its model (fmu_model), or None for the default FMU.
 
     The physical checks (mass > 0, an inertia about the pivot > 0, ...) live in one place, the
-    FMU's model.c, and every tool goes through them here: the FMU, the scipy reference, OpenSim,
+    FMU's model.c, and every tool goes through them here: the FMU, the reference, OpenSim,
     the engines. Each refuses a bad set with the FMU's own message, word for word.
     """
     model = fmu_model(fmu_path)

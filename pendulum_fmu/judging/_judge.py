@@ -5,8 +5,8 @@
 
 A result is a CSV with a time column and theta, optionally omega and alpha (any names and units,
 through --map as compare's: theta=phi*0.0174532925). The verdict compares it with the
-independent reference (reference.reference: the signal read by its own reader, scipy DOP853 at
-1e-12) at the result's own times: pass when max |dtheta| <= the tolerance.
+independent reference (reference.reference: the signal read by its own reader, integrated by
+its Taylor series) at the result's own times: pass when max |dtheta| <= the tolerance.
 
 A result that fails gets a diagnosis. Each candidate mistake is a variant of the run with that
 mistake made: the schedule a master should feed (torque_schedule.schedule) changed as the mistake changes

@@ -213,7 +213,7 @@ it holds, held where it ramps, time grid drift, state not restored, integration 
 residual. `pendulum-fmu judge NAME_out.csv` with the scenario's options (`--torque-file
 NAME_in.csv --step-size ... --set ...`) gives the full table, `--plot` a figure, `--json` the
 numbers. `NAME_ref.csv` holds the reference itself: time (s), torque (N.m), theta (rad), omega
-(rad/s), alpha (rad/s2) at every communication point, from scipy (DOP853, tolerance 1e-12).
+(rad/s), alpha (rad/s2) at every communication point, from the reference (its Taylor series, 1e-14 a step).
 
 With each `NAME_out.csv`, send the FMU's call record of that run as `NAME_calls.log`: the FMU
 writes one `[pendulum-calls]` line per call it receives (category `logCalls`) when the master
