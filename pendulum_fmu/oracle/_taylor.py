@@ -114,11 +114,11 @@ def integrate_piece(
             last_terms = ((x[k + 2], k + 2), (x[k + 1], k + 1), (v[k + 1], k + 1), (v[k], k))
             if not all(math.isfinite(term) for term, _ in last_terms):
                 raise Diverged("a Taylor coefficient is not finite")
-            if k and all(abs(term) * remaining**power <= bound for term, power in last_terms):
-                step = remaining
-                break
-        else:
-            step = min(remaining, *((bound / abs(term)) ** (1.0 / power) for term, power in last_terms if term))
+            if k:  # the longest step at which each of those terms stays below the bound
+                reach = min((bound / abs(term)) ** (1.0 / power) if term else math.inf for term, power in last_terms)
+                if remaining <= reach:
+                    break
+        step = min(remaining, reach)
         stop = end if step == remaining else t + step
         if stop <= t < end:
             raise Diverged(f"the step needed underflows at t = {t:g} s")
