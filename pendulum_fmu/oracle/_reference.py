@@ -322,6 +322,9 @@ def _integrate(
     # Each reported time belongs to the first piece that reaches it (a time a rounding past the
     # end of the run belongs to the last).
     owner = np.minimum(np.searchsorted(ends, at, side="left"), len(ends) - 1)
+    # The reports by piece and, within one, by time: a piece's are a slice, found by bisection.
+    by_piece = np.lexsort((at, owner))
+    owners = owner[by_piece].tolist()
     out = results.empty(len(at))
     out["time"] = at
     theta, omega = float(theta0), float(omega0)
@@ -338,16 +341,14 @@ def _integrate(
         ):
             last += 1
         t0, t1, u0, rate = starts[first], ends[last], pieces.u0[first], pieces.rate[first]
-        mine = np.flatnonzero((owner >= first) & (owner <= last))
-        report = np.clip(at[mine], t0, t1)
-        order = np.argsort(report, kind="stable")
+        mine = by_piece[bisect.bisect_left(owners, first) : bisect.bisect_right(owners, last)]
         try:
             thetas, omegas, theta, omega = integrate_piece(
-                theta, omega, (t0, t1), (u0, rate), model, (rtol, atol), report[order].tolist()
+                theta, omega, (t0, t1), (u0, rate), model, (rtol, atol), np.clip(at[mine], t0, t1).tolist()
             )
         except Diverged as error:
             raise _failed(str(error), t0, parameters, theta0, omega0, pieces) from None
-        out["theta"][mine[order]], out["omega"][mine[order]] = thetas, omegas
+        out["theta"][mine], out["omega"][mine] = thetas, omegas
         first = last + 1
     out["torque"] = pieces.values_after(at)
     # The end of the run reports the torque the last piece reached, as a master reads it back.
