@@ -281,7 +281,7 @@ def equation_of_motion(parameters: dict[str, float]) -> Callable:
     callable
         acceleration(theta, omega, torque).
     """
-    gravity_moment, damping, inverse_inertia = _model(parameters)
+    gravity_moment, damping, inverse_inertia = model_constants(parameters)
 
     def acceleration(theta, omega, u):
         return (u - gravity_moment * np.sin(theta) - damping * omega) * inverse_inertia
@@ -289,8 +289,19 @@ def equation_of_motion(parameters: dict[str, float]) -> Callable:
     return acceleration
 
 
-def _model(parameters: dict[str, float]) -> tuple[float, float, float]:
-    """mass*gravity*length, damping and 1/total inertia: the equation's three constants."""
+def model_constants(parameters: dict[str, float]) -> tuple[float, float, float]:
+    """mass*gravity*length, damping and 1/total inertia: the equation's three constants, as
+    _taylor.integrate_piece takes them.
+
+    Parameters
+    ----------
+    parameters : dict
+        mass, length, inertia, gravity and damping, as resolve_parameters gives them.
+
+    Returns
+    -------
+    (float, float, float)
+    """
     with np.errstate(over="ignore"):  # values past the largest double fail where they are used
         return (
             parameters["mass"] * parameters["gravity"] * parameters["length"],
@@ -316,7 +327,7 @@ def _integrate(
                 f"{name} {value!r} must be a positive finite number (a tolerance of the reference's integrator)"
             )
     parameters = resolve_parameters(parameters, fmu_path)
-    acceleration, model = equation_of_motion(parameters), _model(parameters)
+    acceleration, model = equation_of_motion(parameters), model_constants(parameters)
     starts = [float(s) for s in pieces.starts]
     ends = [*starts[1:], float(pieces.stop)]
     # Each reported time belongs to the first piece that reaches it (a time a rounding past the

@@ -5,6 +5,6 @@ the System Structure and Parameterization file (pendulum-fmu export-ssp); _ssp_m
 through the masters that read SSP; _ssp_judge judges their coupling and _ssp_calls their calls;
 _ssp_kit adds the closed loop to the scenario kit.
 
-May import: judging/, scenarios/, fmu/, the basics and the top's own names (default_fmu, the
-packaged PID controller).
+May import: judging/, scenarios/, oracle/ (the closed loop's reference integrates as it does),
+fmu/, the basics and the top's own names (default_fmu, the packaged PID controller).
 """

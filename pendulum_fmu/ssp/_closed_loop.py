@@ -20,14 +20,14 @@ from fmpy import read_model_description
 from fmpy.container_fmu.cli import create_container_fmu
 from fmpy.container_fmu.config import Component, Configuration, Connection
 from fmpy.model_description import CoSimulation, DefaultExperiment, ModelDescription, ModelVariable
-from scipy.integrate import solve_ivp
 
 from .. import default_fmu
 from .._atomic_files import replacing
 from .._checkout import ROOT, build_tool, is_source_checkout
 from .._errors import InvalidInput
-from ..fmu._parameters import total_inertia
 from ..fmu._simulate import resolve_parameters
+from ..oracle._reference import model_constants
+from ..oracle._taylor import integrate_piece
 
 # Pendulum output -> controller input, and back.
 WIRES = (
@@ -216,7 +216,7 @@ def sampled_loop_reference(
     """time, theta, omega, torque of the sampled loop under one master's coupling.
 
     Each step a torque from the PID law (written here in Python, not the controller FMU's code)
-    is held while scipy integrates the pendulum; the controller's error integral of a held error
+    is held while the reference's Taylor series integrates the pendulum; the controller's error integral of a held error
     is exact. Masters differ in when they read the controller's torque, a direct feedthrough of
     theta (see COUPLINGS): fmpy's container is Gauss-Seidel with the pendulum first, libcosim
     Jacobi, fmpy.ssp Jacobi with no exchange before the first step.
@@ -232,7 +232,7 @@ def sampled_loop_reference(
     coupling : str, optional
         A key of COUPLINGS.
     rtol : float, optional
-        scipy's relative and absolute tolerance per step.
+        The integrator's relative and absolute tolerance a step.
 
     Returns
     -------
@@ -252,12 +252,10 @@ def sampled_loop_reference(
     if coupling not in COUPLINGS:
         raise InvalidInput(f"coupling {coupling!r} is none of {', '.join(COUPLINGS)}")
     gains = {**controller_defaults(), **(controller or {})}
-    p = resolve_parameters(parameters)
-    inverse_inertia = 1.0 / total_inertia(p)
-    gravity_moment = p["mass"] * p["gravity"] * p["length"]
+    model = model_constants(resolve_parameters(parameters))
     n = round(stop_time / step_size)
     out = np.zeros(n + 1, dtype=[("time", "f8"), ("theta", "f8"), ("omega", "f8"), ("torque", "f8")])
-    state, integral = np.zeros(2), 0.0
+    state, integral = (0.0, 0.0), 0.0
     previous = state  # theta, omega at the last communication point, what a Jacobi master last sent
 
     def law(measured, error_integral):
@@ -278,10 +276,6 @@ def sampled_loop_reference(
         out[k] = (k * step_size, state[0], state[1], torque)
         if k == n:
             break
-
-        def rhs(t, y, u=torque):
-            return y[1], (u - gravity_moment * np.sin(y[0]) - p["damping"] * y[1]) * inverse_inertia
-
         integral, previous = next_integral, state
-        state = solve_ivp(rhs, (0.0, step_size), state, method="DOP853", rtol=rtol, atol=rtol).y[:, -1]
+        state = integrate_piece(*state, (0.0, step_size), (torque, 0.0), model, (rtol, rtol), [])[2:]
     return out

@@ -31,7 +31,7 @@ from ._ssp import SspSettings, read_ssp
 from ._ssp_judge import reference_run
 
 # A torque the master passed agrees with the coupling's reference to this, relative to
-# max(1 N.m, |torque|): the record holds doubles at round-trip precision, the reference is scipy's
+# max(1 N.m, |torque|): the record holds doubles at round-trip precision, the reference is integrated
 # at 1e-12 per step, and the couplings' torques differ by 1e-4 N.m and more from the first steps.
 TORQUE_TOLERANCE = 1e-8
 # Step sizes and times a master computed in its own arithmetic (libcosim counts nanoseconds)
