@@ -4,7 +4,7 @@ The API is this package's names. Its folders are its jobs, bottom up: signals/, 
 engines/, figures/, sweep/, comparing/, scenarios/, judging/, ssp/, cli/ (each one's docstring
 says what it may import; docs/layout.md draws them); the modules in them are private. Each
 name is imported from its module on first use, so that ``import pendulum_fmu`` loads neither
-numpy, fmpy, scipy, matplotlib nor dask::
+numpy, fmpy, matplotlib nor dask::
 
     from pendulum_fmu import compare, default_fmu, judge, reference, run_sweep, simulate, Study
 """
