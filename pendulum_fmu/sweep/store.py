@@ -302,7 +302,8 @@ class Store:
         for path in sorted(self.parts("cases").values()):
             with self.filesystem.open(path, "rb") as file:
                 part = pq.ParquetFile(file).read(columns=columns)
-            # The parts' columns have these types (Store.write_table's): only the fields' flags
-            # differ (not nullable there). Not cast: a cast imports pyarrow.compute.
+            # Given the schema, not cast: a cast imports pyarrow.compute even where only the
+            # fields' nullable flags differ, as they do; a column of another type (int32 case
+            # numbers, numpy 1 on Windows) is cast all the same.
             tables.append(pa.Table.from_arrays(part.columns, schema=selected))
         return pa.concat_tables(tables)
