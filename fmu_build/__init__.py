@@ -24,56 +24,113 @@ model's modelDescription.xml, so the XML stays the single source of truth; fmi3.
 FMI 3.0 description from the FMI 2.0 one; wasm_glue.py the WebAssembly component's canonical-ABI
 glue from its WIT world (both run by CMake, standard library only).
 
+Each name is imported from its module on first use (__getattr__ below): what a checkout's
+package asks on every start (its FMU's path and whether it is stale, the build command's help)
+loads sources.py and platforms.py, not fmpy and the zipping of fmu_file.py (start-up time).
+
 Builds only ever run from a source tree (a clone or the sdist): an installed package carries the
 built FMU as package data instead (see pendulum_fmu.default_fmu).
 """
 
+from typing import TYPE_CHECKING
+
+from pendulum_fmu import _imported_on_first_use
 from pendulum_fmu._errors import BuildError, PlatformSkipped
 
-from .binaries import cmake_build, compile_native_loop, run_tool
-from .documentation import documentation_html
-from .fmu_file import build_fmu, build_pid_controller
-from .macho import MachOError, merge_universal
-from .model_variables import ModelDescriptionError, generate_variables
-from .platforms import (
-    PLATFORMS,
-    WASM,
-    WASM_TARGET,
-    ZIG,
-    ZIG_GLIBC,
-    ZIG_PACKAGE,
-    Platform,
-    Target,
-    available_platforms,
-    check_platforms,
-    check_toolchain,
-    check_wasm_toolchain,
-    find_wasm_tools,
-    find_zig,
-)
-from .sources import (
-    CHECKOUT_CONTROLLER,
-    CHECKOUT_FMUS,
-    CMAKE_LISTS,
-    DEFAULT_FMU,
-    FMI_HEADERS,
-    FMI_VERSIONS,
-    HEADERS_DIR,
-    MODEL_DESCRIPTION,
-    MODEL_FILES,
-    MODELS,
-    PENDULUM_DIR,
-    PID_CONTROLLER_DIR,
-    PLUMBING_DIR,
-    ROOT,
-    SOURCE_DIR,
-    TOOLCHAINS,
-    Model,
-    assemble_sources,
-    build_inputs,
-    fmu_is_stale,
-    is_source_checkout,
-)
+if TYPE_CHECKING:  # the names, for the checkers; imported on first use at run time
+    from .binaries import cmake_build, compile_native_loop, run_tool
+    from .documentation import documentation_html
+    from .fmu_file import build_fmu, build_pid_controller
+    from .macho import MachOError, merge_universal
+    from .model_variables import ModelDescriptionError, generate_variables
+    from .platforms import (
+        PLATFORMS,
+        WASM,
+        WASM_TARGET,
+        ZIG,
+        ZIG_GLIBC,
+        ZIG_PACKAGE,
+        Platform,
+        Target,
+        available_platforms,
+        check_platforms,
+        check_toolchain,
+        check_wasm_toolchain,
+        find_wasm_tools,
+        find_zig,
+    )
+    from .sources import (
+        CHECKOUT_CONTROLLER,
+        CHECKOUT_FMUS,
+        CMAKE_LISTS,
+        DEFAULT_FMU,
+        FMI_HEADERS,
+        FMI_VERSIONS,
+        HEADERS_DIR,
+        MODEL_DESCRIPTION,
+        MODEL_FILES,
+        MODELS,
+        PENDULUM_DIR,
+        PID_CONTROLLER_DIR,
+        PLUMBING_DIR,
+        ROOT,
+        SOURCE_DIR,
+        TOOLCHAINS,
+        Model,
+        assemble_sources,
+        build_inputs,
+        fmu_is_stale,
+        is_source_checkout,
+    )
+
+# The public name -> the module that holds it, imported on first use (__getattr__ below).
+_LAZY = {
+    "cmake_build": "binaries",
+    "compile_native_loop": "binaries",
+    "run_tool": "binaries",
+    "documentation_html": "documentation",
+    "build_fmu": "fmu_file",
+    "build_pid_controller": "fmu_file",
+    "MachOError": "macho",
+    "merge_universal": "macho",
+    "ModelDescriptionError": "model_variables",
+    "generate_variables": "model_variables",
+    "PLATFORMS": "platforms",
+    "WASM": "platforms",
+    "WASM_TARGET": "platforms",
+    "ZIG": "platforms",
+    "ZIG_GLIBC": "platforms",
+    "ZIG_PACKAGE": "platforms",
+    "Platform": "platforms",
+    "Target": "platforms",
+    "available_platforms": "platforms",
+    "check_platforms": "platforms",
+    "check_toolchain": "platforms",
+    "check_wasm_toolchain": "platforms",
+    "find_wasm_tools": "platforms",
+    "find_zig": "platforms",
+    "CHECKOUT_CONTROLLER": "sources",
+    "CHECKOUT_FMUS": "sources",
+    "CMAKE_LISTS": "sources",
+    "DEFAULT_FMU": "sources",
+    "FMI_HEADERS": "sources",
+    "FMI_VERSIONS": "sources",
+    "HEADERS_DIR": "sources",
+    "MODEL_DESCRIPTION": "sources",
+    "MODEL_FILES": "sources",
+    "MODELS": "sources",
+    "PENDULUM_DIR": "sources",
+    "PID_CONTROLLER_DIR": "sources",
+    "PLUMBING_DIR": "sources",
+    "ROOT": "sources",
+    "SOURCE_DIR": "sources",
+    "TOOLCHAINS": "sources",
+    "Model": "sources",
+    "assemble_sources": "sources",
+    "build_inputs": "sources",
+    "fmu_is_stale": "sources",
+    "is_source_checkout": "sources",
+}
 
 __all__ = [
     "CHECKOUT_CONTROLLER",
@@ -124,3 +181,11 @@ __all__ = [
     "merge_universal",
     "run_tool",
 ]
+
+
+def __getattr__(name: str):
+    return _imported_on_first_use(globals(), _LAZY, name)
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__})

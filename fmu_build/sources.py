@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from pendulum_fmu import CONTROLLER_FMU_FILE, FMU_FILES
+from pendulum_fmu._checkout import CHECKOUT_FMUS  # FMI version -> the FMU a checkout builds and runs
 from pendulum_fmu._errors import BuildError
 
 from . import fmi3
@@ -27,8 +28,6 @@ PLUMBING_DIR = SOURCE_DIR / "src"
 HEADERS_DIR = SOURCE_DIR / "include"
 MODEL_DESCRIPTION = ROOT / "modelDescription.xml"
 FMI_VERSIONS = tuple(FMU_FILES)
-# FMI version -> the FMU a checkout builds and runs when none is named.
-CHECKOUT_FMUS = {version: ROOT / "dist" / name for version, name in FMU_FILES.items()}
 DEFAULT_FMU = CHECKOUT_FMUS[2]
 CHECKOUT_CONTROLLER = ROOT / "dist" / CONTROLLER_FMU_FILE
 MODEL_FILES = ("config.h", "model.c")

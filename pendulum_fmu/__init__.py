@@ -75,15 +75,23 @@ _LAZY = {
 __all__ = ["FMU_FILES", "__version__", "default_fmu", *_LAZY]
 
 
-def __getattr__(name: str):
-    module = _LAZY.get(name)
+def _imported_on_first_use(namespace: dict, lazy: dict[str, str], name: str):
+    """The value of name in a package whose names are imported on first use (this one, the
+    repository's fmu_build): namespace is the package's globals, lazy its name -> module table
+    (the module relative to the package). Kept in namespace, found there from then on.
+    """
+    module = lazy.get(name)
     if module is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+        raise AttributeError(f"module {namespace['__name__']!r} has no attribute {name!r}")
     from importlib import import_module
 
-    value = getattr(import_module(f"{__name__}.{module}"), name)
-    globals()[name] = value  # found here from now on, without this function
+    value = getattr(import_module(f"{namespace['__name__']}.{module}"), name)
+    namespace[name] = value  # found there from now on, without the package's __getattr__
     return value
+
+
+def __getattr__(name: str):
+    return _imported_on_first_use(globals(), _LAZY, name)
 
 
 def __dir__() -> list[str]:

@@ -13,8 +13,13 @@ import importlib.util
 import sys
 from pathlib import Path
 
+from . import FMU_FILES
+
 ROOT = Path(__file__).resolve().parent.parent
 BUILD_TOOL = ROOT / "fmu_build" / "__init__.py"
+# FMI version -> the FMU a checkout builds and runs when none is named (the build tool's too):
+# here, so that the build command's help names them without importing the build tool's sources.
+CHECKOUT_FMUS = {version: ROOT / "dist" / name for version, name in FMU_FILES.items()}
 # What a checkout has beside the package and an installed package has not.
 CHECKOUT_MARKERS = (BUILD_TOOL, ROOT / "modelDescription.xml", ROOT / "CMakeLists.txt", ROOT / "fmu_src")
 

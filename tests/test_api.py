@@ -21,16 +21,19 @@ HEAVY = ("matplotlib", "dask", "distributed", "scipy", "fmpy", "numpy", "pyarrow
 def _loaded_after(code: str) -> dict:
     """Run code in a fresh interpreter from the repository's root.
 
-    Returns what it printed, the top-level packages and the pendulum_fmu modules it loaded.
+    Returns what it printed, the top-level packages, the pendulum_fmu modules and all the
+    modules it loaded.
     """
-    script = (
-        f"{code}\nimport json, sys\n"
-        "print(json.dumps({'top': sorted({name.split('.')[0] for name in sys.modules}), "
-        "'ours': sorted(name for name in sys.modules if name.startswith('pendulum_fmu'))}))"
-    )
+    script = f"{code}\nimport json, sys\nprint(json.dumps(sorted(sys.modules)))"
     done = subprocess.run([sys.executable, "-c", script], cwd=ROOT, capture_output=True, text=True, check=True)
     *printed, loaded = done.stdout.splitlines()
-    return {**json.loads(loaded), "printed": printed}
+    modules = json.loads(loaded)
+    return {
+        "top": sorted({name.split(".")[0] for name in modules}),
+        "ours": [name for name in modules if name.startswith("pendulum_fmu")],
+        "modules": modules,
+        "printed": printed,
+    }
 
 
 def test_import_pendulum_fmu_loads_no_numerics_nor_plotting():
@@ -75,13 +78,39 @@ def test_the_command_lines_judge_loads_matplotlib_only_to_draw(tmp_path):
     result = pendulum_fmu.simulate(str(torque))
     rows = zip(result["time"].tolist(), result["theta"].tolist(), strict=True)
     (tmp_path / "out.csv").write_text("time,theta\n" + "".join(f"{t!r},{theta!r}\n" for t, theta in rows))
-    judged = f"main(['judge', {str(tmp_path / 'out.csv')!r}, '--torque-file', {str(torque)!r}])"
+    # The FMU named, as the README's quick start names the one fmpy ran.
+    fmu = str(pendulum_fmu.default_fmu())
+    judged = f"main(['judge', {str(tmp_path / 'out.csv')!r}, '--torque-file', {str(torque)!r}, '--fmu', {fmu!r}])"
     loaded = _loaded_after(f"from pendulum_fmu.cli import main\nprint({judged})")
     assert "matplotlib" not in loaded["top"] and "dask" not in loaded["top"]
     assert "pendulum_fmu.figures._plot" not in loaded["ours"]
+    # Nor what a judgement of a short signal has no use for, each a part of its start-up (issue
+    # 42): pyarrow (the signal is read in Python), psutil (only a large run asks for the free
+    # memory), the checkout's build of the FMU (the parser reads only its paths and platforms).
+    assert not {"pyarrow", "psutil"} & set(loaded["top"])
+    assert not {"fmu_build.fmu_file", "fmu_build.binaries"} & set(loaded["modules"])
     # It still judged: the FMU's run agrees with the reference, exit 0.
     assert loaded["printed"][-1] == "0", loaded["printed"]
     assert loaded["printed"][0].startswith(f"{tmp_path / 'out.csv'}: pass: agrees (residual ")
+
+
+def test_the_command_lines_small_study_loads_neither_dask_nor_the_dataset_reader(tmp_path):
+    fmu = str(pendulum_fmu.default_fmu())
+    command = ["sweep", "--torque", "5", "20", "--stop-time", "0.5", "--no-figure", "--fmu", fmu]
+    command += ["--output-dir", str(tmp_path / "study")]
+    loaded = _loaded_after(f"from pendulum_fmu.cli import main\nprint(main({command!r}))")
+    # Run in the process, its cases read back part by part; its start-up (issue 42) builds no
+    # FMU and reads no dataset.
+    assert not {"dask", "distributed", "matplotlib"} & set(loaded["top"])
+    assert not {"pyarrow.dataset", "fmu_build.fmu_file", "fmu_build.binaries"} & set(loaded["modules"])
+    assert loaded["printed"][-1] == "0"
+    # It still ran: its cases table holds the FMU's final angles, against the scipy reference.
+    import pyarrow.parquet as pq
+
+    cases = pq.read_table(tmp_path / "study" / "cases").to_pydict()
+    assert cases["status"] == ["ok", "ok"]
+    oracle = [pendulum_fmu.reference(torque, stop_time=0.5)["theta"][-1] for torque in (5.0, 20.0)]
+    assert cases["final_theta"] == pytest.approx(oracle, abs=1e-9)
 
 
 def test_the_names_at_the_top_are_the_api():

@@ -19,6 +19,7 @@ from importlib import import_module
 
 import numpy as np
 import psutil
+import pyarrow as pa
 import pyarrow.csv
 import pyarrow.dataset as ds
 import pytest
@@ -32,7 +33,7 @@ from pendulum_fmu._errors import InvalidInput
 from pendulum_fmu.cli import main
 from pendulum_fmu.oracle._reference import reference
 from pendulum_fmu.sweep import OUTPUTS, Study, run_sweep, sweep_grid
-from pendulum_fmu.sweep.store import Store, StudyExists
+from pendulum_fmu.sweep.store import SUMMARIES, Store, StudyExists
 from pendulum_fmu.sweep.worker import Task, kept_points, run_chunk
 
 # The module; the package's attribute of that name is its function.
@@ -450,6 +451,26 @@ def test_a_run_commits_only_the_parts_staged_under_its_own_token(tmp_path):
     assert store.done_chunks() == set()
     store.commit(0, "other-run", ("cases",))
     assert store.done_chunks() == {0} and _table(tmp_path / "cases")["case"].tolist() == [0, 1, 2]
+
+
+def test_the_cases_table_reads_back_as_pyarrows_dataset_reads_it_whatever_int_the_parts_hold(tmp_path):
+    """Parts whose case numbers numpy made int32 (numpy 1 on Windows) or int64 read back alike,
+    in the order of their paths: the table pyarrow's dataset gives, case numbers as int64.
+    """
+    store = Store(LocalFileSystem(), str(tmp_path), "parquet")
+    summaries = {name: np.array([0.5, np.nan]) for name in SUMMARIES}
+    for index, integers in ((1, np.int64), (0, np.int32)):  # written in another order than read
+        columns = {"case": np.arange(2, dtype=integers) + 2 * index, "torque": np.array([1.0, 2.0]) + 2 * index}
+        columns |= {**summaries, "status": ["ok", "failed"], "message": ["", "refused"]}
+        store.write_table("cases", index, columns, "run")
+        store.commit(index, "run", ("cases",))
+    table = store.read_cases(["torque"])
+    types = {"case": pa.int64(), "torque": pa.float64(), **dict.fromkeys(SUMMARIES, pa.float64())}
+    dataset = ds.dataset(str(tmp_path / "cases"), format="parquet", schema=pa.schema(types | {"status": pa.string()}))
+    expected = dataset.to_table(columns=table.column_names)
+    assert table.schema == expected.schema
+    assert json.dumps(table.to_pydict()) == json.dumps(expected.to_pydict())  # NaN as NaN
+    assert table["case"].to_pylist() == [0, 1, 2, 3] and table["torque"].to_pylist() == [1.0, 2.0, 3.0, 4.0]
 
 
 def test_output_to_a_file_url(tmp_path):

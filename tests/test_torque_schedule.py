@@ -6,6 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from pendulum_fmu.signals import _torque_csv
 from pendulum_fmu.signals._time_grid import BYTES_PER_STEP, step_count
 from pendulum_fmu.signals._torque_csv import TorqueFileError, read_torque_csv
 from pendulum_fmu.signals._torque_schedule import schedule, write_torque_csv
@@ -173,3 +174,51 @@ def test_quoted_cells_are_numbers(tmp_path):
     csv = tmp_path / "t.csv"
     csv.write_text('time,torque\n"0","1"\n1,2\n')
     assert read_torque_csv(csv).torque.tolist() == [1, 2]
+
+
+# Cells each reader takes in its own way or refuses: the Python reader of a small file must
+# leave every one of them to pyarrow, or read it to pyarrow's double.
+UNUSUAL_CELLS = ["1.", ".5", "-.5", "1E+05", "-0", "007", "+1", " 1", "1 ", "1_0", "\u0663", "inf", "1e400"]
+UNUSUAL_CELLS += ["nan", "", '"2"', "0x10", "1e-400", "4.9e-324", "2.4703282292062328e-324", "9007199254740993"]
+
+
+def _random_decimal(rng: np.random.Generator) -> str:
+    """A decimal of up to 25 significant digits, subnormal to near the largest double: the
+    numbers whose rounding to a double two parsers could disagree on.
+    """
+    digits = "".join(rng.choice(list("0123456789"), size=rng.integers(1, 26)))
+    return f"{'-' if rng.random() < 0.5 else ''}{digits[:1]}.{digits[1:]}e{rng.integers(-330, 309)}"
+
+
+def _read(path) -> tuple:
+    try:
+        table = read_torque_csv(path)
+    except TorqueFileError as error:
+        return ("refused", str(error))
+    return (table.time.tolist(), table.torque.view(np.int64).tolist())  # the doubles' bits
+
+
+def test_a_small_file_reads_as_pyarrow_reads_it(tmp_path, monkeypatch):
+    """Every file, read in Python where it is small and plain, gives what pyarrow alone gives:
+    the same doubles, or the same refusal.
+    """
+    rng = np.random.default_rng(42)
+    read_in_python = 0
+    for case in range(300):
+        plain = case % 2 == 0
+        rows = []
+        for number in range(int(rng.integers(1, 6))):
+            time = str(number) if plain or rng.random() < 0.7 else str(rng.choice(UNUSUAL_CELLS))
+            torque = _random_decimal(rng) if plain or rng.random() < 0.5 else str(rng.choice(UNUSUAL_CELLS))
+            rows.append(f"{time},{torque},x" + ("" if plain or rng.random() < 0.9 else ",y"))
+        ending = str(rng.choice(["\n", "\r\n"] if plain else ["\n", "\r\n", "\r"]))
+        blank = ending if rng.random() < 0.3 else ""
+        path = tmp_path / f"t{case}.csv"
+        path.write_bytes(("time,torque,note" + ending + blank + ending.join(rows) + ending).encode())
+        raw, names = path.read_bytes(), ["time", "torque", "note"]
+        read_in_python += _torque_csv._parse_plain_numbers(raw, names, (0, 1)) is not None
+        in_python = _read(path)
+        with monkeypatch.context() as only_pyarrow:
+            only_pyarrow.setattr(_torque_csv, "SMALL_FILE_BYTES", -1)
+            assert in_python == _read(path), path.read_bytes()
+    assert read_in_python >= 150  # every plain file was read in Python

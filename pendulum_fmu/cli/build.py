@@ -9,7 +9,8 @@ from __future__ import annotations
 import argparse
 import zipfile
 
-from .._checkout import build_tool
+from .. import FMU_FILES
+from .._checkout import CHECKOUT_FMUS, build_tool
 from .._errors import BuildError
 from ._arguments import output_path
 
@@ -25,8 +26,9 @@ def _platforms(text: str) -> tuple[str, ...]:
 
 def add_parser(commands) -> argparse.ArgumentParser:
     """Declare `build` and its options, each with its help, among the parser's commands."""
+    # Every command's parser builds this one: the build tool's platforms alone are read (its
+    # platforms.py), not its sources.py (start-up time).
     tool = build_tool()
-    CHECKOUT_FMUS, FMI_VERSIONS, PLATFORMS = tool.CHECKOUT_FMUS, tool.FMI_VERSIONS, tool.PLATFORMS
     build = commands.add_parser(
         "build",
         help="build the FMU in a checkout (same as python build_fmu.py)",
@@ -41,7 +43,7 @@ def add_parser(commands) -> argparse.ArgumentParser:
     build.add_argument(
         "--fmi-version",
         type=int,
-        choices=FMI_VERSIONS,
+        choices=tuple(FMU_FILES),
         default=2,
         help="FMI standard of the FMU (default: %(default)s)",
     )
@@ -49,7 +51,7 @@ def add_parser(commands) -> argparse.ArgumentParser:
         "--platforms",
         type=_platforms,
         default=None,
-        help=f"comma-separated, among {', '.join(PLATFORMS)} and, for FMI 3.0, {tool.WASM} (the "
+        help=f"comma-separated, among {', '.join(tool.PLATFORMS)} and, for FMI 3.0, {tool.WASM} (the "
         "WebAssembly component) (default: every one whose compiler is installed; the others are skipped "
         "with a note)",
     )
@@ -68,7 +70,7 @@ def add_parser(commands) -> argparse.ArgumentParser:
 def run(args) -> int:
     """Run `pendulum-fmu build` with the parsed arguments; returns the exit status."""
     tool = build_tool()
-    output = args.output or tool.CHECKOUT_FMUS[args.fmi_version]
+    output = args.output or CHECKOUT_FMUS[args.fmi_version]
     path = tool.build_fmu(output, platforms=args.platforms, fmi_version=args.fmi_version, linux_glibc=args.linux_glibc)
     with zipfile.ZipFile(path) as fmu:
         binaries = [name for name in fmu.namelist() if name.startswith("binaries/")]

@@ -124,13 +124,13 @@ def _drifted(torque, times: np.ndarray, ramp: bool) -> list[TorqueSchedule]:
     return [TorqueSchedule(time=points, torque=start, torque_rate=rate)]
 
 
-def _euler(plan: TorqueSchedule, acceleration, theta0: float, omega0: float, semi_implicit: bool) -> np.ndarray:
-    """The equation of motion stepped once per communication step, holding each step's start
-    torque: explicit Euler, or semi-implicit (the new omega moves theta).
+def _euler(run: Run, acceleration, semi_implicit: bool) -> np.ndarray:
+    """The equation of motion stepped once per communication step of the run's plan, holding
+    each step's start torque: explicit Euler, or semi-implicit (the new omega moves theta).
     """
-    out = results.empty(len(plan.time))
+    plan, theta, omega = run.plan, run.theta0, run.omega0
+    out = results.empty(len(plan.time), run.model.recorded)  # its FMU's fields: no other looked up
     out["time"] = plan.time
-    theta, omega = theta0, omega0
     for k, (h, u) in enumerate(zip(plan.step_size.tolist(), plan.torque.tolist(), strict=False)):
         out["theta"][k], out["omega"][k] = theta, omega
         alpha = acceleration(theta, omega, u)
@@ -195,7 +195,7 @@ def _integration(run: Run) -> list[np.ndarray]:
     if index is None:
         return []
     acceleration = equation_of_motion(run.parameters)
-    return [_euler(run.plan, acceleration, run.theta0, run.omega0, semi)[index] for semi in (False, True)]
+    return [_euler(run, acceleration, semi)[index] for semi in (False, True)]
 
 
 def shared_variants(run: Run, torque, held: TorqueSchedule | None, start_torque: float) -> dict[str, list[np.ndarray]]:

@@ -278,7 +278,8 @@ class JudgedRun:
         """
         source = str(result) if isinstance(result, (str, Path)) else "result"
         if isinstance(result, (str, Path)):
-            result = read_result(result, mapping)
+            # The fields of this run's FMU: a judge of a named FMU looks no other up.
+            result = read_result(result, mapping, self.model.recorded)
         elif mapping:
             raise InvalidInput(
                 "a map renames and scales a result file's columns: an array result is "

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import csv
 import math
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -43,7 +44,9 @@ class ResultFileError(InvalidInput):
 _GIVE_CSV = "give the result CSV the tool wrote"
 
 
-def read_result(path: str | Path, mapping: str | dict | None = None) -> np.ndarray:
+def read_result(
+    path: str | Path, mapping: str | dict | None = None, recorded: Sequence[str] | None = None
+) -> np.ndarray:
     """A result CSV as a result array (_results.py); omega and alpha are NaN where it has none.
 
     Parameters
@@ -52,6 +55,9 @@ def read_result(path: str | Path, mapping: str | dict | None = None) -> np.ndarr
         A CSV with a header: a time column and theta, optionally omega and alpha.
     mapping : str or dict, optional
         Their names and unit factors, as --map gives them: "time=t,theta=phi*0.0174532925".
+    recorded : sequence of str, optional
+        The array's fields after time: the judged run's FMU's (FmuModel.recorded; default: the
+        default FMU's, looked up for it).
 
     Returns
     -------
@@ -98,7 +104,7 @@ def read_result(path: str | Path, mapping: str | dict | None = None) -> np.ndarr
     data = numbered[1:]
     if not data:
         raise ResultFileError(f"{path}: no data rows after the header")
-    out = results.empty(len(data))
+    out = results.empty(len(data), recorded)
     out["torque"] = np.nan
     for quantity in OPTIONAL:
         out[quantity] = np.nan

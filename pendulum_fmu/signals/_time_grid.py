@@ -12,7 +12,6 @@ import numbers
 from fractions import Fraction
 
 import numpy as np
-import psutil
 
 from .._errors import InvalidInput
 
@@ -86,6 +85,8 @@ def _check_times(start_time: float, stop_time: float, step_size: float) -> None:
 
 def _available_memory() -> int:
     """Bytes the machine can still give: MemAvailable on Linux, psutil's counterpart elsewhere."""
+    import psutil  # here, not at the top: only a run this large asks, and every command's start-up imports this module
+
     return psutil.virtual_memory().available
 
 

@@ -1,6 +1,7 @@
 """A torque CSV read as a signal: a TorqueTable, piecewise linear with a jump where a time repeats.
 
-The numbers are parsed in C by pyarrow in one pass; a file that is no signal is refused with
+The numbers are parsed in C by pyarrow in one pass, those of a small file of plain numbers in
+Python (quicker than importing pyarrow); a file that is no signal is refused with
 TorqueFileError, naming the file, the line and the problem (docs/signals.md).
 """
 
@@ -8,6 +9,7 @@ from __future__ import annotations
 
 import csv
 import math
+import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
@@ -17,6 +19,15 @@ import numpy as np
 from .._errors import InvalidInput
 from .._received_files import check_lines, shortened
 from ._time_grid import event_tolerance, nearest
+
+# A file up to this size whose numbers are all plain is read in Python, in a few ms: importing
+# pyarrow takes ~30 ms of the start-up of a judge or a simulate given a short signal. A larger file,
+# or one with anything else in it, is pyarrow's to read, to accept or to refuse.
+SMALL_FILE_BYTES = 2**16
+# A cell pyarrow and Python's float both read, to the same double (both round correctly): an
+# optional minus, ASCII digits with a point, an exponent. Each takes forms the other refuses
+# (pyarrow: +1, inf, spaces around; Python: 1_0, other scripts' digits): those go to pyarrow.
+PLAIN_NUMBER = re.compile(r"-?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
 
 
 class TorqueFileError(InvalidInput):
@@ -132,6 +143,31 @@ def _line_of_row(lines: list[str], row: int) -> int:
     return len(lines)
 
 
+def _parse_plain_numbers(
+    raw: bytes, names: list[str], columns: tuple[int, int]
+) -> tuple[np.ndarray, np.ndarray] | None:
+    """The time and torque columns as float arrays, read in Python to what pyarrow reads: when
+    no cell is quoted, every line ends in a newline or a carriage return and a newline, every
+    row that is not blank has the header's number of cells, its time and torque plain finite
+    numbers (PLAIN_NUMBER); None otherwise (then pyarrow reads the file).
+    """
+    text = raw.decode("utf-8").replace("\r\n", "\n")
+    if '"' in text or "\r" in text:
+        return None
+    cells: list[str] = []
+    for line in text.split("\n")[1:]:
+        if not line:  # pyarrow skips a blank line too
+            continue
+        row = line.split(",")
+        if len(row) != len(names) or not all(PLAIN_NUMBER.fullmatch(row[column]) for column in columns):
+            return None
+        cells.extend(row[column] for column in columns)
+    values = np.array([float(cell) for cell in cells]).reshape(-1, 2)
+    if not np.all(np.isfinite(values)):  # 1e400: pyarrow's to take, as every other refusal
+        return None
+    return values[:, 0].copy(), values[:, 1].copy()
+
+
 def _parse_numbers(raw: bytes, names: list[str], columns: tuple[int, int]) -> tuple[np.ndarray, np.ndarray] | None:
     """The time and torque columns as float arrays, parsed by pyarrow's multi-threaded C
     reader; None when a cell is not a number (the caller then finds the line).
@@ -184,7 +220,9 @@ def read_torque_csv(path: str | Path) -> TorqueTable:
                 "the first line must name the columns, e.g. time,torque"
             )
     columns = (header.index("time"), header.index("torque"))
-    data = _parse_numbers(raw, header, columns)
+    data = _parse_plain_numbers(raw, header, columns) if len(raw) <= SMALL_FILE_BYTES else None
+    if data is None:
+        data = _parse_numbers(raw, header, columns)
     if data is None or not all(np.all(np.isfinite(column)) for column in data):
         lines = _decode(path, raw).splitlines()
         bad_row = _first_bad_row(path, lines, columns)
