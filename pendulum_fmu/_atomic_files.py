@@ -6,14 +6,20 @@ into place only when the writer finished without an exception. An interrupted or
 leaves the old file, or none, and no temporary. A target that is a symbolic link replaces the file
 the link leads to, and keeps the link; a target that is no regular file (a device such as
 /dev/null, a named pipe) has nothing to replace and is written into as it is.
+
+replacing_on does the same on an fsspec file system, or on LocalFolders: this machine's, in the
+calls a sweep's store makes of fsspec's, without importing fsspec.
 """
 
 from __future__ import annotations
 
 import contextlib
 import errno
+import fnmatch
 import os
+import shutil
 import stat
+import sys
 import tempfile
 import uuid
 from pathlib import Path
@@ -233,17 +239,60 @@ def replacing_path(path: str | os.PathLike):
         raise
 
 
+class LocalFolders:
+    """The machine's own file system in the calls a sweep's store makes of fsspec's LocalFileSystem
+    (open, exists, makedirs, glob, mv, rm), made as it makes them, on os and shutil: a local
+    output folder then costs no import of fsspec (~20 ms, a twentieth of a small study's time).
+    """
+
+    def open(self, path: str, mode: str = "rb"):
+        return open(path, mode)
+
+    def exists(self, path: str) -> bool:
+        return os.path.exists(path)  # as fsspec's: a link to nothing is not there
+
+    def makedirs(self, path: str, exist_ok: bool = False) -> None:
+        os.makedirs(path, exist_ok=exist_ok)
+
+    def glob(self, pattern: str) -> list[str]:
+        """The paths in the pattern's folder whose names match its last part, the one with
+        wildcards in a store's patterns; as fsspec's, * matches a leading dot too.
+        """
+        folder, _, names = pattern.rpartition("/")
+        try:
+            entries = os.listdir(folder)
+        except (FileNotFoundError, NotADirectoryError):
+            return []
+        return [f"{folder}/{name}" for name in sorted(entries) if fnmatch.fnmatchcase(name, names)]
+
+    def mv(self, source: str, target: str, recursive: bool = True) -> None:
+        shutil.move(source, target)  # a folder with all it holds, as fsspec's
+
+    def rm(self, path: str, recursive: bool = False) -> None:
+        if os.path.isdir(path) and not os.path.islink(path):
+            if not recursive:
+                raise ValueError(f"{path} is a folder: remove it with recursive=True")
+            shutil.rmtree(path)
+        else:
+            os.remove(path)
+
+
+def is_local(filesystem) -> bool:
+    """Whether an fsspec file system, or LocalFolders, is this machine's."""
+    # fsspec's own class is looked for only where fsspec was imported: nothing else made one.
+    local = sys.modules.get("fsspec.implementations.local")
+    return isinstance(filesystem, LocalFolders) or (local is not None and isinstance(filesystem, local.LocalFileSystem))
+
+
 @contextlib.contextmanager
 def replacing_on(filesystem, path: str):
-    """replacing(path, "wb") on any fsspec file system, for outputs given as URLs.
+    """replacing(path, "wb") on any fsspec file system (or LocalFolders), for outputs given as URLs.
 
     The local file system goes through replacing. Elsewhere the content is written to a unique
     temporary name beside path and moved into place (an object store's upload appears whole;
     the move makes that hold for the other file systems too).
     """
-    from fsspec.implementations.local import LocalFileSystem
-
-    if isinstance(filesystem, LocalFileSystem):
+    if is_local(filesystem):
         with replacing(path, "wb") as file:
             yield file
         return

@@ -94,14 +94,14 @@ def test_the_command_lines_judge_loads_matplotlib_only_to_draw(tmp_path):
     assert loaded["printed"][0].startswith(f"{tmp_path / 'out.csv'}: pass: agrees (residual ")
 
 
-def test_the_command_lines_small_study_loads_neither_dask_nor_the_dataset_reader(tmp_path):
+def test_the_command_lines_small_study_loads_neither_dask_fsspec_nor_the_dataset_reader(tmp_path):
     fmu = str(pendulum_fmu.default_fmu())
     command = ["sweep", "--torque", "5", "20", "--stop-time", "0.5", "--no-figure", "--fmu", fmu]
     command += ["--output-dir", str(tmp_path / "study")]
     loaded = _loaded_after(f"from pendulum_fmu.cli import main\nprint(main({command!r}))")
-    # Run in the process, its cases read back part by part; its start-up (issue 42) builds no
-    # FMU and reads no dataset.
-    assert not {"dask", "distributed", "matplotlib"} & set(loaded["top"])
+    # Run in the process, its cases read back part by part, its local folder without fsspec;
+    # its start-up (issue 42) builds no FMU and reads no dataset.
+    assert not {"dask", "distributed", "matplotlib", "fsspec"} & set(loaded["top"])
     assert not {"pyarrow.dataset", "fmu_build.fmu_file", "fmu_build.binaries"} & set(loaded["modules"])
     assert loaded["printed"][-1] == "0"
     # It still ran: its cases table holds the FMU's final angles, against the scipy reference.

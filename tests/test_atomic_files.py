@@ -8,8 +8,9 @@ import sys
 
 import fsspec
 import pytest
+from fsspec.implementations.local import LocalFileSystem
 
-from pendulum_fmu._atomic_files import check_writable, replacing, replacing_on
+from pendulum_fmu._atomic_files import LocalFolders, check_writable, replacing, replacing_on
 from pendulum_fmu._errors import CannotWrite, PendulumFmuError
 
 
@@ -53,6 +54,43 @@ def test_a_failed_write_to_a_url_leaves_neither_file_nor_temporary():
         raise RuntimeError("interrupted")
     assert filesystem.find("/writes") == ["/writes/kept.bin"]
     assert filesystem.cat("/writes/kept.bin") == b"whole"
+
+
+def _a_store_s_calls(filesystem, folder) -> list:
+    """What a sweep's store asks of a file system, in a folder of a study's kinds of entries
+    (parts, staged parts, temporaries, a hidden folder, a link to nothing), and what it got.
+    """
+    for name in ("cases", "trajectories", ".overwrite.1.partial"):
+        filesystem.makedirs(f"{folder}/{name}", exist_ok=True)
+    names = ["cases/part-000001.parquet", "cases/part-000000.parquet", "cases/_part-000002.run.staged"]
+    names += ["cases/.part-000003.parquet.4.partial.parquet", ".study.json.5.partial", "cases/notes.txt"]
+    for name in names:
+        with replacing_on(filesystem, f"{folder}/{name}") as file:
+            file.write(name.encode())
+    os.symlink(f"{folder}/nowhere", f"{folder}/cases/part-000009.parquet")
+    patterns = [".*.partial*", "cases/.*.partial*", "cases/_part-*.staged", "cases/part-*.parquet", "none/*"]
+    got: list = [sorted(filesystem.glob(f"{folder}/{pattern}")) for pattern in patterns]
+    got += [filesystem.exists(f"{folder}/{name}") for name in ("cases", "cases/part-000009.parquet", "none")]
+    filesystem.mv(f"{folder}/cases/_part-000002.run.staged", f"{folder}/cases/part-000002.parquet")
+    filesystem.mv(f"{folder}/.overwrite.1.partial", f"{folder}/moved", recursive=True)
+    for path, recursive in (("cases", False), ("none", True), ("moved", True), ("cases/notes.txt", False)):
+        try:
+            filesystem.rm(f"{folder}/{path}", recursive=recursive)
+        except (ValueError, FileNotFoundError) as error:
+            got.append(type(error).__name__)
+    with filesystem.open(f"{folder}/cases/part-000002.parquet", "r") as file:
+        got.append(file.read())
+    got.append(sorted(str(path.relative_to(folder)) for path in folder.rglob("*")))
+    # The paths relative to the folder, so that two folders' answers compare.
+    return [[str(item).removeprefix(f"{folder}/") for item in each] if isinstance(each, list) else each for each in got]
+
+
+def test_the_local_folders_answer_a_store_as_fsspec_s_local_file_system_does(tmp_path):
+    (tmp_path / "fsspec").mkdir()
+    (tmp_path / "ours").mkdir()
+    ours = _a_store_s_calls(LocalFolders(), tmp_path / "ours")
+    assert ours == _a_store_s_calls(LocalFileSystem(), tmp_path / "fsspec")
+    assert ours[3] == ["cases/part-000000.parquet", "cases/part-000001.parquet", "cases/part-000009.parquet"]
 
 
 # A folder that exists and in which nothing can be created, whoever runs the tests (root too).

@@ -30,7 +30,7 @@ def draw(store: Store, cases_table, names: list[str], outputs: Sequence[str], fm
         figure = Path(scratch) / "sweep.png"
         if cases_table.num_rows <= LINES_UP_TO and {"theta", "omega"} <= set(outputs):
             trajectories = ds.dataset(
-                f"{store.root}/trajectories", format=store.format, filesystem=store.filesystem
+                f"{store.root}/trajectories", format=store.format, filesystem=store.dataset_filesystem()
             ).to_table()
             case_column = trajectories["case"].to_numpy()
             runs = {}

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .._atomic_files import LocalFolders, is_local
 from .._errors import InvalidInput, MissingDependency, WrongType
 from ..fmu._model import fmu_file
 from ..fmu._parameters import pendulum_variables
@@ -245,9 +246,7 @@ def _run_pending(client, task: Task, study: Study, chunk_cases: int, pending: di
 
 def _locate(target: Store, url: str):
     """Where a path inside the output folder is: a Path on the local file system, a URL elsewhere."""
-    from fsspec.implementations.local import LocalFileSystem
-
-    if isinstance(target.filesystem, LocalFileSystem):
+    if is_local(target.filesystem):
         return Path(target.root).joinpath
     return f"{url.rstrip('/')}/".__add__
 
@@ -337,7 +336,14 @@ def _check_options(
 
 
 def _file_system(url: str) -> tuple[object, str]:
-    """(fsspec file system, the folder's path on it) of an output directory."""
+    """(fsspec file system, the folder's path on it) of an output directory; LocalFolders for a
+    POSIX path, whose path is the one fsspec's LocalFileSystem makes of it.
+    """
+    if os.sep == "/" and ":" not in url and not url.startswith("~"):
+        # fsspec's make_path_posix: an absolute path as it is; a relative one after the working
+        # folder, one leading "./" (or "." alone) left out.
+        path = url if url.startswith("/") else f"{os.getcwd()}/{'' if url == '.' else url.removeprefix('./')}"
+        return LocalFolders(), path.rstrip("/")
     import fsspec
 
     try:

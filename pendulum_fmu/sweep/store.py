@@ -30,7 +30,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from .._atomic_files import TEMPORARY_GLOB, make_folder, replacing_on
+from .._atomic_files import TEMPORARY_GLOB, is_local, make_folder, replacing_on
 from .._errors import CannotWrite, PendulumFmuError
 from .._stop_signals import signals_deferred
 
@@ -100,9 +100,15 @@ class Store:
     format.
     """
 
-    filesystem: Any  # an fsspec AbstractFileSystem (fsspec ships no types)
+    filesystem: Any  # an fsspec AbstractFileSystem (fsspec ships no types), or LocalFolders
     root: str
     format: str
+
+    def dataset_filesystem(self):
+        """The file system to give pyarrow's dataset: its own for a local folder (it takes no
+        LocalFolders), the store's elsewhere.
+        """
+        return None if is_local(self.filesystem) else self.filesystem
 
     def part(self, table: str, index: int) -> str:
         """The path of a table's part for a chunk."""
@@ -241,9 +247,8 @@ class Store:
         user's part.
         """
         from filelock import FileLock, Timeout
-        from fsspec.implementations.local import LocalFileSystem
 
-        if not isinstance(self.filesystem, LocalFileSystem):
+        if not is_local(self.filesystem):
             yield
             return
         path = Path(self.root) / LOCK_FILE
@@ -290,7 +295,7 @@ class Store:
                 f"{self.root}/cases",
                 format=ds.CsvFileFormat(convert_options=pyarrow.csv.ConvertOptions(column_types=types)),
                 schema=pa.schema(types),
-                filesystem=self.filesystem,
+                filesystem=self.dataset_filesystem(),
             )
             return dataset.to_table(columns=columns)
         # Part by part, not through pyarrow.dataset, whose import (with pyarrow.compute's, ~35 ms)
