@@ -41,6 +41,8 @@ from ._taylor import Diverged, integrate_piece
 # is that point. Written again here on purpose: the oracle must not borrow the schedule's code.
 _TOLERANCE_STEPS, _TOLERANCE_ULPS = Fraction(1, 10**9), 64
 _DEFAULT_STOP_TIME = Fraction(3)
+# What the reference computes, whatever an FMU records.
+COMPUTED = ("torque", "theta", "omega", "alpha")
 
 
 def _exact(value) -> Fraction:
@@ -336,7 +338,7 @@ def _integrate(
     # The reports by piece and, within one, by time: a piece's are a slice, found by bisection.
     by_piece = np.lexsort((at, owner))
     owners = owner[by_piece].tolist()
-    out = results.empty(len(at))
+    out = results.empty(len(at), COMPUTED)
     out["time"] = at
     theta, omega = float(theta0), float(omega0)
     first = 0
