@@ -420,7 +420,7 @@ def reference(
         The times to report, in s (default: the signal's communication points).
     rtol, atol : float, optional
         The integrator's tolerances: the terms each step leaves out of the series stay below
-        atol + rtol * max(|theta|, |omega|).
+        atol + rtol * max(abs(theta), abs(omega)).
     fmu_path : str or Path, optional
         The FMU whose parameters and defaults apply (default: pendulum_fmu.default_fmu()).
 

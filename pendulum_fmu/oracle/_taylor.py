@@ -70,7 +70,7 @@ def integrate_piece(
     model : (float, float, float)
         mass*gravity*length (N.m), damping (N.m.s/rad) and 1/total inertia (1/(kg.m^2)).
     tolerance : (float, float)
-        rtol and atol: each step's terms past its order stay below atol + rtol*|state|.
+        rtol and atol: each step's terms past its order stay below atol + rtol * max(abs(theta), abs(omega)).
     reports : list of float
         Sorted times within span.
 
