@@ -945,6 +945,7 @@ CALLS = [
     Call(
         "reference", 'reference(20.0, rtol=float("nan"))', "InvalidInput", "rtol nan must be a positive finite number"
     ),
+    Call("reference", "reference(20.0, rtol=1e-20)", "InvalidInput", "rtol 1e-20 asks for more than a double holds"),
     Call("reference", "reference(20.0, at=[5.0])", "InvalidInput", "at: 5.0 is no time of the run, 0 to 3 s"),
     Call("reference", 'reference(lambda t: "x", stop_time=0.01)', "InvalidInput", "the torque is 'x' at t = 0.0"),
     Call(

@@ -35,7 +35,7 @@ from ..fmu._simulate import resolve_parameters
 from ..signals._time_grid import step_count
 from ..signals._torque_csv import read_torque_csv
 from ..signals._torque_schedule import TorqueSchedule
-from ._taylor import Diverged, integrate_piece
+from ._taylor import Diverged, check_tolerances, integrate_piece
 
 # docs/signals.md: an event within max(1e-9 step, 64 ulp of its time) of a communication point
 # is that point. Written again here on purpose: the oracle must not borrow the schedule's code.
@@ -323,11 +323,7 @@ def _integrate(
     fmu_path: Fmu,
 ) -> np.ndarray:
     theta0, omega0 = start_value("theta0", theta0, "rad"), start_value("omega0", omega0, "rad/s")
-    for name, value in (("rtol", rtol), ("atol", atol)):
-        if not (isinstance(value, numbers.Real) and 0 < value < math.inf):
-            raise InvalidInput(
-                f"{name} {value!r} must be a positive finite number (a tolerance of the reference's integrator)"
-            )
+    check_tolerances(rtol, atol)
     parameters = resolve_parameters(parameters, fmu_path)
     acceleration, model = equation_of_motion(parameters), model_constants(parameters)
     starts = [float(s) for s in pieces.starts]

@@ -19,6 +19,7 @@ tight tolerance and to closed-form solutions by tests/test_taylor.py.
 from __future__ import annotations
 
 import math
+import numbers
 from bisect import bisect_right
 
 import numpy as np
@@ -28,6 +29,31 @@ from .._errors import InvalidInput
 # Up to this many reports in a step are summed one by one; more, as one array (numpy's call
 # costs about as much as summing a few).
 _FEW = 8
+
+
+# The smallest rtol: a double's resolution. Below it no step is exact enough, and the steps
+# would shrink without end.
+SMALLEST_RTOL = 1e-16
+
+
+def check_tolerances(rtol: float, atol: float) -> None:
+    """InvalidInput unless atol is a positive finite number and rtol one of at least SMALLEST_RTOL.
+
+    Parameters
+    ----------
+    rtol, atol
+        The tolerances integrate_piece takes.
+    """
+    for name, value in (("rtol", rtol), ("atol", atol)):
+        if not (isinstance(value, numbers.Real) and 0 < value < math.inf):
+            raise InvalidInput(
+                f"{name} {value!r} must be a positive finite number (a tolerance of the reference's integrator)"
+            )
+    if rtol < SMALLEST_RTOL:
+        raise InvalidInput(
+            f"rtol {rtol!r} asks for more than a double holds: give at least {SMALLEST_RTOL:g}, "
+            "the reference's rounding"
+        )
 
 
 class Diverged(InvalidInput):

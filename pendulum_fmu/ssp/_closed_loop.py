@@ -27,7 +27,7 @@ from .._checkout import ROOT, build_tool, is_source_checkout
 from .._errors import InvalidInput
 from ..fmu._simulate import resolve_parameters
 from ..oracle._reference import model_constants
-from ..oracle._taylor import integrate_piece
+from ..oracle._taylor import check_tolerances, integrate_piece
 
 # Pendulum output -> controller input, and back.
 WIRES = (
@@ -243,12 +243,14 @@ def sampled_loop_reference(
     Raises
     ------
     InvalidInput
-        A coupling that is not one of COUPLINGS, or parameters the pendulum refuses.
+        A coupling that is not one of COUPLINGS, parameters the pendulum refuses, or an rtol that
+        is not a number of at least 1e-16.
 
     Examples
     --------
     >>> theta = sampled_loop_reference(3.0, coupling="jacobi", controller={"setpoint": 0.3})["theta"]
     """
+    check_tolerances(rtol, rtol)
     if coupling not in COUPLINGS:
         raise InvalidInput(f"coupling {coupling!r} is none of {', '.join(COUPLINGS)}")
     gains = {**controller_defaults(), **(controller or {})}
