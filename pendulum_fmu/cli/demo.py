@@ -24,7 +24,13 @@ def add_parser(commands) -> argparse.ArgumentParser:
         default=Path("demo"),
         help="folder for the figures and tables (default: %(default)s)",
     )
-    demo.add_argument("--workers", type=int, default=None, help="local dask workers (default: 2)")
+    demo.add_argument(
+        "--workers",
+        type=int,
+        default=None,
+        help="run the parameter study on a local dask cluster of this many workers "
+        "(default: none: a study this small runs in the process)",
+    )
     demo.add_argument(
         "--overwrite",
         action="store_true",
