@@ -117,6 +117,14 @@ def test_a_users_error_is_one_line_and_anything_else_an_internal_error(monkeypat
     assert err.count("\n") == 1
 
 
+def test_a_file_name_holding_a_line_end_stays_on_the_errors_one_line(tmp_path, capsys):
+    missing = tmp_path / "no\nsuch\r.csv"
+    assert main(["judge", str(missing), "--torque", "20"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "\r" not in err
+    assert err.startswith("pendulum-fmu judge: error: ") and "no\\nsuch\\r.csv" in err
+
+
 def test_argument_errors_exit_2_without_traceback():
     result = subprocess.run(
         [sys.executable, "-m", "pendulum_fmu", "simulate", "--torque", "abc"], capture_output=True, text=True

@@ -69,6 +69,11 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _on_one_line(text) -> str:
+    """The text on one line: a line end or another control character in it (a file name's) escaped."""
+    return "".join(c if c.isprintable() or c == "\t" else repr(c)[1:-1] for c in str(text))
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run one command line.
 
@@ -100,7 +105,7 @@ def main(argv: list[str] | None = None) -> int:
 
     def one_line(message, category, *where, **more):
         if issubclass(category, (NotComputed, PlatformSkipped, Skipped, UnencryptedScheduler)):
-            print(f"{command}: {message}", file=sys.stderr)
+            print(f"{command}: {_on_one_line(message)}", file=sys.stderr)
         else:
             shown(message, category, *where, **more)
 
@@ -120,13 +125,13 @@ def main(argv: list[str] | None = None) -> int:
     except PendulumFmuError as error:
         if args.debug:
             raise
-        print(f"{command}: error: {error}", file=sys.stderr)
+        print(f"{command}: error: {_on_one_line(error)}", file=sys.stderr)
         return 2
     except Exception as error:  # a bug of ours: still one line, the traceback on request
         if args.debug:
             raise
         print(
-            f"{command}: internal error: {type(error).__name__}: {error} (run again with --debug "
+            f"{command}: internal error: {type(error).__name__}: {_on_one_line(error)} (run again with --debug "
             "for the traceback, and report it)",
             file=sys.stderr,
         )
