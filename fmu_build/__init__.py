@@ -32,56 +32,8 @@ Builds only ever run from a source tree (a clone or the sdist): an installed pac
 built FMU as package data instead (see pendulum_fmu.default_fmu).
 """
 
-from typing import TYPE_CHECKING
-
 from pendulum_fmu import _imported_on_first_use
 from pendulum_fmu._errors import BuildError, PlatformSkipped
-
-if TYPE_CHECKING:  # the names, for the checkers; imported on first use at run time
-    from .binaries import cmake_build, compile_native_loop, run_tool
-    from .documentation import documentation_html
-    from .fmu_file import build_fmu, build_pid_controller
-    from .macho import MachOError, merge_universal
-    from .model_variables import ModelDescriptionError, generate_variables
-    from .platforms import (
-        PLATFORMS,
-        WASM,
-        WASM_TARGET,
-        ZIG,
-        ZIG_GLIBC,
-        ZIG_PACKAGE,
-        Platform,
-        Target,
-        available_platforms,
-        check_platforms,
-        check_toolchain,
-        check_wasm_toolchain,
-        find_wasm_tools,
-        find_zig,
-    )
-    from .sources import (
-        CHECKOUT_CONTROLLER,
-        CHECKOUT_FMUS,
-        CMAKE_LISTS,
-        DEFAULT_FMU,
-        FMI_HEADERS,
-        FMI_VERSIONS,
-        HEADERS_DIR,
-        MODEL_DESCRIPTION,
-        MODEL_FILES,
-        MODELS,
-        PENDULUM_DIR,
-        PID_CONTROLLER_DIR,
-        PLUMBING_DIR,
-        ROOT,
-        SOURCE_DIR,
-        TOOLCHAINS,
-        Model,
-        assemble_sources,
-        build_inputs,
-        fmu_is_stale,
-        is_source_checkout,
-    )
 
 # The public name -> the module that holds it, imported on first use (__getattr__ below).
 _LAZY = {
@@ -132,55 +84,7 @@ _LAZY = {
     "is_source_checkout": "sources",
 }
 
-__all__ = [
-    "CHECKOUT_CONTROLLER",
-    "CHECKOUT_FMUS",
-    "CMAKE_LISTS",
-    "DEFAULT_FMU",
-    "FMI_HEADERS",
-    "FMI_VERSIONS",
-    "HEADERS_DIR",
-    "MODELS",
-    "MODEL_DESCRIPTION",
-    "MODEL_FILES",
-    "PENDULUM_DIR",
-    "PID_CONTROLLER_DIR",
-    "PLATFORMS",
-    "PLUMBING_DIR",
-    "ROOT",
-    "SOURCE_DIR",
-    "TOOLCHAINS",
-    "WASM",
-    "WASM_TARGET",
-    "ZIG",
-    "ZIG_GLIBC",
-    "ZIG_PACKAGE",
-    "BuildError",
-    "MachOError",
-    "Model",
-    "ModelDescriptionError",
-    "Platform",
-    "PlatformSkipped",
-    "Target",
-    "assemble_sources",
-    "available_platforms",
-    "build_fmu",
-    "build_inputs",
-    "build_pid_controller",
-    "check_platforms",
-    "check_toolchain",
-    "check_wasm_toolchain",
-    "cmake_build",
-    "compile_native_loop",
-    "documentation_html",
-    "find_wasm_tools",
-    "find_zig",
-    "fmu_is_stale",
-    "generate_variables",
-    "is_source_checkout",
-    "merge_universal",
-    "run_tool",
-]
+__all__ = ["BuildError", "PlatformSkipped", *_LAZY]
 
 
 def __getattr__(name: str):
