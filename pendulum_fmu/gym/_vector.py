@@ -97,7 +97,8 @@ class PendulumFmuVectorEnv(VectorEnv):
         if render_mode is not None:
             raise InvalidInput(f"render_mode {render_mode!r}: the vector environment draws nothing; render one env")
         self.num_envs = count("num_envs", num_envs, MAX_ENVS)
-        self.num_threads = count("num_threads", num_threads or default_threads(self.num_envs), MAX_THREADS)
+        threads = default_threads(self.num_envs) if num_threads is None else num_threads
+        self.num_threads = count("num_threads", threads, MAX_THREADS)
         self.settings = settings(
             fmu=fmu,
             max_torque=max_torque,
