@@ -90,7 +90,7 @@ def warn_clipped(tool: str, plan: TorqueSchedule, torque_clipped: np.ndarray, sp
         warnings.warn(
             f"{tool}: Pendulum-v1 clipped {' and '.join(bites)}: its result is the clipped run's",
             Clipped,
-            stacklevel=3,
+            stacklevel=4,  # the caller of the tool's run()
         )
 
 

@@ -12,9 +12,11 @@ bite is Pendulum-v1's clipped run, said in one line (errors.Clipped).
 from __future__ import annotations
 
 import math
+from typing import cast
 
 import gymnasium
 import numpy as np
+from gymnasium.envs.classic_control.pendulum import PendulumEnv
 
 from ..signals._torque_schedule import TorqueSchedule
 from ._pendulum_v1 import MAX_SPEED, pendulum_v1_results, pendulum_v1_runner, rod, warn_clipped
@@ -22,14 +24,14 @@ from ._pendulum_v1 import MAX_SPEED, pendulum_v1_results, pendulum_v1_runner, ro
 
 def simulate(plan: TorqueSchedule, parameters: dict, theta0: float, omega0: float) -> np.ndarray:
     """The schedule through Gymnasium's Pendulum-v1; the result array of _results.py."""
-    g, m, l = rod(parameters, "gymnasium")
+    gravity, mass, length = rod(parameters, "gymnasium")
     n = len(plan.step_size)
     # One step past the run's end, under the last torque, gives the last row's alpha.
     steps, torques = np.r_[plan.step_size, plan.step_size[-1]], np.r_[plan.torque, plan.torque[-1]]
-    env = gymnasium.make("Pendulum-v1", g=g, max_episode_steps=n + 1)
+    env = gymnasium.make("Pendulum-v1", g=gravity, max_episode_steps=n + 1)
     env.reset(seed=0)
-    pendulum = env.unwrapped
-    pendulum.m, pendulum.l = m, l
+    pendulum = cast(PendulumEnv, env.unwrapped)
+    pendulum.m, pendulum.l = mass, length
     pendulum.state = np.array([theta0 - math.pi, omega0])
     theta, omega, torque = np.empty(n + 2), np.empty(n + 2), np.empty(n + 1)
     theta[0], omega[0] = pendulum.state
