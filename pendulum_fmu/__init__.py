@@ -69,6 +69,7 @@ _LAZY = {
     "BuildError": "_errors",
     "PlatformSkipped": "_errors",
     "NotComputed": "_errors",
+    "Clipped": "_errors",
     "Skipped": "_errors",
     "UnencryptedScheduler": "_errors",
 }

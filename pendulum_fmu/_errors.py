@@ -19,6 +19,7 @@ OSError for a file, ...). The kinds that belong to one module live there:
     export.FmuExists                  an export's output file the run was not asked to replace
     engines.ToolCannotRamp            a ramp given to a tool that holds the torque
     engines.drake.UnequalSteps        unequal steps given to drake:default
+    engines._pendulum_v1.NotRepresentable  a run Pendulum-v1 (Gymnasium's, EnvPool's) cannot represent
     sweep.store.InUse                 an output folder another run holds
     sweep.store.StudyExists           an output folder holding a study the run was not asked to replace
     sweep.client.SchedulerUnreachable a dask scheduler that does not answer
@@ -190,6 +191,19 @@ class NotComputed(UserWarning):
 
     >>> from pendulum_fmu import NotComputed
     >>> issubclass(NotComputed, UserWarning)
+    True
+    """
+
+
+class Clipped(UserWarning):
+    """A tool clipped the torque or the speed of its run (Pendulum-v1's +-2 N.m and +-8 rad/s): its
+    result is the clipped run's. The message is one line naming the tool, what it clipped, in how
+    many steps and from when; the command line prints it as that line and goes on.
+
+    Examples
+    --------
+    >>> from pendulum_fmu import Clipped
+    >>> issubclass(Clipped, UserWarning)
     True
     """
 

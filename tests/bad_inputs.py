@@ -359,6 +359,32 @@ CASES = [
     _case("compare", "compare --torque 1 --tools fmu,fmu --output-dir {files}/out", 2, "--tools names fmu twice"),
     _case(
         "compare",
+        "compare --torque 1 --tools fmu,gymnasium --set damping=2 --output-dir {files}/out",
+        2,
+        "gymnasium: Pendulum-v1 has no damping, so damping 2.0 N.m.s/rad cannot be represented",
+    ),
+    _case(
+        "compare",
+        "compare --torque 1 --tools fmu,envpool --step-size 0.05 --output-dir {files}/out",
+        2,
+        "envpool: EnvPool's Pendulum-v1 is a fixed 1 kg, 1 m rod under g = 10",
+    ),
+    _case(
+        "compare",
+        "compare --torque 1 --tools fmu,envpool --set mass=1 --set inertia=0.08333333333333333 --set gravity=10 "
+        "--output-dir {files}/out",
+        2,
+        "envpool: EnvPool's Pendulum-v1 steps 0.05 s, fixed; this run's steps are 0.001 s",
+    ),
+    _case(
+        "compare",
+        "compare --torque 1 --tools fmu,envpool --set mass=1 --set inertia=0.08333333333333333 --set gravity=10 "
+        "--step-size 0.05 --output-dir {files}/out",
+        2,
+        "envpool: EnvPool's Pendulum-v1 cannot be put in a state; it starts where its reset draws (seed 0)",
+    ),
+    _case(
+        "compare",
         "compare --torque 1 --tools fmu --output-dir {files}/out",
         2,
         "compare needs at least two tools, got fmu",

@@ -173,7 +173,54 @@ def quickstart() -> str:
     return "```text\n" + done.stdout.rstrip("\n") + "\n```"
 
 
-GENERATED = {"sweeps": sweeps, "robustness": robustness, "quickstart": quickstart}
+def pendulum_v1() -> str:
+    """Gymnasium's and EnvPool's Pendulum-v1 against the reference over one 200-step episode, the
+    cases of docs/comparing.md; and where the two differ.
+    """
+    import warnings
+
+    import numpy as np
+    from test_pendulum_v1 import ROD
+
+    from pendulum_fmu.engines import envpool, gymnasium
+    from pendulum_fmu.oracle._reference import reference_schedule
+    from pendulum_fmu.signals._torque_schedule import schedule
+
+    theta0, omega0 = envpool.start()
+    levels = np.random.default_rng(0).uniform(-2, 2, 200).astype(np.float32).astype(float)
+    cases = {"random steps": schedule(levels, step_size=0.05), "2 N.m": schedule(2.0, stop_time=10.0, step_size=0.05)}
+    rows = [
+        "| signal | tool | max abs dtheta, 20 steps (rad) | max abs dtheta, 200 steps (rad) "
+        "| max abs domega, 200 steps (rad/s) | steps with the speed clipped |",
+        "|---|---|---|---|---|---|",
+    ]
+    for signal, plan in cases.items():
+        exact = reference_schedule(plan, parameters=ROD, theta0=theta0, omega0=omega0)
+        runs = {}
+        for name, tool in (("gymnasium", gymnasium), ("envpool", envpool)):
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")  # the clips are counted here
+                runs[name] = run = tool.run(plan, parameters=ROD, theta0=theta0, omega0=omega0)
+            dtheta, domega = np.abs(run["theta"] - exact["theta"]), np.abs(run["omega"] - exact["omega"])
+            clipped = int(np.sum(np.abs(run["omega"][1:]) == 8.0))
+            rows.append(
+                f"| {signal} | {name} | {dtheta[:21].max():.1e} | {dtheta.max():.1e} | {domega.max():.1e} | {clipped} |"
+            )
+        apart = np.abs(runs["gymnasium"]["theta"] - runs["envpool"]["theta"])
+        rows.append(
+            f"| {signal} | gymnasium - envpool | {apart[:21].max():.1e} | {apart.max():.1e} "
+            f"| {np.abs(runs['gymnasium']['omega'] - runs['envpool']['omega']).max():.1e} | |"
+        )
+    return "\n".join(
+        [
+            f"From theta0 = {theta0:.7f} rad, omega0 = {omega0:.7f} rad/s (EnvPool's start, seed 0):",
+            "",
+            *rows,
+        ]
+    )
+
+
+GENERATED = {"sweeps": sweeps, "robustness": robustness, "quickstart": quickstart, "pendulum_v1": pendulum_v1}
 
 
 # --- running the commands, checking, updating ----------------------------------------------

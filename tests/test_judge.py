@@ -18,6 +18,7 @@ from pendulum_fmu.judging._diagnoses import (
     DRIFT,
     EARLY,
     EXPLAINS,
+    EXPLICIT_EULER,
     HELD,
     INTEGRATION,
     INTEGRATION_SMALL,
@@ -254,6 +255,8 @@ def test_fmpy_model_exchange_solvers_are_integration_errors(kit, solver):
     )
     judgement = _judged(kit, "constant_torque")
     assert judgement.verdict == "fail" and judgement.diagnosis == INTEGRATION
+    # Its Euler is named; CVode, which no variant explains, is not.
+    assert judgement.integrator == (EXPLICIT_EULER if solver == "Euler" else None)
     if solver == "Euler":
         assert judgement.residual == 0.0 and judgement.max_abs_dtheta > 1e-4
     else:

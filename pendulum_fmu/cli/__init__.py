@@ -20,7 +20,7 @@ import warnings
 
 from .. import __version__
 from .._checkout import is_source_checkout
-from .._errors import NotComputed, PendulumFmuError, PlatformSkipped, Skipped, UnencryptedScheduler
+from .._errors import Clipped, NotComputed, PendulumFmuError, PlatformSkipped, Skipped, UnencryptedScheduler
 from .._stop_signals import STOPPING_SIGNALS, Stopped, restore_signals, stop_on_signals
 from . import build, compare, cross_check, demo, export, export_ssp, judge, scenarios, simulate, sweep, verify
 from ._stdout import UntilTheReaderIsGone
@@ -104,7 +104,7 @@ def main(argv: list[str] | None = None) -> int:
     shown = warnings.showwarning
 
     def one_line(message, category, *where, **more):
-        if issubclass(category, (NotComputed, PlatformSkipped, Skipped, UnencryptedScheduler)):
+        if issubclass(category, (Clipped, NotComputed, PlatformSkipped, Skipped, UnencryptedScheduler)):
             print(f"{command}: {_on_one_line(message)}", file=sys.stderr)
         else:
             shown(message, category, *where, **more)

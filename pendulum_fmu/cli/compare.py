@@ -32,7 +32,8 @@ def add_parser(commands) -> argparse.ArgumentParser:
         default=None,
         help="comma-separated, each once: fmu, reference, opensim, mujoco, drake, "
         "pybullet (NAME:default for the engine's own defaults), wasm (the FMI 3.0 FMU's "
-        "WebAssembly binary, through wasmtime), or "
+        "WebAssembly binary, through wasmtime), gymnasium, envpool (their Pendulum-v1, "
+        "docs/comparing.md), or "
         "LABEL=path/to/Their.fmu for any FMI 2.0/3.0 FMU; the reference always "
         "runs as the judge (default: fmu,reference,opensim, those installed; the line "
         "that says which were skipped says how to install them)",

@@ -1,6 +1,6 @@
 """The tools compare runs, and the parsing of --tools and --map.
 
-    --tools fmu,reference,opensim,mujoco,drake:default,pybullet,theirs=path/to/Their.fmu
+    --tools fmu,reference,opensim,mujoco,drake:default,pybullet,gymnasium,envpool,theirs=path/to/Their.fmu
     --map torque=u,theta=phi*0.0174532925
 
 An item is a tool's name, optionally with a mode (accurate, the default, or default: what the
@@ -155,6 +155,10 @@ KINDS = {
     "drake": Kind("pendulum_fmu.engines.drake:run", "pydrake", "drake", MODES),
     "pybullet": Kind("pendulum_fmu.engines.pybullet:run", "pybullet", "pybullet", MODES),
     "wasm": Kind("pendulum_fmu.comparing._compare_tools:run_wasm", "wasmtime", "wasm"),
+    # Pendulum-v1, the reinforcement-learning pendulum: semi-implicit Euler at the communication
+    # step, with its torque and speed clips; one mode, its own.
+    "gymnasium": Kind("pendulum_fmu.engines.gymnasium:run", "gymnasium", "gym"),
+    "envpool": Kind("pendulum_fmu.engines.envpool:run", "envpool", "envpool"),
 }
 # The tools compare runs when none are named: of these, the ones installed here.
 DEFAULT_TOOLS = ("fmu", "reference", "opensim")
@@ -173,7 +177,7 @@ class ToolInfo:
     Attributes
     ----------
     name : str
-        The tool's name: fmu, reference, opensim, mujoco, drake, pybullet or wasm.
+        The tool's name: fmu, reference, opensim, mujoco, drake, pybullet, wasm, gymnasium or envpool.
     installed : bool
         Whether its Python package can be imported here.
     labels : tuple of str
@@ -200,8 +204,8 @@ def list_tools() -> list[ToolInfo]:
     Returns
     -------
     list of ToolInfo
-        fmu, reference, the engines (opensim, mujoco, drake, pybullet), then wasm: the FMU's
-        WebAssembly binary.
+        fmu, reference, the engines (opensim, mujoco, drake, pybullet), wasm: the FMU's
+        WebAssembly binary, then Gymnasium's and EnvPool's Pendulum-v1 (gymnasium, envpool).
 
     Raises
     ------

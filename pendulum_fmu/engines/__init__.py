@@ -11,6 +11,10 @@ best integrator tight; "default" keeps the engine's own integrator and settings,
 communication step, so a comparison shows the price of the defaults. docs/engines.md says what
 each adapter sets and why. The engine modules import their engine, so import them only when used.
 
+Gymnasium's and EnvPool's Pendulum-v1 (gymnasium.py, envpool.py) are tools here too, with one
+mode, their own; _pendulum_v1.py maps the FMU's parameters onto their rod and says when their
+clips bite.
+
 May import: fmu/, signals/ and the basics. Not the reference: an engine is held to it, in tests.
 """
 

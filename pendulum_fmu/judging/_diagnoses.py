@@ -3,7 +3,8 @@
 Each candidate is a variant of the run with that mistake made (see _judge.py's docstring): the
 schedule changed as the mistake changes it, integrated exactly (reference_schedule) at the
 result's times. diagnose() names the candidate whose variant leaves only noise, an integration
-error, or none.
+error, or none; an integration error whose variant leaves only noise is named by its integrator
+(INTEGRATORS).
 """
 
 from __future__ import annotations
@@ -33,6 +34,13 @@ DRIFT, NOT_RESTORED = "time grid drift", "state not restored"
 
 
 INTEGRATION, UNEXPLAINED = "integration error", "unexplained"
+
+
+# The integrators of integration error's variants, in their order: what a master that integrates
+# the Model Exchange interface itself steps by, and Pendulum-v1 (Gymnasium's, EnvPool's) does.
+EXPLICIT_EULER = "explicit Euler at the communication step"
+SEMI_IMPLICIT_EULER = "semi-implicit (symplectic) Euler at the communication step"
+INTEGRATORS = (EXPLICIT_EULER, SEMI_IMPLICIT_EULER)
 
 
 DIAGNOSES = (AGREES, LATE, EARLY, INTERPOLATED, HELD, DRIFT, NOT_RESTORED, INTEGRATION, UNEXPLAINED)
@@ -191,11 +199,12 @@ def _not_restored(run: Run, correct: np.ndarray, first_wrong: int) -> list[np.nd
 
 
 def _integration(run: Run) -> list[np.ndarray]:
+    """The run stepped by each of INTEGRATORS, in their order, at the result's times."""
     index = _plan_index(run.plan, run.times, run.step_size)
     if index is None:
         return []
     acceleration = equation_of_motion(run.parameters)
-    return [_euler(run, acceleration, semi)[index] for semi in (False, True)]
+    return [_euler(run, acceleration, integrator == SEMI_IMPLICIT_EULER)[index] for integrator in INTEGRATORS]
 
 
 def shared_variants(run: Run, torque, held: TorqueSchedule | None, start_torque: float) -> dict[str, list[np.ndarray]]:
@@ -229,8 +238,10 @@ def candidate_variants(
 
 def diagnose(
     raw: float, tolerance: float, scores: dict[str, dict | None], smallest_input_effect: float | None
-) -> tuple[str, float]:
-    """The candidate that explains the difference, or integration error, or unexplained."""
+) -> tuple[str, float, bool]:
+    """The candidate that explains the difference, or integration error, or unexplained; its
+    residual; and whether its variant explains it (leaves only noise).
+    """
     applicable = {name: score for name, score in scores.items() if score is not None}
     best = min(applicable, key=lambda name: applicable[name]["residual"], default=None)
     if best is not None and applicable[best]["residual"] <= max(EXPLAINS * raw, NOISE * tolerance):
@@ -242,12 +253,12 @@ def diagnose(
             for name in DIAGNOSES
             if name in applicable and applicable[name]["residual"] <= applicable[best]["residual"] + NOISE * tolerance
         ]
-        return tied[0], applicable[tied[0]]["residual"]
+        return tied[0], applicable[tied[0]]["residual"], True
     euler = applicable.get(INTEGRATION)
     if (
         euler is not None
         and raw <= euler["effect"]
         and (smallest_input_effect is None or raw <= INTEGRATION_SMALL * smallest_input_effect)
     ):
-        return INTEGRATION, raw
-    return UNEXPLAINED, applicable[best]["residual"] if best is not None else raw
+        return INTEGRATION, raw, False
+    return UNEXPLAINED, applicable[best]["residual"] if best is not None else raw, False

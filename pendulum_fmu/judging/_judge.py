@@ -24,7 +24,9 @@ explains the result leaves only rounding and solver noise (about 1e-11 rad). The
 - state not restored: from the last row that agrees, the run restarts from the initial state
   (a resumed run that did not restore its saved FMU state);
 - integration error: the FMU's equation stepped by explicit or semi-implicit Euler at the
-  communication step (a master that integrates the Model Exchange interface itself).
+  communication step (a master that integrates the Model Exchange interface itself, or
+  Pendulum-v1's semi-implicit Euler); when one of them leaves only noise, the judgement names it
+  (Judgement.integrator).
 """
 
 from __future__ import annotations
@@ -44,7 +46,16 @@ from ..oracle._reference import reference
 from ..scenarios._scenario_settings import JUDGE_TOLERANCE as DEFAULT_TOLERANCE, read_settings, settings_files
 from ..signals._time_grid import event_tolerance
 from ..signals._torque_schedule import TorqueSchedule, schedule
-from ._diagnoses import AGREES, INPUT_TIMING, Run, candidate_variants, diagnose, shared_variants
+from ._diagnoses import (
+    AGREES,
+    INPUT_TIMING,
+    INTEGRATION,
+    INTEGRATORS,
+    Run,
+    candidate_variants,
+    diagnose,
+    shared_variants,
+)
 from ._regression_tools import format_verdicts, regression_verdicts
 from ._result_file import OPTIONAL, ResultFileError, read_result
 
@@ -70,6 +81,9 @@ class Judgement:
         The result as read, the reference at its times, the variant the diagnosis names.
     source : str
         The result file's name, as reports show it.
+    integrator : str or None
+        For an integration error that one of its variants explains, the integrator the result is
+        (INTEGRATORS: explicit or semi-implicit Euler at the communication step); else None.
 
     Examples
     --------
@@ -103,6 +117,7 @@ class Judgement:
     # The variant the diagnosis names, at the result's times (None for agrees and unexplained).
     explanation: np.ndarray | None = field(default=None, repr=False)
     source: str = "result"
+    integrator: str | None = None
     # csv-compare's tube and the FMI cross-check's band on theta (regression_tools.regression_verdicts).
     regression_tools: list[dict] = field(default_factory=list)
 
@@ -122,6 +137,7 @@ class Judgement:
             "result": self.source,
             "verdict": self.verdict,
             "diagnosis": self.diagnosis,
+            "integrator": self.integrator,
             "residual": self.residual,
             "max_abs_dtheta": self.max_abs_dtheta,
             **worst,
@@ -291,11 +307,11 @@ class JudgedRun:
         difference = np.abs(result["theta"] - correct["theta"])
         raw = float(np.max(difference))
         variants = candidate_variants(shared, run, correct, result, self.tolerance)
-        scores, best_variant, smallest_input_effect = _scores(variants, result, correct, self.tolerance)
+        scores, best, smallest_input_effect = _scores(variants, result, correct, self.tolerance)
         if raw <= self.tolerance:
-            diagnosis, residual = AGREES, raw
+            diagnosis, residual, explained = AGREES, raw, False
         else:
-            diagnosis, residual = diagnose(raw, self.tolerance, scores, smallest_input_effect)
+            diagnosis, residual, explained = diagnose(raw, self.tolerance, scores, smallest_input_effect)
         return Judgement(
             verdict="pass" if raw <= self.tolerance else "fail",
             diagnosis=diagnosis,
@@ -307,20 +323,22 @@ class JudgedRun:
             smallest_input_effect=smallest_input_effect,
             result=result,
             reference=correct,
-            explanation=best_variant.get(diagnosis) if diagnosis != AGREES else None,
+            explanation=variants[diagnosis][best[diagnosis]] if diagnosis in best else None,
             source=source,
+            integrator=INTEGRATORS[best[INTEGRATION]] if explained and diagnosis == INTEGRATION else None,
             regression_tools=regression_verdicts(times, correct["theta"], result["theta"]),
         )
 
 
 def _scores(
     variants: dict[str, list[np.ndarray]], result: np.ndarray, correct: np.ndarray, tolerance: float
-) -> tuple[dict[str, dict | None], dict[str, np.ndarray], float | None]:
+) -> tuple[dict[str, dict | None], dict[str, int], float | None]:
     """Per candidate, the residual and effect of its best variant (None where it does not apply);
-    that variant; and the smallest effect above the tolerance of an input-timing variant.
+    that variant's index in its list; and the smallest effect above the tolerance of an
+    input-timing variant.
     """
     scores: dict[str, dict | None] = {}
-    best_variant: dict[str, np.ndarray] = {}
+    best: dict[str, int] = {}
     timing_effects: list[float] = []
     for name, made in variants.items():
         if not made:
@@ -331,9 +349,9 @@ def _scores(
         if name in INPUT_TIMING:
             timing_effects += [effect for effect in effects if effect > tolerance]
         i = int(np.argmin(residuals))
-        best_variant[name] = made[i]
+        best[name] = i
         scores[name] = {"residual": residuals[i], "effect": effects[i]}
-    return scores, best_variant, min(timing_effects, default=None)
+    return scores, best, min(timing_effects, default=None)
 
 
 def judge(
@@ -497,8 +515,9 @@ def format_judgement(judgement: Judgement) -> str:
     str
         The lines, joined.
     """
+    named = f"{judgement.diagnosis}: {judgement.integrator}" if judgement.integrator else judgement.diagnosis
     lines = [
-        f"{judgement.source}: {judgement.verdict}: {judgement.diagnosis} (residual {judgement.residual:.2e} rad)",
+        f"{judgement.source}: {judgement.verdict}: {named} (residual {judgement.residual:.2e} rad)",
         f"max |dtheta| = {judgement.max_abs_dtheta:.3e} rad at t = {judgement.worst_time!r} s "
         f"(tolerance {judgement.tolerance:g} rad; {len(judgement.result)} points)",
         f"{'candidate':<28} {'residual rad':>12} {'effect rad':>11}",
