@@ -839,6 +839,10 @@ CASES = [
 
 # What the calls below have in scope.
 API_IMPORTS = """\
+import gymnasium
+import numpy as np
+
+import pendulum_fmu.gym
 from pendulum_fmu import (
     Study,
     compare,
@@ -1209,6 +1213,62 @@ CALLS = [
         'read_settings("{files}/settings/input_absolute.json")',
         "InvalidInput",
         'input_absolute.json: input is "/etc/hostname"; it must be the name of a file in the kit\'s folder',
+    ),
+    Call(
+        "gymnasium environment",
+        'gymnasium.make("pendulum_fmu.gym:PendulumFMU-v0", masss=2.0)',
+        "InvalidInput",
+        "unknown keyword 'masss': the keywords are the FMU's parameters (mass, length, inertia, gravity, damping), "
+        "max_torque, dt, tolerance, fmu, render_mode",
+    ),
+    Call(
+        "gymnasium environment",
+        'gymnasium.make("pendulum_fmu.gym:PendulumFMU-v0", dt=-0.05)',
+        "InvalidInput",
+        "dt = -0.05 s must be positive and finite",
+    ),
+    Call(
+        "gymnasium environment",
+        'gymnasium.make("pendulum_fmu.gym:PendulumFMU-v0", mass=0.0)',
+        "FmuError",
+        "initialization failed: [ERROR] fmi2ExitInitializationMode: mass must be > 0",
+    ),
+    Call(
+        "gymnasium environment",
+        'gymnasium.make_vec("pendulum_fmu.gym:PendulumFMU-v0", num_envs=0)',
+        "InvalidInput",
+        "num_envs = 0 must be from 1 to 1,000,000",
+    ),
+    Call(
+        "gymnasium environment",
+        'gymnasium.make_vec("pendulum_fmu.gym:PendulumFMU-v0", num_envs=10**9)',
+        "InvalidInput",
+        "num_envs = 1000000000 must be from 1 to 1,000,000",
+    ),
+    Call(
+        "gymnasium environment",
+        "pendulum_fmu.gym.PendulumFmuEnv().step(np.array([1.0]))",
+        "InvalidInput",
+        "step before reset (or after a step the FMU refused): call reset() first",
+    ),
+    Call(
+        "gymnasium environment",
+        '((env := pendulum_fmu.gym.PendulumFmuEnv()), env.reset(seed=0), env.step(np.array([float("nan")])))',
+        "InvalidInput",
+        "action array([nan]) is not finite: every torque must be a finite number of N.m",
+    ),
+    Call(
+        "gymnasium environment",
+        "((env := pendulum_fmu.gym.PendulumFmuEnv()), env.reset(seed=0), env.step(np.array([1.0, 2.0])))",
+        "InvalidInput",
+        "action of shape (2,): the action space's shape is (1,)",
+    ),
+    Call(
+        "gymnasium environment",
+        '((envs := gymnasium.make_vec("pendulum_fmu.gym:PendulumFMU-v0", num_envs=4)), envs.reset(seed=0), '
+        "envs.step(np.zeros(4)))",
+        "InvalidInput",
+        "action of shape (4,): the action space's shape is (4, 1)",
     ),
     Call("other", "default_fmu(fmi_version=4)", "InvalidInput", "no FMI 4 FMU: the FMI versions are 2, 3"),
     Call(

@@ -158,10 +158,12 @@ def test_every_api_docstring_has_numpydoc_sections_and_its_examples_give_what_th
     assert runner.failures == 0 and runner.tries > 0, name
 
 
-def _autosummary_blocks(page: str) -> list[list[str]]:
-    """The names of each autosummary block of a docs page, in order."""
-    blocks = re.findall(r"^\.\. autosummary::\n(?:   :.*\n)*\n((?:   \S+\n)+)", page, re.MULTILINE)
-    return [block.split() for block in blocks]
+def _autosummary_blocks(page: str, module: str = "pendulum_fmu") -> list[list[str]]:
+    """The names of each autosummary block of a docs page under `.. currentmodule:: module`, in order."""
+    blocks = re.findall(
+        r"^\.\. currentmodule:: (\S+)\n\n\.\. autosummary::\n(?:   :.*\n)*\n((?:   \S+\n)+)", page, re.MULTILINE
+    )
+    return [names.split() for current, names in blocks if current == module]
 
 
 def _lazy_groups() -> list[list[str]]:
@@ -187,3 +189,10 @@ def test_the_api_reference_lists_every_public_name_once_grouped_as_the_package_g
     assert sum(map(len, groups)) == len(pendulum_fmu._LAZY) and len(groups) > 1
     assert [sorted(block) for block in blocks[1:]] == [sorted(group) for group in groups]
     assert sorted(blocks[0]) == sorted(set(pendulum_fmu.__all__) - set(pendulum_fmu._LAZY))
+
+
+def test_the_api_reference_lists_the_gymnasium_environments_names():
+    import pendulum_fmu.gym
+
+    page = (ROOT / "docs" / "api_reference.md").read_text(encoding="utf-8")
+    assert _autosummary_blocks(page, "pendulum_fmu.gym") == [sorted(pendulum_fmu.gym.__all__)]

@@ -191,10 +191,13 @@ class FmuBatch:
         self.modes.fill(STEP)
         if worst > 1:
             failed = int(np.flatnonzero(self._statuses > 1)[0])
-            call = cs_loop.CALLS[int(self._failed_calls[failed])]
-            instance = self.instances[failed]
+            call = int(self._failed_calls[failed])
+            messages = self.instances[failed].messages
+            where = f"instance {failed} of {self.size}: " if self.size > 1 else ""
+            if call >= _RESET:
+                raise messages.initialization_error(f"{where}{cs_loop.CALLS[call]} failed")
             status = int(self._statuses[failed])
-            raise instance.messages.error(status, f"environment {failed}: {call} at t = {self.time[failed]:.17g}")
+            raise messages.error(status, f"{where}{cs_loop.CALLS[call]} at t = {self.time[failed]:.17g}")
 
     def _advance_python(self) -> int:
         """advance() through fmpy's calls, in the order of _cs_batch.c; the worst status."""

@@ -87,7 +87,13 @@ class PendulumFmuEnv(gymnasium.Env):
         if render_mode not in (None, *self.metadata["render_modes"]):
             raise InvalidInput(f"render_mode {render_mode!r}: the render modes are {self.metadata['render_modes']}")
         self.settings = settings(
-            fmu=fmu, max_torque=max_torque, dt=dt, max_episode_steps=None, tolerance=tolerance, parameters=parameters
+            fmu=fmu,
+            max_torque=max_torque,
+            dt=dt,
+            max_episode_steps=None,
+            tolerance=tolerance,
+            parameters=parameters,
+            keywords=("max_torque", "dt", "tolerance", "fmu", "render_mode"),
         )
         self.render_mode = render_mode
         self.metadata = {**self.metadata, "render_fps": round(1 / self.settings.dt)}

@@ -75,8 +75,11 @@ def settings(
     max_episode_steps: Any,
     tolerance: Any,
     parameters: dict[str, Any],
+    keywords: tuple[str, ...],
 ) -> Settings:
-    """The Settings of make keywords; InvalidInput (one line) for any the environment refuses."""
+    """The Settings of make keywords; InvalidInput (one line) for any the environment refuses.
+    parameters: the keywords beyond the environment's own (keywords), which must be the FMU's.
+    """
     model = fmu_model(fmu)
     if model.fmi_version != 2:
         raise InvalidInput(f"fmu {model.path} is an FMI {model.fmi_version} FMU: the environment runs FMI 2.0 FMUs")
@@ -84,7 +87,7 @@ def settings(
     if unknown:
         raise InvalidInput(
             f"unknown keyword {unknown[0]!r}: the keywords are the FMU's parameters "
-            f"({', '.join(model.default_parameters)}), max_torque, dt, max_episode_steps, tolerance, fmu"
+            f"({', '.join(model.default_parameters)}), {', '.join(keywords)}"
         )
     defaults = {name: PENDULUM_V1_PARAMETERS.get(name, value) for name, value in model.default_parameters.items()}
     return Settings(

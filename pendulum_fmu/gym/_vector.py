@@ -106,6 +106,7 @@ class PendulumFmuVectorEnv(VectorEnv):
             max_episode_steps=max_episode_steps,
             tolerance=tolerance,
             parameters=parameters,
+            keywords=("max_torque", "dt", "tolerance", "fmu", "max_episode_steps", "num_threads"),
         )
         self._max_episode_steps = int(max_episode_steps)
         self.single_observation_space = observation_space()
