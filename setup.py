@@ -177,7 +177,13 @@ def _linux_glibc(command):
 setup(
     # Declared so that setuptools builds it (in place too) and tags the wheel for a platform;
     # BuildNativeLoop builds it with CMake, not with setuptools' compiler.
-    ext_modules=[Extension("pendulum_fmu.fmu._cs_loop", sources=["pendulum_fmu/fmu/_cs_loop.c"])],
+    ext_modules=[
+        Extension(
+            "pendulum_fmu.fmu._cs_loop",
+            sources=["pendulum_fmu/fmu/_cs_loop.c", "pendulum_fmu/fmu/_cs_batch.c"],
+            depends=["pendulum_fmu/fmu/_cs_loop.h"],
+        )
+    ],
     cmdclass={
         "build_py": BuildPyWithFmu,
         "build_ext": BuildNativeLoop,

@@ -190,7 +190,14 @@ def test_each_native_loop_exports_the_loop_and_needs_only_the_systems_libraries(
             symbols = _llvm("llvm-nm", binary, tmp_path, "--defined-only", "-D")
             exports = re.findall(r" T (\w+)$", symbols, re.M)
         slices = 2 if platform == "darwin64" else 1
-        expected = ["cs_loop_interface", "cs_loop_run", "cs_loop_run_cases"] * slices
+        expected = [
+            "cs_loop_interface",
+            "cs_loop_run",
+            "cs_loop_run_cases",
+            "cs_loop_batch_pool_new",
+            "cs_loop_batch_pool_free",
+            "cs_loop_batch_advance",
+        ] * slices
         assert sorted(exports) == sorted(expected), (platform, exports)
 
 

@@ -16,37 +16,12 @@
    cs_loop_run_cases runs a chunk of cases (a parameter study's) in one call: each case a restart
    with its own start values, then every step with no input set, into one preallocated array. */
 
-#include <stddef.h>
+#include "_cs_loop.h"
 
-#include "fmi2FunctionTypes.h"
-
-#if defined(_WIN32)
-#define CS_LOOP_EXPORT __declspec(dllexport)
-#else
-#define CS_LOOP_EXPORT __attribute__((visibility("default")))
-#endif
-
-/* Changes whenever cs_loop_run's or cs_loop_run_cases' arguments do, so that Python never calls a stale build with
-   the wrong arguments (_native_loop.py checks it). */
-CS_LOOP_EXPORT int cs_loop_interface(void) { return 6; }
-
-/* The FMU's functions, in this order (_native_loop.py passes them as an array of addresses). */
-typedef struct {
-    fmi2ResetTYPE *reset;
-    fmi2SetupExperimentTYPE *setup_experiment;
-    fmi2EnterInitializationModeTYPE *enter_initialization_mode;
-    fmi2ExitInitializationModeTYPE *exit_initialization_mode;
-    fmi2SetRealTYPE *set_real;
-    fmi2SetRealInputDerivativesTYPE *set_real_input_derivatives;
-    fmi2GetRealTYPE *get_real;
-    fmi2DoStepTYPE *do_step;
-} CsFunctions;
-
-/* Which call failed, as reported through *failed_call. */
-enum { CALL_SET_REAL = 0, CALL_SET_RATE = 1, CALL_GET_REAL = 2, CALL_DO_STEP = 3,
-       CALL_GET_OUTPUTS_AT_END = 4, CALL_RESET = 5, CALL_SETUP_EXPERIMENT = 6,
-       CALL_ENTER_INITIALIZATION_MODE = 7, CALL_SET_START_VALUES = 8,
-       CALL_EXIT_INITIALIZATION_MODE = 9 };
+/* Changes whenever the arguments of cs_loop_run, cs_loop_run_cases or the batch's functions
+   (_cs_batch.c) do, so that Python never calls a stale build with the wrong arguments
+   (_native_loop.py checks it). */
+CS_LOOP_EXPORT int cs_loop_interface(void) { return 7; }
 
 /* Runs one case.
 

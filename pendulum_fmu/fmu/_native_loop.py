@@ -19,9 +19,9 @@ from pathlib import Path
 
 import numpy as np
 
-# The call that failed, by the index _cs_loop.c reports: _AT_END the read after the last step,
+# The call that failed, by the index _cs_loop.h's CALL_ values give it: _AT_END the read after the last step,
 # from _RESTART on the restart's.
-_CALLS = (
+CALLS = (
     "fmi2SetReal",
     "fmi2SetRealInputDerivatives",
     "fmi2GetReal",
@@ -48,39 +48,55 @@ _FMI_FUNCTIONS = (
 
 
 # What _cs_loop.c's cs_loop_interface() returns for the arguments this module passes.
-INTERFACE = 6
+INTERFACE = 7
 
 
 @lru_cache(maxsize=1)
-def _library():
-    """The compiled loop's (run, run_cases) functions, or None when it was not built (or is a
-    stale build).
+def library() -> ctypes.CDLL | None:
+    """The compiled loop (_cs_loop.c, _cs_batch.c) with its functions' argument types set, or None
+    when it was not built (or is a stale build).
     """
     # setup.py gives it the platform's plain extension name (_cs_loop.so, _cs_loop.pyd).
     path = Path(__file__).resolve().parent / f"_cs_loop{importlib.machinery.EXTENSION_SUFFIXES[-1]}"
     if not path.is_file():
         return None
-    library = ctypes.CDLL(str(path))
-    if not hasattr(library, "cs_loop_interface") or library.cs_loop_interface() != INTERFACE:
+    loaded = ctypes.CDLL(str(path))
+    if not hasattr(loaded, "cs_loop_interface") or loaded.cs_loop_interface() != INTERFACE:
         return None
-    run = library.cs_loop_run
     pointer, size = ctypes.c_void_p, ctypes.c_size_t
-    run.argtypes = [pointer] * 3 + [size] + [pointer] * 3 + [size, pointer, size, size] + [pointer] * 7
-    run.restype = ctypes.c_int
-    run_cases = library.cs_loop_run_cases
-    run_cases.argtypes = [pointer] * 3 + [size] + [pointer] * 3 + [size] * 4 + [pointer] * 6
-    run_cases.restype = ctypes.c_int
-    return run, run_cases
+    signatures = {
+        "cs_loop_run": (
+            [pointer] * 3 + [size] + [pointer] * 3 + [size, pointer, size, size] + [pointer] * 7,
+            ctypes.c_int,
+        ),
+        "cs_loop_run_cases": ([pointer] * 3 + [size] + [pointer] * 3 + [size] * 4 + [pointer] * 6, ctypes.c_int),
+        "cs_loop_batch_pool_new": ([size], pointer),
+        "cs_loop_batch_pool_free": ([pointer], None),
+        "cs_loop_batch_advance": ([pointer, pointer], ctypes.c_int),
+    }
+    for name, (argtypes, restype) in signatures.items():
+        function = getattr(loaded, name)
+        function.argtypes, function.restype = argtypes, restype
+    return loaded
 
 
 def available() -> bool:
     """Whether the native loop (the compiled _cs_loop library) could be loaded here."""
-    return _library() is not None
+    return library() is not None
 
 
 def drives(slave) -> bool:
     """Whether the native loop can step this fmpy slave: it was compiled, and the FMU is FMI 2.0."""
     return available() and slave.fmi_version == 2
+
+
+def fmi_functions(slave) -> ctypes.Array:
+    """The addresses of the FMI functions of an fmpy slave's library, as CsFunctions (_cs_loop.h)
+    lays them out.
+    """
+    return (ctypes.c_void_p * len(_FMI_FUNCTIONS))(
+        *[ctypes.cast(slave.dll[name], ctypes.c_void_p) for name in _FMI_FUNCTIONS]
+    )
 
 
 def _checked(array: np.ndarray, shape: tuple[int, ...], dtype, what: str) -> np.ndarray:
@@ -117,9 +133,7 @@ class Stepper:
         self.starts = len(start_references)
         # Kept alive for the addresses.
         self._references = input_references, output_references, start_references
-        self._functions = (ctypes.c_void_p * len(_FMI_FUNCTIONS))(
-            *[ctypes.cast(slave.dll[name], ctypes.c_void_p) for name in _FMI_FUNCTIONS]
-        )
+        self._functions = fmi_functions(slave)
         self._first_order = np.ones(self.inputs, np.int32)  # fmi2Integer is int
         self._failed_step, self._failed_call = ctypes.c_size_t(), ctypes.c_int()
         self._tolerance = ctypes.c_double()
@@ -139,7 +153,10 @@ class Stepper:
         self._failed_case = ctypes.c_size_t()
         self._case_outputs = np.empty((0, self.outputs))  # run_cases' room for one case, kept
         self._reports = ctypes.byref(self._failed_step), ctypes.byref(self._failed_call)
-        self._run, self._run_cases = _library()
+        loaded = library()
+        if loaded is None:
+            raise ValueError("the native loop is not compiled here")
+        self._run, self._run_cases = loaded.cs_loop_run, loaded.cs_loop_run_cases
 
     def run(
         self,
@@ -258,6 +275,6 @@ class Stepper:
         """
         call = self._failed_call.value
         if call >= _RESTART:
-            return self.messages.initialization_error(f"{_CALLS[call]} failed")
+            return self.messages.initialization_error(f"{CALLS[call]} failed")
         where = "at the end" if call == _AT_END else f"at t = {time[self._failed_step.value]:.17g}"
-        return self.messages.error(status, f"{_CALLS[call]} {where}")
+        return self.messages.error(status, f"{CALLS[call]} {where}")

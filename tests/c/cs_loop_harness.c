@@ -18,7 +18,7 @@
 #include "bare_master.h"
 
 /* What _native_loop.py checks too: the arguments below are those of this interface. */
-#define CS_LOOP_INTERFACE 6
+#define CS_LOOP_INTERFACE 7
 
 typedef int CsLoopInterface(void);
 typedef int CsLoopRun(void *const *functions, fmi2Component component,
