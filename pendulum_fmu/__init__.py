@@ -27,6 +27,9 @@ _LAZY = {
     "FmuInstance": "fmu._instance",
     "FmuFileError": "fmu._model",
     "total_inertia": "fmu._parameters",
+    # control: the FMU linearised from its own directional derivatives
+    "linearize": "fmu._linearize",
+    "Linearization": "fmu._linearize",
     # torque signals
     "schedule": "signals._torque_schedule",
     "TorqueSchedule": "signals._torque_schedule",

@@ -88,6 +88,7 @@ def test_the_examples_page_shows_every_figure_the_examples_wrote(site):
         "gravity_overlay",
         "parameter_study",
         "closed_loop_pd",
+        "swing_up_lqr",
         "compare_with_opensim",
         "fmpy_command_line",
     ):

@@ -19,6 +19,7 @@ EXAMPLES = {
     "gravity_overlay": [],
     "parameter_study": ["--overwrite"],
     "closed_loop_pd": [],
+    "swing_up_lqr": [],
     "compare_with_opensim": [],
     "fmpy_command_line": [],
 }

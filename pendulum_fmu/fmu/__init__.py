@@ -5,7 +5,8 @@ and defaults; _instance is one FMI instance (opened, initialized, its messages k
 a schedule through it, in Python or in the native loop (_native_loop loads _cs_loop.c, compiled
 beside it, with ctypes); _results is the one result format every tool returns (its fields the
 FMU's recorded variables). _export hands a user the FMU; _cross_check writes its results in the
-FMI cross-check layout.
+FMI cross-check layout. _linearize asks an instance for its directional derivatives at an
+operating point: A, B, C, D (linearize).
 _build_record is what an FMU records of how it was made (its build.json), and its archive
 written the same way every time.
 _signing reads the Ed25519 keys an FMU's record is signed and checked with.
