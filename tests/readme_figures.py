@@ -220,7 +220,19 @@ def pendulum_v1() -> str:
     )
 
 
-GENERATED = {"sweeps": sweeps, "robustness": robustness, "quickstart": quickstart, "pendulum_v1": pendulum_v1}
+def swing_up() -> str:
+    """What examples/swing_up_lqr.py prints: its gain and both environments' returns."""
+    printed = run(".venv/bin/python examples/swing_up_lqr.py --output-dir out/swing_up_lqr")
+    return "\n".join(["```text", printed, "```"])
+
+
+GENERATED = {
+    "sweeps": sweeps,
+    "robustness": robustness,
+    "quickstart": quickstart,
+    "pendulum_v1": pendulum_v1,
+    "swing_up": swing_up,
+}
 
 
 # --- running the commands, checking, updating ----------------------------------------------

@@ -41,6 +41,7 @@ DOCS_PAGES = tuple(
         "python_api",
         "command_line",
         "comparing",
+        "reinforcement_learning",
         "judging",
         "scenario_kit",
         "masters",
