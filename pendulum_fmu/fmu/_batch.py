@@ -56,7 +56,7 @@ class _CsBatch(ctypes.Structure):
         ("output_references", ctypes.c_void_p),
         ("n_outputs", ctypes.c_size_t),
         ("outputs", ctypes.c_void_p),
-        ("time", ctypes.c_void_p),
+        ("steps", ctypes.c_void_p),
         ("step_size", ctypes.c_double),
         ("statuses", ctypes.c_void_p),
         ("failed_calls", ctypes.c_void_p),
@@ -96,8 +96,8 @@ class FmuBatch:
         RESTART at its start values, or HOLD (nothing but read its outputs).
     outputs : numpy.ndarray
         (size, len(output_names)): read after each instance's restart or step.
-    time : numpy.ndarray
-        (size,): each instance's time.
+    steps : numpy.ndarray
+        (size,) uint64: each instance's steps since its restart; it stands at time steps * step_size.
     """
 
     def __init__(
@@ -124,7 +124,7 @@ class FmuBatch:
         self.inputs = np.zeros((size, len(input_names)))
         self.modes = np.full(size, RESTART, np.uint8)
         self.outputs = np.full((size, len(output_names)), np.nan)
-        self.time = np.zeros(size)
+        self.steps = np.zeros(size, np.uint64)
         self._statuses = np.zeros(size, np.intc)
         self._failed_calls = np.zeros(size, np.intc)
         self.instances: list[FmuInstance] = []
@@ -161,7 +161,7 @@ class FmuBatch:
             outputs.ctypes.data,
             len(outputs),
             self.outputs.ctypes.data,
-            self.time.ctypes.data,
+            self.steps.ctypes.data,
             self.step_size,
             self._statuses.ctypes.data,
             self._failed_calls.ctypes.data,
@@ -197,7 +197,8 @@ class FmuBatch:
             if call >= _RESET:
                 raise messages.initialization_error(f"{where}{cs_loop.CALLS[call]} failed")
             status = int(self._statuses[failed])
-            raise messages.error(status, f"{where}{cs_loop.CALLS[call]} at t = {self.time[failed]:.17g}")
+            time = float(self.steps[failed]) * self.step_size
+            raise messages.error(status, f"{where}{cs_loop.CALLS[call]} at t = {time:.17g}")
 
     def _advance_python(self) -> int:
         """advance() through fmpy's calls, in the order of _cs_batch.c; the worst status."""
@@ -215,12 +216,13 @@ class FmuBatch:
                     instance.setReal(start, list(self.start_values[i]))
                     call = _EXIT_INITIALIZATION
                     instance.exitInitializationMode()
-                    self.time[i] = 0.0
+                    self.steps[i] = 0
                 elif self.modes[i] == STEP:
                     instance.setReal(inputs, list(self.inputs[i]))
                     call = _DO_STEP
-                    instance.doStep(currentCommunicationPoint=self.time[i], communicationStepSize=self.step_size)
-                    self.time[i] += self.step_size
+                    time = float(self.steps[i]) * self.step_size
+                    instance.doStep(currentCommunicationPoint=time, communicationStepSize=self.step_size)
+                    self.steps[i] += 1
                 call = _GET_REAL
                 self.outputs[i] = instance.getReal(outputs)
             except Exception as error:  # fmpy's, for a status above fmi2Warning

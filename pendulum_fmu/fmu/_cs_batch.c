@@ -9,18 +9,21 @@
 
    Per instance i, by modes[i], in the order of the Python loop in _batch.py (the readable
    reference, which gives the same numbers bit for bit):
-     BATCH_STEP     fmi2SetReal(inputs of row i), fmi2DoStep(time[i], step_size);
-                    time[i] += step_size
+     BATCH_STEP     fmi2SetReal(inputs of row i),
+                    fmi2DoStep(start_time + steps[i] * step_size, step_size); steps[i] += 1
      BATCH_RESTART  fmi2Reset, fmi2SetupExperiment(tolerance, start_time),
                     fmi2EnterInitializationMode, fmi2SetReal(start values of row i),
-                    fmi2ExitInitializationMode; time[i] = start_time
+                    fmi2ExitInitializationMode; steps[i] = 0
      BATCH_HOLD     nothing
-   then fmi2GetReal(outputs of row i). */
+   then fmi2GetReal(outputs of row i). The communication points are start_time + k * step_size, as
+   every other loop of the package has them (not a running sum, whose rounding the FMU's steps would
+   see), so that an instance's steps are those of a schedule's run bit for bit. */
 
 #if !defined(_WIN32)
 #define _POSIX_C_SOURCE 200809L
 #endif
 
+#include <stdint.h>
 #include <stdlib.h>
 
 #include "_cs_loop.h"
@@ -76,7 +79,7 @@ typedef struct {
     const fmi2ValueReference *output_references;
     size_t n_outputs;
     double *outputs;                /* [n_instances][n_outputs] */
-    double *time;                   /* [n_instances] */
+    uint64_t *steps;                /* [n_instances]: the steps since the last restart */
     double step_size;
     int *statuses;                  /* [n_instances] */
     int *failed_calls;              /* [n_instances] */
@@ -106,14 +109,16 @@ static int advance(const CsBatch *b, size_t i) {
                                 b->start_values + i * b->n_start),
                   CALL_SET_START_VALUES);
         CHECK(fmi->exit_initialization_mode(component), CALL_EXIT_INITIALIZATION_MODE);
-        b->time[i] = b->start_time;
+        b->steps[i] = 0;
     } else if (b->modes[i] == BATCH_STEP) {
         if (b->n_inputs)
             CHECK(fmi->set_real(component, b->input_references, b->n_inputs,
                                 b->inputs + i * b->n_inputs),
                   CALL_SET_REAL);
-        CHECK(fmi->do_step(component, b->time[i], b->step_size, fmi2True), CALL_DO_STEP);
-        b->time[i] += b->step_size;
+        CHECK(fmi->do_step(component, b->start_time + (double)b->steps[i] * b->step_size, b->step_size,
+                          fmi2True),
+              CALL_DO_STEP);
+        b->steps[i]++;
     }
     CHECK(fmi->get_real(component, b->output_references, b->n_outputs,
                         b->outputs + i * b->n_outputs),
