@@ -241,3 +241,14 @@ def test_a_step_before_reset_is_refused():
         envs.step(np.zeros(2))
     env.close()
     envs.close()
+
+
+@pytest.mark.parametrize("name", ["PendulumFmuEnv", "PendulumFmuVectorEnv"])
+def test_the_docstring_examples_run_as_written(name):
+    import doctest
+
+    thing = getattr(pendulum_fmu.gym, name)
+    [test] = doctest.DocTestFinder(recurse=False).find(thing, name, globs={})
+    runner = doctest.DocTestRunner()
+    runner.run(test)
+    assert runner.failures == 0 and runner.tries > 3

@@ -53,6 +53,14 @@ class PendulumFmuEnv(gymnasium.Env):
         The FMU's parameters (mass, length, inertia, gravity, damping) over Pendulum-v1's rod:
         mass 1 kg, length 0.5 m, inertia 1/12 kg.m2, gravity 10 m/s2, damping 0.
 
+    Attributes
+    ----------
+    settings : Settings
+        What it was made with, checked: ``settings.parameters`` (the FMU's, defaults included),
+        ``settings.max_torque``, ``settings.dt``, ``settings.tolerance``, ``settings.model``.
+    dt, max_torque : float
+        As Pendulum-v1 has them.
+
     Raises
     ------
     InvalidInput

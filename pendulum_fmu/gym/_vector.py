@@ -60,6 +60,13 @@ class PendulumFmuVectorEnv(VectorEnv):
     max_torque, dt, tolerance, fmu, **parameters
         As PendulumFmuEnv.
 
+    Attributes
+    ----------
+    settings : Settings
+        What it was made with, checked, as PendulumFmuEnv's.
+    num_threads : int
+        The threads a step runs on.
+
     Raises
     ------
     InvalidInput
