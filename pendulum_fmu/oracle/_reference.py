@@ -41,6 +41,9 @@ from ._taylor import Diverged, check_tolerances, integrate_piece
 # is that point. Written again here on purpose: the oracle must not borrow the schedule's code.
 _TOLERANCE_STEPS, _TOLERANCE_ULPS = Fraction(1, 10**9), 64
 _DEFAULT_STOP_TIME = Fraction(3)
+# Times: a _Grid, a list of exact or double times, or an array of doubles; torques likewise.
+_Times = Sequence[Fraction | float] | np.ndarray
+_Values = Sequence[float] | np.ndarray
 # What the reference computes, whatever an FMU records.
 COMPUTED = ("torque", "theta", "omega", "alpha")
 
@@ -118,13 +121,13 @@ class _TorqueFile:
         j = bisect.bisect_right(self.times, t + tolerance)
         return max(t, self.times[j - 1]) if j and self.times[j - 1] >= t - tolerance else t
 
-    def held_after(self, points: list[Fraction], step: Fraction) -> list[float]:
+    def held_after(self, points: Sequence[Fraction], step: Fraction) -> np.ndarray:
         """after(latest_event_near(p, step)) of each point, the same values: the row times as
         doubles decide each point with no row near it on a flat stretch (its value is the row's);
         the exact methods decide the others.
         """
         times, torques = self.times, self.torques
-        row_doubles, doubles = np.array([float(t) for t in times]), np.array([float(p) for p in points])
+        row_doubles, doubles = np.array([float(t) for t in times]), _doubles(points)
         reach = np.maximum(float(_TOLERANCE_STEPS * step), _TOLERANCE_ULPS * np.spacing(np.abs(doubles)))
         # Widened by what the doubles may be off by (each time's rounding, the tolerance's):
         # a few ulp, bounded here by 16.
@@ -136,27 +139,67 @@ class _TorqueFile:
         before = np.clip(after - 1, 0, len(times) - 1)
         torque_doubles = np.array(torques)
         sloped = torque_doubles[before] != torque_doubles[np.minimum(after, len(times) - 1)]
-        values = torque_doubles[before].tolist()
+        values = torque_doubles[before]
         for k in np.flatnonzero(near | sloped).tolist():
             values[k] = self.after(self.latest_event_near(points[k], step))
         return values
 
 
-def _grid(start: Fraction, stop: Fraction, step: Fraction) -> list[Fraction]:
+class _Grid(Sequence[Fraction]):
+    """start + k*step for k < regular, then stop where it is given: the grid as exact fractions,
+    each regular only when asked for (a run of millions of steps holds none of them), and as
+    doubles in one array (doubles()).
+    """
+
+    def __init__(self, start: Fraction, step: Fraction, regular: int, stop: Fraction | None):
+        self.start, self.step, self.regular, self.stop = start, step, regular, stop
+
+    def __len__(self) -> int:
+        return self.regular + (self.stop is not None)
+
+    def __getitem__(self, k):
+        if isinstance(k, slice):
+            if k == slice(None, -1, None) and len(self):  # the steps' starts: the grid less its end
+                return _Grid(self.start, self.step, self.regular - (self.stop is None), None)
+            return [self[i] for i in range(*k.indices(len(self)))]
+        if k < 0:
+            k += len(self)
+        if not 0 <= k < len(self):
+            raise IndexError(k)
+        return self.start + k * self.step if k < self.regular else self.stop
+
+    def doubles(self) -> np.ndarray:
+        """Each point as the double nearest it (float of the fraction), in one array."""
+        (a, b), (c, d) = self.start.as_integer_ratio(), self.step.as_integer_ratio()
+        # (a*d + k*c*b) / (b*d): exact integers below 2**53 are exact doubles, and one IEEE
+        # division of them is correctly rounded, as float(Fraction) is.
+        if max(abs(a * d), abs(a * d + (self.regular - 1) * c * b), b * d) < 2**53:
+            out = (a * d + np.arange(self.regular, dtype=np.int64) * (c * b)) / float(b * d)
+        else:
+            out = np.array([float(self.start + k * self.step) for k in range(self.regular)])
+        return out if self.stop is None else np.append(out, float(self.stop))
+
+
+def _doubles(points: _Times) -> np.ndarray:
+    """A sequence of times (a _Grid, fractions or doubles) as an array of doubles."""
+    if isinstance(points, _Grid):
+        return points.doubles()
+    if isinstance(points, np.ndarray):
+        return points.astype(float)
+    return np.array([float(p) for p in points])
+
+
+def _grid(start: Fraction, stop: Fraction, step: Fraction) -> _Grid:
     """Start + k*step up to stop; stop itself ends a shorter last step unless it is on the grid."""
     # Only checked by the schedule's code, in simulate()'s words (a step that is not positive, a
     # stop not after the start, a run too long to hold): the grid below is the oracle's own.
     step_count(float(start), float(stop), float(step))
-    points, k, last = [], 0, stop - _tolerance(stop, step)
-    point = start
-    while point < last:
-        points.append(point)
-        k += 1
-        point = start + k * step
-    return [*points, stop]
+    # The points start + k*step before stop less its tolerance: k < (last - start) / step.
+    last = stop - _tolerance(stop, step)
+    return _Grid(start, step, max(math.ceil((last - start) / step), 0), stop)
 
 
-def _with_events(grid: list[Fraction], events: list[Fraction], step: Fraction) -> list[Fraction]:
+def _with_events(grid: _Grid, events: list[Fraction], step: Fraction) -> Sequence[Fraction]:
     """The grid plus every event inside it that is not within the tolerance of a grid point."""
     extra = []
     for event in events:
@@ -165,6 +208,8 @@ def _with_events(grid: list[Fraction], events: list[Fraction], step: Fraction) -
         j = bisect.bisect_left(grid, event)
         if min(grid[j] - event, event - grid[j - 1]) > _tolerance(event, step):
             extra.append(event)
+    if not extra:  # the grid as it is, its points made only when asked for
+        return grid
     # The grid is sorted and no extra event is on it: merged, not sorted anew.
     return list(heapq.merge(grid, sorted(set(extra))))
 
@@ -176,11 +221,11 @@ class _Pieces:
 
     def __init__(
         self,
-        starts: Sequence[Fraction | float],
+        starts: _Times,
         stop: Fraction | float,
-        u0: list[float],
-        rate: list[float],
-        points: Sequence[Fraction | float],
+        u0: _Values,
+        rate: _Values,
+        points: _Times,
         values_after: Callable[[np.ndarray], np.ndarray],
     ):
         self.starts, self.stop, self.u0, self.rate = starts, stop, u0, rate
@@ -195,11 +240,11 @@ def _signal_pieces(torque, start: Fraction, stop: Fraction | None, step: Fractio
         grid = _grid(start, stop, step)
         if ramp:
             # The file's own piecewise-linear signal: a piece between consecutive row times.
-            points = sorted({start, stop} | {t for t in signal.times if start < t < stop})
-            u0 = [signal.after(a) for a in points[:-1]]
-            rate = [(signal.before(b) - signal.after(a)) / float(b - a) for a, b in itertools.pairwise(points)]
+            rows = sorted({start, stop} | {t for t in signal.times if start < t < stop})
+            u0 = [signal.after(a) for a in rows[:-1]]
+            rate = [(signal.before(b) - signal.after(a)) / float(b - a) for a, b in itertools.pairwise(rows)]
             return _Pieces(
-                points[:-1],
+                rows[:-1],
                 stop,
                 u0,
                 rate,
@@ -208,9 +253,9 @@ def _signal_pieces(torque, start: Fraction, stop: Fraction | None, step: Fractio
                     [signal.after(signal.latest_event_near(_exact(t), step)) for t in times.tolist()]
                 ),
             )
-        points = _with_events(grid, signal.jumps(), step)
-        held = signal.held_after(points[:-1], step)
-        return _Pieces(points[:-1], stop, held, [0.0] * len(held), points, _Holding(points, held, step).values_after)
+        events = _with_events(grid, signal.jumps(), step)
+        held = signal.held_after(events[:-1], step)
+        return _Pieces(events[:-1], stop, held, np.zeros(len(held)), events, _Holding(events, held, step).values_after)
 
     if isinstance(torque, (list, tuple, np.ndarray)):
         values = [_torque(u, f"at step {k} of the array") for k, u in enumerate(torque)]
@@ -220,7 +265,7 @@ def _signal_pieces(torque, start: Fraction, stop: Fraction | None, step: Fractio
     else:
         points = _grid(start, _DEFAULT_STOP_TIME if stop is None else stop, step)
         sample = torque if callable(torque) else (lambda t, u=torque: u)
-        values = [_torque(sample(float(p)), f"at t = {float(p)}") for p in points]
+        values = [_torque(sample(p), f"at t = {p}") for p in _doubles(points).tolist()]
     if ramp:
         rate = [(b - a) / float(t1 - t0) for a, b, t0, t1 in zip(values, values[1:], points, points[1:], strict=False)]
     else:
@@ -238,9 +283,9 @@ class _Holding:
     rounding of a point, where doubles cannot tell the side, is decided by value_after.
     """
 
-    def __init__(self, points: Sequence[Fraction | float], values: list[float], step: Fraction):
+    def __init__(self, points: _Times, values: _Values, step: Fraction):
         self.points, self.values, self.step = points, values, step
-        self._point_doubles = np.array([float(p) for p in points])
+        self._point_doubles = _doubles(points)
         self._value_doubles = np.array(values, dtype=float)
         self._step_tolerance = float(_TOLERANCE_STEPS * step)
 
@@ -326,31 +371,27 @@ def _integrate(
     check_tolerances(rtol, atol)
     parameters = resolve_parameters(parameters, fmu_path)
     acceleration, model = equation_of_motion(parameters), model_constants(parameters)
-    starts = [float(s) for s in pieces.starts]
-    ends = [*starts[1:], float(pieces.stop)]
+    starts = _doubles(pieces.starts)
+    ends = np.append(starts[1:], float(pieces.stop))
+    u0s, rates = np.asarray(pieces.u0, dtype=float), np.asarray(pieces.rate, dtype=float)
     # Each reported time belongs to the first piece that reaches it (a time a rounding past the
     # end of the run belongs to the last).
     owner = np.minimum(np.searchsorted(ends, at, side="left"), len(ends) - 1)
-    # The reports by piece and, within one, by time: a piece's are a slice, found by bisection.
+    # The reports by piece and, within one, by time: a run of pieces' are a slice.
     by_piece = np.lexsort((at, owner))
-    owners = owner[by_piece].tolist()
+    owners = owner[by_piece]
+    # Pieces that continue one another (the same held torque) are one run, so that the series
+    # restarts only where the torque changes.
+    continues = (rates[1:] == 0) & (rates[:-1] == 0) & (u0s[1:] == u0s[:-1])
+    firsts = np.flatnonzero(np.r_[True, ~continues])
+    lasts = np.r_[firsts[1:] - 1, len(starts) - 1]
+    runs = np.stack([firsts, lasts, np.searchsorted(owners, firsts, "left"), np.searchsorted(owners, lasts, "right")])
     out = results.empty(len(at), COMPUTED)
     out["time"] = at
     theta, omega = float(theta0), float(omega0)
-    first = 0
-    while first < len(starts):
-        # Merge pieces that continue one another (the same held torque), so that the series
-        # restarts only where the torque changes.
-        last = first
-        while (
-            last + 1 < len(starts)
-            and pieces.rate[first] == 0
-            and pieces.rate[last + 1] == 0
-            and pieces.u0[last + 1] == pieces.u0[first]
-        ):
-            last += 1
-        t0, t1, u0, rate = starts[first], ends[last], pieces.u0[first], pieces.rate[first]
-        mine = by_piece[bisect.bisect_left(owners, first) : bisect.bisect_right(owners, last)]
+    for first, last, lo, hi in runs.T.tolist():
+        t0, t1, u0, rate = float(starts[first]), float(ends[last]), float(u0s[first]), float(rates[first])
+        mine = by_piece[lo:hi]
         try:
             thetas, omegas, theta, omega = integrate_piece(
                 theta, omega, (t0, t1), (u0, rate), model, (rtol, atol), np.clip(at[mine], t0, t1).tolist()
@@ -358,11 +399,10 @@ def _integrate(
         except Diverged as error:
             raise _failed(str(error), t0, parameters, theta0, omega0, pieces) from None
         out["theta"][mine], out["omega"][mine] = thetas, omegas
-        first = last + 1
     out["torque"] = pieces.values_after(at)
     # The end of the run reports the torque the last piece reached, as a master reads it back.
     at_end = at >= ends[-1]
-    out["torque"][at_end] = pieces.u0[-1] + pieces.rate[-1] * (ends[-1] - starts[-1])
+    out["torque"][at_end] = u0s[-1] + rates[-1] * (ends[-1] - starts[-1])
     with np.errstate(over="ignore", invalid="ignore"):
         out["alpha"] = acceleration(out["theta"], out["omega"], out["torque"])
     if not np.isfinite(out["alpha"]).all():  # the states stayed finite, the acceleration did not
@@ -453,7 +493,7 @@ def reference(
     stop = None if stop_time is None else _seconds("stop time", stop_time)
     pieces = _signal_pieces(torque, start, stop, step, ramp)
     if at is None:
-        at = np.array([float(t) for t in pieces.points])
+        at = _doubles(pieces.points)
     return _integrate(pieces, _times(at, pieces, step), parameters, theta0, omega0, rtol, atol, fmu_path)
 
 
@@ -522,8 +562,7 @@ def reference_schedule(
         raise WrongType(f"plan is a TorqueSchedule (torque_schedule.schedule(...)), not a {type(plan).__name__}")
     # Doubles, compared with exact times exactly where it matters (a Fraction and a float compare
     # by value): converting 3000 points to fractions would cost more than the integration.
-    points = plan.time.tolist()
-    u0, rate = plan.torque.tolist(), plan.torque_rate.tolist()
+    points, u0, rate = plan.time, plan.torque, plan.torque_rate
     # The schedule's points are the tools' own: no tolerance beyond rounding.
     pieces = _Pieces(points[:-1], points[-1], u0, rate, points, _Holding(points, u0, Fraction(0)).values_after)
     return _integrate(
