@@ -47,7 +47,7 @@ _LAZY = {
     "judge": "judging._judge",
     "judge_kit": "judging._judge",
     "judge_results": "judging._judge",
-    "Judgement": "judging._judge",
+    "Judgement": "judging._judgement",
     "ResultFileError": "judging._result_file",
     "write_scenarios": "scenarios._scenarios",
     "read_settings": "scenarios._scenario_settings",

@@ -127,7 +127,8 @@ def run(args) -> int:
 
 def _judge_kit(args, signal) -> int:
     """`judge KIT`: every NAME_out.csv beside a scenario kit's NAME.json, each its own run."""
-    from ..judging._judge import format_kit, judge_kit, write_json
+    from ..judging._judge import judge_kit
+    from ..judging._judgement import format_kit, write_json
 
     kit_files = [path for path in args.result.iterdir() if path.is_file()]
     check_outputs(
@@ -159,7 +160,8 @@ def _judge_results(args, signal, results: list[Path]) -> int:
     result that cannot be judged gets its one line and the others are judged; the exit status is
     the worst: 2 for such a result, else 1 for a fail, else 0.
     """
-    from ..judging._judge import JudgedRun, Judgement, format_judgement, write_json
+    from ..judging._judge import JudgedRun
+    from ..judging._judgement import Judgement, format_judgement, write_json
     from ..judging._result_file import ResultFileError
 
     several = len(results) > 1

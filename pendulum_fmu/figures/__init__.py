@@ -1,5 +1,7 @@
 """Every figure the package draws: runs overlaid, their differences, a sweep's cases, a judgement.
 
+_plot draws them; _drawn_points keeps a long run's extremes in a few thousand points.
+
 matplotlib is imported here and only here, and only by a command that draws.
 
 May import: fmu/ (the units and parameters in the labels) and the basics. It draws what it is

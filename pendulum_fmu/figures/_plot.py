@@ -19,6 +19,7 @@ from numpy.typing import ArrayLike
 from .._atomic_files import replacing_path
 from .._errors import InvalidInput
 from ..fmu._parameters import Fmu, merged_parameters, unit
+from ._drawn_points import drawn_points
 
 THETA_LABEL = r"Position $\theta$ in rad"
 OMEGA_LABEL = r"Velocity $\omega$ in rad/s"
@@ -390,32 +391,39 @@ def plot_judgement(judgement, path: str | Path, title: str) -> Path:
     """A judged result (judge.Judgement): the torque the run asks for and, when the diagnosis
     names a variant, the torque that variant applies (N.m); theta of the result and of the
     reference (rad); |theta_result - theta_reference| and the variant's own difference from the
-    reference (rad, log), with the tolerance. Exact zeros are said in words, not drawn.
+    reference (rad, log), with the tolerance. Exact zeros are said in words, not drawn. A long
+    run is drawn from drawn_points: a few thousand points that keep every extreme.
     """
     result, reference, variant = judgement.result, judgement.reference, judgement.explanation
-    time = result["time"]
+    difference = result["theta"] - reference["theta"]
+    zeros, points = int(np.count_nonzero(difference == 0)), len(difference)
+    drawn = [reference["torque"], reference["theta"], result["theta"], difference]
+    if variant is not None:
+        drawn += [variant["torque"], variant["theta"] - reference["theta"]]
+    kept = drawn_points(result["time"], *drawn)
+    time, torque, theta, given, difference = (values[kept] for values in [result["time"], *drawn[:4]])
     fig = _figure(10, 8)
     axes = fig.subplots(3, 1, sharex=True)
-    axes[0].step(time, reference["torque"], where="post", linewidth=2, label="the run's torque")
+    axes[0].step(time, torque, where="post", linewidth=2, label="the run's torque")
     if variant is not None and not np.array_equal(variant["torque"], reference["torque"]):
         axes[0].step(
             time,
-            variant["torque"],
+            drawn[4][kept],
             where="post",
             linestyle="--",
             linewidth=1.5,
             label=f"applied if {judgement.diagnosis}",
         )
     axes[0].set_ylabel(r"Torque $\tau$ in N.m")
-    axes[1].plot(time, reference["theta"], linewidth=2, label="reference")
-    axes[1].plot(time, result["theta"], linestyle="--", linewidth=1.5, label=judgement.source)
+    axes[1].plot(time, theta, linewidth=2, label="reference")
+    axes[1].plot(time, given, linestyle="--", linewidth=1.5, label=judgement.source)
     axes[1].set_ylabel(THETA_LABEL)
-    zeros = _log_difference(axes[2], time, result["theta"] - reference["theta"], "|result - reference|", linewidth=1.5)
+    _log_difference(axes[2], time, difference, "|result - reference|", linewidth=1.5)
     if variant is not None:
         _log_difference(
             axes[2],
             time,
-            variant["theta"] - reference["theta"],
+            drawn[5][kept],
             f"|{judgement.diagnosis} - reference|",
             linestyle="--",
             linewidth=1.5,
@@ -425,8 +433,8 @@ def plot_judgement(judgement, path: str | Path, title: str) -> Path:
     if zeros:
         note = (
             "the result equals the reference exactly at every point (difference 0 rad)"
-            if zeros == len(time)
-            else f"difference exactly 0 rad at {zeros:,} of {len(time):,} points (not drawn)"
+            if zeros == points
+            else f"difference exactly 0 rad at {zeros:,} of {points:,} points (not drawn)"
         )
         axes[2].text(0.01, 0.04, note, transform=axes[2].transAxes, fontsize=9)
     axes[2].set_ylabel(r"$|\Delta\theta|$ in rad")

@@ -27,170 +27,29 @@ explains the result leaves only rounding and solver noise (about 1e-11 rad). The
   communication step (a master that integrates the Model Exchange interface itself, or
   Pendulum-v1's semi-implicit Euler); when one of them leaves only noise, the judgement names it
   (Judgement.integrator).
+
+The reading is _result_file.py's, the variants' integration _variants.py's, the verdict and
+what is printed of it _judgement.py's.
 """
 
 from __future__ import annotations
 
-import json
 import math
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from .._atomic_files import replacing
 from .._errors import InvalidInput
 from ..fmu._model import FmuModel, fmu_model
 from ..fmu._simulate import resolve_parameters
 from ..oracle._reference import reference
 from ..scenarios._scenario_settings import JUDGE_TOLERANCE as DEFAULT_TOLERANCE, read_settings, settings_files
-from ..signals._time_grid import event_tolerance
-from ..signals._torque_schedule import TorqueSchedule, schedule
-from ._diagnoses import (
-    AGREES,
-    INPUT_TIMING,
-    INTEGRATION,
-    INTEGRATORS,
-    Run,
-    candidate_variants,
-    diagnose,
-    shared_variants,
-)
-from ._regression_tools import format_verdicts, regression_verdicts
-from ._result_file import OPTIONAL, ResultFileError, read_result
-
-
-@dataclass
-class Judgement:
-    """The verdict on one result and its diagnosis (see the module's docstring).
-
-    Attributes
-    ----------
-    verdict : {"pass", "fail"}
-        Whether max |dtheta| is within the tolerance; ``passed`` says the same as a bool.
-    diagnosis : str
-        The mistake that explains the difference, "agrees" or "unexplained".
-    residual, max_abs_dtheta, worst_time, tolerance : float
-        What is left once the diagnosis is explained (rad); the largest |dtheta| (rad) and its time
-        (s); the tolerance (rad).
-    candidates : dict
-        Per candidate mistake, the residual of its best variant (rad); None where it does not apply.
-    smallest_input_effect : float or None
-        The smallest difference an input-timing variant makes to this run (rad).
-    result, reference, explanation : numpy.ndarray
-        The result as read, the reference at its times, the variant the diagnosis names.
-    source : str
-        The result file's name, as reports show it.
-    integrator : str or None
-        For an integration error that one of its variants explains, the integrator the result is
-        (INTEGRATORS: explicit or semi-implicit Euler at the communication step); else None.
-
-    Examples
-    --------
-    A run whose torque steps 1 ms after the signal's step, and the mistake it is given:
-
-    >>> import tempfile
-    >>> from pathlib import Path
-    >>> from pendulum_fmu import judge, simulate
-    >>> from pendulum_fmu.fmu._results import write_csv
-    >>> late = simulate(lambda t: 0.0 if t < 0.251 else 20.0, stop_time=0.5)
-    >>> judgement = judge(write_csv(late, Path(tempfile.mkdtemp()) / "late.csv"),
-    ...                   lambda t: 0.0 if t < 0.25 else 20.0, stop_time=0.5)
-    >>> judgement.verdict, judgement.diagnosis, f"{judgement.max_abs_dtheta:.2e} rad"
-    ('fail', 'input one step late', '1.55e-04 rad')
-    """
-
-    verdict: str
-    diagnosis: str
-    residual: float
-    max_abs_dtheta: float
-    worst_time: float
-    tolerance: float
-    # Per candidate: the residual of its best variant and how far that variant is from the
-    # reference (rad); None where the candidate does not apply to this run.
-    candidates: dict[str, dict | None]
-    # The smallest difference from the reference an input-timing variant that changes this run
-    # makes (rad; None when none does): an integration error must be small beside it.
-    smallest_input_effect: float | None
-    result: np.ndarray = field(repr=False)
-    reference: np.ndarray = field(repr=False)
-    # The variant the diagnosis names, at the result's times (None for agrees and unexplained).
-    explanation: np.ndarray | None = field(default=None, repr=False)
-    source: str = "result"
-    integrator: str | None = None
-    # csv-compare's tube and the FMI cross-check's band on theta (regression_tools.regression_verdicts).
-    regression_tools: list[dict] = field(default_factory=list)
-
-    @property
-    def passed(self) -> bool:
-        """Whether the verdict is pass."""
-        return self.verdict == "pass"
-
-    def summary(self) -> dict:
-        """What --json writes: plain numbers, rad and s."""
-        worst = {}
-        for name in OPTIONAL:
-            given = self.result[name] if name in (self.result.dtype.names or ()) else np.nan
-            if np.all(np.isfinite(given)):
-                worst[f"max_abs_d{name}"] = float(np.max(np.abs(given - self.reference[name])))
-        return {
-            "result": self.source,
-            "verdict": self.verdict,
-            "diagnosis": self.diagnosis,
-            "integrator": self.integrator,
-            "residual": self.residual,
-            "max_abs_dtheta": self.max_abs_dtheta,
-            **worst,
-            "worst_time": self.worst_time,
-            "tolerance": self.tolerance,
-            "points": len(self.result),
-            "candidates": self.candidates,
-            "smallest_input_effect": self.smallest_input_effect,
-            "regression_tools": self.regression_tools,
-            "units": {
-                "residual": "rad",
-                "max_abs_dtheta": "rad",
-                "max_abs_domega": "rad/s",
-                "max_abs_dalpha": "rad/s2",
-                "worst_time": "s",
-                "tolerance": "rad",
-                "candidates": "rad",
-                "smallest_input_effect": "rad",
-            },
-        }
-
-
-def _check_span(result: np.ndarray, plan: TorqueSchedule, step_size: float, source: str) -> None:
-    """Refuse a result that is not a record of this run: times outside it, or a first or last row
-    that is not the run's start or stop. A result that stops short (a master that crashed, a file
-    cut off, only the t = 0 row) agrees with the reference wherever it has rows, so judged it would
-    pass a run that never happened.
-    """
-    start, stop = float(plan.time[0]), float(plan.time[-1])
-    slack = float(event_tolerance(max(abs(start), abs(stop)), step_size))
-    first, last = float(result["time"][0]), float(result["time"][-1])
-    if first < start - slack:
-        raise ResultFileError(
-            f"{source}: time {first:.17g} is before the run's start time {start:g} s; give the run's --start-time"
-        )
-    if last > stop + slack:
-        raise ResultFileError(
-            f"{source}: time {last:.17g} is after the run's stop time {stop:g} s; give the run's --stop-time"
-        )
-    # Half the first and the last step: a master's times may drift off the grid (a diagnosis of
-    # its own), but a first or last row nearer another communication point is another run's.
-    if first > start + (plan.time[1] - start) / 2:
-        raise ResultFileError(
-            f"{source}: the result starts at {first:.17g} s, not at the run's start "
-            f"time {start:g} s: write a row per communication point from the start "
-            "(judging a file alone, give the run's --start-time)"
-        )
-    if last < stop - (stop - plan.time[-2]) / 2:
-        raise ResultFileError(
-            f"{source}: the result ends at {last:.17g} s, before the run's stop "
-            f"time {stop:g} s, so it covers only part of the run: run it to the stop "
-            "time (judging a file alone, give the run's --stop-time)"
-        )
+from ..signals._torque_schedule import schedule
+from ._diagnoses import AGREES, INTEGRATION, INTEGRATORS, diagnose
+from ._judgement import Judgement, score_variants
+from ._regression_tools import regression_verdicts
+from ._result_file import ResultFileError, check_span, read_result
+from ._variants import Run, candidate_variants, shared_variants
 
 
 class JudgedRun:
@@ -301,13 +160,13 @@ class JudgedRun:
                 "a map renames and scales a result file's columns: an array result is "
                 "judged as it is, in the fields time and theta (rad); leave out mapping"
             )
-        _check_span(result, self.plan, self.step_size, source)
+        check_span(result, self.plan, self.step_size, source)
         times = np.asarray(result["time"], dtype=float)
         correct, run, shared = self._shared(times)
         difference = np.abs(result["theta"] - correct["theta"])
         raw = float(np.max(difference))
         variants = candidate_variants(shared, run, correct, result, self.tolerance)
-        scores, best, smallest_input_effect = _scores(variants, result, correct, self.tolerance)
+        scores, best, smallest_input_effect = score_variants(variants, result, correct, self.tolerance)
         if raw <= self.tolerance:
             diagnosis, residual, explained = AGREES, raw, False
         else:
@@ -328,30 +187,6 @@ class JudgedRun:
             integrator=INTEGRATORS[best[INTEGRATION]] if explained and diagnosis == INTEGRATION else None,
             regression_tools=regression_verdicts(times, correct["theta"], result["theta"]),
         )
-
-
-def _scores(
-    variants: dict[str, list[np.ndarray]], result: np.ndarray, correct: np.ndarray, tolerance: float
-) -> tuple[dict[str, dict | None], dict[str, int], float | None]:
-    """Per candidate, the residual and effect of its best variant (None where it does not apply);
-    that variant's index in its list; and the smallest effect above the tolerance of an
-    input-timing variant.
-    """
-    scores: dict[str, dict | None] = {}
-    best: dict[str, int] = {}
-    timing_effects: list[float] = []
-    for name, made in variants.items():
-        if not made:
-            scores[name] = None
-            continue
-        residuals = [float(np.max(np.abs(result["theta"] - v["theta"]))) for v in made]
-        effects = [float(np.max(np.abs(v["theta"] - correct["theta"]))) for v in made]
-        if name in INPUT_TIMING:
-            timing_effects += [effect for effect in effects if effect > tolerance]
-        i = int(np.argmin(residuals))
-        best[name] = i
-        scores[name] = {"residual": residuals[i], "effect": effects[i]}
-    return scores, best, min(timing_effects, default=None)
 
 
 def judge(
@@ -501,70 +336,6 @@ def judge_results(
     return [run.judge(result, mapping) for result in results]
 
 
-def format_judgement(judgement: Judgement) -> str:
-    """The lines the command prints for one result: verdict and diagnosis, max |dtheta| and
-    where, and every candidate's residual and effect.
-
-    Parameters
-    ----------
-    judgement : Judgement
-        What judge() returned.
-
-    Returns
-    -------
-    str
-        The lines, joined.
-    """
-    named = f"{judgement.diagnosis}: {judgement.integrator}" if judgement.integrator else judgement.diagnosis
-    lines = [
-        f"{judgement.source}: {judgement.verdict}: {named} (residual {judgement.residual:.2e} rad)",
-        f"max |dtheta| = {judgement.max_abs_dtheta:.3e} rad at t = {judgement.worst_time!r} s "
-        f"(tolerance {judgement.tolerance:g} rad; {len(judgement.result)} points)",
-        f"{'candidate':<28} {'residual rad':>12} {'effect rad':>11}",
-    ]
-    for name, score in judgement.candidates.items():
-        if score is None:
-            lines.append(f"{name:<28} {'does not apply to this run':>24}")
-        else:
-            lines.append(f"{name:<28} {score['residual']:>12.2e} {score['effect']:>11.2e}")
-    if judgement.regression_tools:
-        lines.append("what regression tools would say, on theta against the reference:")
-        lines.extend(f"  {line}" for line in format_verdicts(judgement.regression_tools))
-    return "\n".join(lines)
-
-
-def format_kit(verdicts: dict[str, Judgement | None]) -> str:
-    """The lines the command prints for a kit: one per scenario, then how many pass.
-
-    Parameters
-    ----------
-    verdicts : dict
-        What judge_kit() returned: {scenario: Judgement, or None where it was not run}.
-
-    Returns
-    -------
-    str
-        The lines, joined.
-    """
-    lines = []
-    for name, judgement in verdicts.items():
-        if judgement is None:
-            lines.append(f"{name:<18} not run: no {name}_out.csv")
-        else:
-            lines.append(
-                f"{name:<18} {judgement.verdict:<4}  {judgement.diagnosis:<28} max|dtheta| "
-                f"{judgement.max_abs_dtheta:.2e} rad at t = {judgement.worst_time:.6g} s, "
-                f"residual {judgement.residual:.1e} rad"
-            )
-    judged = [judgement for judgement in verdicts.values() if judgement is not None]
-    not_run = len(verdicts) - len(judged)
-    lines.append(
-        f"{sum(j.passed for j in judged)} of {len(judged)} results pass"
-        + (f"; {not_run} scenarios not run" if not_run else "")
-    )
-    return "\n".join(lines)
-
-
 def judge_kit(
     folder: str | Path,
     *,
@@ -635,44 +406,4 @@ def judge_kit(
     return verdicts
 
 
-def write_json(verdicts: dict[str, Judgement | None] | Judgement | list[Judgement | dict], path: str | Path) -> Path:
-    """Write --json whole or not at all: one judgement's summary (Judgement.summary),
-    {"scenarios": {name: summary or null}} for a kit, or {"results": [summary, ...]} for many
-    results of one run.
-
-    Parameters
-    ----------
-    verdicts : Judgement, dict or list
-        What judge(), judge_kit() or judge_results() returned; a list may also hold, for a result
-        that could not be judged, {"result": its name, "error": the one line saying why}.
-    path : str or Path
-        The JSON file.
-
-    Returns
-    -------
-    Path
-        path.
-    """
-    content: dict
-    if isinstance(verdicts, Judgement):
-        content = verdicts.summary()
-    elif isinstance(verdicts, list):
-        content = {"results": [j.summary() if isinstance(j, Judgement) else j for j in verdicts]}
-    else:
-        content = {"scenarios": {name: j.summary() if j else None for name, j in verdicts.items()}}
-    with replacing(path) as file:
-        json.dump(content, file, indent=2)
-        file.write("\n")
-    return Path(path)
-
-
-__all__ = [
-    "JudgedRun",
-    "Judgement",
-    "format_judgement",
-    "format_kit",
-    "judge",
-    "judge_kit",
-    "judge_results",
-    "write_json",
-]
+__all__ = ["JudgedRun", "judge", "judge_kit", "judge_results"]

@@ -5,8 +5,11 @@ alpha where it has them), under any names and units a --map gives.
 from __future__ import annotations
 
 import csv
+import io
 import math
-from collections.abc import Sequence
+import os
+from array import array
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -15,6 +18,8 @@ from .._errors import InvalidInput
 from .._received_files import bounded_lines, shortened
 from ..comparing._mapped_fmu import as_map
 from ..fmu import _results as results
+from ..signals._time_grid import event_tolerance
+from ..signals._torque_schedule import TorqueSchedule
 
 RESULT_QUANTITIES = ("time", "theta", "omega", "alpha")
 
@@ -44,10 +49,23 @@ class ResultFileError(InvalidInput):
 _GIVE_CSV = "give the result CSV the tool wrote"
 
 
+# A result larger than this is read by pyarrow (_read_arrow): importing it takes about 0.2 s,
+# more than the csv module takes to read a quick start's result (3,000 rows, 0.2 MB).
+ARROW_BYTES = 4 << 20
+
+
+# pyarrow's block: rows a block holds are converted together, on every core.
+_BLOCK_BYTES = 16 << 20
+
+
 def read_result(
     path: str | Path, mapping: str | dict | None = None, recorded: Sequence[str] | None = None
 ) -> np.ndarray:
     """A result CSV as a result array (_results.py); omega and alpha are NaN where it has none.
+
+    The file is read as it is when the reading starts (its size then): a file larger than
+    ARROW_BYTES by pyarrow's CSV reader, in blocks, only the judged columns converted; a smaller
+    one, or one pyarrow refuses, row by row, which names the first row that cannot be judged.
 
     Parameters
     ----------
@@ -68,23 +86,66 @@ def read_result(
     ------
     ResultFileError
         One line naming the file, the line and the problem: no time column, a mapped column
-        missing, a cell that is not a finite number, times that go backwards, no rows.
+        missing, a cell that is not a finite number, times that go backwards, a last line cut
+        short, no rows; or a file that grew or shrank while it was read (a master still writing it).
     """
     path = Path(path)
     mapped = as_map(mapping, RESULT_QUANTITIES)
     try:
-        with open(path, newline="", encoding="utf-8-sig") as file:
-            rows = list(csv.reader(bounded_lines(file, str(path), ResultFileError, _GIVE_CSV)))
+        with open(path, "rb") as raw:
+            size = os.fstat(raw.fileno()).st_size
+            values = _read(path, raw, size, mapped)
+        now = path.stat().st_size
     except OSError as error:
         raise ResultFileError(f"{path}: cannot read: {error.strerror}") from None
+    if now != size:
+        raise ResultFileError(
+            f"{path}: the file went from {size:,} to {now:,} bytes while it was read: a master is "
+            "still writing it; judge it once the run has finished"
+        )
+    out = results.empty(len(values["time"]), recorded)
+    out["torque"] = np.nan
+    for quantity in OPTIONAL:
+        out[quantity] = np.nan
+    for quantity, column in values.items():
+        out[quantity] = column
+    return out
+
+
+def _read(path: Path, raw: io.BufferedReader, size: int, mapped: dict) -> dict[str, np.ndarray]:
+    """{quantity: its column, in SI} of the file's first size bytes (read_result)."""
+    cut = _ends_mid_line(raw, size)
+    try:
+        with _text(raw, size) as text:
+            rows = _numbered_rows(path, text)
+            found = next(((number, row) for number, row in rows if any(cell.strip() for cell in row)), None)
+            if found is None:
+                raise ResultFileError(f"{path}: the file is empty; expected a header such as time,theta")
+            header = [cell.strip() for cell in found[1]]
+            columns = _columns(path, header, mapped)
+            if found[0] == 1 and size > ARROW_BYTES:
+                fast = _read_arrow(raw, size, len(header), columns)
+                if fast is not None:
+                    return fast
+                # Read again row by row: the first row pyarrow could not take is named.
+                with _text(raw, size) as again:
+                    rows = _numbered_rows(path, again)
+                    next(rows)
+                    return _read_rows(path, rows, columns, cut)
+            return _read_rows(path, rows, columns, cut)
     except csv.Error as error:  # a quoted cell across lines, over csv.field_size_limit()
         raise ResultFileError(f"{path}: not a CSV the judge reads ({error}); {_GIVE_CSV}") from None
     except UnicodeDecodeError:
         raise ResultFileError(f"{path}: not UTF-8 text; save the result as a UTF-8 CSV") from None
-    numbered = [(number, row) for number, row in enumerate(rows, start=1) if any(c.strip() for c in row)]
-    if not numbered:
-        raise ResultFileError(f"{path}: the file is empty; expected a header such as time,theta")
-    header = [cell.strip() for cell in numbered[0][1]]
+
+
+def _numbered_rows(path: Path, text: io.TextIOWrapper) -> Iterator[tuple[int, list[str]]]:
+    """The CSV's rows, each with its number from 1."""
+    return enumerate(csv.reader(bounded_lines(text, str(path), ResultFileError, _GIVE_CSV)), start=1)
+
+
+def _columns(path: Path, header: list[str], mapped: dict) -> dict[str, tuple[int, float]]:
+    """{quantity: (its column's index, its factor to SI)} of the quantities the header has."""
     listed = shortened(",".join(header))
     columns = {}
     for quantity in RESULT_QUANTITIES:
@@ -101,49 +162,149 @@ def read_result(
                 f"{path}:1: no column {quantity!r} (header is {listed}); "
                 f"name the result's {quantity} column with --map {quantity}=NAME"
             )
-    data = numbered[1:]
-    if not data:
-        raise ResultFileError(f"{path}: no data rows after the header")
-    out = results.empty(len(data), recorded)
-    out["torque"] = np.nan
-    for quantity in OPTIONAL:
-        out[quantity] = np.nan
-    if _read_columns(out, data, columns):
-        return out
-    _refuse_rows(path, out, data, columns)
+    return columns
+
+
+class _Snapshot(io.RawIOBase):
+    """The first size bytes of a file open for reading: what it held when the reading started,
+    whatever a master appends to it meanwhile.
+    """
+
+    def __init__(self, raw: io.BufferedReader, size: int):
+        self.raw, self.left = raw, size
+        raw.seek(0)
+
+    def readable(self) -> bool:
+        return True
+
+    def readinto(self, buffer) -> int:
+        view = memoryview(buffer)[: self.left]
+        count = self.raw.readinto(view) or 0
+        self.left -= count
+        return count
+
+
+def _text(raw: io.BufferedReader, size: int) -> io.TextIOWrapper:
+    """The snapshot (_Snapshot) as text, a BOM skipped, line ends left to the csv module."""
+    return io.TextIOWrapper(io.BufferedReader(_Snapshot(raw, size)), encoding="utf-8-sig", newline="")
+
+
+def _ends_mid_line(raw: io.BufferedReader, size: int) -> bool:
+    """Whether the snapshot's last line has no line end (a file cut off, or still being written)."""
+    if not size:
+        return False
+    raw.seek(size - 1)
+    return raw.read(1) not in (b"\n", b"\r")
+
+
+def _read_arrow(raw: io.BufferedReader, size: int, width: int, columns: dict) -> dict[str, np.ndarray] | None:
+    """The columns by pyarrow's CSV reader, block by block, only those judged converted; None
+    when it refuses a row or one is not finite, or the times go backwards (_read_rows then names
+    the row). pyarrow is imported here only: it takes longer to import than a short result to read.
+    """
+    import pyarrow as pa
+    from pyarrow import csv as pa_csv
+
+    names = [f"c{index}" for index in range(width)]
+    wanted = {quantity: names[index] for quantity, (index, _) in columns.items()}
+    try:
+        reader = pa_csv.open_csv(
+            io.BufferedReader(_Snapshot(raw, size), buffer_size=_BLOCK_BYTES),
+            read_options=pa_csv.ReadOptions(column_names=names, skip_rows=1, block_size=_BLOCK_BYTES),
+            convert_options=pa_csv.ConvertOptions(
+                include_columns=list(wanted.values()), column_types=dict.fromkeys(wanted.values(), pa.float64())
+            ),
+        )
+        blocks = [[batch.column(name).to_numpy(zero_copy_only=False) for name in wanted.values()] for batch in reader]
+    except (pa.ArrowException, ValueError):
+        return None
+    out = {}
+    for (quantity, (_, factor)), parts in zip(columns.items(), zip(*blocks, strict=True), strict=True):
+        values = np.concatenate(parts) if parts else np.empty(0)
+        if not np.isfinite(values).all():  # nulls (an empty cell, NA) are NaN too
+            return None
+        out[quantity] = values * factor if factor != 1.0 else values
+    if not blocks or np.any(np.diff(out["time"]) < 0):
+        return None
     return out
 
 
-def _read_columns(out: np.ndarray, data: list, columns: dict) -> bool:
-    """Fill out's columns from the rows a column at a time; False, with nothing to trust in out,
-    when a cell is missing, not a number or not finite, or a time goes backwards (_refuse_rows
-    then finds the first such row and says what is wrong with it).
+def _number(cell: str) -> float:
+    """The cell's number; NaN when it is none."""
+    try:
+        return float(cell)
+    except ValueError:
+        return math.nan
+
+
+def _read_rows(
+    path: Path, rows: Iterator[tuple[int, list[str]]], columns: dict, ends_mid_line: bool
+) -> dict[str, np.ndarray]:
+    """The columns from numbered rows, read one by one: ResultFileError at the first that cannot
+    be judged (a cell missing, not a number or not finite, a time that goes backwards, the last
+    line cut short).
     """
-    for quantity, (column, factor) in columns.items():
-        try:
-            values = np.array([float(row[column]) for _, row in data])
-        except (ValueError, IndexError):
-            return False
-        if not np.isfinite(values).all():
-            return False
-        out[quantity] = values * factor
-    return not np.any(np.diff(out["time"]) < 0)
-
-
-def _refuse_rows(path: Path, out: np.ndarray, data: list, columns: dict) -> None:
-    """Read the rows one by one, raising ResultFileError at the first that cannot be judged."""
-    for i, (number, row) in enumerate(data):
-        for quantity, (column, factor) in columns.items():
+    read = {quantity: array("d") for quantity in columns}
+    wanted = [(quantity, column, factor, read[quantity].append) for quantity, (column, factor) in columns.items()]
+    previous = -math.inf
+    for number, row in rows:
+        if not any(cell.strip() for cell in row):
+            continue
+        for quantity, column, factor, append in wanted:
             cell = row[column].strip() if column < len(row) else ""
-            try:
-                value = float(cell)
-            except ValueError:
-                raise ResultFileError(f"{path}:{number}: {quantity} {shortened(repr(cell))} is not a number") from None
+            value = _number(cell)
             if not math.isfinite(value):
+                # The row is refused: the next may be read. None, and no line end: the last
+                # line was cut off (a master still writing, a copy cut short), not miswritten.
+                if ends_mid_line and next(rows, None) is None:
+                    raise ResultFileError(
+                        f"{path}:{number}: the last line is cut short ({len(row)} cells, no line end): "
+                        "the file ends mid-row; judge the result once the tool has written it whole"
+                    )
+                if math.isnan(value) and cell.lower().lstrip("+-") != "nan":
+                    raise ResultFileError(f"{path}:{number}: {quantity} {shortened(repr(cell))} is not a number")
                 raise ResultFileError(f"{path}:{number}: {quantity} is {shortened(cell)}; values must be finite")
-            out[quantity][i] = value * factor
-        if i and out["time"][i] < out["time"][i - 1]:
+            append(value * factor)
+        time = read["time"][-1]
+        if time < previous:
             raise ResultFileError(
-                f"{path}:{number}: time {out['time'][i]:.17g} goes backwards (previous "
-                f"row: {out['time'][i - 1]:.17g}); a result's times must not decrease"
+                f"{path}:{number}: time {time:.17g} goes backwards (previous "
+                f"row: {previous:.17g}); a result's times must not decrease"
             )
+        previous = time
+    if not read["time"]:
+        raise ResultFileError(f"{path}: no data rows after the header")
+    return {quantity: np.frombuffer(values, dtype=float) for quantity, values in read.items()}
+
+
+def check_span(result: np.ndarray, plan: TorqueSchedule, step_size: float, source: str) -> None:
+    """Refuse a result that is not a record of this run: times outside it, or a first or last row
+    that is not the run's start or stop. A result that stops short (a master that crashed, a file
+    cut off, only the t = 0 row) agrees with the reference wherever it has rows, so judged it would
+    pass a run that never happened.
+    """
+    start, stop = float(plan.time[0]), float(plan.time[-1])
+    slack = float(event_tolerance(max(abs(start), abs(stop)), step_size))
+    first, last = float(result["time"][0]), float(result["time"][-1])
+    if first < start - slack:
+        raise ResultFileError(
+            f"{source}: time {first:.17g} is before the run's start time {start:g} s; give the run's --start-time"
+        )
+    if last > stop + slack:
+        raise ResultFileError(
+            f"{source}: time {last:.17g} is after the run's stop time {stop:g} s; give the run's --stop-time"
+        )
+    # Half the first and the last step: a master's times may drift off the grid (a diagnosis of
+    # its own), but a first or last row nearer another communication point is another run's.
+    if first > start + (plan.time[1] - start) / 2:
+        raise ResultFileError(
+            f"{source}: the result starts at {first:.17g} s, not at the run's start "
+            f"time {start:g} s: write a row per communication point from the start "
+            "(judging a file alone, give the run's --start-time)"
+        )
+    if last < stop - (stop - plan.time[-2]) / 2:
+        raise ResultFileError(
+            f"{source}: the result ends at {last:.17g} s, before the run's stop "
+            f"time {stop:g} s, so it covers only part of the run: run it to the stop "
+            "time (judging a file alone, give the run's --stop-time)"
+        )

@@ -1,0 +1,212 @@
+"""The variants of a run with a candidate mistake made: the schedule changed as the mistake
+changes it, integrated exactly (reference_schedule) at the result's times; integration error's
+variants stepped by each of INTEGRATORS. _diagnoses.py names the candidates and decides.
+"""
+
+from __future__ import annotations
+
+import math
+from array import array
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..fmu import _results as results
+from ..fmu._model import FmuModel
+from ..oracle._reference import model_constants, reference_schedule
+from ..signals._time_grid import event_tolerance
+from ..signals._torque_csv import TorqueTable, read_torque_csv
+from ..signals._torque_schedule import TorqueSchedule
+from ._diagnoses import (
+    DIAGNOSES,
+    DRIFT,
+    EARLY,
+    HELD,
+    INTEGRATION,
+    INTEGRATORS,
+    INTERPOLATED,
+    LATE,
+    NOT_RESTORED,
+    SEMI_IMPLICIT_EULER,
+)
+
+
+def _plan_index(plan: TorqueSchedule, times: np.ndarray, step_size: float) -> np.ndarray | None:
+    """For each time, the index of the communication point it is; None when one is off them."""
+    index = np.clip(np.searchsorted(plan.time, times), 1, len(plan.time) - 1)
+    index = np.where(np.abs(plan.time[index] - times) < np.abs(plan.time[index - 1] - times), index, index - 1)
+    on_grid = np.abs(plan.time[index] - times) <= event_tolerance(times, step_size)
+    return index if np.all(on_grid) else None
+
+
+def _changed(plan: TorqueSchedule, torque: np.ndarray, rate: np.ndarray | None = None) -> TorqueSchedule:
+    return TorqueSchedule(time=plan.time, torque=torque, torque_rate=plan.torque_rate if rate is None else rate)
+
+
+def _late(plan: TorqueSchedule, start_torque: float) -> list[TorqueSchedule]:
+    """Step k holds what step k-1 should; the first step the signal's first value or the FMU's
+    start value (whatever the master set before it began).
+    """
+    variants = []
+    for first in dict.fromkeys((float(plan.torque[0]), start_torque)):
+        first_rate = plan.torque_rate[0] if first == plan.torque[0] else 0.0
+        variants.append(_changed(plan, np.r_[first, plan.torque[:-1]], np.r_[first_rate, plan.torque_rate[:-1]]))
+    return variants
+
+
+def _early(plan: TorqueSchedule) -> list[TorqueSchedule]:
+    return [_changed(plan, np.r_[plan.torque[1:], plan.torque[-1]], np.r_[plan.torque_rate[1:], 0.0])]
+
+
+def _interpolated(plan: TorqueSchedule) -> list[TorqueSchedule]:
+    """Each step ramps from its value to the next step's; the last one holds."""
+    return [_changed(plan, plan.torque, np.r_[np.diff(plan.torque) / plan.step_size[:-1], 0.0])]
+
+
+def _signal_values(torque, times: np.ndarray, side: str) -> np.ndarray | None:
+    """The signal just after (side "after") or before each time, sampled as a master would,
+    without the definition's snapping of events onto communication points; None for a per-step
+    array, which has no value between its steps.
+    """
+    if isinstance(torque, (str, Path)):
+        torque = read_torque_csv(torque)
+    if isinstance(torque, TorqueTable):
+        return torque.value_after(times) if side == "after" else torque.value_before(times)
+    if callable(torque):
+        return np.array([float(torque(t)) for t in times.tolist()])
+    if isinstance(torque, (list, tuple, np.ndarray)):
+        return None
+    return np.full(len(times), float(torque))
+
+
+def _drifted(torque, times: np.ndarray, ramp: bool) -> list[TorqueSchedule]:
+    """The master's steps are the result's own times; each samples the signal at its start."""
+    points = np.unique(times)
+    start = _signal_values(torque, points[:-1], "after")
+    if start is None or len(points) < 2:
+        return []
+    rate = (_signal_values(torque, points[1:], "before") - start) / np.diff(points) if ramp else np.zeros(len(start))
+    return [TorqueSchedule(time=points, torque=start, torque_rate=rate)]
+
+
+def _euler(run: Run, semi_implicit: bool) -> np.ndarray:
+    """The equation of motion stepped once per communication step of the run's plan, holding
+    each step's start torque: explicit Euler, or semi-implicit (the new omega moves theta).
+    """
+    plan, theta, omega = run.plan, run.theta0, run.omega0
+    # The equation written out with math.sin: a step in Python costs a third of one through numpy.
+    gravity_moment, damping, inverse_inertia = model_constants(run.parameters)
+    thetas, omegas = array("d"), array("d")
+    for h, u in zip(plan.step_size.tolist(), plan.torque.tolist(), strict=True):
+        thetas.append(theta)
+        omegas.append(omega)
+        alpha = (u - gravity_moment * math.sin(theta) - damping * omega) * inverse_inertia
+        if semi_implicit:
+            omega += h * alpha
+            theta += h * omega
+        else:
+            theta, omega = theta + h * omega, omega + h * alpha
+    thetas.append(theta)
+    omegas.append(omega)
+    out = results.empty(len(plan.time), run.model.recorded)  # its FMU's fields: no other looked up
+    out["time"], out["theta"], out["omega"] = plan.time, thetas, omegas
+    out["torque"][:-1], out["torque"][-1] = plan.torque, plan.torque[-1]
+    return out
+
+
+_SCHEDULE = ("time", "torque", "torque_rate")
+
+
+@dataclass
+class Run:
+    """What every variant of one run needs."""
+
+    plan: TorqueSchedule
+    times: np.ndarray
+    step_size: float
+    parameters: dict
+    theta0: float
+    omega0: float
+    model: FmuModel
+
+    # The schedules integrated at the result's times, and what came out: variants of a run whose
+    # torque holds for long stretches are often the run itself (a constant torque one step late).
+    _made: list[tuple[TorqueSchedule, np.ndarray]] = field(default_factory=list, repr=False)
+
+    def integrate(self, plan: TorqueSchedule, at: np.ndarray | None = None) -> np.ndarray:
+        """The schedule from the run's initial state, exactly, at the result's times (or at)."""
+        if at is None:
+            for other, made in self._made:
+                if all(np.array_equal(getattr(plan, name), getattr(other, name)) for name in _SCHEDULE):
+                    return made
+        integrated = reference_schedule(
+            plan,
+            parameters=self.parameters,
+            theta0=self.theta0,
+            omega0=self.omega0,
+            at=self.times if at is None else at,
+            fmu_path=self.model,
+        )
+        if at is None:
+            self._made.append((plan, integrated))
+        return integrated
+
+
+def _not_restored(run: Run, correct: np.ndarray, first_wrong: int) -> list[np.ndarray]:
+    """Up to a point the reference; from there the run restarts from its initial state, as a
+    resumed run that did not restore its saved FMU state. The restart is where the first row that
+    disagrees is (it shows the initial state), or the row before it (it shows the old instance's
+    state, the next row the new one's).
+    """
+    variants = []
+    for restart_row in (first_wrong, first_wrong - 1):
+        if restart_row < 1:  # a restart at the very start is no restart
+            continue
+        restart = run.times[restart_row]
+        k = int(np.argmin(np.abs(run.plan.time - restart)))
+        off = abs(run.plan.time[k] - restart) > event_tolerance(restart, run.step_size)
+        if off or k + 1 >= len(run.plan.time):
+            continue
+        tail = TorqueSchedule(time=run.plan.time[k:], torque=run.plan.torque[k:], torque_rate=run.plan.torque_rate[k:])
+        variant = correct.copy()
+        variant[first_wrong:] = run.integrate(tail, at=run.times[first_wrong:])
+        variants.append(variant)
+    return variants
+
+
+def _integration(run: Run) -> list[np.ndarray]:
+    """The run stepped by each of INTEGRATORS, in their order, at the result's times."""
+    index = _plan_index(run.plan, run.times, run.step_size)
+    if index is None:
+        return []
+    return [_euler(run, integrator == SEMI_IMPLICIT_EULER)[index] for integrator in INTEGRATORS]
+
+
+def shared_variants(run: Run, torque, held: TorqueSchedule | None, start_torque: float) -> dict[str, list[np.ndarray]]:
+    """{candidate: its variants at the result's times} of every candidate whose variants do not
+    depend on the result (all but state not restored): made once for the results of a run that
+    share their times. An empty list where a candidate does not apply.
+    held: for a ramp run, the same signal held over each step (schedule without ramp).
+    """
+    plan, ramp = run.plan, held is not None
+    off_grid = _plan_index(plan, run.times, run.step_size) is None
+    return {
+        LATE: [run.integrate(p) for p in _late(plan, start_torque)],
+        EARLY: [run.integrate(p) for p in _early(plan)],
+        INTERPOLATED: [] if ramp else [run.integrate(p) for p in _interpolated(plan)],
+        HELD: [run.integrate(held)] if held is not None else [],
+        DRIFT: [run.integrate(p) for p in _drifted(torque, run.times, ramp)] if off_grid else [],
+        INTEGRATION: _integration(run),
+    }
+
+
+def candidate_variants(
+    shared: dict[str, list[np.ndarray]], run: Run, correct: np.ndarray, result: np.ndarray, tolerance: float
+) -> dict[str, list[np.ndarray]]:
+    """{candidate: its variants at the result's times}, in DIAGNOSES' order: the shared ones
+    (shared_variants) and state not restored, which restarts where this result first disagrees.
+    """
+    wrong = np.flatnonzero(np.abs(result["theta"] - correct["theta"]) > tolerance)
+    own = {NOT_RESTORED: _not_restored(run, correct, int(wrong[0])) if len(wrong) else []}
+    return {name: own[name] if name in own else shared[name] for name in DIAGNOSES if name in own or name in shared}
