@@ -30,7 +30,8 @@ def scipy_run(theta0, omega0, span, torque, damping, times, method, gravity_mome
 
 def taylor_run(theta0, omega0, span, torque, damping, times, gravity_moment=GRAVITY_MOMENT, tolerance=TIGHT):
     model = (gravity_moment, damping, 1.0 / TOTAL_INERTIA)
-    return integrate_piece(theta0, omega0, span, torque, model, tolerance, list(times))
+    thetas, omegas, theta, omega = integrate_piece(theta0, omega0, span, torque, model, tolerance, list(times))
+    return thetas.tolist(), omegas.tolist(), theta, omega
 
 
 def test_gravity_off_constant_torque_is_the_parabola():

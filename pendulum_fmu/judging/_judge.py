@@ -49,7 +49,7 @@ from ._diagnoses import AGREES, INTEGRATION, INTEGRATORS, diagnose
 from ._judgement import Judgement, score_variants
 from ._regression_tools import regression_verdicts
 from ._result_file import ResultFileError, check_span, read_result
-from ._variants import Run, candidate_variants, shared_variants
+from ._variants import KEEP_ROWS, Run, Variant, candidate_variants, shared_variants
 
 
 class JudgedRun:
@@ -57,7 +57,8 @@ class JudgedRun:
 
     The schedule is made once. The reference and the variants of the candidate mistakes that do
     not depend on the result (all but state not restored) are made once per set of result times
-    and kept for the next result on the same times: the results of one scenario share them.
+    and kept for the next result on the same times: the results of one scenario share them. A
+    result of more than KEEP_ROWS rows keeps none: its variants are made one at a time.
 
     Parameters
     ----------
@@ -102,14 +103,15 @@ class JudgedRun:
         )
         self.held = schedule(torque, start_time=start_time, stop_time=stop_time, step_size=step_size) if ramp else None
         self.start_torque = float(self.model.variables["torque"].start or 0.0)
-        self._kept: dict[bytes, tuple[np.ndarray, Run, dict[str, list[np.ndarray]]]] = {}
+        self._kept: dict[bytes, tuple[np.ndarray, Run, dict[str, list[Variant]]]] = {}
 
-    def _shared(self, times: np.ndarray) -> tuple[np.ndarray, Run, dict[str, list[np.ndarray]]]:
+    def _shared(self, times: np.ndarray) -> tuple[np.ndarray, Run, dict[str, list[Variant]]]:
         """The reference at these times, the frame of the run's variants, and the variants every
-        result on these times shares (made here the first time, kept for the next).
+        result on these times shares (made here the first time, kept for the next: for a result
+        of up to KEEP_ROWS rows).
         """
-        key = times.tobytes()
-        if key not in self._kept:
+        key = times.tobytes() if len(times) <= KEEP_ROWS else None
+        if key is None or key not in self._kept:
             correct = reference(
                 self.torque,
                 start_time=self.start_time,
@@ -123,6 +125,9 @@ class JudgedRun:
                 fmu_path=self.model,
             )
             run = Run(self.plan, times, self.step_size, self.parameters, self.theta0, self.omega0, self.model)
+            run.keep = key is not None
+            if key is None:
+                return correct, run, shared_variants(run, self.torque, self.held, self.start_torque)
             if len(self._kept) >= self.KEPT_TIMES:
                 del self._kept[next(iter(self._kept))]
             self._kept[key] = (correct, run, shared_variants(run, self.torque, self.held, self.start_torque))
@@ -182,7 +187,7 @@ class JudgedRun:
             smallest_input_effect=smallest_input_effect,
             result=result,
             reference=correct,
-            explanation=variants[diagnosis][best[diagnosis]] if diagnosis in best else None,
+            explanation=variants[diagnosis][best[diagnosis]]() if diagnosis in best else None,
             source=source,
             integrator=INTEGRATORS[best[INTEGRATION]] if explained and diagnosis == INTEGRATION else None,
             regression_tools=regression_verdicts(times, correct["theta"], result["theta"]),

@@ -14,6 +14,7 @@ from .._atomic_files import replacing
 from ._diagnoses import INPUT_TIMING
 from ._regression_tools import format_verdicts
 from ._result_file import OPTIONAL
+from ._variants import Variant
 
 
 @dataclass
@@ -117,11 +118,11 @@ class Judgement:
 
 
 def score_variants(
-    variants: dict[str, list[np.ndarray]], result: np.ndarray, correct: np.ndarray, tolerance: float
+    variants: dict[str, list[Variant]], result: np.ndarray, correct: np.ndarray, tolerance: float
 ) -> tuple[dict[str, dict | None], dict[str, int], float | None]:
     """Per candidate, the residual and effect of its best variant (None where it does not apply);
     that variant's index in its list; and the smallest effect above the tolerance of an
-    input-timing variant.
+    input-timing variant. Each variant is made, scored and let go before the next is made.
     """
     scores: dict[str, dict | None] = {}
     best: dict[str, int] = {}
@@ -130,8 +131,11 @@ def score_variants(
         if not made:
             scores[name] = None
             continue
-        residuals = [float(np.max(np.abs(result["theta"] - v["theta"]))) for v in made]
-        effects = [float(np.max(np.abs(v["theta"] - correct["theta"]))) for v in made]
+        residuals, effects = [], []
+        for make in made:
+            theta = make()["theta"]
+            residuals.append(float(np.max(np.abs(result["theta"] - theta))))
+            effects.append(float(np.max(np.abs(theta - correct["theta"]))))
         if name in INPUT_TIMING:
             timing_effects += [effect for effect in effects if effect > tolerance]
         i = int(np.argmin(residuals))

@@ -5,8 +5,10 @@ variants stepped by each of INTEGRATORS. _diagnoses.py names the candidates and 
 
 from __future__ import annotations
 
+import functools
 import math
 from array import array
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -90,32 +92,51 @@ def _drifted(torque, times: np.ndarray, ramp: bool) -> list[TorqueSchedule]:
     return [TorqueSchedule(time=points, torque=start, torque_rate=rate)]
 
 
-def _euler(run: Run, semi_implicit: bool) -> np.ndarray:
+def _euler(run: Run, semi_implicit: bool, index: np.ndarray) -> np.ndarray:
     """The equation of motion stepped once per communication step of the run's plan, holding
-    each step's start torque: explicit Euler, or semi-implicit (the new omega moves theta).
+    each step's start torque: explicit Euler, or semi-implicit (the new omega moves theta); at
+    the plan's points index (the result's rows).
     """
     plan, theta, omega = run.plan, run.theta0, run.omega0
     # The equation written out with math.sin: a step in Python costs a third of one through numpy.
     gravity_moment, damping, inverse_inertia = model_constants(run.parameters)
     thetas, omegas = array("d"), array("d")
-    for h, u in zip(plan.step_size.tolist(), plan.torque.tolist(), strict=True):
-        thetas.append(theta)
-        omegas.append(omega)
-        alpha = (u - gravity_moment * math.sin(theta) - damping * omega) * inverse_inertia
-        if semi_implicit:
-            omega += h * alpha
-            theta += h * omega
-        else:
-            theta, omega = theta + h * omega, omega + h * alpha
+    # The steps' lengths and torques as floats a block at a time: lists of a whole long run's
+    # would take 64 bytes a step.
+    for begin in range(0, len(plan.torque), _BLOCK):
+        block = slice(begin, begin + _BLOCK)
+        for h, u in zip(plan.step_size[block].tolist(), plan.torque[block].tolist(), strict=True):
+            thetas.append(theta)
+            omegas.append(omega)
+            alpha = (u - gravity_moment * math.sin(theta) - damping * omega) * inverse_inertia
+            if semi_implicit:
+                omega += h * alpha
+                theta += h * omega
+            else:
+                theta, omega = theta + h * omega, omega + h * alpha
     thetas.append(theta)
     omegas.append(omega)
-    out = results.empty(len(plan.time), run.model.recorded)  # its FMU's fields: no other looked up
-    out["time"], out["theta"], out["omega"] = plan.time, thetas, omegas
-    out["torque"][:-1], out["torque"][-1] = plan.torque, plan.torque[-1]
+    out = results.empty(len(index), run.model.recorded)  # its FMU's fields: no other looked up
+    out["time"] = plan.time[index]
+    out["theta"], out["omega"] = np.frombuffer(thetas)[index], np.frombuffer(omegas)[index]
+    out["torque"] = plan.torque[np.minimum(index, len(plan.torque) - 1)]
     return out
 
 
 _SCHEDULE = ("time", "torque", "torque_rate")
+
+
+# Steps of integration error's Euler taken as floats at once.
+_BLOCK = 1 << 16
+
+
+# A variant at the result's times, made when called.
+Variant = Callable[[], np.ndarray]
+
+
+# Results up to this many rows keep their variants once made (for the next result on the same
+# times; 40 bytes a row each); a longer one's are made one at a time, scored and let go.
+KEEP_ROWS = 200_000
 
 
 @dataclass
@@ -130,16 +151,17 @@ class Run:
     omega0: float
     model: FmuModel
 
-    # The schedules integrated at the result's times, and what came out: variants of a run whose
-    # torque holds for long stretches are often the run itself (a constant torque one step late).
-    _made: list[tuple[TorqueSchedule, np.ndarray]] = field(default_factory=list, repr=False)
+    # Kept: whether this run's variants stay made once made (KEEP_ROWS), and the run's own
+    # schedule integrated, which variants of a run holding its torque for long stretches often
+    # are (a constant torque one step late).
+    keep: bool = True
+    _own: np.ndarray | None = field(default=None, repr=False)
 
     def integrate(self, plan: TorqueSchedule, at: np.ndarray | None = None) -> np.ndarray:
         """The schedule from the run's initial state, exactly, at the result's times (or at)."""
-        if at is None:
-            for other, made in self._made:
-                if all(np.array_equal(getattr(plan, name), getattr(other, name)) for name in _SCHEDULE):
-                    return made
+        own = at is None and all(np.array_equal(getattr(plan, name), getattr(self.plan, name)) for name in _SCHEDULE)
+        if own and self._own is not None:
+            return self._own
         integrated = reference_schedule(
             plan,
             parameters=self.parameters,
@@ -148,18 +170,26 @@ class Run:
             at=self.times if at is None else at,
             fmu_path=self.model,
         )
-        if at is None:
-            self._made.append((plan, integrated))
+        if own:
+            self._own = integrated
         return integrated
 
+    def variant(self, make: Callable[[], np.ndarray]) -> Variant:
+        """A variant made by make() when it is first asked for: kept then for a short run (its
+        results share it), made anew each time for a long one, which holds one at a time.
+        """
+        if not self.keep:
+            return make
+        return functools.cache(make)
 
-def _not_restored(run: Run, correct: np.ndarray, first_wrong: int) -> list[np.ndarray]:
+
+def _not_restored(run: Run, correct: np.ndarray, first_wrong: int) -> list[Variant]:
     """Up to a point the reference; from there the run restarts from its initial state, as a
     resumed run that did not restore its saved FMU state. The restart is where the first row that
     disagrees is (it shows the initial state), or the row before it (it shows the old instance's
     state, the next row the new one's).
     """
-    variants = []
+    variants: list[Variant] = []
     for restart_row in (first_wrong, first_wrong - 1):
         if restart_row < 1:  # a restart at the very start is no restart
             continue
@@ -169,41 +199,67 @@ def _not_restored(run: Run, correct: np.ndarray, first_wrong: int) -> list[np.nd
         if off or k + 1 >= len(run.plan.time):
             continue
         tail = TorqueSchedule(time=run.plan.time[k:], torque=run.plan.torque[k:], torque_rate=run.plan.torque_rate[k:])
-        variant = correct.copy()
-        variant[first_wrong:] = run.integrate(tail, at=run.times[first_wrong:])
-        variants.append(variant)
+        variants.append(functools.partial(_restarted, run, correct, first_wrong, tail))
     return variants
 
 
-def _integration(run: Run) -> list[np.ndarray]:
+def _restarted(run: Run, correct: np.ndarray, first_wrong: int, tail: TorqueSchedule) -> np.ndarray:
+    """The reference up to first_wrong, the tail of the schedule from the initial state after."""
+    variant = correct.copy()
+    variant[first_wrong:] = run.integrate(tail, at=run.times[first_wrong:])
+    return variant
+
+
+def _integration(run: Run) -> list[Variant]:
     """The run stepped by each of INTEGRATORS, in their order, at the result's times."""
     index = _plan_index(run.plan, run.times, run.step_size)
     if index is None:
         return []
-    return [_euler(run, integrator == SEMI_IMPLICIT_EULER)[index] for integrator in INTEGRATORS]
+    return [run.variant(functools.partial(_stepped, run, integrator, index)) for integrator in INTEGRATORS]
 
 
-def shared_variants(run: Run, torque, held: TorqueSchedule | None, start_torque: float) -> dict[str, list[np.ndarray]]:
+def _stepped(run: Run, integrator: str, index: np.ndarray) -> np.ndarray:
+    """The run stepped by the integrator (one of INTEGRATORS), at the result's rows (index)."""
+    return _euler(run, integrator == SEMI_IMPLICIT_EULER, index)
+
+
+def shared_variants(run: Run, torque, held: TorqueSchedule | None, start_torque: float) -> dict[str, list[Variant]]:
     """{candidate: its variants at the result's times} of every candidate whose variants do not
     depend on the result (all but state not restored): made once for the results of a run that
-    share their times. An empty list where a candidate does not apply.
+    share their times (Run.variant). An empty list where a candidate does not apply.
     held: for a ramp run, the same signal held over each step (schedule without ramp).
     """
     plan, ramp = run.plan, held is not None
     off_grid = _plan_index(plan, run.times, run.step_size) is None
+
+    def integrated(make: Callable[..., list[TorqueSchedule]], *args) -> list[Variant]:
+        # The schedules are made again by each variant when it is made: a long run's would
+        # hold 24 bytes a step each, all the while.
+        return [run.variant(functools.partial(_integrated, run, make, args, i)) for i in range(len(make(*args)))]
+
     return {
-        LATE: [run.integrate(p) for p in _late(plan, start_torque)],
-        EARLY: [run.integrate(p) for p in _early(plan)],
-        INTERPOLATED: [] if ramp else [run.integrate(p) for p in _interpolated(plan)],
-        HELD: [run.integrate(held)] if held is not None else [],
-        DRIFT: [run.integrate(p) for p in _drifted(torque, run.times, ramp)] if off_grid else [],
+        LATE: integrated(_late, plan, start_torque),
+        EARLY: integrated(_early, plan),
+        INTERPOLATED: [] if ramp else integrated(_interpolated, plan),
+        HELD: integrated(_held, held) if held is not None else [],
+        DRIFT: integrated(_drifted, torque, run.times, ramp) if off_grid else [],
         INTEGRATION: _integration(run),
     }
 
 
+def _integrated(run: Run, make: Callable[..., list[TorqueSchedule]], args: tuple, i: int) -> np.ndarray:
+    """The i-th schedule make(*args) gives, integrated at the result's times."""
+    return run.integrate(make(*args)[i])
+
+
+def _held(held: TorqueSchedule) -> list[TorqueSchedule]:
+    """A ramp run's signal held over each step: the one variant of input held."""
+    return [held]
+
+
 def candidate_variants(
-    shared: dict[str, list[np.ndarray]], run: Run, correct: np.ndarray, result: np.ndarray, tolerance: float
-) -> dict[str, list[np.ndarray]]:
+    shared: dict[str, list[Variant]], run: Run, correct: np.ndarray, result: np.ndarray, tolerance: float
+) -> dict[str, list[Variant]]:
     """{candidate: its variants at the result's times}, in DIAGNOSES' order: the shared ones
     (shared_variants) and state not restored, which restarts where this result first disagrees.
     """

@@ -40,6 +40,8 @@ from ._taylor import Diverged, check_tolerances, integrate_piece
 # docs/signals.md: an event within max(1e-9 step, 64 ulp of its time) of a communication point
 # is that point. Written again here on purpose: the oracle must not borrow the schedule's code.
 _TOLERANCE_STEPS, _TOLERANCE_ULPS = Fraction(1, 10**9), 64
+# Times whose torque _Holding looks up at once.
+_BLOCK = 1 << 16
 _DEFAULT_STOP_TIME = Fraction(3)
 # Times: a _Grid, a list of exact or double times, or an array of doubles; torques likewise.
 _Times = Sequence[Fraction | float] | np.ndarray
@@ -147,7 +149,7 @@ class _TorqueFile:
 
 class _Grid(Sequence[Fraction]):
     """start + k*step for k < regular, then stop where it is given: the grid as exact fractions,
-    each regular only when asked for (a run of millions of steps holds none of them), and as
+    each made only when asked for (a run of millions of steps holds none of them), and as
     doubles in one array (doubles()).
     """
 
@@ -297,6 +299,13 @@ class _Holding:
     def values_after(self, times: np.ndarray) -> np.ndarray:
         """value_after of each time, read as the decimal a person wrote (_exact)."""
         times = np.asarray(times, dtype=float)
+        out = np.empty(len(times))
+        # A block at a time: a dozen arrays of a block's times, not of millions.
+        for begin in range(0, len(times), _BLOCK):
+            out[begin : begin + _BLOCK] = self._values_after(times[begin : begin + _BLOCK])
+        return out
+
+    def _values_after(self, times: np.ndarray) -> np.ndarray:
         tolerance = np.maximum(self._step_tolerance, _TOLERANCE_ULPS * np.spacing(np.abs(times)))
         reach = times + tolerance
         points = self._point_doubles
@@ -305,7 +314,9 @@ class _Holding:
         # What the doubles may be off by: the decimal of t and its double, the tolerance's and the
         # sum's roundings, each point's double; a few ulp of the largest magnitude, bounded
         # here by 16.
-        scale = np.maximum.reduce([np.abs(times), tolerance, np.abs(reach), np.abs(below), np.abs(above)])
+        scale = np.abs(times)  # the largest magnitude, one array at a time (not five stacked)
+        for other in (tolerance, reach, below, above):
+            np.maximum(scale, np.abs(other), out=scale)
         margin = 16 * np.spacing(scale)
         near = (np.abs(reach - below) <= margin) | (np.abs(above - reach) <= margin)
         out = self._value_doubles[np.clip(j, 0, len(self.values) - 1)]
@@ -374,30 +385,31 @@ def _integrate(
     starts = _doubles(pieces.starts)
     ends = np.append(starts[1:], float(pieces.stop))
     u0s, rates = np.asarray(pieces.u0, dtype=float), np.asarray(pieces.rate, dtype=float)
-    # Each reported time belongs to the first piece that reaches it (a time a rounding past the
-    # end of the run belongs to the last).
-    owner = np.minimum(np.searchsorted(ends, at, side="left"), len(ends) - 1)
-    # The reports by piece and, within one, by time: a run of pieces' are a slice.
-    by_piece = np.lexsort((at, owner))
-    owners = owner[by_piece]
     # Pieces that continue one another (the same held torque) are one run, so that the series
     # restarts only where the torque changes.
     continues = (rates[1:] == 0) & (rates[:-1] == 0) & (u0s[1:] == u0s[:-1])
     firsts = np.flatnonzero(np.r_[True, ~continues])
     lasts = np.r_[firsts[1:] - 1, len(starts) - 1]
-    runs = np.stack([firsts, lasts, np.searchsorted(owners, firsts, "left"), np.searchsorted(owners, lasts, "right")])
+    # The reports in time order (a result's are: no copy is made). Each belongs to the first piece
+    # that reaches it, so a run's are a slice: those after the run before's end, up to its own (a
+    # time a rounding past the end of the run belongs to the last).
+    order = None if np.all(at[1:] >= at[:-1]) else np.argsort(at, kind="stable")
+    ordered = at if order is None else at[order]
+    bounds = np.searchsorted(ordered, ends[lasts], side="right")
+    bounds[-1] = len(at)
+    runs = np.stack([firsts, lasts, np.r_[0, bounds[:-1]], bounds])
     out = results.empty(len(at), COMPUTED)
     out["time"] = at
     theta, omega = float(theta0), float(omega0)
     for first, last, lo, hi in runs.T.tolist():
         t0, t1, u0, rate = float(starts[first]), float(ends[last]), float(u0s[first]), float(rates[first])
-        mine = by_piece[lo:hi]
         try:
             thetas, omegas, theta, omega = integrate_piece(
-                theta, omega, (t0, t1), (u0, rate), model, (rtol, atol), np.clip(at[mine], t0, t1).tolist()
+                theta, omega, (t0, t1), (u0, rate), model, (rtol, atol), np.clip(ordered[lo:hi], t0, t1)
             )
         except Diverged as error:
             raise _failed(str(error), t0, parameters, theta0, omega0, pieces) from None
+        mine = slice(lo, hi) if order is None else order[lo:hi]
         out["theta"][mine], out["omega"][mine] = thetas, omegas
     out["torque"] = pieces.values_after(at)
     # The end of the run reports the torque the last piece reached, as a master reads it back.

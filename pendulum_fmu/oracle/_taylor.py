@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import math
 import numbers
-from bisect import bisect_right
 
 import numpy as np
 
@@ -81,8 +80,8 @@ def integrate_piece(
     torque: tuple[float, float],
     model: tuple[float, float, float],
     tolerance: tuple[float, float],
-    reports: list[float],
-) -> tuple[list[float], list[float], float, float]:
+    reports: np.ndarray | list[float],
+) -> tuple[np.ndarray, np.ndarray, float, float]:
     """Theta and omega at each of reports and at the piece's end, from theta, omega at its start.
 
     Parameters
@@ -97,12 +96,12 @@ def integrate_piece(
         mass*gravity*length (N.m), damping (N.m.s/rad) and 1/total inertia (1/(kg.m^2)).
     tolerance : (float, float)
         rtol and atol: each step's terms past its order stay below atol + rtol * max(abs(theta), abs(omega)).
-    reports : list of float
+    reports : numpy.ndarray or list of float
         Sorted times within span.
 
     Returns
     -------
-    (list of float, list of float, float, float)
+    (numpy.ndarray, numpy.ndarray, float, float)
         theta and omega at each report; theta and omega at span[1].
 
     Raises
@@ -115,8 +114,10 @@ def integrate_piece(
     gravity_moment, damping, inverse_inertia = model
     rtol, atol = tolerance
     order_limit = _order_limit(min(rtol, atol))
-    thetas: list[float] = []
-    omegas: list[float] = []
+    # Arrays, filled a Taylor step's reports at a time: a piece may hold millions of reports,
+    # which as lists of floats took four times the memory.
+    reports = np.asarray(reports, dtype=float)
+    thetas, omegas = np.empty(len(reports)), np.empty(len(reports))
     t, next_report = start, 0
     while True:
         remaining = end - t
@@ -148,15 +149,15 @@ def integrate_piece(
         stop = end if step == remaining else t + step
         if stop <= t < end:
             raise Diverged(f"the step needed underflows at t = {t:g} s")
-        upto = len(reports) if stop == end else bisect_right(reports, stop, next_report)
+        upto = len(reports) if stop == end else int(np.searchsorted(reports, stop, side="right"))
         if upto - next_report > _FEW:
-            taus = np.asarray(reports[next_report:upto]) - t
-            thetas.extend(np.polyval(x[::-1], taus).tolist())
-            omegas.extend(np.polyval(v[::-1], taus).tolist())
+            taus = reports[next_report:upto] - t
+            thetas[next_report:upto] = np.polyval(x[::-1], taus)
+            omegas[next_report:upto] = np.polyval(v[::-1], taus)
         else:
-            for report in reports[next_report:upto]:
-                thetas.append(_sum(x, report - t))
-                omegas.append(_sum(v, report - t))
+            for i, report in enumerate(reports[next_report:upto].tolist(), start=next_report):
+                thetas[i] = _sum(x, report - t)
+                omegas[i] = _sum(v, report - t)
         next_report = upto
         theta, omega = _sum(x, stop - t), _sum(v, stop - t)
         if not (math.isfinite(theta) and math.isfinite(omega)):
