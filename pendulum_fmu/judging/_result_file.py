@@ -8,6 +8,7 @@ import csv
 import io
 import math
 import os
+import stat
 from array import array
 from collections.abc import Iterator, Sequence
 from pathlib import Path
@@ -93,9 +94,13 @@ def read_result(
     mapped = as_map(mapping, RESULT_QUANTITIES)
     try:
         with open(path, "rb") as raw:
-            size = os.fstat(raw.fileno()).st_size
-            values = _read(path, raw, size, mapped)
-        now = path.stat().st_size
+            regular = stat.S_ISREG(os.fstat(raw.fileno()).st_mode)
+            # A pipe (judge <(...)) is read once, whole: it cannot be read again from its start.
+            whole = b"" if regular else raw.read()
+            source = raw if regular else io.BytesIO(whole)
+            size = os.fstat(raw.fileno()).st_size if regular else len(whole)
+            values = _read(path, source, size, mapped)
+        now = path.stat().st_size if regular else size
     except OSError as error:
         raise ResultFileError(f"{path}: cannot read: {error.strerror}") from None
     if now != size:
@@ -112,7 +117,7 @@ def read_result(
     return out
 
 
-def _read(path: Path, raw: io.BufferedReader, size: int, mapped: dict) -> dict[str, np.ndarray]:
+def _read(path: Path, raw: io.BufferedIOBase, size: int, mapped: dict) -> dict[str, np.ndarray]:
     """{quantity: its column, in SI} of the file's first size bytes (read_result)."""
     cut = _ends_mid_line(raw, size)
     try:
@@ -170,7 +175,7 @@ class _Snapshot(io.RawIOBase):
     whatever a master appends to it meanwhile.
     """
 
-    def __init__(self, raw: io.BufferedReader, size: int):
+    def __init__(self, raw: io.BufferedIOBase, size: int):
         self.raw, self.left = raw, size
         raw.seek(0)
 
@@ -184,12 +189,12 @@ class _Snapshot(io.RawIOBase):
         return count
 
 
-def _text(raw: io.BufferedReader, size: int) -> io.TextIOWrapper:
+def _text(raw: io.BufferedIOBase, size: int) -> io.TextIOWrapper:
     """The snapshot (_Snapshot) as text, a BOM skipped, line ends left to the csv module."""
     return io.TextIOWrapper(io.BufferedReader(_Snapshot(raw, size)), encoding="utf-8-sig", newline="")
 
 
-def _ends_mid_line(raw: io.BufferedReader, size: int) -> bool:
+def _ends_mid_line(raw: io.BufferedIOBase, size: int) -> bool:
     """Whether the snapshot's last line has no line end (a file cut off, or still being written)."""
     if not size:
         return False
@@ -197,7 +202,7 @@ def _ends_mid_line(raw: io.BufferedReader, size: int) -> bool:
     return raw.read(1) not in (b"\n", b"\r")
 
 
-def _read_arrow(raw: io.BufferedReader, size: int, width: int, columns: dict) -> dict[str, np.ndarray] | None:
+def _read_arrow(raw: io.BufferedIOBase, size: int, width: int, columns: dict) -> dict[str, np.ndarray] | None:
     """The columns by pyarrow's CSV reader, block by block, only those judged converted; None
     when it refuses a row or one is not finite, or the times go backwards (_read_rows then names
     the row). pyarrow is imported here only: it takes longer to import than a short result to read.
