@@ -252,3 +252,17 @@ def test_the_docstring_examples_run_as_written(name):
     runner = doctest.DocTestRunner()
     runner.run(test)
     assert runner.failures == 0 and runner.tries > 3
+
+
+def test_the_docs_pages_python_runs_as_written():
+    import re
+    from pathlib import Path
+
+    page = (Path(__file__).resolve().parent.parent / "docs" / "reinforcement_learning.md").read_text(encoding="utf-8")
+    blocks = re.findall(r"```python\n(.*?)```", page, re.S)
+    namespace: dict = {}
+    for block in blocks:
+        exec(block, namespace)
+    assert len(blocks) == 4
+    assert namespace["observations"].shape == (1024, 3) and namespace["system"].nstates == 2
+    namespace["env"].close()
