@@ -59,8 +59,9 @@ def test_make_keywords_set_the_fmus_parameters_torque_limit_and_step():
     inertia = 0.02 + 2.0 * 0.4**2
     for action in (7.0, -1.0, 3.0):
         observation = env.step(np.array([action]))[0]
+        clipped = min(action, 5.0)
 
-        def pendulum(t, x, torque=min(action, 5.0)):
+        def pendulum(t, x, torque=clipped):
             return [x[1], (torque - 2.0 * 9.81 * 0.4 * math.sin(x[0]) - 0.3 * x[1]) / inertia]
 
         state = solve_ivp(pendulum, (0, 0.02), state, method="DOP853", rtol=1e-13, atol=1e-13).y[:, -1]
