@@ -25,12 +25,16 @@ from __future__ import annotations
 import argparse
 import json
 import platform
+import shutil
 import subprocess
 import sys
 import sysconfig
 from pathlib import Path
 
-import fmpy
+try:
+    import fmpy
+except ModuleNotFoundError:
+    sys.exit("platform_check.py: no fmpy here: pip install the wheel first (it brings fmpy)")
 
 TORQUE_CSV = "time,torque\n0,20\n1,20\n1,-20\n3,-20\n"
 RUN_OPTIONS = ["--stop-time", "3", "--output-interval", "0.001"]
@@ -44,8 +48,11 @@ CASES = {
 
 
 def script(name: str) -> str:
-    """The installed console script of this interpreter (a .exe in Scripts on Windows)."""
-    return str(Path(sysconfig.get_path("scripts"), name))
+    """The installed console script of this interpreter (name.exe in Scripts on Windows)."""
+    found = shutil.which(name, path=sysconfig.get_path("scripts"))
+    if found is None:
+        sys.exit(f"platform_check.py: no {name} in {sysconfig.get_path('scripts')}: pip install the wheel first")
+    return found
 
 
 def not_run_here(case: str) -> str | None:
