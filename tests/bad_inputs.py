@@ -265,6 +265,12 @@ CASES = [
     ),
     _case(
         "run length",
+        "compare --torque 20 --tools fmu,reference --stop-time 1e10 --step-size 1e9 --output-dir {files}/out",
+        2,
+        "the reference would take about 40,594,443,387 Taylor steps from 0 to 1e+10 s (rtol 1e-14), over its limit",
+    ),
+    _case(
+        "run length",
         "sweep --torque 1 --step-size 1e-320 --output-dir {files}/out",
         2,
         "is about 3e+320 steps, over the limit of 10,000,000",
@@ -333,7 +339,7 @@ CASES = [
         "torque file",
         "compare --torque-file {files}/huge_torque.csv --tools fmu,reference --output-dir {files}/out",
         2,
-        "the reference cannot integrate the pendulum from t = 0 s with mass = 40",
+        "the reference would take about 1.04e+285 Taylor steps from 0 to 0.01 s (rtol 1e-14), over its limit",
     ),
     _case(
         "torque file",
@@ -972,6 +978,12 @@ CALLS = [
         "reference(20.0, stop_time=1e308)",
         "InvalidInput",
         "is about 1e+311 steps, over the limit of 10,000,000",
+    ),
+    Call(
+        "reference",
+        "reference(20.0, stop_time=1e10, step_size=1e9)",
+        "InvalidInput",
+        "Taylor steps from 0 to 1e+10 s (rtol 1e-14), over its limit of 10,000,000: give a shorter stop time",
     ),
     Call(
         "reference", 'reference(20.0, rtol=float("nan"))', "InvalidInput", "rtol nan must be a positive finite number"
