@@ -8,6 +8,9 @@ from __future__ import annotations
 
 import sys
 
+# Off a terminal: a line this often (s), from this long after the start on.
+LOG_INTERVAL = 5.0
+
 
 class _Lines:
     """tqdm's output for a log: each redraw a line of its own, where a terminal's is redrawn in
@@ -69,8 +72,8 @@ def progress_bar(label: str, counts: str, total: float, done: float = 0, enabled
         disable=not enabled,
         file=_Lines(sys.stderr),
         miniters=1,
-        mininterval=5.0,
-        delay=5.0,
+        mininterval=LOG_INTERVAL,
+        delay=LOG_INTERVAL,
         leave=False,
         postfix=postfix,
         bar_format=f"{label}: {counts}",

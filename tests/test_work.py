@@ -15,6 +15,8 @@ from pendulum_fmu.oracle import _reference, _work
 from pendulum_fmu.oracle._reference import model_constants
 from pendulum_fmu.oracle._work import MAX_STEPS, Spans, speed_bound
 
+# How far from the steps taken the estimate may be, as a factor: below and above.
+ESTIMATE_WITHIN = (0.5, 4.0)
 DEFAULTS = {"mass": 40.0, "length": 0.5, "inertia": 20.0, "gravity": 9.81, "damping": 0.0}
 
 # (what, reference()'s arguments): the README's quick start and the tests' usual runs, swings,
@@ -59,7 +61,7 @@ def test_the_estimate_is_the_steps_taken_within_a_factor(monkeypatch, case):
     estimate, taken, _ = steps_taken(monkeypatch, *CASES[case])
     # Measured 0.67 (theta0 = 3, near the top: the swing's harmonics) to 2.6 (the ramp: the
     # largest torque taken from the start) at the time of writing.
-    assert 0.5 * taken <= estimate <= 4 * taken, (estimate, taken)
+    assert ESTIMATE_WITHIN[0] * taken <= estimate <= ESTIMATE_WITHIN[1] * taken, (estimate, taken)
 
 
 @pytest.mark.parametrize("case", CASES)
