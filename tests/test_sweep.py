@@ -458,6 +458,7 @@ class _Bar:
 
 def test_a_run_commits_only_the_parts_staged_under_its_own_token(tmp_path):
     store = Store(LocalFileSystem(), str(tmp_path), "parquet")
+    store.start({}, 3, "other-run", ("cases",))  # its folder, as the run makes it
     store.write_table("cases", 0, {"case": np.arange(3)}, "other-run")
     with pytest.raises(FileNotFoundError):
         store.commit(0, "this-run", ("cases",))
@@ -471,6 +472,7 @@ def test_the_cases_table_reads_back_as_pyarrows_dataset_reads_it_whatever_int_th
     in the order of their paths: the table pyarrow's dataset gives, case numbers as int64.
     """
     store = Store(LocalFileSystem(), str(tmp_path), "parquet")
+    store.start({}, 2, "run", ("cases",))  # its folder, as the run makes it
     summaries = {name: np.array([0.5, np.nan]) for name in SUMMARIES}
     for index, integers in ((1, np.int64), (0, np.int32)):  # written in another order than read
         columns = {"case": np.arange(2, dtype=integers) + 2 * index, "torque": np.array([1.0, 2.0]) + 2 * index}
