@@ -36,6 +36,7 @@ from ..signals._time_grid import step_count
 from ..signals._torque_csv import read_torque_csv
 from ..signals._torque_schedule import TorqueSchedule
 from ._taylor import Diverged, check_tolerances, integrate_piece
+from ._work import Spans, check_steps, progress, taylor_steps
 
 # docs/signals.md: an event within max(1e-9 step, 64 ulp of its time) of a communication point
 # is that point. Written again here on purpose: the oracle must not borrow the schedule's code.
@@ -336,29 +337,27 @@ def _integrate(
     owners = owner[by_piece].tolist()
     out = results.empty(len(at), COMPUTED)
     out["time"] = at
+    # The series restarts only where the torque changes: pieces that continue one another (the
+    # same held torque) are one span.
+    u0, rate = np.array(pieces.u0, dtype=float), np.array(pieces.rate, dtype=float)
+    continues = (rate[1:] == 0) & (rate[:-1] == 0) & (u0[1:] == u0[:-1])
+    firsts = np.flatnonzero(np.concatenate(([True], ~continues)))
+    lasts = np.append(firsts[1:] - 1, len(starts) - 1)
+    spans = Spans(np.array(starts)[firsts], np.array(ends)[lasts], u0[firsts], rate[firsts])
+    steps = taylor_steps(spans, model, theta0, omega0, (rtol, atol))
+    check_steps(steps, starts[0], ends[-1], rtol)
     theta, omega = float(theta0), float(omega0)
-    first = 0
-    while first < len(starts):
-        # Merge pieces that continue one another (the same held torque), so that the series
-        # restarts only where the torque changes.
-        last = first
-        while (
-            last + 1 < len(starts)
-            and pieces.rate[first] == 0
-            and pieces.rate[last + 1] == 0
-            and pieces.u0[last + 1] == pieces.u0[first]
-        ):
-            last += 1
-        t0, t1, u0, rate = starts[first], ends[last], pieces.u0[first], pieces.rate[first]
-        mine = by_piece[bisect.bisect_left(owners, first) : bisect.bisect_right(owners, last)]
-        try:
-            thetas, omegas, theta, omega = integrate_piece(
-                theta, omega, (t0, t1), (u0, rate), model, (rtol, atol), np.clip(at[mine], t0, t1).tolist()
-            )
-        except Diverged as error:
-            raise _failed(str(error), t0, parameters, theta0, omega0, pieces) from None
-        out["theta"][mine], out["omega"][mine] = thetas, omegas
-        first = last + 1
+    with progress(steps, starts[0], ends[-1]) as on_step:
+        for first, last in zip(firsts.tolist(), lasts.tolist(), strict=True):
+            t0, t1, u, slope = starts[first], ends[last], pieces.u0[first], pieces.rate[first]
+            mine = by_piece[bisect.bisect_left(owners, first) : bisect.bisect_right(owners, last)]
+            try:
+                thetas, omegas, theta, omega = integrate_piece(
+                    theta, omega, (t0, t1), (u, slope), model, (rtol, atol), np.clip(at[mine], t0, t1).tolist(), on_step
+                )
+            except Diverged as error:
+                raise _failed(str(error), t0, parameters, theta0, omega0, pieces) from None
+            out["theta"][mine], out["omega"][mine] = thetas, omegas
     out["torque"] = pieces.values_after(at)
     # The end of the run reports the torque the last piece reached, as a master reads it back.
     at_end = at >= ends[-1]
