@@ -53,6 +53,7 @@ def chunk_cpu(outputs: tuple[str, ...]) -> tuple[float, float, float]:
             1,
             "benchmark",
         )
+        task.store.start({}, CASES, task.run, task.tables())  # the run's folders and mark, as run_sweep makes them
         run_chunk(0, 0, _values(), task)  # the FMU unzipped and instantiated once, as on a worker
         for _ in range(ROUNDS):
             chunks = [run_chunk(index, 0, _values(), task)[3:] for index in range(CHUNKS)]

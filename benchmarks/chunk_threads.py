@@ -31,6 +31,7 @@ def main() -> None:
     values = {"torque": np.linspace(1.0, 40.0, CASES), "gravity": np.full(CASES, 9.81)}
     with tempfile.TemporaryDirectory(prefix="pendulum-chunk-threads-") as folder:
         task = Task(str(default_fmu()), Store(LocalFileSystem(), folder, "parquet"), 3.0, 1e-3, OUTPUTS, 1, "benchmark")
+        task.store.start({}, CASES, task.run, task.tables())  # the run's folders and mark, as run_sweep makes them
         run_chunk(0, 0, values, task)  # the FMU unzipped and instantiated once, as on a worker
         for pool in ("default", "one thread"):
             if pool == "one thread":

@@ -8,7 +8,8 @@ Built by the one command the README names (from the repository root):
 files of this folder (MyST), the API reference comes from the numpydoc docstrings (autodoc,
 autosummary), the command line from the parser (sphinx-argparse), and the examples page from
 running examples/*.py during the build (_ext/example_pages.py), and the wasm page's scripts
-from the FMU's wasm binary (_ext/wasm_page.py: Node and `npm ci --prefix web` needed).
+from the FMU's wasm binary (_ext/wasm_page.py: Node 20 needed; on a fresh clone it runs
+`npm ci --prefix web` itself, from the npm registry).
 """
 
 import importlib
@@ -57,14 +58,17 @@ numpydoc_validation_exclude = {r"\.__init__$"}
 html_theme = "pydata_sphinx_theme"
 html_title = f"pendulum-fmu {release}"
 html_static_path = []
+templates_path = ["_templates"]
 html_theme_options = {
     "navigation_with_keys": False,
-    # The page titles are long: three in the header, the rest under "More".
-    "header_links_before_dropdown": 3,
+    # The sidebar lists every page (below): the header's links to the same pages would repeat it.
+    "navbar_center": [],
     "show_toc_level": 2,
     "secondary_sidebar_items": ["page-toc"],
 }
-html_sidebars = {"**": ["sidebar-nav-bs"]}
+# Every page, by index.md's captions (_templates/sidebar-site-nav.html): the theme's section
+# navigation is empty on a site whose pages are all top-level.
+html_sidebars = {"**": ["sidebar-site-nav"]}
 
 # The parser's help texts are plain text that sphinx-argparse reads as reStructuredText, where
 # |dtheta| would be a substitution: each stands for itself.

@@ -15,8 +15,9 @@ From the FMI 3.0 FMU (default: the checkout's, pendulum_fmu.default_fmu(3)) it w
 - fmu_host.js, page.js and run_node.js from web/: the host (shared by the page and Node), the page's
   script, the Node command line.
 
-jco comes from web/package-lock.json (`npm ci --prefix web`); the docs build (docs/_ext/wasm_page.py)
-runs this module, so building the docs site needs Node and that install.
+jco comes from web/package-lock.json: where web/node_modules has no jco yet (a fresh clone), this
+module runs `npm ci --prefix web` first, which needs Node 20's npm and the npm registry. The docs
+build (docs/_ext/wasm_page.py) runs this module, so the README's one docs command is the whole of it.
 """
 
 from __future__ import annotations
@@ -45,15 +46,20 @@ NATIVE_CASES = {
     "seed": {"kind": "constant", "value": 20.0},
     "quick start's jump": {"kind": "step", "before": 20.0, "after": -20.0, "at": 1.0},
 }
-JCO_MISSING = "jco is not installed: run `npm ci --prefix web` (Node 20 and npm) to build the wasm page"
 
 
-def _jco() -> Path:
-    jco = WEB / "node_modules" / ".bin" / "jco"
-    if shutil.which("node") is None:
-        raise BuildError("node is not on PATH: install Node 20 and npm to build the wasm page")
+def _jco(web: Path = WEB) -> Path:
+    """The jco of the folder web, installed from its package-lock.json (`npm ci`) when missing."""
+    jco = web / "node_modules" / ".bin" / "jco"
+    if shutil.which("node") is None or shutil.which("npm") is None:
+        raise BuildError("node or npm is not on PATH: install Node 20 and npm to build the wasm page")
     if not jco.is_file():
-        raise BuildError(JCO_MISSING)
+        print(f"installing jco: npm ci --prefix {web}", file=sys.stderr, flush=True)
+        command = [shutil.which("npm"), "ci", "--prefix", str(web), "--no-audit", "--no-fund"]
+        done = subprocess.run(command, capture_output=True, text=True, timeout=600, check=False)
+        if done.returncode or not jco.is_file():
+            last = (done.stderr.strip() or done.stdout.strip() or "no jco after it").splitlines()[-1]
+            raise BuildError(f"`npm ci --prefix {web}` failed (it needs the npm registry): {last}")
     return jco
 
 

@@ -81,14 +81,16 @@ def _longest_name(folder: Path) -> int:
         return 255
 
 
-def _temporary_beside(path: Path, suffix: str) -> tuple[int, str]:
+def _temporary_beside(path: Path, suffix: str, make_folders: bool = True) -> tuple[int, str]:
     """A new file beside path with the permissions of the file it replaces, or those a plain
     open() would give (mkstemp's are 0600, which would hide an FMU or a table from the other users
-    of a shared folder).
+    of a shared folder). make_folders=False: FileNotFoundError where path's folder is not there.
     """
     try:
         descriptor, temporary = _new_file_beside(path, suffix)
-    except OSError:
+    except OSError as error:
+        if isinstance(error, FileNotFoundError) and not make_folders:
+            raise
         # Only now the folders on the way, which cost a few system calls each: a sweep's worker
         # writes two files per chunk into a folder that exists.
         for folder in (path.parent, *path.parent.parents):
@@ -200,27 +202,28 @@ def _check_writable(path: Path) -> None:
 
 
 @contextlib.contextmanager
-def replacing(path: str | os.PathLike, mode: str = "w", **open_arguments):
+def replacing(path: str | os.PathLike, mode: str = "w", make_folders: bool = True, **open_arguments):
     """Open a unique temporary beside path for writing; on success rename it to path.
 
     with replacing("out.csv", newline="") as file: ...
+    make_folders=False: FileNotFoundError where path's folder is not there, rather than make it.
     """
     # The file closes before replacing_path renames it.
-    with replacing_path(path) as temporary, open(temporary, mode, **open_arguments) as file:
+    with replacing_path(path, make_folders) as temporary, open(temporary, mode, **open_arguments) as file:
         yield file
 
 
 @contextlib.contextmanager
-def replacing_path(path: str | os.PathLike):
+def replacing_path(path: str | os.PathLike, make_folders: bool = True):
     """A unique temporary path beside path, for writers that want a file name (savefig, zip);
-    renamed to path on success, removed otherwise.
+    renamed to path on success, removed otherwise. make_folders: as replacing.
     """
     path = Path(path)
     if _streamed(path):
         yield path
         return
     _refuse_link(path)
-    descriptor, temporary = _temporary_beside(path, f".partial{path.suffix}")
+    descriptor, temporary = _temporary_beside(path, f".partial{path.suffix}", make_folders)
     os.close(descriptor)
     try:
         try:
@@ -285,15 +288,16 @@ def is_local(filesystem) -> bool:
 
 
 @contextlib.contextmanager
-def replacing_on(filesystem, path: str):
+def replacing_on(filesystem, path: str, make_folders: bool = True):
     """replacing(path, "wb") on any fsspec file system (or LocalFolders), for outputs given as URLs.
+    make_folders: as replacing, on the local file system (elsewhere no folder is made).
 
     The local file system goes through replacing. Elsewhere the content is written to a unique
     temporary name beside path and moved into place (an object store's upload appears whole;
     the move makes that hold for the other file systems too).
     """
     if is_local(filesystem):
-        with replacing(path, "wb") as file:
+        with replacing(path, "wb", make_folders) as file:
             yield file
         return
     parent, _, name = path.rpartition("/")

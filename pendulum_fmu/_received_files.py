@@ -20,7 +20,7 @@ disk or the memory, or keeping a core busy for hours:
 - a text file read line by line (bounded_lines, check_lines): no line over MAX_LINE_CHARS, and
   no NUL byte, which no text has (the readers' regular expressions take time linear in a line's
   length: benchmarks/hostile_lines.py);
-- a small file read whole (bounded_text): at most a given size.
+- a file read whole (bounded_read, bounded_text): at most its size below, the one place for them.
 """
 
 from __future__ import annotations
@@ -59,6 +59,14 @@ RATIO_CHECKED_BYTES = 2**20
 # line of the FMU's call record under 2 kB; the csv module refuses a cell over 128 Ki characters
 # (csv.field_size_limit()), so a line within this bound holds no cell it refuses.
 MAX_LINE_CHARS = 2**17
+# A kit's NAME.json is under 1 kB; one of a megabyte is no scenario's, and is not read.
+MAX_SETTINGS_BYTES = 2**20
+# A sweep's study.json holds its grid's values, about 25 bytes each: 256 MiB is ten million
+# values, ten times the default limit of cases (DEFAULT_MAX_CASES) on a single axis.
+MAX_STUDY_BYTES = 2**28
+# A torque CSV of a row a step for the longest run without --max-steps (DEFAULT_MAX_STEPS, 10
+# million) at up to 100 bytes a row.
+MAX_TORQUE_CSV_BYTES = 2**30
 # How much of an XML document check_xml hands the parser at a time, to stop at its root element.
 _XML_CHUNK = 2**16
 
@@ -343,8 +351,49 @@ def shortened(text: str, most: int = 80) -> str:
     return text if len(text) <= most else f"{text[:most]}... ({len(text):,} characters)"
 
 
+def bounded_read(file: IO[bytes], shown: str, limit: int, error: type[Exception], advice: str) -> bytes:
+    """The bytes of a file read whole, read no further than limit bytes.
+
+    Parameters
+    ----------
+    file : binary file
+        The file, open for reading (a local file's or an fsspec file system's).
+    shown : str
+        Its path, for the message.
+    limit : int
+        The most bytes taken: one of the MAX_*_BYTES above.
+    error : type
+        The PendulumFmuError subclass to raise.
+    advice : str
+        What to do, ending the message.
+
+    Raises
+    ------
+    error
+        ``FILE: over LIMIT bytes, longer than any such file; ADVICE``.
+
+    Examples
+    --------
+    >>> import io
+    >>> try:
+    ...     bounded_read(io.BytesIO(b"x" * 9), "study.json", 8, ValueError, "write it again")
+    ... except ValueError as refused:
+    ...     print(refused)
+    study.json: over 8 bytes, longer than any such file; write it again
+    """
+    try:  # refused by its size where the file has one, before anything is read
+        size = file.seek(0, 2)
+        file.seek(0)
+    except OSError:  # a pipe: read as far as the limit to see
+        size = 0
+    raw = b"" if size > limit else file.read(limit + 1)
+    if size > limit or len(raw) > limit:
+        raise error(f"{shown}: over {limit:,} bytes, longer than any such file; {advice}")
+    return raw
+
+
 def bounded_text(path: Path, limit: int, error: type[Exception], advice: str, encoding: str = "utf-8") -> str:
-    """The text of a small file, read no further than limit bytes.
+    """The text of a small file, read no further than limit bytes (bounded_read).
 
     Raises
     ------
@@ -354,7 +403,4 @@ def bounded_text(path: Path, limit: int, error: type[Exception], advice: str, en
         As reading it does.
     """
     with open(path, "rb") as file:
-        raw = file.read(limit + 1)
-    if len(raw) > limit:
-        raise error(f"{path}: over {limit:,} bytes, longer than any such file; {advice}")
-    return raw.decode(encoding)
+        return bounded_read(file, str(path), limit, error, advice).decode(encoding)

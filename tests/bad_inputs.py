@@ -265,6 +265,18 @@ CASES = [
     ),
     _case(
         "run length",
+        "compare --torque 20 --tools fmu,reference --stop-time 1e10 --step-size 1e9 --output-dir {files}/out",
+        2,
+        "the reference would take about 40,594,443,387 Taylor steps from 0 to 1e+10 s (rtol 1e-14), over its limit",
+    ),
+    _case(
+        "sweep",
+        "sweep --torque 1 --stop-time 0.01 --output-dir {files}/huge_study --resume",
+        2,
+        "huge_study/study.json: over 268,435,456 bytes, longer than any such file; choose another output directory",
+    ),
+    _case(
+        "run length",
         "sweep --torque 1 --step-size 1e-320 --output-dir {files}/out",
         2,
         "is about 3e+320 steps, over the limit of 10,000,000",
@@ -333,7 +345,13 @@ CASES = [
         "torque file",
         "compare --torque-file {files}/huge_torque.csv --tools fmu,reference --output-dir {files}/out",
         2,
-        "the reference cannot integrate the pendulum from t = 0 s with mass = 40",
+        "the reference would take about 1.04e+285 Taylor steps from 0 to 0.01 s (rtol 1e-14), over its limit",
+    ),
+    _case(
+        "torque file",
+        "simulate --torque-file {files}/huge_torque_file.csv",
+        2,
+        "huge_torque_file.csv: over 1,073,741,824 bytes, longer than any such file; give a CSV of time,torque rows",
     ),
     _case(
         "torque file",
@@ -974,6 +992,12 @@ CALLS = [
         "is about 1e+311 steps, over the limit of 10,000,000",
     ),
     Call(
+        "reference",
+        "reference(20.0, stop_time=1e10, step_size=1e9)",
+        "InvalidInput",
+        "Taylor steps from 0 to 1e+10 s (rtol 1e-14), over its limit of 10,000,000: give a shorter stop time",
+    ),
+    Call(
         "reference", 'reference(20.0, rtol=float("nan"))', "InvalidInput", "rtol nan must be a positive finite number"
     ),
     Call("reference", "reference(20.0, rtol=1e-20)", "InvalidInput", "rtol 1e-20 asks for more than a double holds"),
@@ -1319,12 +1343,38 @@ def alpha_not_an_output(xml: str) -> str:
     return edited
 
 
+@dataclass(frozen=True)
+class Sparse:
+    """A file of this many zero bytes, which takes no room on the disk."""
+
+    size: int
+
+
+def sparse_files() -> dict[str, Sparse]:
+    """Files past the size a file read whole may have (_received_files.py's MAX_*_BYTES)."""
+    from pendulum_fmu._received_files import MAX_STUDY_BYTES, MAX_TORQUE_CSV_BYTES
+
+    return {
+        "huge_study/study.json": Sparse(MAX_STUDY_BYTES + 1),
+        "huge_torque_file.csv": Sparse(MAX_TORQUE_CSV_BYTES + 1),
+    }
+
+
 def write_files(folder: Path) -> None:
-    files = {**FILES, **received_files(), **{name: _edited_fmu(edit) for name, edit in EDITED_FMUS.items()}}
+    files = {
+        **FILES,
+        **received_files(),
+        **{name: _edited_fmu(edit) for name, edit in EDITED_FMUS.items()},
+        **sparse_files(),
+    }
     for name, content in files.items():
         path = folder / name
         path.parent.mkdir(exist_ok=True)
-        path.write_bytes(content) if isinstance(content, bytes) else path.write_text(content)
+        if isinstance(content, Sparse):
+            with open(path, "wb") as file:
+                file.truncate(content.size)
+        else:
+            path.write_bytes(content) if isinstance(content, bytes) else path.write_text(content)
 
 
 @contextlib.contextmanager

@@ -85,6 +85,7 @@ def _wrapped(text: str) -> str:
 
 def sweeps() -> str:
     """The sweep's limits and the figure's kinds, from the package."""
+    from pendulum_fmu._received_files import MAX_STUDY_BYTES
     from pendulum_fmu.figures._plot import QUANTILE_BANDS
     from pendulum_fmu.sweep import DEFAULT_MAX_CASES
     from pendulum_fmu.sweep.figure import LINES_UP_TO
@@ -92,10 +93,53 @@ def sweeps() -> str:
     bands = " and ".join(f"{low * 100:g}-{high * 100:g} %" for low, high in QUANTILE_BANDS)
     return _wrapped(
         f"A study of more than {DEFAULT_MAX_CASES:,} cases is refused unless "
-        f"`--max-cases` allows it. `sweep.png` draws every case when there are up to "
+        f"`--max-cases` allows it, and a `study.json` over {_mib(MAX_STUDY_BYTES)} (read whole "
+        "on `--resume`) is refused unread. `sweep.png` draws every case when there are up to "
         f"{LINES_UP_TO}, else the median and the {bands} bands of the largest and the "
         "final theta per swept value (where each value has one case, the cases alone), "
         "its axes in the FMU's units."
+    )
+
+
+def _mib(size: int) -> str:
+    return f"{size / 2**20:g} MiB"
+
+
+def reference_work() -> str:
+    """The reference's bound on its work and its progress bar, from the package and its tests."""
+    from test_work import CASES, ESTIMATE_WITHIN
+
+    from pendulum_fmu._progress_bar import LOG_INTERVAL
+    from pendulum_fmu.oracle._work import BAR_FROM, MAX_STEPS
+
+    low, high = ESTIMATE_WITHIN
+    return _wrapped(
+        "Before it integrates, the reference estimates the Taylor steps the run needs (from the "
+        "horizon and a bound on |omega| from the energy and the torque's work): over "
+        f"{MAX_STEPS:,} steps it refuses the run in one line naming what to change (a shorter stop "
+        "time, smaller torques or speeds, a looser rtol); from "
+        f"{BAR_FROM:,} steps it shows its progress in simulated seconds on stderr (redrawn on a "
+        f"terminal, elsewhere a line every {LOG_INTERVAL:g} s), and Ctrl-C stops it with one line. "
+        f"Over the {len(CASES)} runs `tests/test_work.py` tries, the estimate is between {low:g} and "
+        f"{high:g} times the steps taken."
+    )
+
+
+def files_read_whole() -> str:
+    """The files the package reads whole, and their bounds, from _received_files.py."""
+    from pendulum_fmu._received_files import MAX_SETTINGS_BYTES, MAX_STUDY_BYTES, MAX_TORQUE_CSV_BYTES
+
+    rows = [
+        ("a scenario kit's `NAME.json`", MAX_SETTINGS_BYTES),
+        ("a sweep's `study.json`, on `--resume`", MAX_STUDY_BYTES),
+        ("a torque CSV", MAX_TORQUE_CSV_BYTES),
+    ]
+    return "\n".join(
+        [
+            "| the file read whole | refused, unread, past |",
+            "|---|---|",
+            *(f"| {what} | {_mib(size)} |" for what, size in rows),
+        ]
     )
 
 
@@ -228,6 +272,8 @@ def swing_up() -> str:
 
 GENERATED = {
     "sweeps": sweeps,
+    "reference_work": reference_work,
+    "files_read_whole": files_read_whole,
     "robustness": robustness,
     "quickstart": quickstart,
     "pendulum_v1": pendulum_v1,

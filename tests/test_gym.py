@@ -59,8 +59,9 @@ def test_make_keywords_set_the_fmus_parameters_torque_limit_and_step():
     inertia = 0.02 + 2.0 * 0.4**2
     for action in (7.0, -1.0, 3.0):
         observation = env.step(np.array([action]))[0]
+        clipped = min(action, 5.0)
 
-        def pendulum(t, x, torque=min(action, 5.0)):
+        def pendulum(t, x, torque=clipped):
             return [x[1], (torque - 2.0 * 9.81 * 0.4 * math.sin(x[0]) - 0.3 * x[1]) / inertia]
 
         state = solve_ivp(pendulum, (0, 0.02), state, method="DOP853", rtol=1e-13, atol=1e-13).y[:, -1]
@@ -252,3 +253,17 @@ def test_the_docstring_examples_run_as_written(name):
     runner = doctest.DocTestRunner()
     runner.run(test)
     assert runner.failures == 0 and runner.tries > 3
+
+
+def test_the_docs_pages_python_runs_as_written():
+    import re
+    from pathlib import Path
+
+    page = (Path(__file__).resolve().parent.parent / "docs" / "reinforcement_learning.md").read_text(encoding="utf-8")
+    blocks = re.findall(r"```python\n(.*?)```", page, re.S)
+    namespace: dict = {}
+    for block in blocks:
+        exec(block, namespace)
+    assert len(blocks) == 4
+    assert namespace["observations"].shape == (1024, 3) and namespace["system"].nstates == 2
+    namespace["env"].close()

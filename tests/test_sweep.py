@@ -4,6 +4,7 @@ concurrent runs, and the studies refused before anything starts.
 """
 
 import contextlib
+import dataclasses
 import glob
 import json
 import logging
@@ -145,6 +146,7 @@ def test_a_trajectories_part_is_stored_as_measured(tmp_path):
     import pyarrow.parquet as pq
 
     task = Task(str(default_fmu()), Store(LocalFileSystem(), str(tmp_path), "parquet"), 0.05, 1e-3, OUTPUTS, 1, "run")
+    task.store.start({}, 3, task.run, task.tables())
     run_chunk(0, 7, {"torque": np.array([1.0, 2.0, 3.0])}, task)
     metadata = pq.ParquetFile(task.store.staged("trajectories", 0, "run")).metadata
     columns = {metadata.schema.column(j).name: metadata.row_group(0).column(j) for j in range(metadata.num_columns)}
@@ -289,7 +291,7 @@ def _stale_task(output_dir) -> Task:
     )
 
 
-def test_a_stale_workers_part_never_enters_the_study_that_replaced_its_own(tmp_path, threads_scheduler):
+def test_a_stale_workers_part_never_enters_the_study_that_replaced_its_own(tmp_path, threads_scheduler, caplog):
     # Issue 32: a worker stopped mid-study writes its chunk after the study was replaced by
     # another (--overwrite, another grid) in the same folder.
     old_cases = sweep_grid([10.0, 20.0], [9.81], {"damping": [0.0, 0.5]})
@@ -306,9 +308,20 @@ def test_a_stale_workers_part_never_enters_the_study_that_replaced_its_own(tmp_p
     assert new.chunks == 4 and _stale_task(tmp_path).run != stale.run
     parts = {p: p.read_bytes() for p in tmp_path.glob("*/part-*")}
     cases, trajectories = _table(tmp_path / "cases"), _table(tmp_path / "trajectories")
-    # The stopped worker continues: chunk 1 of the old study, case 1, damping 0.5.
-    assert run_chunk(1, 1, old_cases.columns(1, 2), stale)[:3] == (1, 1, 0)
-    assert len(list(tmp_path.glob("*/_part-000001.*.staged"))) == 2  # it did write
+    # The stopped worker continues: chunk 1 of the old study, case 1, damping 0.5. It stages its
+    # parts and, its run ended, removes them: the folder holds nothing of it.
+    caplog.clear()
+    assert run_chunk(1, 1, old_cases.columns(1, 2), stale)[:4] == (1, 1, 0, 0)
+    assert caplog.messages == [f"chunk 1 of run {stale.run} not kept: the run ended while it ran"]
+    assert not list(tmp_path.glob("**/_part-*")) and not list(tmp_path.glob("**/.*"))
+    # A worker of the new run, which was written apart and moved into place, woken now: its
+    # folder is gone, and it makes none.
+    stale_new = _stale_task(tmp_path)
+    apart = dataclasses.replace(
+        stale_new, store=Store(LocalFileSystem(), str(tmp_path / ".overwrite.0.partial"), "parquet")
+    )
+    assert run_chunk(2, 2, new_cases.columns(2, 3), apart)[:4] == (2, 1, 0, 0)
+    assert not list(tmp_path.glob("**/.*"))
     # No reader takes it: the folder's tables, the package's reading of the cases, a resume.
     assert {p: p.read_bytes() for p in tmp_path.glob("*/part-*")} == parts
     for name, table in (("cases", cases), ("trajectories", trajectories)):
@@ -445,6 +458,7 @@ class _Bar:
 
 def test_a_run_commits_only_the_parts_staged_under_its_own_token(tmp_path):
     store = Store(LocalFileSystem(), str(tmp_path), "parquet")
+    store.start({}, 3, "other-run", ("cases",))  # its folder, as the run makes it
     store.write_table("cases", 0, {"case": np.arange(3)}, "other-run")
     with pytest.raises(FileNotFoundError):
         store.commit(0, "this-run", ("cases",))
@@ -458,6 +472,7 @@ def test_the_cases_table_reads_back_as_pyarrows_dataset_reads_it_whatever_int_th
     in the order of their paths: the table pyarrow's dataset gives, case numbers as int64.
     """
     store = Store(LocalFileSystem(), str(tmp_path), "parquet")
+    store.start({}, 2, "run", ("cases",))  # its folder, as the run makes it
     summaries = {name: np.array([0.5, np.nan]) for name in SUMMARIES}
     for index, integers in ((1, np.int64), (0, np.int32)):  # written in another order than read
         columns = {"case": np.arange(2, dtype=integers) + 2 * index, "torque": np.array([1.0, 2.0]) + 2 * index}
@@ -844,7 +859,7 @@ def test_a_scheduler_killed_mid_study_is_one_line_and_resume_on_a_new_one_finish
 def test_a_worker_stopped_mid_study_and_continued_after_an_overwrite_changes_nothing(tmp_path, monkeypatch):
     # Issue 32, fault 1 with the real fault: a worker (no nanny) stopped with SIGSTOP mid-study;
     # the study finishes without it; another grid replaces it (--overwrite); the worker is
-    # continued and writes its old chunk into the folder.
+    # continued, stages its old chunk in the folder and, its run ended, removes it.
     monkeypatch.setenv("DASK_DISTRIBUTED__SCHEDULER__WORKER_TTL", "2s")  # a stopped worker is dropped
     torques = list(np.linspace(1.0, 40.0, 128))  # 64 chunks of 4 cases, a few s in all
     options = dict(stop_time=600.0, outputs=["theta"], output_interval=1.0)
@@ -857,9 +872,11 @@ def test_a_worker_stopped_mid_study_and_continued_after_an_overwrite_changes_not
         folder = tmp_path / f"try-{attempt}"
         parts, stale = _stop_replace_and_continue(folder, old, new)
         assert {p: p.read_bytes() for p in folder.glob("*/part-*")} == parts
+        # Nothing of the stale chunk: no staged part, no temporary, no folder (issue 48).
+        assert not list(folder.glob("**/_part-*")) and not list(folder.glob("**/.*"))
         if stale:
             break
-    assert stale, "in two tries the worker continued wrote no part of the study it was stopped in"
+    assert stale, "in two tries the worker continued finished no chunk of the study it was stopped in"
     table, trajectories = _table(folder / "cases"), _table(folder / "trajectories")
     assert table["case"].tolist() == list(range(256)) and set(table["damping"]) == {0.0, 0.25}
     assert len(trajectories["case"]) == 256 * 601
@@ -877,9 +894,12 @@ def _stop_replace_and_continue(folder, old: Study, new: Study) -> tuple[dict, bo
     """On a cluster of 2 workers without nannies: old run into folder, one worker stopped while it
     computes, old finished without it, new run into folder with overwrite, the worker continued.
     Returns the new study's parts (path: bytes) as new left them, and whether the continued
-    worker wrote its stale chunk (staged under old's run) within 60 s.
+    worker finished its stale chunk (old's run) within 60 s, as its log says.
     """
-    with benchmarks.scale.dask_process_handles(2, nanny=False) as (address, processes):
+    log = folder.parent / f"{folder.name}-worker.log"
+    logged = ("sh", "-c", f'exec "$@" 2>>"{log}"', "sh")  # the stopped worker's stderr, its log
+    places = [(logged, "127.0.0.1"), ((), "127.0.0.1")]
+    with benchmarks.scale.dask_process_handles(2, nanny=False, places=places) as (address, processes):
         stopped = psutil.Process(processes[1].pid)
         results = []
         first = threading.Thread(
@@ -897,7 +917,7 @@ def _stop_replace_and_continue(folder, old: Study, new: Study) -> tuple[dict, bo
         parts = {p: p.read_bytes() for p in folder.glob("*/part-*")}
         stopped.resume()
         deadline = time.monotonic() + 60
-        while not list(folder.glob(f"cases/_part-*.{stale_run}.staged")):
+        while f"of run {stale_run} not kept: the run ended while it ran" not in log.read_text():
             if time.monotonic() > deadline:
                 return parts, False
             time.sleep(0.05)

@@ -8,6 +8,7 @@ host (fmpy's loader, ctypes) of an independent build (gcc) of the same C sources
 
 import ctypes
 import json
+import os
 import shutil
 import struct
 import subprocess
@@ -22,6 +23,7 @@ from test_docs import _built_site
 from fmu_build import wasm_page as wasm_page_build
 from fmu_build.wasm_page import WEB, write_page_files
 from pendulum_fmu import schedule, simulate
+from pendulum_fmu._errors import BuildError
 from pendulum_fmu.judging._result_file import read_result
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -37,6 +39,38 @@ def _need_node() -> None:
         pytest.skip("needs Node 20 (node on PATH)")
     if not (WEB / "node_modules" / ".bin" / "jco").is_file():
         pytest.skip("needs jco: npm ci --prefix web")
+
+
+def _fake_npm(folder: Path, monkeypatch, script: str) -> Path:
+    """A bin folder first on PATH holding node and an npm that runs script (bash), logging its arguments."""
+    bin_folder = folder / "bin"
+    bin_folder.mkdir()
+    for name, body in {"node": "exit 0", "npm": f'echo "$@" >> {folder}/npm.log\n{script}'}.items():
+        (bin_folder / name).write_text(f"#!/bin/bash\n{body}\n", encoding="utf-8")
+        (bin_folder / name).chmod(0o755)
+    monkeypatch.setenv("PATH", f"{bin_folder}:{os.environ['PATH']}")
+    return folder / "npm.log"
+
+
+def test_a_fresh_clone_s_jco_is_installed_by_npm_ci_from_the_lock_file(tmp_path, monkeypatch):
+    web = tmp_path / "web"
+    web.mkdir()
+    log = _fake_npm(tmp_path, monkeypatch, 'mkdir -p "$3/node_modules/.bin" && touch "$3/node_modules/.bin/jco"')
+    assert wasm_page_build._jco(web) == web / "node_modules" / ".bin" / "jco"
+    assert log.read_text(encoding="utf-8").split() == ["ci", "--prefix", str(web), "--no-audit", "--no-fund"]
+    wasm_page_build._jco(web)  # installed now: npm is not run again
+    assert len(log.read_text(encoding="utf-8").splitlines()) == 1
+
+
+def test_a_failed_jco_install_stops_the_page_in_one_line(tmp_path, monkeypatch):
+    web = tmp_path / "web"
+    web.mkdir()
+    _fake_npm(tmp_path, monkeypatch, 'echo "npm error request to the registry failed" >&2; exit 1')
+    with pytest.raises(BuildError) as failed:
+        wasm_page_build._jco(web)
+    assert str(failed.value) == (
+        f"`npm ci --prefix {web}` failed (it needs the npm registry): npm error request to the registry failed"
+    )
 
 
 @pytest.fixture(scope="session")

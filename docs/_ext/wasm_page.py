@@ -3,8 +3,9 @@ made during the build by the repository's build tool (fmu_build/wasm_page.py) in
 wasm/ folder.
 
 The FMU is the checkout's FMI 3.0 one (pendulum_fmu.default_fmu(3), rebuilt when stale) unless
-the build names another: ``sphinx-build -D wasm_page_fmu=path/to/Pendulum-fmi3.fmu ...``. Node and
-web/'s jco install (``npm ci --prefix web``) are needed: without them the build stops, saying so.
+the build names another: ``sphinx-build -D wasm_page_fmu=path/to/Pendulum-fmi3.fmu ...``. Node 20
+and npm are needed, and web/'s jco, which the build installs (``npm ci --prefix web``, from the
+npm registry) where it is missing: without them the build stops, saying so in one line.
 """
 
 from pathlib import Path

@@ -95,7 +95,7 @@ class JudgedRun:
             raise InvalidInput(f"the tolerance {tolerance} must be a positive finite number (rad)")
         self.torque, self.tolerance = torque, tolerance
         self.start_time, self.stop_time, self.step_size, self.ramp = start_time, stop_time, step_size, ramp
-        self.theta0, self.omega0 = theta0, omega0
+        self.theta0, self.omega0, self.max_steps = theta0, omega0, max_steps
         self.model = fmu_model(fmu_path)
         self.parameters = resolve_parameters(parameters, self.model)
         self.plan = schedule(
@@ -123,6 +123,7 @@ class JudgedRun:
                 omega0=self.omega0,
                 at=times,
                 fmu_path=self.model,
+                max_steps=self.max_steps,
             )
             run = Run(self.plan, times, self.step_size, self.parameters, self.theta0, self.omega0, self.model)
             run.keep = key is not None

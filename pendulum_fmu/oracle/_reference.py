@@ -36,6 +36,7 @@ from ..signals._time_grid import step_count
 from ..signals._torque_csv import read_torque_csv
 from ..signals._torque_schedule import TorqueSchedule
 from ._taylor import Diverged, check_tolerances, integrate_piece
+from ._work import Spans, check_steps, progress, taylor_steps
 
 # docs/signals.md: an event within max(1e-9 step, 64 ulp of its time) of a communication point
 # is that point. Written again here on purpose: the oracle must not borrow the schedule's code.
@@ -191,11 +192,11 @@ def _doubles(points: _Times) -> np.ndarray:
     return np.array([float(p) for p in points])
 
 
-def _grid(start: Fraction, stop: Fraction, step: Fraction) -> _Grid:
+def _grid(start: Fraction, stop: Fraction, step: Fraction, max_steps: int | None) -> _Grid:
     """Start + k*step up to stop; stop itself ends a shorter last step unless it is on the grid."""
     # Only checked by the schedule's code, in simulate()'s words (a step that is not positive, a
     # stop not after the start, a run too long to hold): the grid below is the oracle's own.
-    step_count(float(start), float(stop), float(step))
+    step_count(float(start), float(stop), float(step), max_steps)
     # The points start + k*step before stop less its tolerance: k < (last - start) / step.
     last = stop - _tolerance(stop, step)
     return _Grid(start, step, max(math.ceil((last - start) / step), 0), stop)
@@ -234,12 +235,14 @@ class _Pieces:
         self.points, self.values_after = points, values_after
 
 
-def _signal_pieces(torque, start: Fraction, stop: Fraction | None, step: Fraction, ramp: bool) -> _Pieces:
+def _signal_pieces(
+    torque, start: Fraction, stop: Fraction | None, step: Fraction, ramp: bool, max_steps: int | None
+) -> _Pieces:
     if isinstance(torque, (str, Path)):
         read_torque_csv(torque)  # a file that is no signal refused where it is wrong; read below anew
         signal = _TorqueFile(Path(torque))
         stop = signal.times[-1] if stop is None else stop
-        grid = _grid(start, stop, step)
+        grid = _grid(start, stop, step, max_steps)
         if ramp:
             # The file's own piecewise-linear signal: a piece between consecutive row times.
             rows = sorted({start, stop} | {t for t in signal.times if start < t < stop})
@@ -261,11 +264,11 @@ def _signal_pieces(torque, start: Fraction, stop: Fraction | None, step: Fractio
 
     if isinstance(torque, (list, tuple, np.ndarray)):
         values = [_torque(u, f"at step {k} of the array") for k, u in enumerate(torque)]
-        points = _grid(start, start + len(values) * step if stop is None else stop, step)
+        points = _grid(start, start + len(values) * step if stop is None else stop, step, max_steps)
         if len(points) - 1 != len(values):
             raise InvalidInput(f"the torque array has {len(values)} values for {len(points) - 1} steps")
     else:
-        points = _grid(start, _DEFAULT_STOP_TIME if stop is None else stop, step)
+        points = _grid(start, _DEFAULT_STOP_TIME if stop is None else stop, step, max_steps)
         sample = torque if callable(torque) else (lambda t, u=torque: u)
         values = [_torque(sample(p), f"at t = {p}") for p in _doubles(points).tolist()]
     if ramp:
@@ -400,17 +403,21 @@ def _integrate(
     runs = np.stack([firsts, lasts, np.r_[0, bounds[:-1]], bounds])
     out = results.empty(len(at), COMPUTED)
     out["time"] = at
+    spans = Spans(starts[firsts], ends[lasts], u0s[firsts], rates[firsts])
+    steps = taylor_steps(spans, model, theta0, omega0, (rtol, atol))
+    check_steps(steps, starts[0], ends[-1], rtol)
     theta, omega = float(theta0), float(omega0)
-    for first, last, lo, hi in runs.T.tolist():
-        t0, t1, u0, rate = float(starts[first]), float(ends[last]), float(u0s[first]), float(rates[first])
-        try:
-            thetas, omegas, theta, omega = integrate_piece(
-                theta, omega, (t0, t1), (u0, rate), model, (rtol, atol), np.clip(ordered[lo:hi], t0, t1)
-            )
-        except Diverged as error:
-            raise _failed(str(error), t0, parameters, theta0, omega0, pieces) from None
-        mine = slice(lo, hi) if order is None else order[lo:hi]
-        out["theta"][mine], out["omega"][mine] = thetas, omegas
+    with progress(steps, float(starts[0]), float(ends[-1])) as on_step:
+        for first, last, lo, hi in runs.T.tolist():
+            t0, t1, u0, rate = float(starts[first]), float(ends[last]), float(u0s[first]), float(rates[first])
+            try:
+                thetas, omegas, theta, omega = integrate_piece(
+                    theta, omega, (t0, t1), (u0, rate), model, (rtol, atol), np.clip(ordered[lo:hi], t0, t1), on_step
+                )
+            except Diverged as error:
+                raise _failed(str(error), t0, parameters, theta0, omega0, pieces) from None
+            mine = slice(lo, hi) if order is None else order[lo:hi]
+            out["theta"][mine], out["omega"][mine] = thetas, omegas
     out["torque"] = pieces.values_after(at)
     # The end of the run reports the torque the last piece reached, as a master reads it back.
     at_end = at >= ends[-1]
@@ -451,6 +458,7 @@ def reference(
     rtol: float = 1e-14,
     atol: float = 1e-14,
     fmu_path: Fmu = None,
+    max_steps: int | None = None,
 ) -> np.ndarray:
     """The trajectory under a signal as docs/signals.md defines it, integrated by the pendulum's
     Taylor series: the independent oracle, which reads the signal itself.
@@ -471,6 +479,9 @@ def reference(
         atol + rtol * max(abs(theta), abs(omega)).
     fmu_path : str or Path, optional
         The FMU whose parameters and defaults apply (default: pendulum_fmu.default_fmu()).
+    max_steps : int, optional
+        The most communication steps the run may have, as simulate() takes it (default:
+        DEFAULT_MAX_STEPS).
 
     Returns
     -------
@@ -503,7 +514,7 @@ def reference(
         raise InvalidInput("a per-step torque array is held over each step; ramp needs a CSV or a callable")
     step, start = _seconds("step size", step_size), _seconds("start time", start_time)
     stop = None if stop_time is None else _seconds("stop time", stop_time)
-    pieces = _signal_pieces(torque, start, stop, step, ramp)
+    pieces = _signal_pieces(torque, start, stop, step, ramp, max_steps)
     if at is None:
         at = _doubles(pieces.points)
     return _integrate(pieces, _times(at, pieces, step), parameters, theta0, omega0, rtol, atol, fmu_path)

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 import numbers
+from collections.abc import Callable
 
 import numpy as np
 
@@ -59,7 +60,7 @@ class Diverged(InvalidInput):
     """The series cannot be summed: a coefficient is not finite, or the step underflows."""
 
 
-def _order_limit(tolerance: float) -> int:
+def order_limit(tolerance: float) -> int:
     """Jorba and Zou's order for a tolerance: the terms' ratio at the step is then about e**-2.
     At most 30 (a tolerance of 1e-24): a smaller tolerance takes smaller steps instead.
     """
@@ -81,6 +82,7 @@ def integrate_piece(
     model: tuple[float, float, float],
     tolerance: tuple[float, float],
     reports: np.ndarray | list[float],
+    on_step: Callable[[float], None] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, float, float]:
     """Theta and omega at each of reports and at the piece's end, from theta, omega at its start.
 
@@ -98,6 +100,8 @@ def integrate_piece(
         rtol and atol: each step's terms past its order stay below atol + rtol * max(abs(theta), abs(omega)).
     reports : numpy.ndarray or list of float
         Sorted times within span.
+    on_step : callable, optional
+        Called with the time each step reaches (a progress bar's).
 
     Returns
     -------
@@ -113,7 +117,7 @@ def integrate_piece(
     u0, rate = torque
     gravity_moment, damping, inverse_inertia = model
     rtol, atol = tolerance
-    order_limit = _order_limit(min(rtol, atol))
+    order = order_limit(min(rtol, atol))
     # Arrays, filled a Taylor step's reports at a time: a piece may hold millions of reports,
     # which as lists of floats took four times the memory.
     reports = np.asarray(reports, dtype=float)
@@ -125,7 +129,7 @@ def integrate_piece(
         x, v = [theta, omega], [omega]
         sines, cosines = [math.sin(theta)], [math.cos(theta)]
         inputs = (u0 + rate * (t - start), rate)
-        for k in range(order_limit):
+        for k in range(order):
             if k:  # sin and cos to order k, from theta's terms up to k
                 sine = cosine = 0.0
                 for j in range(1, k + 1):
@@ -163,5 +167,7 @@ def integrate_piece(
         if not (math.isfinite(theta) and math.isfinite(omega)):
             raise Diverged("the state is not finite")
         t = stop
+        if on_step is not None:
+            on_step(t)
         if t == end:
             return thetas, omegas, theta, omega

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .._errors import InvalidInput
-from .._received_files import bounded_text, shortened
+from .._received_files import MAX_SETTINGS_BYTES, bounded_text, shortened
 from ._scenario_list import Scenario
 
 # The tolerance the kit's FMU is run at (its own default); the judge's, in rad.
@@ -130,10 +130,6 @@ SETTINGS_READ = (
     "omega0",
     "tolerance",
 )
-
-
-# A NAME.json the kit writes is under 1 kB; one of a megabyte is no scenario's, and is not read.
-MAX_SETTINGS_BYTES = 2**20
 
 _AGAIN = "write the kit again with pendulum-fmu scenarios --output-dir FOLDER --overwrite"
 

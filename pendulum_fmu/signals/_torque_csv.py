@@ -17,7 +17,7 @@ from typing import Literal
 import numpy as np
 
 from .._errors import InvalidInput
-from .._received_files import check_lines, shortened
+from .._received_files import MAX_TORQUE_CSV_BYTES, bounded_read, check_lines, shortened
 from ._time_grid import event_tolerance, nearest
 
 # A file up to this size whose numbers are all plain is read in Python, in a few ms: importing
@@ -198,7 +198,8 @@ def read_torque_csv(path: str | Path) -> TorqueTable:
     """
     path = Path(path)
     try:
-        raw = path.read_bytes()
+        with open(path, "rb") as file:
+            raw = bounded_read(file, str(path), MAX_TORQUE_CSV_BYTES, TorqueFileError, "give a CSV of time,torque rows")
     except OSError as error:
         raise TorqueFileError(f"{path}: cannot read: {error.strerror}") from None
     raw = raw[3:] if raw.startswith(b"\xef\xbb\xbf") else raw  # spreadsheets write a byte-order mark

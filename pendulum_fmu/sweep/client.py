@@ -15,7 +15,6 @@ import queue
 import re
 import signal
 import ssl
-import sys
 import threading
 import time
 from collections.abc import Iterable
@@ -24,6 +23,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from .._errors import InvalidInput, PendulumFmuError
+from .._progress_bar import progress_bar as shown_bar
 from .security import client_security, run_certificates
 from .worker import Task, run_chunk
 
@@ -297,58 +297,11 @@ def _ctrl_c_held():
         signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
-class _Lines:
-    """tqdm's output for a log: each redraw a line of its own, where a terminal's is redrawn in
-    place (tqdm starts it with a carriage return).
-    """
-
-    def __init__(self, stream):
-        self.stream = stream
-
-    def write(self, text: str) -> None:
-        text = text.strip("\r\n ")
-        if text:
-            self.stream.write(text + "\n")
-
-    def flush(self) -> None:
-        self.stream.flush()
-
-
 def progress_bar(total: int, done: int, enabled: bool):
-    """A tqdm bar of the cases on stderr, `done` of them already: redrawn in place on a terminal;
-    elsewhere (a log) a plain line every few seconds, and the last count.
-    """
-    from tqdm import tqdm
-
+    """A bar of the cases on stderr, `done` of them already (_progress_bar.py)."""
     # No time: the run's one duration, cluster and figure included, is the summary's (run_sweep's
     # seconds), which a second, shorter one here would contradict.
-    counts = "{n_fmt}/{total_fmt} cases{postfix}"
-    # miniters=1: every update counts and only the interval thins them out, so tqdm's monitor
-    # thread never redraws a bar on its own.
-    if sys.stderr.isatty():
-        return tqdm(
-            total=total,
-            initial=done,
-            disable=not enabled,
-            file=sys.stderr,
-            miniters=1,
-            mininterval=0.2,
-            ascii=" #",
-            postfix="0 failed",
-            bar_format="sweep [{bar:30}] " + counts,
-        )
-    return tqdm(
-        total=total,
-        initial=done,
-        disable=not enabled,
-        file=_Lines(sys.stderr),
-        miniters=1,
-        mininterval=5.0,
-        delay=5.0,
-        leave=False,
-        postfix="0 failed",
-        bar_format="sweep: " + counts,
-    )
+    return shown_bar("sweep", "{n_fmt}/{total_fmt} cases{postfix}", total, done, enabled, postfix="0 failed")
 
 
 @dataclass

@@ -23,7 +23,7 @@ from .client import SchedulerLost, Totals, dask_client, progress_bar, run_chunks
 from .figure import draw
 from .grid import columns
 from .here import check_place, run_chunks_here, runs_here
-from .store import Held, Store, StudyExists
+from .store import Store, StudyExists
 from .study import Study, SweepResult
 from .worker import Task
 
@@ -158,7 +158,7 @@ def run_sweep(
         # What no run owns now (the staged parts of a worker of an earlier run that wrote after
         # its run ended, temporaries of writes cut short) goes before the folder is read.
         target.remove_unfinished()
-        chunk_cases = _chunk_cases(target.held(), definition, study, resume, overwrite, url)
+        chunk_cases = _chunk_cases(target, definition, study, resume, overwrite, url)
         # A study that replaces another is written apart and moved into place once whole.
         store = target.staging() if overwrite else target
         # This run's token: only parts staged under it are committed (see store.py).
@@ -180,7 +180,7 @@ def run_sweep(
                     if here
                     else dask_client(scheduler, workers, connect_timeout, security, keep_cluster) as client
                 ):
-                    store.start(definition, chunk_cases, task.run)
+                    store.start(definition, chunk_cases, task.run, task.tables())
                     try:
                         totals = _run_pending(client, task, study, chunk_cases, pending, progress)
                     except CancelledError as error:  # this run cancels none: the cluster did
@@ -269,11 +269,14 @@ def _lost(scheduler: str | None, error: CancelledError, url: str, overwrite: boo
     return SchedulerLost(f"{which} was lost mid-study ({reason}); {kept}")
 
 
-def _chunk_cases(held: Held, definition: dict, study: Study, resume: bool, overwrite: bool, output_dir: str) -> int:
+def _chunk_cases(target: Store, definition: dict, study: Study, resume: bool, overwrite: bool, output_dir: str) -> int:
     """The cases per chunk of this run: the study's own, or on resume those of the run it
     continues. StudyExists where the run would replace a study without being asked to.
     """
-    if overwrite or not held.entries:
+    if overwrite:  # what the folder holds is not read: it goes
+        return study.chunk_cases()
+    held = target.held()
+    if not held.entries:
         return study.chunk_cases()
     if held.manifest is None:
         raise StudyExists(

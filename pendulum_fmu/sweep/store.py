@@ -14,6 +14,14 @@ of another run (one stopped, then continued after its study was finished, replac
 never becomes part of a study, and every reader, resume included, lists only parts a client
 committed. A run removes the staged parts it finds, of any run, when it ends.
 
+Nor does such a worker leave its parts behind. A run marks itself live (.live-<run>) while it
+runs, and ends by removing the mark, then the staged parts it finds. A worker checks its run's mark
+after it has staged its parts, and removes them when the mark is gone. Either the check comes
+before the mark goes, and the parts, staged before it, are there when the run removes what it
+finds; or it comes after, and the worker removes them itself. A worker never makes a folder
+either: a study written apart (overwrite) is moved into place when its run ends, and a worker
+of that run, woken later, finds no folder to stage into and writes nothing.
+
 A study that a run replaces (overwrite) stays whole until the new one is: the new study is
 written into a hidden folder inside the output folder and moved into place at the end, with
 Ctrl-C held off while it moves.
@@ -31,7 +39,8 @@ from pathlib import Path
 from typing import Any
 
 from .._atomic_files import TEMPORARY_GLOB, is_local, make_folder, replacing_on
-from .._errors import CannotWrite, PendulumFmuError
+from .._errors import CannotWrite, InvalidInput, PendulumFmuError
+from .._received_files import MAX_STUDY_BYTES, bounded_read
 from .._stop_signals import signals_deferred
 
 SUMMARIES = ("final_theta", "final_omega", "final_alpha", "max_abs_theta")
@@ -42,6 +51,10 @@ ENTRIES = ("study.json", "trajectories", "cases", "sweep.png")
 LOCK_FILE = ".sweep.lock"
 # What a worker writes and only its run's client moves into place (see the module's doc).
 STAGED_GLOB = "_part-*.staged"
+# What to do with a study.json too long to be one a sweep wrote.
+_STUDY_ADVICE = "choose another output directory, or add --overwrite to replace what it holds"
+# There while a run is writing the study, one per run (.live-<run>): see Store.is_live.
+LIVE_GLOB = ".live-*"
 
 
 def parquet_options(columns: list[str], series: tuple = ()) -> dict:
@@ -121,7 +134,8 @@ class Store:
     def write_table(self, name: str, index: int, columns: dict, run: str, series: tuple = ()) -> int:
         """Write one part of a table, staged for run (see commit); returns its size in bytes.
         series: the columns that are float series over the time grid (a trajectories part's time
-        and outputs), stored as parquet_options says.
+        and outputs), stored as parquet_options says. FileNotFoundError where the table's folder
+        is not there (start makes it): no folder is made after the run's start.
         """
         import pyarrow as pa
 
@@ -131,7 +145,7 @@ class Store:
             list(arrays.values()),
             schema=pa.schema([pa.field(column, array.type, nullable=False) for column, array in arrays.items()]),
         )
-        with replacing_on(self.filesystem, self.staged(name, index, run)) as file:
+        with replacing_on(self.filesystem, self.staged(name, index, run), make_folders=False) as file:
             if self.format == "parquet":
                 import pyarrow.parquet as pq
 
@@ -148,6 +162,20 @@ class Store:
         """
         for table in tables:  # the cases part last: it marks the chunk done
             self.filesystem.mv(self.staged(table, index, run), self.part(table, index))
+
+    def live(self, run: str) -> str:
+        """The path of run's mark: there from the run's start until it ends."""
+        return f"{self.root}/.live-{run}"
+
+    def is_live(self, run: str) -> bool:
+        """Whether run is still writing this study (see the module's doc)."""
+        return self.filesystem.exists(self.live(run))
+
+    def discard_staged(self, index: int, run: str, tables: tuple[str, ...]) -> None:
+        """Remove run's staged parts of a chunk, where they are."""
+        for table in tables:
+            with contextlib.suppress(FileNotFoundError):
+                self.filesystem.rm(self.staged(table, index, run))
 
     def parts(self, table: str) -> dict[int, str]:
         """{chunk index: path} of a table's parts."""
@@ -166,10 +194,12 @@ class Store:
                     self.filesystem.rm(path, recursive=True)
 
     def remove_unfinished(self) -> None:
-        """What interrupted chunks leave: the temporaries of writes cut short (a killed worker, see
+        """End every run of the folder: their marks first (see the module's doc), then what
+        interrupted chunks leave: the temporaries of writes cut short (a killed worker, see
         _atomic_files.py), the staged parts no client committed (of this run or any other), and
         trajectory parts whose chunk did not get to commit its cases part.
         """
+        self.remove((LIVE_GLOB,))
         self.remove(
             (
                 TEMPORARY_GLOB,
@@ -188,10 +218,15 @@ class Store:
 
     def held(self) -> Held:
         """What the folder holds of a study."""
-        fs, manifest = self.filesystem, None
-        with contextlib.suppress(OSError, ValueError):
-            with fs.open(f"{self.root}/study.json", "r") as file:
-                content = json.load(file)
+        fs, manifest, path = self.filesystem, None, f"{self.root}/study.json"
+        try:
+            with fs.open(path, "rb") as file:
+                raw = bounded_read(file, path, MAX_STUDY_BYTES, InvalidInput, _STUDY_ADVICE)
+        except OSError:  # none there
+            raw = b"{}"
+        # Not JSON, or JSON nested deeper than the decoder recurses: no study.json a sweep wrote.
+        with contextlib.suppress(ValueError, RecursionError):
+            content = json.loads(raw)
             if (
                 isinstance(content, dict)
                 and isinstance(content.get("study"), dict)
@@ -201,13 +236,18 @@ class Store:
         entries = tuple(name for name in ENTRIES if fs.exists(f"{self.root}/{name}"))
         return Held(manifest, entries, len(self.done_chunks()) if entries else 0)
 
-    def start(self, definition: dict, chunk_cases: int, run: str) -> None:
+    def start(self, definition: dict, chunk_cases: int, run: str, tables: tuple[str, ...]) -> None:
         """Write study.json: what the study is, its cases per chunk, and the token of the run
-        now writing it.
+        now writing it; make the folders of the tables' parts, and mark the run live.
         """
         with replacing_on(self.filesystem, f"{self.root}/study.json") as file:
             # One line: json's C encoder (indent= takes its Python one, 0.2 s for 50,000 values).
             file.write(json.dumps({"study": definition, "chunk_cases": chunk_cases, "run": run}).encode())
+        if is_local(self.filesystem):  # elsewhere a file's path makes its folders, if it has any
+            for table in tables:
+                make_folder(Path(self.root, table), self.root, "output directory")
+        with replacing_on(self.filesystem, self.live(run)):
+            pass
 
     def staging(self) -> Store:
         """A new hidden folder inside this one, where a study that replaces this one is written."""

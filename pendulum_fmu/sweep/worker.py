@@ -9,6 +9,7 @@ loop, runs each case through fmpy's calls.
 
 from __future__ import annotations
 
+import logging
 import threading
 import time
 from dataclasses import dataclass
@@ -23,6 +24,9 @@ from ..fmu._simulate import run_schedule_python, simulator
 from ..signals._time_grid import communication_points
 from ..signals._torque_schedule import TorqueSchedule
 from .store import SUMMARIES, Store
+
+# A dask worker's log: what a worker woken after its run ended did with its chunk.
+_log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -139,44 +143,59 @@ def run_chunk(index: int, first: int, values: dict[str, np.ndarray], task: Task)
     ok = np.array([not message for message in messages], bool)
     numbers = first + np.arange(count)
     written = 0
-    if task.outputs:
-        keep = kept_points(len(points), task.stride)
-        kept = recorded if ok.all() else recorded[:, ok]  # a copy only when a case failed
-        if len(keep) < len(points):
-            kept = kept[:, :, keep]
-        # Each output's series of the chunk is contiguous: pyarrow takes its buffer as it is.
+    try:
+        if task.outputs:
+            keep = kept_points(len(points), task.stride)
+            kept = recorded if ok.all() else recorded[:, ok]  # a copy only when a case failed
+            if len(keep) < len(points):
+                kept = kept[:, :, keep]
+            # Each output's series of the chunk is contiguous: pyarrow takes its buffer as it is.
+            written += task.store.write_table(
+                "trajectories",
+                index,
+                {
+                    "case": _repeated(numbers[ok], len(keep)),
+                    "time": _tiled(points[keep], int(ok.sum())),
+                    **{name: kept[runner.outputs.index(name)].reshape(-1) for name in task.outputs},
+                },
+                task.run,
+                series=("time", *task.outputs),
+            )
+        # The summaries by name; NaN (never zeros) for a variable the FMU does not output.
+        not_output = np.full((count, 1), np.nan)
+        theta, omega, alpha = (
+            recorded[runner.outputs.index(name)] if name in runner.outputs else not_output
+            for name in ("theta", "omega", "alpha")
+        )
+        # max |theta| as |max(max, -min)|: two passes and no temporary the size of the chunk (the
+        # outer abs only for theta all -0.0, where abs first gives 0.0).
+        summaries = [
+            theta[:, -1],
+            omega[:, -1],
+            alpha[:, -1],
+            np.abs(np.maximum(theta.max(axis=1), -theta.min(axis=1))),
+        ]
         written += task.store.write_table(
-            "trajectories",
+            "cases",
             index,
             {
-                "case": _repeated(numbers[ok], len(keep)),
-                "time": _tiled(points[keep], int(ok.sum())),
-                **{name: kept[runner.outputs.index(name)].reshape(-1) for name in task.outputs},
+                "case": numbers,
+                **values,
+                **dict(zip(SUMMARIES, summaries, strict=False)),
+                "status": np.where(ok, "ok", "failed").tolist(),
+                "message": messages,
             },
             task.run,
-            series=("time", *task.outputs),
         )
-    # The summaries by name; NaN (never zeros) for a variable the FMU does not output.
-    not_output = np.full((count, 1), np.nan)
-    theta, omega, alpha = (
-        recorded[runner.outputs.index(name)] if name in runner.outputs else not_output
-        for name in ("theta", "omega", "alpha")
-    )
-    # max |theta| as |max(max, -min)|: two passes and no temporary the size of the chunk (the
-    # outer abs only for theta all -0.0, where abs first gives 0.0).
-    summaries = [theta[:, -1], omega[:, -1], alpha[:, -1], np.abs(np.maximum(theta.max(axis=1), -theta.min(axis=1)))]
-    written += task.store.write_table(
-        "cases",
-        index,
-        {
-            "case": numbers,
-            **values,
-            **dict(zip(SUMMARIES, summaries, strict=False)),
-            "status": np.where(ok, "ok", "failed").tolist(),
-            "message": messages,
-        },
-        task.run,
-    )
+    except FileNotFoundError:  # no folder to stage into: a study written apart, moved since
+        if task.store.is_live(task.run):
+            raise
+    if not task.store.is_live(task.run):
+        # Woken after its run ended (stopped, cut off): the run has removed, or will never see,
+        # what the worker staged, so the worker removes it (store.py says why nothing stays).
+        task.store.discard_staged(index, task.run, task.tables())
+        _log.warning("chunk %d of run %s not kept: the run ended while it ran", index, task.run)
+        written = 0
     return index, count, count - int(ok.sum()), written, time.thread_time() - cpu, stepping
 
 
