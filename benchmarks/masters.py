@@ -36,7 +36,11 @@ WRONG_MASTERS = [
     ("ramp", "held", "input held"),
     ("random_steps", "drift", "time grid drift"),
     ("decimal_steps", "drift", "time grid drift"),
+    ("random_steps", "shifted", "time column one step off"),
+    ("steps_on_grid", "shifted", "time column one step off"),
     ("resume", "not_restored", "state not restored"),
+    ("random_steps", "single", "result in single precision"),
+    ("steps_on_grid", "single", "result in single precision"),
     ("constant_torque", "euler", "integration error"),
     ("random_steps", "euler", "integration error"),
     ("constant_torque", "heun", "integration error"),
@@ -52,7 +56,9 @@ MISTAKES = {
     "ramped": "input derivatives where the signal holds",
     "held": "no input derivatives on a ramp",
     "drift": "time summed in single precision",
+    "shifted": "each step's result filed under its start",
     "not_restored": "resumed without restoring the state",
+    "single": "outputs handed out in single precision",
     "euler": "Model Exchange, explicit Euler at the step",
     "heun": "Model Exchange, Heun at the step",
     "late_once": "only the first change one step late",
@@ -191,6 +197,11 @@ def co_simulation(kit: Kit, mistake: str | None = None) -> Path:
         rows.append(slave.getReal(outputs))
         slave.doStep(currentCommunicationPoint=t, communicationStepSize=h)
     rows.append(slave.getReal(outputs))
+    if mistake == "shifted":  # each step's result under its start time, one more step at the end (cofmupy)
+        slave.doStep(currentCommunicationPoint=times[-1], communicationStepSize=times[-1] - times[-2])
+        rows = [*rows[1:], slave.getReal(outputs)]
+    elif mistake == "single":  # outputs as float32 (fmugym's observations)
+        rows = [np.float32(row).tolist() for row in rows]
     slave.terminate()
     slave.freeInstance()
     return kit.write(times, rows)

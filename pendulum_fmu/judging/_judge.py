@@ -21,8 +21,12 @@ explains the result leaves only rounding and solver noise (about 1e-11 rad). The
 - input held: each step holds where the run asked for a ramp (ramp runs only);
 - time grid drift: the master stepped on the result's own times, off the communication points,
   sampling the signal there (only when the result's times are off the grid);
+- time column one step off: each row holds the run's state at the next communication point (a
+  master that files a step's result under the step's start), or at the one before;
 - state not restored: from the last row that agrees, the run restarts from the initial state
   (a resumed run that did not restore its saved FMU state);
+- result in single precision: the reference with theta rounded to float32 (only when every theta
+  of the result is a float32 value);
 - integration error: the FMU's equation stepped by explicit or semi-implicit Euler at the
   communication step (a master that integrates the Model Exchange interface itself, or
   Pendulum-v1's semi-implicit Euler); when one of them leaves only noise, the judgement names it
