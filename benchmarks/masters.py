@@ -36,6 +36,8 @@ WRONG_MASTERS = [
     ("ramp", "held", "input held"),
     ("random_steps", "drift", "time grid drift"),
     ("decimal_steps", "drift", "time grid drift"),
+    ("random_steps", "summed_clock", "time grid drift"),
+    ("decimal_steps", "summed_clock", "time grid drift"),
     ("random_steps", "shifted", "time column one step off"),
     ("steps_on_grid", "shifted", "time column one step off"),
     ("resume", "not_restored", "state not restored"),
@@ -56,6 +58,7 @@ MISTAKES = {
     "ramped": "input derivatives where the signal holds",
     "held": "no input derivatives on a ramp",
     "drift": "time summed in single precision",
+    "summed_clock": "steps where its time passes a summed clock",
     "shifted": "each step's result filed under its start",
     "not_restored": "resumed without restoring the state",
     "single": "outputs handed out in single precision",
@@ -207,6 +210,29 @@ def co_simulation(kit: Kit, mistake: str | None = None) -> Path:
     return kit.write(times, rows)
 
 
+def summed_clock(kit: Kit) -> Path:
+    """A master that steps the FMU while its own time is at or past the FMU's next point on a
+    clock summed step by step, compared without a tolerance, then sets the signal at its time for
+    the next step (FMI++'s FixedStepSizeFMU.sync): where the clocks round apart, a step skipped,
+    two taken later.
+    """
+    slave = _slave(kit, kit.times[0], "summed")
+    torque_vr, outputs = [kit.vr["torque"]], [kit.vr[n] for n in OUTPUTS]
+    torque, _ = kit.torques(kit.times)
+    slave.setReal(torque_vr, [torque[0]])
+    clock, rows = kit.times[0], [slave.getReal(outputs)]
+    for k, t in enumerate(kit.times[1:], start=1):
+        while t >= clock + kit.step:
+            slave.doStep(currentCommunicationPoint=clock, communicationStepSize=kit.step)
+            clock += kit.step
+        rows.append(slave.getReal(outputs))
+        if k < len(torque):
+            slave.setReal(torque_vr, [torque[k]])
+    slave.terminate()
+    slave.freeInstance()
+    return kit.write(kit.times, rows)
+
+
 def model_exchange(kit: Kit, method: str) -> Path:
     """A master that integrates the Model Exchange interface itself, one solver step per
     communication step, holding each step's torque: explicit Euler, or Heun (second order).
@@ -259,6 +285,8 @@ def run(folder: Path, name: str, mistake: str | None = None) -> Path:
     kit = Kit(folder, name)
     if mistake in ("euler", "heun"):
         return model_exchange(kit, mistake)
+    if mistake == "summed_clock":
+        return summed_clock(kit)
     return co_simulation(kit, mistake)
 
 

@@ -140,6 +140,29 @@ def _drifted(torque, times: np.ndarray, ramp: bool) -> list[TorqueSchedule]:
     return [TorqueSchedule(time=points, torque=start, torque_rate=rate)]
 
 
+def _summed_clock(run: Run, ramp: bool) -> list[np.ndarray]:
+    """The master steps the FMU while its own time, the result's, is at or past the FMU's next
+    communication point on a clock summed step by step, compared without a tolerance (FMI++'s
+    FixedStepSizeFMU.sync); after each row it sets the torque of the step that starts at the row's
+    time. Where the two clocks round apart a step is skipped, the FMU a step behind (its rows a
+    step old, its input a step early) until a row takes two. Only for a row per communication
+    point, where a step is skipped.
+    """
+    plan, times = run.plan, run.times
+    index = _plan_index(plan, times, run.step_size)
+    if ramp or index is None or not np.array_equal(index, np.arange(len(plan.time))):
+        return []
+    clock = np.cumsum(np.r_[plan.time[0], np.full(len(plan.step_size), run.step_size)])
+    # The FMU's steps done when each row is written (none before the start: a row within rounding of it).
+    done = np.maximum(np.searchsorted(clock, times, side="right") - 1, 0)
+    if done[-1] < 1 or np.array_equal(done, np.arange(len(times))):
+        return []
+    # Step j runs with what the row before the first row that has it done set.
+    setter = np.searchsorted(done, np.arange(done[-1]) + 1, side="left") - 1
+    steps = TorqueSchedule(time=plan.time[: done[-1] + 1], torque=plan.torque[setter], torque_rate=np.zeros(done[-1]))
+    return [run.integrate(steps, at=plan.time[done])]
+
+
 def _shifted(run: Run) -> list[np.ndarray]:
     """Each row holds the run's state one communication point after its time (a master that files
     a step's result under the step's start), or one before; the first row the initial state. The
@@ -258,7 +281,7 @@ def shared_variants(run: Run, torque, held: TorqueSchedule | None, start_torque:
         EARLY: [run.integrate(p) for p in _early(plan)],
         INTERPOLATED: [] if ramp else [run.integrate(p) for p in _interpolated(plan)],
         HELD: [run.integrate(held)] if held is not None else [],
-        DRIFT: [run.integrate(p) for p in _drifted(torque, run.times, ramp)] if off_grid else [],
+        DRIFT: [run.integrate(p) for p in _drifted(torque, run.times, ramp)] if off_grid else _summed_clock(run, ramp),
         SHIFTED: _shifted(run),
         INTEGRATION: _integration(run),
     }
