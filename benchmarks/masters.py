@@ -38,6 +38,8 @@ WRONG_MASTERS = [
     ("decimal_steps", "drift", "time grid drift"),
     ("random_steps", "summed_clock", "time grid drift"),
     ("decimal_steps", "summed_clock", "time grid drift"),
+    ("random_steps", "exact_events", "time grid drift"),
+    ("steps_on_grid", "exact_events", "time grid drift"),
     ("random_steps", "shifted", "time column one step off"),
     ("steps_on_grid", "shifted", "time column one step off"),
     ("resume", "not_restored", "state not restored"),
@@ -59,6 +61,7 @@ MISTAKES = {
     "held": "no input derivatives on a ramp",
     "drift": "time summed in single precision",
     "summed_clock": "steps where its time passes a summed clock",
+    "exact_events": "changes fired at exact summed-clock times",
     "shifted": "each step's result filed under its start",
     "not_restored": "resumed without restoring the state",
     "single": "outputs handed out in single precision",
@@ -168,6 +171,12 @@ def co_simulation(kit: Kit, mistake: str | None = None) -> Path:
         torque, slope = [torque[0], *torque[:-1]], [slope[0], *slope[:-1]]
     elif mistake == "early":
         torque, slope = [*torque[1:], torque[-1]], [*slope[1:], 0.0]
+    elif mistake == "exact_events":  # a change only where a summed clock equals its time (ECOS's scenarios)
+        clock = np.cumsum(np.r_[times[0], np.full(len(torque) - 1, kit.step)])
+        applied = [torque[0]]
+        for k in range(1, len(torque)):
+            applied.append(torque[k] if torque[k] != torque[k - 1] and clock[k] == times[k] else applied[-1])
+        torque = applied
     elif mistake == "late_once":  # only the first change of the torque reaches the FMU a step late
         k = next(k for k in range(1, len(torque)) if torque[k] != torque[k - 1])
         torque = [*torque[:k], torque[k - 1], *torque[k + 1 :]]

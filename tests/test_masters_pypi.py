@@ -101,9 +101,10 @@ def ecos_actions_with_tolerance(simulation):
 
 
 def test_ecos_scenario_never_switches_the_torque(fmu):
+    # ECOS's summed clock reads 1.0000000000000007 s where the action is at 1 s: no time equals it.
     times, theta = ecos_run(fmu, ecos_actions)
     judgement = judged(times, theta, fmu)
-    assert not judgement.passed and judgement.max_abs_dtheta > 0.3
+    assert judgement.diagnosis == DRIFT and judgement.residual < 1e-12 < 0.3 < judgement.max_abs_dtheta
     # The torque stayed at its first action's 20 N.m: the run of that constant agrees.
     assert judged(times, theta, fmu, signal=20.0).max_abs_dtheta < 1e-12
     assert judged(*ecos_run(fmu, ecos_actions_with_tolerance), fmu).passed

@@ -141,26 +141,38 @@ def _drifted(torque, times: np.ndarray, ramp: bool) -> list[TorqueSchedule]:
 
 
 def _summed_clock(run: Run, ramp: bool) -> list[np.ndarray]:
-    """The master steps the FMU while its own time, the result's, is at or past the FMU's next
-    communication point on a clock summed step by step, compared without a tolerance (FMI++'s
-    FixedStepSizeFMU.sync); after each row it sets the torque of the step that starts at the row's
-    time. Where the two clocks round apart a step is skipped, the FMU a step behind (its rows a
-    step old, its input a step early) until a row takes two. Only for a row per communication
-    point, where a step is skipped.
+    """Masters whose clock is summed step by step and compared with times without a tolerance.
+
+    One steps the FMU while its own time, the result's, is at or past the FMU's next communication
+    point on that clock (FMI++'s FixedStepSizeFMU.sync), and after each row sets the torque of the
+    step that starts at the row's time: where the clocks round apart a step is skipped, the FMU a
+    step behind (its rows a step old, its input a step early) until a row takes two. Only for a
+    row per communication point, where a step is skipped. The other applies a change of the
+    torque only where its clock equals the change's time (a scenario's actions, ECOS's through
+    ecospy): a change it misses never reaches the FMU. Only where a change is missed.
     """
     plan, times = run.plan, run.times
-    index = _plan_index(plan, times, run.step_size)
-    if ramp or index is None or not np.array_equal(index, np.arange(len(plan.time))):
+    if ramp:
         return []
     clock = np.cumsum(np.r_[plan.time[0], np.full(len(plan.step_size), run.step_size)])
-    # The FMU's steps done when each row is written (none before the start: a row within rounding of it).
-    done = np.maximum(np.searchsorted(clock, times, side="right") - 1, 0)
-    if done[-1] < 1 or np.array_equal(done, np.arange(len(times))):
-        return []
-    # Step j runs with what the row before the first row that has it done set.
-    setter = np.searchsorted(done, np.arange(done[-1]) + 1, side="left") - 1
-    steps = TorqueSchedule(time=plan.time[: done[-1] + 1], torque=plan.torque[setter], torque_rate=np.zeros(done[-1]))
-    return [run.integrate(steps, at=plan.time[done])]
+    variants = []
+    index = _plan_index(plan, times, run.step_size)
+    if index is not None and np.array_equal(index, np.arange(len(plan.time))):
+        # The FMU's steps done when each row is written (none before the start: a row within rounding of it).
+        done = np.maximum(np.searchsorted(clock, times, side="right") - 1, 0)
+        if done[-1] >= 1 and not np.array_equal(done, np.arange(len(times))):
+            # Step j runs with what the row before the first row that has it done set.
+            setter = np.searchsorted(done, np.arange(done[-1]) + 1, side="left") - 1
+            steps = TorqueSchedule(
+                time=plan.time[: done[-1] + 1], torque=plan.torque[setter], torque_rate=np.zeros(done[-1])
+            )
+            variants.append(run.integrate(steps, at=plan.time[done]))
+    changes = np.flatnonzero(np.diff(plan.torque)) + 1
+    applied = np.r_[0, changes[clock[changes] == plan.time[changes]]]
+    if len(applied) <= len(changes):
+        last_applied = applied[np.searchsorted(applied, np.arange(len(plan.torque)), side="right") - 1]
+        variants.append(run.integrate(_changed(plan, plan.torque[last_applied])))
+    return variants
 
 
 def _shifted(run: Run) -> list[np.ndarray]:

@@ -20,10 +20,11 @@ explains the result leaves only rounding and solver noise (about 1e-11 rad). The
 - input interpolated linearly: each step ramps to the next step's value where the signal holds;
 - input held: each step holds where the run asked for a ramp (ramp runs only);
 - time grid drift: the master stepped on the result's own times, off the communication points,
-  sampling the signal there (when the result's times are off the grid); or, a row per
-  communication point, it stepped wherever its time reached the FMU's next point on a clock
-  summed step by step, compared without a tolerance (FMI++'s FixedStepSizeFMU.sync), and set the
-  signal at its time after each row (only where that skips a step);
+  sampling the signal there (when the result's times are off the grid); or its clock is summed
+  step by step and compared without a tolerance: it stepped wherever its time reached the FMU's
+  next point on that clock (FMI++'s FixedStepSizeFMU.sync; a row per communication point, where
+  that skips a step), or applied a change of the torque only where that clock equals the change's
+  time (ECOS's scenarios through ecospy; where that misses a change);
 - time column one step off: each row holds the run's state at the next communication point (a
   master that files a step's result under the step's start), or at the one before;
 - state not restored: from the last row that agrees, the run restarts from the initial state
