@@ -33,6 +33,11 @@ INTERPOLATED, HELD = "input interpolated linearly", "input held"
 DRIFT, NOT_RESTORED = "time grid drift", "state not restored"
 
 
+# A time column one step off its values (a master that files a step's result under the step's
+# start, or the reverse), and a result whose theta went through single precision (float32).
+SHIFTED, SINGLE = "time column one step off", "result in single precision"
+
+
 INTEGRATION, UNEXPLAINED = "integration error", "unexplained"
 
 
@@ -43,11 +48,14 @@ SEMI_IMPLICIT_EULER = "semi-implicit (symplectic) Euler at the communication ste
 INTEGRATORS = (EXPLICIT_EULER, SEMI_IMPLICIT_EULER)
 
 
-DIAGNOSES = (AGREES, LATE, EARLY, INTERPOLATED, HELD, DRIFT, NOT_RESTORED, INTEGRATION, UNEXPLAINED)
+DIAGNOSES = (
+    AGREES, LATE, EARLY, INTERPOLATED, HELD, DRIFT, SHIFTED, NOT_RESTORED, SINGLE, INTEGRATION, UNEXPLAINED
+)  # fmt: skip
 
 
-# The mistakes in how the input reaches the FMU: a solver's error must be small beside them.
-INPUT_TIMING = (LATE, EARLY, INTERPOLATED, HELD, DRIFT)
+# The mistakes in the timing of the input or of the result's rows: a solver's error must be
+# small beside them.
+INPUT_TIMING = (LATE, EARLY, INTERPOLATED, HELD, DRIFT, SHIFTED)
 
 
 # A candidate explains a result when its variant removes nearly all of the difference: its
@@ -130,6 +138,71 @@ def _drifted(torque, times: np.ndarray, ramp: bool) -> list[TorqueSchedule]:
         return []
     rate = (_signal_values(torque, points[1:], "before") - start) / np.diff(points) if ramp else np.zeros(len(start))
     return [TorqueSchedule(time=points, torque=start, torque_rate=rate)]
+
+
+def _summed_clock(run: Run, ramp: bool) -> list[np.ndarray]:
+    """Masters whose clock is summed step by step and compared with times without a tolerance.
+
+    One steps the FMU while its own time, the result's, is at or past the FMU's next communication
+    point on that clock (FMI++'s FixedStepSizeFMU.sync), and after each row sets the torque of the
+    step that starts at the row's time: where the clocks round apart a step is skipped, the FMU a
+    step behind (its rows a step old, its input a step early) until a row takes two. Only for a
+    row per communication point, where a step is skipped. The other applies a change of the
+    torque only where its clock equals the change's time (a scenario's actions, ECOS's through
+    ecospy): a change it misses never reaches the FMU. Only where a change is missed.
+    """
+    plan, times = run.plan, run.times
+    if ramp:
+        return []
+    clock = np.cumsum(np.r_[plan.time[0], np.full(len(plan.step_size), run.step_size)])
+    variants = []
+    index = _plan_index(plan, times, run.step_size)
+    if index is not None and np.array_equal(index, np.arange(len(plan.time))):
+        # The FMU's steps done when each row is written (none before the start: a row within rounding of it).
+        done = np.maximum(np.searchsorted(clock, times, side="right") - 1, 0)
+        if done[-1] >= 1 and not np.array_equal(done, np.arange(len(times))):
+            # Step j runs with what the row before the first row that has it done set.
+            setter = np.searchsorted(done, np.arange(done[-1]) + 1, side="left") - 1
+            steps = TorqueSchedule(
+                time=plan.time[: done[-1] + 1], torque=plan.torque[setter], torque_rate=np.zeros(done[-1])
+            )
+            variants.append(run.integrate(steps, at=plan.time[done]))
+    changes = np.flatnonzero(np.diff(plan.torque)) + 1
+    applied = np.r_[0, changes[clock[changes] == plan.time[changes]]]
+    if len(applied) <= len(changes):
+        last_applied = applied[np.searchsorted(applied, np.arange(len(plan.torque)), side="right") - 1]
+        variants.append(run.integrate(_changed(plan, plan.torque[last_applied])))
+    return variants
+
+
+def _shifted(run: Run) -> list[np.ndarray]:
+    """Each row holds the run's state one communication point after its time (a master that files
+    a step's result under the step's start), or one before; the first row the initial state. The
+    last row's next point is one more step of the run's last torque, as the FMU makes it.
+    """
+    index = _plan_index(run.plan, run.times, run.step_size)
+    if index is None:
+        return []
+    plan = run.plan
+    end_torque = plan.torque[-1] + plan.torque_rate[-1] * plan.step_size[-1]
+    beyond = TorqueSchedule(
+        time=np.r_[plan.time, plan.time[-1] + plan.step_size[-1]],
+        torque=np.r_[plan.torque, end_torque],
+        torque_rate=np.r_[plan.torque_rate, 0.0],
+    )
+    return [run.integrate(beyond, at=beyond.time[np.maximum(index + shift, 0)]) for shift in (1, -1)]
+
+
+def _single_precision(correct: np.ndarray, result: np.ndarray) -> list[np.ndarray]:
+    """The reference with theta rounded to float32, where every theta of the result is a float32
+    value (a master that hands observations out in single precision); else none.
+    """
+    theta = np.asarray(result["theta"], dtype=float)
+    if not np.array_equal(theta.astype(np.float32).astype(float), theta):
+        return []
+    variant = correct.copy()
+    variant["theta"] = correct["theta"].astype(np.float32)
+    return [variant]
 
 
 def _euler(run: Run, acceleration, semi_implicit: bool) -> np.ndarray:
@@ -220,7 +293,8 @@ def shared_variants(run: Run, torque, held: TorqueSchedule | None, start_torque:
         EARLY: [run.integrate(p) for p in _early(plan)],
         INTERPOLATED: [] if ramp else [run.integrate(p) for p in _interpolated(plan)],
         HELD: [run.integrate(held)] if held is not None else [],
-        DRIFT: [run.integrate(p) for p in _drifted(torque, run.times, ramp)] if off_grid else [],
+        DRIFT: [run.integrate(p) for p in _drifted(torque, run.times, ramp)] if off_grid else _summed_clock(run, ramp),
+        SHIFTED: _shifted(run),
         INTEGRATION: _integration(run),
     }
 
@@ -229,10 +303,14 @@ def candidate_variants(
     shared: dict[str, list[np.ndarray]], run: Run, correct: np.ndarray, result: np.ndarray, tolerance: float
 ) -> dict[str, list[np.ndarray]]:
     """{candidate: its variants at the result's times}, in DIAGNOSES' order: the shared ones
-    (shared_variants) and state not restored, which restarts where this result first disagrees.
+    (shared_variants), state not restored, which restarts where this result first disagrees, and
+    single precision, which applies to a result whose theta are all float32 values.
     """
     wrong = np.flatnonzero(np.abs(result["theta"] - correct["theta"]) > tolerance)
-    own = {NOT_RESTORED: _not_restored(run, correct, int(wrong[0])) if len(wrong) else []}
+    own = {
+        NOT_RESTORED: _not_restored(run, correct, int(wrong[0])) if len(wrong) else [],
+        SINGLE: _single_precision(correct, result),
+    }
     return {name: own[name] if name in own else shared[name] for name in DIAGNOSES if name in own or name in shared}
 
 
