@@ -36,7 +36,15 @@ WRONG_MASTERS = [
     ("ramp", "held", "input held"),
     ("random_steps", "drift", "time grid drift"),
     ("decimal_steps", "drift", "time grid drift"),
+    ("random_steps", "summed_clock", "time grid drift"),
+    ("decimal_steps", "summed_clock", "time grid drift"),
+    ("random_steps", "exact_events", "time grid drift"),
+    ("steps_on_grid", "exact_events", "time grid drift"),
+    ("random_steps", "shifted", "time column one step off"),
+    ("steps_on_grid", "shifted", "time column one step off"),
     ("resume", "not_restored", "state not restored"),
+    ("random_steps", "single", "result in single precision"),
+    ("steps_on_grid", "single", "result in single precision"),
     ("constant_torque", "euler", "integration error"),
     ("random_steps", "euler", "integration error"),
     ("constant_torque", "heun", "integration error"),
@@ -52,7 +60,11 @@ MISTAKES = {
     "ramped": "input derivatives where the signal holds",
     "held": "no input derivatives on a ramp",
     "drift": "time summed in single precision",
+    "summed_clock": "steps where its time passes a summed clock",
+    "exact_events": "changes fired at exact summed-clock times",
+    "shifted": "each step's result filed under its start",
     "not_restored": "resumed without restoring the state",
+    "single": "outputs handed out in single precision",
     "euler": "Model Exchange, explicit Euler at the step",
     "heun": "Model Exchange, Heun at the step",
     "late_once": "only the first change one step late",
@@ -159,6 +171,12 @@ def co_simulation(kit: Kit, mistake: str | None = None) -> Path:
         torque, slope = [torque[0], *torque[:-1]], [slope[0], *slope[:-1]]
     elif mistake == "early":
         torque, slope = [*torque[1:], torque[-1]], [*slope[1:], 0.0]
+    elif mistake == "exact_events":  # a change only where a summed clock equals its time (ECOS's scenarios)
+        clock = np.cumsum(np.r_[times[0], np.full(len(torque) - 1, kit.step)])
+        applied = [torque[0]]
+        for k in range(1, len(torque)):
+            applied.append(torque[k] if torque[k] != torque[k - 1] and clock[k] == times[k] else applied[-1])
+        torque = applied
     elif mistake == "late_once":  # only the first change of the torque reaches the FMU a step late
         k = next(k for k in range(1, len(torque)) if torque[k] != torque[k - 1])
         torque = [*torque[:k], torque[k - 1], *torque[k + 1 :]]
@@ -191,9 +209,37 @@ def co_simulation(kit: Kit, mistake: str | None = None) -> Path:
         rows.append(slave.getReal(outputs))
         slave.doStep(currentCommunicationPoint=t, communicationStepSize=h)
     rows.append(slave.getReal(outputs))
+    if mistake == "shifted":  # each step's result under its start time, one more step at the end (cofmupy)
+        slave.doStep(currentCommunicationPoint=times[-1], communicationStepSize=times[-1] - times[-2])
+        rows = [*rows[1:], slave.getReal(outputs)]
+    elif mistake == "single":  # outputs as float32 (fmugym's observations)
+        rows = [np.float32(row).tolist() for row in rows]
     slave.terminate()
     slave.freeInstance()
     return kit.write(times, rows)
+
+
+def summed_clock(kit: Kit) -> Path:
+    """A master that steps the FMU while its own time is at or past the FMU's next point on a
+    clock summed step by step, compared without a tolerance, then sets the signal at its time for
+    the next step (FMI++'s FixedStepSizeFMU.sync): where the clocks round apart, a step skipped,
+    two taken later.
+    """
+    slave = _slave(kit, kit.times[0], "summed")
+    torque_vr, outputs = [kit.vr["torque"]], [kit.vr[n] for n in OUTPUTS]
+    torque, _ = kit.torques(kit.times)
+    slave.setReal(torque_vr, [torque[0]])
+    clock, rows = kit.times[0], [slave.getReal(outputs)]
+    for k, t in enumerate(kit.times[1:], start=1):
+        while t >= clock + kit.step:
+            slave.doStep(currentCommunicationPoint=clock, communicationStepSize=kit.step)
+            clock += kit.step
+        rows.append(slave.getReal(outputs))
+        if k < len(torque):
+            slave.setReal(torque_vr, [torque[k]])
+    slave.terminate()
+    slave.freeInstance()
+    return kit.write(kit.times, rows)
 
 
 def model_exchange(kit: Kit, method: str) -> Path:
@@ -248,6 +294,8 @@ def run(folder: Path, name: str, mistake: str | None = None) -> Path:
     kit = Kit(folder, name)
     if mistake in ("euler", "heun"):
         return model_exchange(kit, mistake)
+    if mistake == "summed_clock":
+        return summed_clock(kit)
     return co_simulation(kit, mistake)
 
 

@@ -29,6 +29,8 @@ from fmu_build import build_fmu, build_pid_controller
 SLOW_MARKERS = ("packaging", "wine", "qemu", "sanitizers", "fuzz", "docs", "build", "notebook", "readme", "cluster")
 # ... and the wasm hosts: Node (jco) and Chromium.
 SLOW_MARKERS += ("node", "browser")
+# ... and the masters from the package index, each in the environment its pins allow.
+SLOW_MARKERS += ("masters",)
 
 
 @pytest.hookimpl(tryfirst=True)

@@ -25,6 +25,8 @@ from pendulum_fmu.judging._diagnoses import (
     INTERPOLATED,
     LATE,
     NOT_RESTORED,
+    SHIFTED,
+    SINGLE,
     UNEXPLAINED,
 )
 from pendulum_fmu.judging._judge import judge
@@ -51,7 +53,8 @@ def test_a_wrong_master_is_diagnosed_as_made(kit, name, mistake, expected):
     run(kit, name, mistake)
     judgement = _judged(kit, name)
     raw = judgement.max_abs_dtheta
-    assert judgement.verdict == "fail" and raw > 1e-7
+    # float32 outputs lose half a float32 ulp of theta: 6e-8 rad at 1 rad
+    assert judgement.verdict == "fail" and raw > (1e-9 if expected == SINGLE else 1e-7)
     assert judgement.diagnosis == expected, judgement.candidates
     residuals = {n: s["residual"] for n, s in judgement.candidates.items() if s is not None}
     if expected in (INTEGRATION, UNEXPLAINED) and mistake != "euler":
@@ -125,7 +128,9 @@ def test_the_command_exits_0_on_pass_and_1_on_fail_and_writes_json_and_plot(kit,
     worst = np.argmax(np.abs(out["theta"] - ref["theta"]))
     assert summary["worst_time"] == out["time"][worst] and summary["candidates"][HELD] is None
     assert summary["max_abs_dtheta"] == pytest.approx(abs(out["theta"] - ref["theta"])[worst], rel=1e-6)
-    assert set(summary["candidates"]) == {LATE, EARLY, INTERPOLATED, HELD, DRIFT, NOT_RESTORED, INTEGRATION}
+    assert set(summary["candidates"]) == {
+        LATE, EARLY, INTERPOLATED, HELD, DRIFT, SHIFTED, NOT_RESTORED, SINGLE, INTEGRATION
+    }  # fmt: skip
     assert (tmp_path / "j.png").read_bytes()[:4] == b"\x89PNG"
     run(kit, "decimal_steps")
     assert main([*arguments, "--tol", "1e-9"]) == 0

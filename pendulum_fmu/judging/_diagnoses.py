@@ -20,6 +20,11 @@ INTERPOLATED, HELD = "input interpolated linearly", "input held"
 DRIFT, NOT_RESTORED = "time grid drift", "state not restored"
 
 
+# A time column one step off its values (a master that files a step's result under the step's
+# start, or the reverse), and a result whose theta went through single precision (float32).
+SHIFTED, SINGLE = "time column one step off", "result in single precision"
+
+
 INTEGRATION, UNEXPLAINED = "integration error", "unexplained"
 
 
@@ -30,11 +35,14 @@ SEMI_IMPLICIT_EULER = "semi-implicit (symplectic) Euler at the communication ste
 INTEGRATORS = (EXPLICIT_EULER, SEMI_IMPLICIT_EULER)
 
 
-DIAGNOSES = (AGREES, LATE, EARLY, INTERPOLATED, HELD, DRIFT, NOT_RESTORED, INTEGRATION, UNEXPLAINED)
+DIAGNOSES = (
+    AGREES, LATE, EARLY, INTERPOLATED, HELD, DRIFT, SHIFTED, NOT_RESTORED, SINGLE, INTEGRATION, UNEXPLAINED
+)  # fmt: skip
 
 
-# The mistakes in how the input reaches the FMU: a solver's error must be small beside them.
-INPUT_TIMING = (LATE, EARLY, INTERPOLATED, HELD, DRIFT)
+# The mistakes in the timing of the input or of the result's rows: a solver's error must be
+# small beside them.
+INPUT_TIMING = (LATE, EARLY, INTERPOLATED, HELD, DRIFT, SHIFTED)
 
 
 # A candidate explains a result when its variant removes nearly all of the difference: its

@@ -20,9 +20,17 @@ explains the result leaves only rounding and solver noise (about 1e-11 rad). The
 - input interpolated linearly: each step ramps to the next step's value where the signal holds;
 - input held: each step holds where the run asked for a ramp (ramp runs only);
 - time grid drift: the master stepped on the result's own times, off the communication points,
-  sampling the signal there (only when the result's times are off the grid);
+  sampling the signal there (when the result's times are off the grid); or its clock is summed
+  step by step and compared without a tolerance: it stepped wherever its time reached the FMU's
+  next point on that clock (FMI++'s FixedStepSizeFMU.sync; a row per communication point, where
+  that skips a step), or applied a change of the torque only where that clock equals the change's
+  time (ECOS's scenarios through ecospy; where that misses a change);
+- time column one step off: each row holds the run's state at the next communication point (a
+  master that files a step's result under the step's start), or at the one before;
 - state not restored: from the last row that agrees, the run restarts from the initial state
   (a resumed run that did not restore its saved FMU state);
+- result in single precision: the reference with theta rounded to float32 (only when every theta
+  of the result is a float32 value);
 - integration error: the FMU's equation stepped by explicit or semi-implicit Euler at the
   communication step (a master that integrates the Model Exchange interface itself, or
   Pendulum-v1's semi-implicit Euler); when one of them leaves only noise, the judgement names it

@@ -31,6 +31,8 @@ from ._diagnoses import (
     LATE,
     NOT_RESTORED,
     SEMI_IMPLICIT_EULER,
+    SHIFTED,
+    SINGLE,
 )
 
 
@@ -90,6 +92,80 @@ def _drifted(torque, times: np.ndarray, ramp: bool) -> list[TorqueSchedule]:
         return []
     rate = (_signal_values(torque, points[1:], "before") - start) / np.diff(points) if ramp else np.zeros(len(start))
     return [TorqueSchedule(time=points, torque=start, torque_rate=rate)]
+
+
+def _summed_clock(run: Run, ramp: bool) -> list[Variant]:
+    """Masters whose clock is summed step by step and compared with times without a tolerance.
+
+    One steps the FMU while its own time, the result's, is at or past the FMU's next communication
+    point on that clock (FMI++'s FixedStepSizeFMU.sync), and after each row sets the torque of the
+    step that starts at the row's time: where the clocks round apart a step is skipped, the FMU a
+    step behind (its rows a step old, its input a step early) until a row takes two. Only for a
+    row per communication point, where a step is skipped. The other applies a change of the
+    torque only where its clock equals the change's time (a scenario's actions, ECOS's through
+    ecospy): a change it misses never reaches the FMU. Only where a change is missed.
+    """
+    plan, times = run.plan, run.times
+    if ramp:
+        return []
+    clock = np.cumsum(np.r_[plan.time[0], np.full(len(plan.step_size), run.step_size)])
+    variants = []
+    index = _plan_index(plan, times, run.step_size)
+    if index is not None and np.array_equal(index, np.arange(len(plan.time))):
+        # The FMU's steps done when each row is written (none before the start: a row within rounding of it).
+        done = np.maximum(np.searchsorted(clock, times, side="right") - 1, 0)
+        if done[-1] >= 1 and not np.array_equal(done, np.arange(len(times))):
+            # Step j runs with what the row before the first row that has it done set.
+            setter = np.searchsorted(done, np.arange(done[-1]) + 1, side="left") - 1
+            steps = TorqueSchedule(
+                time=plan.time[: done[-1] + 1], torque=plan.torque[setter], torque_rate=np.zeros(done[-1])
+            )
+            variants.append(run.variant(functools.partial(run.integrate, steps, at=plan.time[done])))
+    changes = np.flatnonzero(np.diff(plan.torque)) + 1
+    applied = np.r_[0, changes[clock[changes] == plan.time[changes]]]
+    if len(applied) <= len(changes):
+        last_applied = applied[np.searchsorted(applied, np.arange(len(plan.torque)), side="right") - 1]
+        variants.append(run.variant(functools.partial(run.integrate, _changed(plan, plan.torque[last_applied]))))
+    return variants
+
+
+def _shifted(run: Run) -> list[Variant]:
+    """Each row holds the run's state one communication point after its time (a master that files
+    a step's result under the step's start), or one before; the first row the initial state. The
+    last row's next point is one more step of the run's last torque, as the FMU makes it.
+    """
+    index = _plan_index(run.plan, run.times, run.step_size)
+    if index is None:
+        return []
+    return [run.variant(functools.partial(_shifted_by, run, index, shift)) for shift in (1, -1)]
+
+
+def _shifted_by(run: Run, index: np.ndarray, shift: int) -> np.ndarray:
+    """The run one more step long, at the plan's points index + shift (the first at the start)."""
+    plan = run.plan
+    end_torque = plan.torque[-1] + plan.torque_rate[-1] * plan.step_size[-1]
+    beyond = TorqueSchedule(
+        time=np.r_[plan.time, plan.time[-1] + plan.step_size[-1]],
+        torque=np.r_[plan.torque, end_torque],
+        torque_rate=np.r_[plan.torque_rate, 0.0],
+    )
+    return run.integrate(beyond, at=beyond.time[np.maximum(index + shift, 0)])
+
+
+def _single_precision(correct: np.ndarray, result: np.ndarray) -> list[Variant]:
+    """The reference with theta rounded to float32, where every theta of the result is a float32
+    value (a master that hands observations out in single precision); else none.
+    """
+    theta = np.asarray(result["theta"], dtype=float)
+    if not np.array_equal(theta.astype(np.float32).astype(float), theta):
+        return []
+    return [functools.partial(_rounded_to_single, correct)]
+
+
+def _rounded_to_single(correct: np.ndarray) -> np.ndarray:
+    variant = correct.copy()
+    variant["theta"] = correct["theta"].astype(np.float32)
+    return variant
 
 
 def _euler(run: Run, semi_implicit: bool, index: np.ndarray) -> np.ndarray:
@@ -242,7 +318,8 @@ def shared_variants(run: Run, torque, held: TorqueSchedule | None, start_torque:
         EARLY: integrated(_early, plan),
         INTERPOLATED: [] if ramp else integrated(_interpolated, plan),
         HELD: integrated(_held, held) if held is not None else [],
-        DRIFT: integrated(_drifted, torque, run.times, ramp) if off_grid else [],
+        DRIFT: integrated(_drifted, torque, run.times, ramp) if off_grid else _summed_clock(run, ramp),
+        SHIFTED: _shifted(run),
         INTEGRATION: _integration(run),
     }
 
@@ -261,8 +338,12 @@ def candidate_variants(
     shared: dict[str, list[Variant]], run: Run, correct: np.ndarray, result: np.ndarray, tolerance: float
 ) -> dict[str, list[Variant]]:
     """{candidate: its variants at the result's times}, in DIAGNOSES' order: the shared ones
-    (shared_variants) and state not restored, which restarts where this result first disagrees.
+    (shared_variants), state not restored, which restarts where this result first disagrees, and
+    single precision, which applies to a result whose theta are all float32 values.
     """
     wrong = np.flatnonzero(np.abs(result["theta"] - correct["theta"]) > tolerance)
-    own = {NOT_RESTORED: _not_restored(run, correct, int(wrong[0])) if len(wrong) else []}
+    own = {
+        NOT_RESTORED: _not_restored(run, correct, int(wrong[0])) if len(wrong) else [],
+        SINGLE: _single_precision(correct, result),
+    }
     return {name: own[name] if name in own else shared[name] for name in DIAGNOSES if name in own or name in shared}
