@@ -105,4 +105,4 @@ def test_held_after_equals_the_exact_look_up_on_random_files(tmp_path, seed, run
     signal = _TorqueFile(write_rows(tmp_path / "signal.csv", rows))
     points = _with_events(_grid(Fraction(0), Fraction(2), step), signal.jumps(), step)
     exact = [signal.after(signal.latest_event_near(p, step)) for p in points]
-    assert signal.held_after(points, step) == exact
+    assert signal.held_after(points, step).tolist() == exact

@@ -9,6 +9,7 @@ import io
 import math
 import os
 import stat
+import sys
 from array import array
 from collections.abc import Iterator, Sequence
 from pathlib import Path
@@ -108,17 +109,24 @@ def read_result(
             f"{path}: the file went from {size:,} to {now:,} bytes while it was read: a master is "
             "still writing it; judge it once the run has finished"
         )
-    out = results.empty(len(values["time"]), recorded)
+    out = results.empty(sum(map(len, values["time"])), recorded)
     out["torque"] = np.nan
     for quantity in OPTIONAL:
         out[quantity] = np.nan
-    for quantity, column in values.items():
-        out[quantity] = column
+    # Block by block into the result: no whole column is made beside it.
+    for quantity, parts in values.items():
+        begin = 0
+        for part in parts:
+            out[quantity][begin : begin + len(part)] = part
+            begin += len(part)
+    del values
+    if "pyarrow" in sys.modules:  # it read the blocks, now let go: its pool hands their memory back
+        sys.modules["pyarrow"].default_memory_pool().release_unused()
     return out
 
 
-def _read(path: Path, raw: io.BufferedIOBase, size: int, mapped: dict) -> dict[str, np.ndarray]:
-    """{quantity: its column, in SI} of the file's first size bytes (read_result)."""
+def _read(path: Path, raw: io.BufferedIOBase, size: int, mapped: dict) -> dict[str, list[np.ndarray]]:
+    """{quantity: its column in SI, in blocks} of the file's first size bytes (read_result)."""
     cut = _ends_mid_line(raw, size)
     try:
         with _text(raw, size) as text:
@@ -202,10 +210,10 @@ def _ends_mid_line(raw: io.BufferedIOBase, size: int) -> bool:
     return raw.read(1) not in (b"\n", b"\r")
 
 
-def _read_arrow(raw: io.BufferedIOBase, size: int, width: int, columns: dict) -> dict[str, np.ndarray] | None:
-    """The columns by pyarrow's CSV reader, block by block, only those judged converted; None
-    when it refuses a row or one is not finite, or the times go backwards (_read_rows then names
-    the row). pyarrow is imported here only: it takes longer to import than a short result to read.
+def _read_arrow(raw: io.BufferedIOBase, size: int, width: int, columns: dict) -> dict[str, list[np.ndarray]] | None:
+    """The columns in blocks by pyarrow's CSV reader, only those judged converted; None when it
+    refuses a row or one is not finite, or the times go backwards (_read_rows then names the row).
+    pyarrow is imported here only: it takes longer to import than a short result to read.
     """
     import pyarrow as pa
     from pyarrow import csv as pa_csv
@@ -220,18 +228,31 @@ def _read_arrow(raw: io.BufferedIOBase, size: int, width: int, columns: dict) ->
                 include_columns=list(wanted.values()), column_types=dict.fromkeys(wanted.values(), pa.float64())
             ),
         )
-        blocks = [[batch.column(name).to_numpy(zero_copy_only=False) for name in wanted.values()] for batch in reader]
+        # Each block's columns as arrays over pyarrow's own memory (no copy without nulls), in SI.
+        blocks = [
+            {
+                q: _in_si(batch.column(wanted[q]).to_numpy(zero_copy_only=False), factor)
+                for q, (_, factor) in columns.items()
+            }
+            for batch in reader
+        ]
     except (pa.ArrowException, ValueError):
         return None
-    out = {}
-    for (quantity, (_, factor)), parts in zip(columns.items(), zip(*blocks, strict=True), strict=True):
-        values = np.concatenate(parts) if parts else np.empty(0)
-        if not np.isfinite(values).all():  # nulls (an empty cell, NA) are NaN too
+    last = -math.inf
+    for block in blocks:
+        # Nulls (an empty cell, NA) are NaN too.
+        if not all(np.isfinite(values).all() for values in block.values()):
             return None
-        out[quantity] = values * factor if factor != 1.0 else values
-    if not blocks or np.any(np.diff(out["time"]) < 0):
-        return None
-    return out
+        time = block["time"]
+        if len(time) and (time[0] < last or np.any(np.diff(time) < 0)):
+            return None
+        last = time[-1] if len(time) else last
+    return {quantity: [block[quantity] for block in blocks] for quantity in columns} if blocks else None
+
+
+def _in_si(values: np.ndarray, factor: float) -> np.ndarray:
+    """A column times its --map factor (the same array where the factor is 1)."""
+    return values * factor if factor != 1.0 else values
 
 
 def _number(cell: str) -> float:
@@ -244,7 +265,7 @@ def _number(cell: str) -> float:
 
 def _read_rows(
     path: Path, rows: Iterator[tuple[int, list[str]]], columns: dict, ends_mid_line: bool
-) -> dict[str, np.ndarray]:
+) -> dict[str, list[np.ndarray]]:
     """The columns from numbered rows, read one by one: ResultFileError at the first that cannot
     be judged (a cell missing, not a number or not finite, a time that goes backwards, the last
     line cut short).
@@ -279,7 +300,7 @@ def _read_rows(
         previous = time
     if not read["time"]:
         raise ResultFileError(f"{path}: no data rows after the header")
-    return {quantity: np.frombuffer(values, dtype=float) for quantity, values in read.items()}
+    return {quantity: [np.frombuffer(values, dtype=float)] for quantity, values in read.items()}
 
 
 def check_span(result: np.ndarray, plan: TorqueSchedule, step_size: float, source: str) -> None:

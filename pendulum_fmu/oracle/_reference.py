@@ -192,7 +192,7 @@ def _doubles(points: _Times) -> np.ndarray:
     return np.array([float(p) for p in points])
 
 
-def _grid(start: Fraction, stop: Fraction, step: Fraction, max_steps: int | None) -> _Grid:
+def _grid(start: Fraction, stop: Fraction, step: Fraction, max_steps: int | None = None) -> _Grid:
     """Start + k*step up to stop; stop itself ends a shorter last step unless it is on the grid."""
     # Only checked by the schedule's code, in simulate()'s words (a step that is not positive, a
     # stop not after the start, a run too long to hold): the grid below is the oracle's own.
