@@ -1,7 +1,7 @@
 """The oracle's torque look-ups, from doubles precomputed once, against the plain exact ones.
 
 The oracle decides which step holds a time in exact fractions (docs/signals.md's tolerance); its
-look-ups over whole arrays (_Holding.values_after, _TorqueFile.held_after) decide most times with
+look-ups over whole arrays (Holding.values_after, TorqueFile.held_after) decide most times with
 doubles and must give the very same values. The signals are random, with jumps on step
 boundaries (decimal multiples of awkward steps), an ulp off them and within or just outside the
 tolerance; the times are the grid, the jumps, and the doubles around where a time's tolerance
@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from benchmarks.signal_cases import random_step_rows, write_rows
-from pendulum_fmu.oracle._reference import _TOLERANCE_STEPS, _exact, _grid, _Holding, _TorqueFile, _with_events
+from pendulum_fmu.oracle._exact_signal import TOLERANCE_STEPS, Holding, TorqueFile, exact_time, time_grid, with_events
 
 AWKWARD_STEPS = (3e-4, 7e-4, 9e-4, 1e-3, 9e-3, 0.03, 0.3, 1 / 3000)
 
@@ -28,15 +28,15 @@ def _events(rng, start: Fraction, step: Fraction, stop: Fraction) -> list[Fracti
     events = []
     for k in rng.integers(1, count, size=12).tolist():
         boundary = float(start + k * step)
-        tolerance = float(_TOLERANCE_STEPS * step)
+        tolerance = float(TOLERANCE_STEPS * step)
         events += [
-            _exact(boundary),
-            _exact(math.nextafter(boundary, math.inf)),
-            _exact(boundary + 0.5 * tolerance),
-            _exact(boundary - 0.5 * tolerance),
-            _exact(boundary + 2 * tolerance),
+            exact_time(boundary),
+            exact_time(math.nextafter(boundary, math.inf)),
+            exact_time(boundary + 0.5 * tolerance),
+            exact_time(boundary - 0.5 * tolerance),
+            exact_time(boundary + 2 * tolerance),
         ]
-    events += [_exact(t) for t in rng.uniform(float(start), float(stop), size=12).tolist()]
+    events += [exact_time(t) for t in rng.uniform(float(start), float(stop), size=12).tolist()]
     return sorted(set(events))
 
 
@@ -46,7 +46,7 @@ def _times(rng, points: list[Fraction], step: Fraction) -> np.ndarray:
     """
     doubles = np.array([float(p) for p in points])
     grid = doubles[0] + float(step) * np.arange(len(points))
-    reach = doubles - np.maximum(float(_TOLERANCE_STEPS * step), 64 * np.spacing(np.abs(doubles)))
+    reach = doubles - np.maximum(float(TOLERANCE_STEPS * step), 64 * np.spacing(np.abs(doubles)))
     nudged = [reach]
     for k in range(1, 4):  # k ulp either side
         below, above = reach.copy(), reach.copy()
@@ -60,28 +60,28 @@ def _times(rng, points: list[Fraction], step: Fraction) -> np.ndarray:
 @pytest.mark.parametrize("seed", range(8))
 def test_values_after_equals_the_exact_look_up_on_random_signals(seed):
     rng = np.random.default_rng(seed)
-    step = _exact(AWKWARD_STEPS[seed % len(AWKWARD_STEPS)])
-    start = _exact([0.0, 0.25, -1.5, 1e4][seed % 4])
+    step = exact_time(AWKWARD_STEPS[seed % len(AWKWARD_STEPS)])
+    start = exact_time([0.0, 0.25, -1.5, 1e4][seed % 4])
     stop = start + 60 * step
-    points = _with_events(_grid(start, stop, step), _events(rng, start, step, stop), step)
+    points = with_events(time_grid(start, stop, step), _events(rng, start, step, stop), step)
     values = rng.uniform(-40, 40, size=len(points) - 1).tolist()
     for signal_step in (step, Fraction(0)):  # a signal's tolerance, and a schedule's (none)
-        holding = _Holding(points, values, signal_step)
+        holding = Holding(points, values, signal_step)
         times = _times(rng, points, step)
-        exact = [holding.value_after(_exact(t)) for t in times.tolist()]
+        exact = [holding.value_after(exact_time(t)) for t in times.tolist()]
         assert holding.values_after(times).tolist() == exact
 
 
 def test_values_after_decides_a_grid_by_doubles(monkeypatch):
     """The grid a master steps on, 3001 points, needs no exact look-up at all."""
-    step = _exact(1e-3)
-    points = _grid(Fraction(0), Fraction(3), step)
-    holding = _Holding(points, [float(k % 7) for k in range(len(points) - 1)], step)
+    step = exact_time(1e-3)
+    points = time_grid(Fraction(0), Fraction(3), step)
+    holding = Holding(points, [float(k % 7) for k in range(len(points) - 1)], step)
     exact_calls = []
     plain = holding.value_after
     monkeypatch.setattr(holding, "value_after", lambda t: exact_calls.append(t) or plain(t))
     times = 1e-3 * np.arange(3001)
-    assert holding.values_after(times).tolist() == [plain(_exact(t)) for t in times.tolist()]
+    assert holding.values_after(times).tolist() == [plain(exact_time(t)) for t in times.tolist()]
     assert exact_calls == []
 
 
@@ -89,12 +89,12 @@ def test_values_after_decides_a_grid_by_doubles(monkeypatch):
 @pytest.mark.parametrize("running_sum", [False, True])
 def test_held_after_equals_the_exact_look_up_on_random_files(tmp_path, seed, running_sum):
     rng = np.random.default_rng(300 + seed)
-    step = _exact(AWKWARD_STEPS[seed % len(AWKWARD_STEPS)])
+    step = exact_time(AWKWARD_STEPS[seed % len(AWKWARD_STEPS)])
     rows = random_step_rows(rng, stop_time=1.0, running_sum=running_sum)
     # Jumps on step boundaries, and a sloped stretch (held at each step's start, not a row's).
     boundary = repr(float(40 * step))
     # Rows around the edge of a point's tolerance, an ulp or two either side of it.
-    edge = float(20 * step) + float(_TOLERANCE_STEPS * step)
+    edge = float(20 * step) + float(TOLERANCE_STEPS * step)
     edges = [edge]
     for _ in range(2):
         edges = [math.nextafter(edges[0], -math.inf), *edges, math.nextafter(edges[-1], math.inf)]
@@ -102,7 +102,7 @@ def test_held_after_equals_the_exact_look_up_on_random_files(tmp_path, seed, run
     added += [(repr(t), u) for t, u in zip(edges, rng.uniform(-40, 40, size=len(edges)).tolist(), strict=True)]
     taken = {float(t) for t, _ in added}
     rows = sorted([*[row for row in rows if float(row[0]) not in taken], *added], key=lambda row: float(row[0]))
-    signal = _TorqueFile(write_rows(tmp_path / "signal.csv", rows))
-    points = _with_events(_grid(Fraction(0), Fraction(2), step), signal.jumps(), step)
+    signal = TorqueFile(write_rows(tmp_path / "signal.csv", rows))
+    points = with_events(time_grid(Fraction(0), Fraction(2), step), signal.jumps(), step)
     exact = [signal.after(signal.latest_event_near(p, step)) for p in points]
     assert signal.held_after(points, step).tolist() == exact

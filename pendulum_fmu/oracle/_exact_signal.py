@@ -1,0 +1,310 @@
+"""The torque signal as the oracle reads it, on its own: times as exact fractions of the decimals
+written, its own reader of a torque CSV (TorqueFile), the communication points (Grid), the pieces
+on which the torque is linear (Pieces, signal_pieces) and the torque held at given times
+(Holding). _reference.py integrates what this gives; docs/signals.md is the definition both follow.
+"""
+
+from __future__ import annotations
+
+import bisect
+import csv
+import heapq
+import itertools
+import math
+import numbers
+from collections.abc import Callable, Sequence
+from fractions import Fraction
+from pathlib import Path
+
+import numpy as np
+
+from .._errors import InvalidInput
+from ..signals._time_grid import step_count
+from ..signals._torque_csv import read_torque_csv
+
+# docs/signals.md: an event within max(1e-9 step, 64 ulp of its time) of a communication point
+# is that point. Written again here on purpose: the oracle must not borrow the schedule's code.
+TOLERANCE_STEPS, TOLERANCE_ULPS = Fraction(1, 10**9), 64
+# Times whose torque Holding looks up at once.
+_BLOCK = 1 << 16
+_DEFAULT_STOP_TIME = Fraction(3)
+# Times: a Grid, a list of exact or double times, or an array of doubles; torques likewise.
+Times = Sequence[Fraction | float] | np.ndarray
+Values = Sequence[float] | np.ndarray
+
+
+def exact_time(value) -> Fraction:
+    """A number as the decimal a person wrote: 0.009 is 9/1000, not the double nearest it."""
+    return Fraction(repr(float(value))) if not isinstance(value, (str, Fraction)) else Fraction(value)
+
+
+def seconds(name: str, value) -> Fraction:
+    """A time argument as the decimal a person wrote; InvalidInput unless a finite number."""
+    if not (isinstance(value, numbers.Real) and math.isfinite(value)):
+        raise InvalidInput(f"{name} {value!r} must be a finite number of seconds")
+    return exact_time(value)
+
+
+def torque_value(value, where: str) -> float:
+    """A torque value of the signal; InvalidInput unless a finite number."""
+    # A signal written with numpy may return a 0-d array (np.where, np.interp of a scalar).
+    if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
+        value = value.item()
+    if not (isinstance(value, numbers.Real) and math.isfinite(value)):
+        raise InvalidInput(f"the torque is {value!r} {where}; it must be a finite number of N.m")
+    return float(value)
+
+
+def event_tolerance(time: Fraction | float, step: Fraction) -> Fraction:
+    return max(TOLERANCE_STEPS * step, Fraction(TOLERANCE_ULPS * math.ulp(float(time))))
+
+
+class TorqueFile:
+    """A time,torque CSV as exact times and float torques: linear between rows, a jump where a
+    time repeats, held outside.
+    """
+
+    def __init__(self, path: Path):
+        with open(path, newline="", encoding="utf-8-sig") as file:
+            rows = [row for row in csv.reader(file) if any(cell.strip() for cell in row)]
+        header = [cell.strip() for cell in rows[0]]
+        time_column, torque_column = header.index("time"), header.index("torque")
+        self.times = [Fraction(row[time_column].strip()) for row in rows[1:]]
+        self.torques = [float(row[torque_column]) for row in rows[1:]]
+
+    def after(self, t: Fraction) -> float:
+        times, torques = self.times, self.torques
+        if t >= times[-1]:
+            return torques[-1]
+        if t < times[0]:
+            return torques[0]
+        j = bisect.bisect_right(times, t)  # times[j-1] <= t < times[j]
+        return self._between(j, t)
+
+    def before(self, t: Fraction) -> float:
+        times, torques = self.times, self.torques
+        if t > times[-1]:
+            return torques[-1]
+        if t <= times[0]:
+            return torques[0]
+        j = bisect.bisect_left(times, t)  # times[j-1] < t <= times[j]
+        return self._between(j, t)
+
+    def _between(self, j: int, t: Fraction) -> float:
+        t0, t1, u0, u1 = self.times[j - 1], self.times[j], self.torques[j - 1], self.torques[j]
+        share = float((t - t0) / (t1 - t0))
+        value = u0 + (u1 - u0) * share
+        # docs/signals.md's form, unless rows near the largest double differ by inf.
+        return value if math.isfinite(value) else u0 * (1 - share) + u1 * share
+
+    def jumps(self) -> list[Fraction]:
+        return sorted({a for a, b in zip(self.times, self.times[1:], strict=False) if a == b})
+
+    def latest_event_near(self, t: Fraction, step: Fraction) -> Fraction:
+        """t, or the latest row time within the tolerance of t: that event is at t."""
+        tolerance = event_tolerance(t, step)
+        j = bisect.bisect_right(self.times, t + tolerance)
+        return max(t, self.times[j - 1]) if j and self.times[j - 1] >= t - tolerance else t
+
+    def held_after(self, points: Sequence[Fraction], step: Fraction) -> np.ndarray:
+        """after(latest_event_near(p, step)) of each point, the same values: the row times as
+        doubles decide each point with no row near it on a flat stretch (its value is the row's);
+        the exact methods decide the others.
+        """
+        times, torques = self.times, self.torques
+        row_doubles, doubles = np.array([float(t) for t in times]), time_doubles(points)
+        reach = np.maximum(float(TOLERANCE_STEPS * step), TOLERANCE_ULPS * np.spacing(np.abs(doubles)))
+        # Widened by what the doubles may be off by (each time's rounding, the tolerance's):
+        # a few ulp, bounded here by 16.
+        reach += 16 * np.spacing(np.maximum(np.abs(doubles), reach))
+        near = np.searchsorted(row_doubles, doubles + reach, "right") > np.searchsorted(
+            row_doubles, doubles - reach, "left"
+        )
+        after = np.searchsorted(row_doubles, doubles, "right")  # times[j-1] <= p < times[j]
+        before = np.clip(after - 1, 0, len(times) - 1)
+        torque_doubles = np.array(torques)
+        sloped = torque_doubles[before] != torque_doubles[np.minimum(after, len(times) - 1)]
+        values = torque_doubles[before]
+        for k in np.flatnonzero(near | sloped).tolist():
+            values[k] = self.after(self.latest_event_near(points[k], step))
+        return values
+
+
+class Grid(Sequence[Fraction]):
+    """start + k*step for k < regular, then stop where it is given: the grid as exact fractions,
+    each made only when asked for (a run of millions of steps holds none of them), and as
+    doubles in one array (doubles()).
+    """
+
+    def __init__(self, start: Fraction, step: Fraction, regular: int, stop: Fraction | None):
+        self.start, self.step, self.regular, self.stop = start, step, regular, stop
+
+    def __len__(self) -> int:
+        return self.regular + (self.stop is not None)
+
+    def __getitem__(self, k):
+        if isinstance(k, slice):
+            if k == slice(None, -1, None) and len(self):  # the steps' starts: the grid less its end
+                return Grid(self.start, self.step, self.regular - (self.stop is None), None)
+            return [self[i] for i in range(*k.indices(len(self)))]
+        if k < 0:
+            k += len(self)
+        if not 0 <= k < len(self):
+            raise IndexError(k)
+        return self.start + k * self.step if k < self.regular else self.stop
+
+    def doubles(self) -> np.ndarray:
+        """Each point as the double nearest it (float of the fraction), in one array."""
+        (a, b), (c, d) = self.start.as_integer_ratio(), self.step.as_integer_ratio()
+        # (a*d + k*c*b) / (b*d): exact integers below 2**53 are exact doubles, and one IEEE
+        # division of them is correctly rounded, as float(Fraction) is.
+        if max(abs(a * d), abs(a * d + (self.regular - 1) * c * b), b * d) < 2**53:
+            out = (a * d + np.arange(self.regular, dtype=np.int64) * (c * b)) / float(b * d)
+        else:
+            out = np.array([float(self.start + k * self.step) for k in range(self.regular)])
+        return out if self.stop is None else np.append(out, float(self.stop))
+
+
+def time_doubles(points: Times) -> np.ndarray:
+    """A sequence of times (a Grid, fractions or doubles) as an array of doubles."""
+    if isinstance(points, Grid):
+        return points.doubles()
+    if isinstance(points, np.ndarray):
+        return points.astype(float)
+    return np.array([float(p) for p in points])
+
+
+def time_grid(start: Fraction, stop: Fraction, step: Fraction, max_steps: int | None = None) -> Grid:
+    """Start + k*step up to stop; stop itself ends a shorter last step unless it is on the grid."""
+    # Only checked by the schedule's code, in simulate()'s words (a step that is not positive, a
+    # stop not after the start, a run too long to hold): the grid below is the oracle's own.
+    step_count(float(start), float(stop), float(step), max_steps)
+    # The points start + k*step before stop less its tolerance: k < (last - start) / step.
+    last = stop - event_tolerance(stop, step)
+    return Grid(start, step, max(math.ceil((last - start) / step), 0), stop)
+
+
+def with_events(grid: Grid, events: list[Fraction], step: Fraction) -> Sequence[Fraction]:
+    """The grid plus every event inside it that is not within the tolerance of a grid point."""
+    extra = []
+    for event in events:
+        if not grid[0] < event < grid[-1]:
+            continue
+        j = bisect.bisect_left(grid, event)
+        if min(grid[j] - event, event - grid[j - 1]) > event_tolerance(event, step):
+            extra.append(event)
+    if not extra:  # the grid as it is, its points made only when asked for
+        return grid
+    # The grid is sorted and no extra event is on it: merged, not sorted anew.
+    return list(heapq.merge(grid, sorted(set(extra))))
+
+
+class Pieces:
+    """The torque as pieces [start, end) on which it is u0 + rate * (t - start), the
+    communication points the signal defines, and the torque just after each of an array of times.
+    """
+
+    def __init__(
+        self,
+        starts: Times,
+        stop: Fraction | float,
+        u0: Values,
+        rate: Values,
+        points: Times,
+        values_after: Callable[[np.ndarray], np.ndarray],
+    ):
+        self.starts, self.stop, self.u0, self.rate = starts, stop, u0, rate
+        self.points, self.values_after = points, values_after
+
+
+def signal_pieces(
+    torque, start: Fraction, stop: Fraction | None, step: Fraction, ramp: bool, max_steps: int | None
+) -> Pieces:
+    if isinstance(torque, (str, Path)):
+        read_torque_csv(torque)  # a file that is no signal refused where it is wrong; read below anew
+        signal = TorqueFile(Path(torque))
+        stop = signal.times[-1] if stop is None else stop
+        grid = time_grid(start, stop, step, max_steps)
+        if ramp:
+            # The file's own piecewise-linear signal: a piece between consecutive row times.
+            rows = sorted({start, stop} | {t for t in signal.times if start < t < stop})
+            u0 = [signal.after(a) for a in rows[:-1]]
+            rate = [(signal.before(b) - signal.after(a)) / float(b - a) for a, b in itertools.pairwise(rows)]
+            return Pieces(
+                rows[:-1],
+                stop,
+                u0,
+                rate,
+                with_events(grid, signal.times, step),
+                lambda times: np.array(
+                    [signal.after(signal.latest_event_near(exact_time(t), step)) for t in times.tolist()]
+                ),
+            )
+        events = with_events(grid, signal.jumps(), step)
+        held = signal.held_after(events[:-1], step)
+        return Pieces(events[:-1], stop, held, np.zeros(len(held)), events, Holding(events, held, step).values_after)
+
+    if isinstance(torque, (list, tuple, np.ndarray)):
+        values = [torque_value(u, f"at step {k} of the array") for k, u in enumerate(torque)]
+        points = time_grid(start, start + len(values) * step if stop is None else stop, step, max_steps)
+        if len(points) - 1 != len(values):
+            raise InvalidInput(f"the torque array has {len(values)} values for {len(points) - 1} steps")
+    else:
+        points = time_grid(start, _DEFAULT_STOP_TIME if stop is None else stop, step, max_steps)
+        sample = torque if callable(torque) else (lambda t, u=torque: u)
+        values = [torque_value(sample(p), f"at t = {p}") for p in time_doubles(points).tolist()]
+    if ramp:
+        rate = [(b - a) / float(t1 - t0) for a, b, t0, t1 in zip(values, values[1:], points, points[1:], strict=False)]
+    else:
+        rate = [0.0] * (len(points) - 1)
+    u0 = values[: len(points) - 1]
+    return Pieces(points[:-1], points[-1], u0, rate, points, Holding(points, u0, step).values_after)
+
+
+class Holding:
+    """The torque just after t of a signal holding values[k] from points[k]: the step holding t
+    is the one starting at the latest point at or (within the tolerance) just after t.
+
+    value_after(t) decides it in exact fractions. values_after(times) decides a whole array with
+    the points as doubles, looked up once; a time whose reach (t plus its tolerance) lies within
+    rounding of a point, where doubles cannot tell the side, is decided by value_after.
+    """
+
+    def __init__(self, points: Times, values: Values, step: Fraction):
+        self.points, self.values, self.step = points, values, step
+        self._point_doubles = time_doubles(points)
+        self._value_doubles = np.array(values, dtype=float)
+        self._step_tolerance = float(TOLERANCE_STEPS * step)
+
+    def value_after(self, t: Fraction) -> float:
+        """The value held just after the exact time t."""
+        j = max(bisect.bisect_right(self.points, t + event_tolerance(t, self.step)) - 1, 0)
+        return self.values[min(j, len(self.values) - 1)]
+
+    def values_after(self, times: np.ndarray) -> np.ndarray:
+        """value_after of each time, read as the decimal a person wrote (exact_time)."""
+        times = np.asarray(times, dtype=float)
+        out = np.empty(len(times))
+        # A block at a time: a dozen arrays of a block's times, not of millions.
+        for begin in range(0, len(times), _BLOCK):
+            out[begin : begin + _BLOCK] = self._values_after(times[begin : begin + _BLOCK])
+        return out
+
+    def _values_after(self, times: np.ndarray) -> np.ndarray:
+        tolerance = np.maximum(self._step_tolerance, TOLERANCE_ULPS * np.spacing(np.abs(times)))
+        reach = times + tolerance
+        points = self._point_doubles
+        j = np.searchsorted(points, reach, side="right") - 1
+        below, above = points[np.clip(j, 0, len(points) - 1)], points[np.clip(j + 1, 0, len(points) - 1)]
+        # What the doubles may be off by: the decimal of t and its double, the tolerance's and the
+        # sum's roundings, each point's double; a few ulp of the largest magnitude, bounded
+        # here by 16.
+        scale = np.abs(times)  # the largest magnitude, one array at a time (not five stacked)
+        for other in (tolerance, reach, below, above):
+            np.maximum(scale, np.abs(other), out=scale)
+        margin = 16 * np.spacing(scale)
+        near = (np.abs(reach - below) <= margin) | (np.abs(above - reach) <= margin)
+        out = self._value_doubles[np.clip(j, 0, len(self.values) - 1)]
+        for i in np.flatnonzero(near).tolist():
+            out[i] = self.value_after(exact_time(times[i]))
+        return out
