@@ -47,10 +47,10 @@ def check_held(plan: TorqueSchedule, tool: str) -> None:
         )
 
 
-def check_mode(mode: str, tool: str) -> None:
-    """InvalidInput unless mode is one of MODES."""
-    if mode not in MODES:
-        raise InvalidInput(f"{tool}: unknown mode {mode!r}; choose {' or '.join(MODES)}")
+def check_mode(mode: str, tool: str, modes: tuple[str, ...] = MODES) -> None:
+    """InvalidInput unless mode is one of the tool's modes (MODES unless told)."""
+    if mode not in modes:
+        raise InvalidInput(f"{tool}: unknown mode {mode!r}; choose {' or '.join(modes)}")
 
 
 def substeps(step_size: np.ndarray, largest: float) -> np.ndarray:
@@ -71,7 +71,7 @@ def held_results(plan: TorqueSchedule) -> np.ndarray:
 
 def runner(tool: str, simulate: Callable[..., np.ndarray], setups: dict) -> Callable[..., np.ndarray]:
     """The uniform run() of an engine module from its simulate(plan, parameters, theta0, omega0,
-    setup) and its setup per mode.
+    setup) and its setup per mode (its modes: setups' keys).
     """
 
     def run(
@@ -84,8 +84,8 @@ def runner(tool: str, simulate: Callable[..., np.ndarray], setups: dict) -> Call
         fmu_path: str | Path | FmuModel | None = None,
     ) -> np.ndarray:
         check_held(plan, tool)
-        check_mode(mode, tool)
+        check_mode(mode, tool, tuple(setups))
         return simulate(plan, resolve_parameters(parameters, fmu_path), theta0, omega0, setups[mode])
 
-    run.__doc__ = f"The schedule through {tool} in mode accurate or default; see docs/engines.md."
+    run.__doc__ = f"The schedule through {tool} in mode {' or '.join(setups)}; see docs/engines.md."
     return run

@@ -24,16 +24,13 @@ from __future__ import annotations
 import math
 import warnings
 from collections.abc import Callable
-from pathlib import Path
 
 import numpy as np
 
 from .._errors import Clipped, InvalidInput
-from ..fmu._model import FmuModel
 from ..fmu._parameters import total_inertia
-from ..fmu._simulate import resolve_parameters
 from ..signals._torque_schedule import TorqueSchedule
-from . import check_held, held_results
+from . import held_results, runner
 
 # Pendulum-v1's clips, in Gymnasium (max_torque, max_speed) and EnvPool (kMaxTorque, kMaxSpeed).
 MAX_TORQUE, MAX_SPEED = 2.0, 8.0
@@ -96,22 +93,10 @@ def warn_clipped(tool: str, plan: TorqueSchedule, torque_clipped: np.ndarray, sp
 
 def pendulum_v1_runner(tool: str, simulate: Callable[..., np.ndarray]) -> Callable[..., np.ndarray]:
     """The run() of a Pendulum-v1 tool from its simulate(plan, parameters, theta0, omega0): one
-    mode, Pendulum-v1's own, the torque held over each step.
+    mode, Pendulum-v1's own (accurate), the torque held over each step.
     """
-
-    def run(
-        plan: TorqueSchedule,
-        *,
-        parameters: dict | None = None,
-        theta0: float = 0.0,
-        omega0: float = 0.0,
-        mode: str = "accurate",
-        fmu_path: str | Path | FmuModel | None = None,
-    ) -> np.ndarray:
-        check_held(plan, tool)
-        if mode != "accurate":
-            raise InvalidInput(f"{tool}: unknown mode {mode!r}; it has one, Pendulum-v1's own: give {tool}")
-        return simulate(plan, resolve_parameters(parameters, fmu_path), theta0, omega0)
-
-    run.__doc__ = f"The schedule through {tool}'s Pendulum-v1, the torque held over each step; see docs/engines.md."
-    return run
+    return runner(
+        tool,
+        lambda plan, parameters, theta0, omega0, setup: simulate(plan, parameters, theta0, omega0),
+        {"accurate": None},
+    )
