@@ -56,6 +56,14 @@ MEMORY_CHECKED_FROM = 2**26  # bytes (64 MiB: about 700,000 steps)
 BYTES_PER_STEP = 8 * (3 + 5 + 4)
 
 
+# Grid steps per window where a long run is walked a window at a time (schedule_windows,
+# reference_windows, the judge): 131,072 steps are about 3 MiB a window of the schedule's three
+# arrays (24 bytes a step) and a dozen MiB of the judge's arrays, well inside a 256 MB budget,
+# while each window's fixed cost (the oracle's work estimate on its own grid, a restart of the
+# series, numpy's calls) is spread over enough steps to cost a few percent of its integration.
+WINDOW_STEPS = 1 << 17
+
+
 def event_tolerance(time, step_size: float):
     """How close an event must be to a communication point to be that point (s)."""
     if isinstance(time, float):  # math.ulp is np.spacing for a scalar, without numpy's overhead
@@ -90,10 +98,18 @@ def _available_memory() -> int:
     return psutil.virtual_memory().available
 
 
-def step_count(start_time: float, stop_time: float, step_size: float, max_steps: int | None = None) -> int:
+def step_count(
+    start_time: float,
+    stop_time: float,
+    step_size: float,
+    max_steps: int | None = None,
+    *,
+    check_memory: bool = True,
+) -> int:
     """The number of grid steps from start to stop (the last one shorter when stop is off the
     grid). A run over max_steps (default DEFAULT_MAX_STEPS), or one whose arrays would not fit in
-    the memory the machine has left, is refused here, before anything is allocated.
+    the memory the machine has left, is refused here, before anything is allocated. A run walked
+    a window at a time holds no whole-run array: check_memory=False leaves out the second check.
     """
     _check_times(start_time, stop_time, step_size)
     span = stop_time - start_time
@@ -118,7 +134,7 @@ def step_count(start_time: float, stop_time: float, step_size: float, max_steps:
             "stop time, or raise the limit (--max-steps) if the run is meant to be that long"
         )
     needed = steps * BYTES_PER_STEP
-    if needed > MEMORY_CHECKED_FROM:
+    if check_memory and needed > MEMORY_CHECKED_FROM:
         available = _available_memory()
         if needed > available:
             raise InvalidInput(
@@ -154,6 +170,16 @@ def communication_points(
     rounding accumulates over a long run. max_steps: see step_count.
     """
     steps = step_count(start_time, stop_time, step_size, max_steps)
-    grid = start_time + step_size * np.arange(steps + 1, dtype=float)
-    grid[-1] = stop_time if abs(grid[-1] - stop_time) > event_tolerance(stop_time, step_size) else grid[-1]
-    return grid
+    return grid_points(start_time, stop_time, step_size, steps, np.arange(steps + 1))
+
+
+def grid_points(start_time: float, stop_time: float, step_size: float, steps: int, k: np.ndarray) -> np.ndarray:
+    """The grid points of the indices k (sorted, 0 to steps) of a run of `steps` steps, as
+    communication_points gives them: each computed on its own, so that a window of the run, or a
+    few points anywhere in it, are the whole grid's bit for bit.
+    """
+    points = start_time + step_size * np.asarray(k, dtype=float)
+    # The last point is stop, unless stop is within the event tolerance of start + steps * h.
+    if len(points) and k[-1] == steps and abs(points[-1] - stop_time) > event_tolerance(stop_time, step_size):
+        points[-1] = stop_time
+    return points

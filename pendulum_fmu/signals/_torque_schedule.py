@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import inspect
 import numbers
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -41,7 +41,7 @@ from typing import Union
 import numpy as np
 
 from .._errors import InvalidInput
-from ._time_grid import communication_points, event_tolerance, nearest
+from ._time_grid import WINDOW_STEPS, event_tolerance, grid_points, nearest, step_count
 from ._torque_csv import TorqueTable, read_torque_csv
 
 TorqueSignal = Union[float, int, Callable[[float], float], str, Path, Sequence[float], np.ndarray, "TorqueTable"]
@@ -149,20 +149,8 @@ def write_torque_csv(path: str | Path, plan: TorqueSchedule) -> Path:
     return Path(path)
 
 
-def _with_events(grid: np.ndarray, events: np.ndarray | None, step_size: float) -> np.ndarray:
-    """The grid plus the events inside it that are not within event_tolerance of a grid point."""
-    if events is None or not len(events):
-        return grid
-    events = np.unique(events[(events > grid[0]) & (events < grid[-1])])
-    if len(events):
-        distance = np.abs(nearest(grid, events) - events)
-        events = events[distance > event_tolerance(events, step_size)]
-    return np.union1d(grid, events)
-
-
-def _array_schedule(
-    values, start_time: float, stop_time: float | None, step_size: float, ramp: bool, max_steps: int | None
-) -> TorqueSchedule:
+def _checked_array(values, ramp: bool) -> np.ndarray:
+    """A per-step array as floats, or InvalidInput in schedule()'s words."""
     try:
         torque = np.asarray(values, dtype=float)
     except (TypeError, ValueError):
@@ -175,20 +163,7 @@ def _array_schedule(
         )
     if ramp:
         raise InvalidInput("a per-step torque array is held over each step; ramp needs a CSV or a callable")
-    if stop_time is None:
-        stop_time = start_time + len(torque) * step_size
-    time = communication_points(start_time, stop_time, step_size, max_steps=max_steps)
-    steps = len(time) - 1
-    if steps != len(torque):
-        raise InvalidInput(
-            f"the torque array has {len(torque)} values but {start_time:g} to {stop_time:g} s "
-            f"in steps of {step_size:g} s is {steps} steps; give one value per step or "
-            "leave out the stop time"
-        )
-    bad = np.flatnonzero(~np.isfinite(torque))
-    if len(bad):
-        raise InvalidInput(f"the torque array's value {bad[0]} is {torque[bad[0]]}; values must be finite")
-    return TorqueSchedule(time=time, torque=torque, torque_rate=np.zeros(len(torque)))
+    return torque
 
 
 def _shortened(values) -> str:
@@ -270,52 +245,208 @@ def schedule(
     >>> schedule([5.0, 7.0], step_size=0.5).time.tolist()  # an array's steps set the stop time
     [0.0, 0.5, 1.0]
     """
-    source = "the torque table"
-    if isinstance(torque, (str, Path)):
-        source, torque = str(torque), read_torque_csv(torque)
-    if isinstance(torque, (list, tuple, np.ndarray)):
-        return _array_schedule(torque, start_time, stop_time, step_size, ramp, max_steps)
-    if isinstance(torque, TorqueTable):
-        stop = float(torque.time[-1]) if stop_time is None else stop_time
-        if stop <= start_time and stop_time is None:
-            raise InvalidInput(
-                f"{source} ends at {stop:g} s, not after the start time {start_time:g} s; give a stop time"
-            )
-        grid = communication_points(start_time, stop, step_size, max_steps=max_steps)
-        table = torque.snapped(grid, step_size)
-        time = _with_events(grid, table.time if ramp else table.jumps(), step_size)
-        start_values = table.value_after(time[:-1])
-        end_values = table.value_before(time[1:])
-    else:
-        time = communication_points(
-            start_time, DEFAULT_STOP_TIME if stop_time is None else stop_time, step_size, max_steps=max_steps
-        )
-        if callable(torque):
-            samples = np.array([_sample(torque, t) for t in _takes_time(torque, time.tolist())])
-        else:
-            try:
-                # Whatever else it is is tried as a number: float() refuses what is none.
-                samples = np.full(len(time), float(torque))  # type: ignore[arg-type]
-            except (TypeError, ValueError):
+    signal = _Signal(torque, start_time, stop_time, step_size, ramp, max_steps, check_memory=True)
+    # The whole run is one window: the windows' code, so that the two cannot part.
+    return signal.window(0, signal.steps)
+
+
+def schedule_windows(
+    torque: TorqueSignal,
+    *,
+    start_time: float = 0.0,
+    stop_time: float | None = None,
+    step_size: float = 1e-3,
+    ramp: bool = False,
+    max_steps: int | None = None,
+    window_steps: int = WINDOW_STEPS,
+) -> Iterator[TorqueSchedule]:
+    """schedule()'s schedule a window of grid steps at a time, for a run too long to hold whole.
+
+    Window j covers the grid steps k0 = j * window_steps to k1 = min(k0 + window_steps, N): its
+    time is the grid points k0 to k1 and the events strictly between them (a held CSV's jumps off
+    the grid, a ramped CSV's row times), its torque and torque_rate those of its steps.
+    Consecutive windows share their boundary point; the windows joined, each later one less its
+    first point, are schedule()'s arrays bit for bit.
+
+    Every check schedule() makes of the times, the signal and max_steps is made here, at the
+    call, in its words, and a CSV is read here, once. Only what depends on the value at a point
+    is found in the window holding it: a callable's value that is not finite, a ramp past the
+    largest double. A callable is sampled once a point (the boundary's sample is carried to the
+    next window). Memory: no array of the whole run is made (nor is the machine's free memory
+    checked against one); a window holds O(window_steps + the CSV rows inside it), beside the
+    CSV's table, which is held whole, and a per-step array, which is the caller's.
+
+    Parameters
+    ----------
+    torque, start_time, stop_time, step_size, ramp, max_steps
+        As schedule() takes them.
+    window_steps : int, optional
+        Grid steps per window (default WINDOW_STEPS); the last window may have fewer.
+
+    Returns
+    -------
+    iterator of TorqueSchedule
+        The windows, in time order.
+
+    Raises
+    ------
+    InvalidInput, TorqueFileError
+        As schedule() raises them, at the call; a sample or a ramp refused, when its window is
+        made.
+
+    Examples
+    --------
+    >>> from pendulum_fmu.signals._torque_schedule import schedule_windows
+    >>> [w.time.tolist() for w in schedule_windows(20.0, stop_time=0.005, window_steps=2)]
+    [[0.0, 0.001, 0.002], [0.002, 0.003, 0.004], [0.004, 0.005]]
+    """
+    if not (isinstance(window_steps, numbers.Integral) and window_steps >= 1):
+        raise InvalidInput(f"window steps {window_steps!r} must be a whole number of steps, at least 1")
+    signal = _Signal(torque, start_time, stop_time, step_size, ramp, max_steps, check_memory=False)
+    return _walk(signal, int(window_steps))
+
+
+def _walk(signal: _Signal, window_steps: int) -> Iterator[TorqueSchedule]:
+    for k0 in range(0, signal.steps, window_steps):
+        yield signal.window(k0, min(k0 + window_steps, signal.steps))
+
+
+class _Signal:
+    """A signal checked, and a CSV read, once; its schedule made a window of grid steps at a time."""
+
+    def __init__(
+        self,
+        torque: TorqueSignal,
+        start_time: float,
+        stop_time: float | None,
+        step_size: float,
+        ramp: bool,
+        max_steps: int | None,
+        *,
+        check_memory: bool,
+    ):
+        self.source, self.ramp, self.step_size = "the torque table", ramp, step_size
+        self.table: TorqueTable | None = None
+        self.values: np.ndarray | None = None
+        self.function: Callable | None = None
+        self.constant = 0.0
+        # A callable's sample at the end of the window last made, for the next one to start from.
+        self._carried: tuple[int, float] | None = None
+        if isinstance(torque, (str, Path)):
+            self.source, torque = str(torque), read_torque_csv(torque)
+        if isinstance(torque, (list, tuple, np.ndarray)):
+            self.values = _checked_array(torque, ramp)
+            if stop_time is None:
+                stop_time = start_time + len(self.values) * step_size
+            self._count(start_time, stop_time, max_steps, check_memory)
+            if self.steps != len(self.values):
                 raise InvalidInput(
-                    f"a torque is a number, a callable of time, a per-step array or a CSV "
-                    f"path; got {type(torque).__name__}"
-                ) from None
-        if not np.isfinite(samples).all():
-            bad = np.flatnonzero(~np.isfinite(samples))[0]
-            raise InvalidInput(f"the torque is {samples[bad]} at t = {time[bad]}; it must be finite")
-        start_values, end_values = samples[:-1], samples[1:]
-    if not ramp:
-        return TorqueSchedule(time=time, torque=start_values, torque_rate=np.zeros(len(time) - 1))
-    with np.errstate(over="ignore", invalid="ignore"):
-        rate = (end_values - start_values) / np.diff(time)
-    steep = np.flatnonzero(~np.isfinite(rate))
-    if len(steep):
-        k = steep[0]
-        raise InvalidInput(
-            f"{source if isinstance(torque, TorqueTable) else 'the torque'} ramps from "
-            f"{start_values[k]:g} to {end_values[k]:g} N.m between t = {time[k]:g} and "
-            f"{time[k + 1]:g} s, a rate past the largest double: hold the torque "
-            "(no ramp) or give values that change less steeply"
-        )
-    return TorqueSchedule(time=time, torque=start_values, torque_rate=rate)
+                    f"the torque array has {len(self.values)} values but {start_time:g} to {stop_time:g} s "
+                    f"in steps of {step_size:g} s is {self.steps} steps; give one value per step or "
+                    "leave out the stop time"
+                )
+            bad = np.flatnonzero(~np.isfinite(self.values))
+            if len(bad):
+                raise InvalidInput(f"the torque array's value {bad[0]} is {self.values[bad[0]]}; values must be finite")
+        elif isinstance(torque, TorqueTable):
+            stop = float(torque.time[-1]) if stop_time is None else stop_time
+            if stop <= start_time and stop_time is None:
+                raise InvalidInput(
+                    f"{self.source} ends at {stop:g} s, not after the start time {start_time:g} s; give a stop time"
+                )
+            self._count(start_time, stop, max_steps, check_memory)
+            self.table = torque.snapped(self._points_near(torque.time), step_size)
+            self.events = self._off_grid(self.table.time if ramp else self.table.jumps())
+        else:
+            self._count(start_time, DEFAULT_STOP_TIME if stop_time is None else stop_time, max_steps, check_memory)
+            first = self.points(0, 0)
+            if callable(torque):
+                self.function = torque
+                _takes_time(torque, first.tolist())
+            else:
+                try:
+                    # Whatever else it is is tried as a number: float() refuses what is none.
+                    self.constant = float(torque)  # type: ignore[arg-type]
+                except (TypeError, ValueError):
+                    raise InvalidInput(
+                        f"a torque is a number, a callable of time, a per-step array or a CSV "
+                        f"path; got {type(torque).__name__}"
+                    ) from None
+                _check_finite(np.array([self.constant]), first)
+
+    def _count(self, start_time: float, stop_time: float, max_steps: int | None, check_memory: bool) -> None:
+        self.start_time, self.stop_time = start_time, stop_time
+        self.steps = step_count(start_time, stop_time, self.step_size, max_steps, check_memory=check_memory)
+
+    def _grid(self, k: np.ndarray) -> np.ndarray:
+        return grid_points(self.start_time, self.stop_time, self.step_size, self.steps, k)
+
+    def points(self, k0: int, k1: int) -> np.ndarray:
+        """The grid points k0 to k1, as the whole run's grid holds them."""
+        return self._grid(np.arange(k0, k1 + 1))
+
+    def _points_near(self, times: np.ndarray) -> np.ndarray:
+        """The grid points around each time: nearest() of them is nearest() of the whole grid,
+        found without it (the two points either side of each time, and a margin for rounding).
+        """
+        with np.errstate(over="ignore", invalid="ignore"):
+            guess = np.clip(np.floor((times - self.start_time) / self.step_size), 0, self.steps)
+        return self._grid(np.unique(np.clip(guess[:, None] + np.arange(-2, 4), 0, self.steps).astype(np.int64)))
+
+    def _off_grid(self, events: np.ndarray) -> np.ndarray:
+        """The events strictly inside the run not within event_tolerance of a grid point, sorted."""
+        first, last = self._grid(np.array([0, self.steps]))
+        events = np.unique(events[(events > first) & (events < last)])
+        if len(events):
+            distance = np.abs(nearest(self._points_near(events), events) - events)
+            events = events[distance > event_tolerance(events, self.step_size)]
+        return events
+
+    def window(self, k0: int, k1: int) -> TorqueSchedule:
+        """The schedule of grid steps k0 to k1: the points, the events between them, the torques."""
+        time = self.points(k0, k1)
+        if self.table is not None:
+            lo, hi = np.searchsorted(self.events, time[0], "right"), np.searchsorted(self.events, time[-1])
+            inside = self.events[lo:hi]
+            time = np.union1d(time, inside) if len(inside) else time
+            start_values, end_values = self.table.value_after(time[:-1]), self.table.value_before(time[1:])
+        elif self.values is not None:
+            start_values = end_values = self.values[k0:k1]
+        else:
+            samples = self._samples(k0, time)
+            start_values, end_values = samples[:-1], samples[1:]
+        if not self.ramp:
+            return TorqueSchedule(time=time, torque=start_values, torque_rate=np.zeros(len(time) - 1))
+        with np.errstate(over="ignore", invalid="ignore"):
+            rate = (end_values - start_values) / np.diff(time)
+        steep = np.flatnonzero(~np.isfinite(rate))
+        if len(steep):
+            k = steep[0]
+            raise InvalidInput(
+                f"{self.source if self.table is not None else 'the torque'} ramps from "
+                f"{start_values[k]:g} to {end_values[k]:g} N.m between t = {time[k]:g} and "
+                f"{time[k + 1]:g} s, a rate past the largest double: hold the torque "
+                "(no ramp) or give values that change less steeply"
+            )
+        return TorqueSchedule(time=time, torque=start_values, torque_rate=rate)
+
+    def _samples(self, k0: int, time: np.ndarray) -> np.ndarray:
+        """The signal at each point: a constant's value, or a callable's samples, each point once."""
+        if self.function is None:
+            return np.full(len(time), self.constant)
+        samples = np.empty(len(time))
+        first = 0
+        if self._carried is not None and self._carried[0] == k0:
+            samples[0], first = self._carried[1], 1
+        function = self.function
+        for i, t in enumerate(time[first:].tolist(), start=first):
+            samples[i] = _sample(function, t)
+        _check_finite(samples, time)
+        self._carried = (k0 + len(time) - 1, float(samples[-1]))
+        return samples
+
+
+def _check_finite(samples: np.ndarray, time: np.ndarray) -> None:
+    if not np.isfinite(samples).all():
+        bad = np.flatnonzero(~np.isfinite(samples))[0]
+        raise InvalidInput(f"the torque is {samples[bad]} at t = {time[bad]}; it must be finite")
