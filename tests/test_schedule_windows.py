@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 
@@ -14,7 +16,7 @@ from pendulum_fmu.signals._torque_schedule import schedule, schedule_windows
 def joined(windows):
     """The windows' arrays end to end, each later window less its first point (the boundary)."""
     windows = list(windows)
-    for before, after in zip(windows, windows[1:], strict=False):
+    for before, after in itertools.pairwise(windows):
         assert before.time[-1] == after.time[0]
     time = np.concatenate([windows[0].time] + [w.time[1:] for w in windows[1:]])
     return windows, time, np.concatenate([w.torque for w in windows]), np.concatenate([w.torque_rate for w in windows])
