@@ -83,38 +83,110 @@ def speed_bound(
         bound(times): at each time of an array, |omega| is not above it then; and the time the
         bound starts to grow.
     """
-    gravity_moment, damping, inverse_inertia = model
-    g = abs(gravity_moment)
-    torques = np.maximum(np.abs(spans.u0), np.abs(spans.u0 + spans.rate * (spans.ends - spans.starts)))
-    # The torque's impulse from the start, at each span's edge: sqrt(E) grows by at most the
-    # impulse over sqrt(2 I), |omega| by at most the impulse over I.
-    edges = np.concatenate((spans.starts[:1], spans.ends))
-    impulse = np.concatenate(([0.0], np.cumsum(torques * (spans.ends - spans.starts))))
-    # The gravity's potential, between 0 and 2 g: g - mgL cos(theta).
-    energy = 0.5 * np.float64(omega0) ** 2 / inverse_inertia + g - gravity_moment * math.cos(theta0)
-    since, start_speed = float(spans.starts[0]), math.sqrt(2 * energy * inverse_inertia)
-    trapped = start_speed
-    held = _held_from_start(spans)
-    if held and (speed := _well_speed(float(spans.u0[0]), model, theta0, omega0)) is not None:
-        # In the well until the held torque changes; then the energy grows as the torque may.
-        since, trapped = float(spans.ends[held - 1]), speed
-        start_speed = math.sqrt(speed**2 + 4 * g * inverse_inertia)
-    ceiling = math.inf
-    if damping > 0:
-        most = float(torques.max())
-        ceiling = math.sqrt(2 * inverse_inertia * max(energy, 2 * g + 0.5 * (most / damping) ** 2 / inverse_inertia))
-    pushed_before = float(np.interp(since, edges, impulse))
-
-    def bound(times: np.ndarray) -> np.ndarray:
-        pushed = np.maximum(np.interp(times, edges, impulse) - pushed_before, 0.0)
-        return np.minimum(np.where(times <= since, trapped, start_speed + pushed * inverse_inertia), ceiling)
-
-    return bound, since
+    return Work(model, theta0, omega0, (1.0, 1.0)).bound(spans)
 
 
-def _held_from_start(spans: Spans) -> int:
-    """How many spans from the first hold its torque (0 when it ramps)."""
-    ramps_or_changes = (spans.rate != 0) | (spans.u0 != spans.u0[0])
+class Work:
+    """taylor_steps of a run whose spans come a window at a time, in time order (add()): what
+    bounds the speed carried from each window to the next (the torque's impulse so far, whether
+    the torque held from the start still holds, the largest torque so far), and each window's
+    rate integrated on a grid of its own. A run given as one window is taylor_steps' run.
+
+    Parameters
+    ----------
+    model, theta0, omega0, tolerance
+        As taylor_steps takes them.
+    """
+
+    def __init__(self, model: tuple[float, float, float], theta0: float, omega0: float, tolerance: tuple[float, float]):
+        self.model, self.theta0, self.omega0, self.tolerance = model, theta0, omega0, tolerance
+        self.steps = 0.0
+        gravity_moment, _, inverse_inertia = model
+        # nan where a value is not finite: add() counts nan steps, and the integration refuses it.
+        self.finite = all(math.isfinite(value) for value in (*model, theta0, omega0))
+        self.energy = math.nan
+        if self.finite:
+            with np.errstate(over="ignore", invalid="ignore"):
+                # The gravity's potential, between 0 and 2 g: g - mgL cos(theta).
+                self.energy = (
+                    0.5 * np.float64(omega0) ** 2 / inverse_inertia
+                    + abs(gravity_moment)
+                    - gravity_moment * math.cos(theta0)
+                )
+        self.start_speed = self.trapped = math.sqrt(2 * self.energy * inverse_inertia)
+        self.since: float | None = None  # the end of the torque held from the start, as far as known
+        self.holding = False  # whether the torque has held its first value, in its well, up to since
+        self.first_u0 = 0.0
+        self.impulse, self.pushed_before, self.most = 0.0, 0.0, 0.0
+
+    def bound(self, spans: Spans) -> tuple[Callable, float]:
+        """speed_bound over the next window's spans, from what the windows before it carry."""
+        gravity_moment, damping, inverse_inertia = self.model
+        g = abs(gravity_moment)
+        torques = np.maximum(np.abs(spans.u0), np.abs(spans.u0 + spans.rate * (spans.ends - spans.starts)))
+        # The torque's impulse from the start, at each span's edge: sqrt(E) grows by at most the
+        # impulse over sqrt(2 I), |omega| by at most the impulse over I.
+        edges = np.concatenate((spans.starts[:1], spans.ends))
+        impulse = self.impulse + np.concatenate(([0.0], np.cumsum(torques * (spans.ends - spans.starts))))
+        if self.since is None:  # the run's first window
+            self.since, self.first_u0 = float(spans.starts[0]), float(spans.u0[0])
+            speed = _well_speed(self.first_u0, self.model, self.theta0, self.omega0) if spans.rate[0] == 0 else None
+            if speed is not None:
+                # In the well until the held torque changes; then the energy grows as the torque may.
+                self.holding, self.trapped = True, speed
+                self.start_speed = math.sqrt(speed**2 + 4 * g * inverse_inertia)
+        if self.holding:
+            held = _held_from_start(spans, self.first_u0)
+            self.since = float(spans.ends[held - 1]) if held else self.since
+            self.holding = held == len(spans.starts)
+            self.pushed_before = float(np.interp(self.since, edges, impulse))
+        self.impulse, self.most = float(impulse[-1]), max(self.most, float(torques.max()))
+        ceiling = math.inf
+        if damping > 0:
+            most = self.most
+            ceiling = math.sqrt(
+                2 * inverse_inertia * max(self.energy, 2 * g + 0.5 * (most / damping) ** 2 / inverse_inertia)
+            )
+        since, trapped, start_speed, pushed_before = self.since, self.trapped, self.start_speed, self.pushed_before
+
+        def bound(times: np.ndarray) -> np.ndarray:
+            pushed = np.maximum(np.interp(times, edges, impulse) - pushed_before, 0.0)
+            return np.minimum(np.where(times <= since, trapped, start_speed + pushed * inverse_inertia), ceiling)
+
+        return bound, since
+
+    def add(self, spans: Spans) -> float:
+        """Count the next window's steps; the run's steps so far (inf, nan: see taylor_steps)."""
+        gravity_moment, damping, inverse_inertia = self.model
+        if not self.finite:
+            self.steps = math.nan
+            return self.steps
+        n = order_limit(min(self.tolerance)) - 1  # the power of the last term of omega's series
+        w0 = math.sqrt(abs(gravity_moment) * inverse_inertia)
+        with np.errstate(over="ignore", invalid="ignore"):
+            bound, since = self.bound(spans)
+
+        def rate(times: np.ndarray) -> np.ndarray:
+            spin = bound(times) ** (1 - 1 / n) * w0 ** (2 / n)
+            return np.maximum(np.maximum(_SWING * w0, spin), damping * inverse_inertia)
+
+        with np.errstate(over="ignore", invalid="ignore"):
+            # The rate's integral from the window's start, on a grid fine enough for its bends
+            # (the speed's ceiling, the torque's changes); a span's is the difference at its ends.
+            start, stop = float(spans.starts[0]), float(spans.ends[-1])
+            grid = np.linspace(start, stop, _GRID)
+            grid = np.union1d(grid, [since]) if start <= since <= stop else grid
+            rates = rate(grid)
+            turns = np.concatenate(([0.0], np.cumsum(np.diff(grid) * (rates[1:] + rates[:-1]) / 2)))
+            spanned = np.interp(spans.ends, grid, turns) - np.interp(spans.starts, grid, turns)
+            steps = np.maximum(np.ceil(spanned / _reach(min(self.tolerance), n)), 1)
+        self.steps += float(steps.sum()) if np.isfinite(steps).all() else math.inf
+        return self.steps
+
+
+def _held_from_start(spans: Spans, u: float) -> int:
+    """How many spans from the first hold the torque u (0 when it ramps)."""
+    ramps_or_changes = (spans.rate != 0) | (spans.u0 != u)
     return int(np.argmax(ramps_or_changes)) if ramps_or_changes.any() else len(spans.starts)
 
 
@@ -167,28 +239,7 @@ def taylor_steps(
         The steps: inf where the run has more than a double counts, nan where the model's
         constants or the state are not finite (the integration refuses those in its own words).
     """
-    gravity_moment, damping, inverse_inertia = model
-    if not all(math.isfinite(value) for value in (*model, theta0, omega0)):
-        return math.nan
-    n = order_limit(min(tolerance)) - 1  # the power of the last term of omega's series
-    w0 = math.sqrt(abs(gravity_moment) * inverse_inertia)
-    with np.errstate(over="ignore", invalid="ignore"):
-        bound, since = speed_bound(spans, model, theta0, omega0)
-
-    def rate(times: np.ndarray) -> np.ndarray:
-        spin = bound(times) ** (1 - 1 / n) * w0 ** (2 / n)
-        return np.maximum(np.maximum(_SWING * w0, spin), damping * inverse_inertia)
-
-    with np.errstate(over="ignore", invalid="ignore"):
-        # The rate's integral from the start, on a grid fine enough for its bends (the speed's
-        # ceiling, the torque's changes); a span's is the difference at its ends.
-        start, stop = float(spans.starts[0]), float(spans.ends[-1])
-        grid = np.union1d(np.linspace(start, stop, _GRID), [since])
-        rates = rate(grid)
-        turns = np.concatenate(([0.0], np.cumsum(np.diff(grid) * (rates[1:] + rates[:-1]) / 2)))
-        spanned = np.interp(spans.ends, grid, turns) - np.interp(spans.starts, grid, turns)
-        steps = np.maximum(np.ceil(spanned / _reach(min(tolerance), n)), 1)
-    return float(steps.sum()) if np.isfinite(steps).all() else math.inf
+    return Work(model, theta0, omega0, tolerance).add(spans)
 
 
 def check_steps(steps: float, start: float, stop: float, rtol: float) -> None:
