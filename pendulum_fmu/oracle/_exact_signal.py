@@ -1,6 +1,6 @@
 """The torque signal as the oracle reads it, on its own: times as exact fractions of the decimals
 written, its own reader of a torque CSV (TorqueFile), the communication points (Grid), the pieces
-on which the torque is linear (Pieces, signal_pieces) and the torque held at given times
+on which the torque is linear (Pieces, SignalWindows: a window of the run at a time) and the torque held at given times
 (Holding). _reference.py integrates what this gives; docs/signals.md is the definition both follow.
 """
 
@@ -174,29 +174,42 @@ def time_doubles(points: Times) -> np.ndarray:
     return np.array([float(p) for p in points])
 
 
-def time_grid(start: Fraction, stop: Fraction, step: Fraction, max_steps: int | None = None) -> Grid:
+def time_grid(
+    start: Fraction, stop: Fraction, step: Fraction, max_steps: int | None = None, check_memory: bool = True
+) -> Grid:
     """Start + k*step up to stop; stop itself ends a shorter last step unless it is on the grid."""
     # Only checked by the schedule's code, in simulate()'s words (a step that is not positive, a
     # stop not after the start, a run too long to hold): the grid below is the oracle's own.
-    step_count(float(start), float(stop), float(step), max_steps)
+    step_count(float(start), float(stop), float(step), max_steps, check_memory=check_memory)
     # The points start + k*step before stop less its tolerance: k < (last - start) / step.
     last = stop - event_tolerance(stop, step)
     return Grid(start, step, max(math.ceil((last - start) / step), 0), stop)
 
 
-def with_events(grid: Grid, events: list[Fraction], step: Fraction) -> Sequence[Fraction]:
-    """The grid plus every event inside it that is not within the tolerance of a grid point."""
-    extra = []
+def off_grid(grid: Grid, events: list[Fraction], step: Fraction) -> list[Fraction]:
+    """The events inside the grid not within the tolerance of a grid point, sorted, once each."""
+    extra = set()
     for event in events:
         if not grid[0] < event < grid[-1]:
             continue
         j = bisect.bisect_left(grid, event)
         if min(grid[j] - event, event - grid[j - 1]) > event_tolerance(event, step):
-            extra.append(event)
-    if not extra:  # the grid as it is, its points made only when asked for
+            extra.add(event)
+    return sorted(extra)
+
+
+def with_events(grid: Grid, events: list[Fraction], step: Fraction) -> Sequence[Fraction]:
+    """The grid plus every event inside it that is not within the tolerance of a grid point."""
+    return with_extra(grid, off_grid(grid, events, step))
+
+
+def with_extra(grid: Grid, extra: list[Fraction]) -> Sequence[Fraction]:
+    """The grid plus the events of extra (off_grid's of the run) strictly inside it."""
+    inside = extra[bisect.bisect_right(extra, grid[0]) : bisect.bisect_left(extra, grid[-1])]
+    if not inside:  # the grid as it is, its points made only when asked for
         return grid
     # The grid is sorted and no extra event is on it: merged, not sorted anew.
-    return list(heapq.merge(grid, sorted(set(extra))))
+    return list(heapq.merge(grid, inside))
 
 
 class Pieces:
@@ -217,48 +230,109 @@ class Pieces:
         self.points, self.values_after = points, values_after
 
 
-def signal_pieces(
-    torque, start: Fraction, stop: Fraction | None, step: Fraction, ramp: bool, max_steps: int | None
-) -> Pieces:
-    if isinstance(torque, (str, Path)):
-        read_torque_csv(torque)  # a file that is no signal refused where it is wrong; read below anew
-        signal = TorqueFile(Path(torque))
-        stop = signal.times[-1] if stop is None else stop
-        grid = time_grid(start, stop, step, max_steps)
-        if ramp:
-            # The file's own piecewise-linear signal: a piece between consecutive row times.
-            rows = sorted({start, stop} | {t for t in signal.times if start < t < stop})
-            u0 = [signal.after(a) for a in rows[:-1]]
-            rate = [(signal.before(b) - signal.after(a)) / float(b - a) for a, b in itertools.pairwise(rows)]
-            return Pieces(
-                rows[:-1],
-                stop,
-                u0,
-                rate,
-                with_events(grid, signal.times, step),
-                lambda times: np.array(
-                    [signal.after(signal.latest_event_near(exact_time(t), step)) for t in times.tolist()]
-                ),
-            )
-        events = with_events(grid, signal.jumps(), step)
-        held = signal.held_after(events[:-1], step)
-        return Pieces(events[:-1], stop, held, np.zeros(len(held)), events, Holding(events, held, step).values_after)
+class SignalWindows:
+    """A signal read once, its pieces made a window of grid steps at a time: window(k0, k1) is
+    the pieces of the oracle's own grid steps k0 to k1 (and the events between them), so that a
+    run of millions of steps holds one window's pieces at a time. A CSV's table is held whole.
+    """
 
-    if isinstance(torque, (list, tuple, np.ndarray)):
-        values = [torque_value(u, f"at step {k} of the array") for k, u in enumerate(torque)]
-        points = time_grid(start, start + len(values) * step if stop is None else stop, step, max_steps)
-        if len(points) - 1 != len(values):
-            raise InvalidInput(f"the torque array has {len(values)} values for {len(points) - 1} steps")
-    else:
-        points = time_grid(start, _DEFAULT_STOP_TIME if stop is None else stop, step, max_steps)
-        sample = torque if callable(torque) else (lambda t, u=torque: u)
-        values = [torque_value(sample(p), f"at t = {p}") for p in time_doubles(points).tolist()]
-    if ramp:
-        rate = [(b - a) / float(t1 - t0) for a, b, t0, t1 in zip(values, values[1:], points, points[1:], strict=False)]
-    else:
-        rate = [0.0] * (len(points) - 1)
-    u0 = values[: len(points) - 1]
-    return Pieces(points[:-1], points[-1], u0, rate, points, Holding(points, u0, step).values_after)
+    def __init__(
+        self,
+        torque,
+        start: Fraction,
+        stop: Fraction | None,
+        step: Fraction,
+        ramp: bool,
+        max_steps: int | None,
+        *,
+        check_memory: bool = True,
+    ):
+        self.step, self.ramp = step, ramp
+        self.file: TorqueFile | None = None
+        self.values: np.ndarray | None = None
+        self.sample: Callable | None = None
+        # A callable's sample at the end of the window last made, for the next one to start from.
+        self._carried: tuple[int, float] | None = None
+        if isinstance(torque, (str, Path)):
+            read_torque_csv(torque)  # a file that is no signal refused where it is wrong; read below anew
+            self.file = TorqueFile(Path(torque))
+            stop = self.file.times[-1] if stop is None else stop
+            self.grid = time_grid(start, stop, step, max_steps, check_memory)
+            self.extra = off_grid(self.grid, self.file.times if ramp else self.file.jumps(), step)
+        elif isinstance(torque, (list, tuple, np.ndarray)):
+            self.values = np.fromiter(
+                (torque_value(u, f"at step {k} of the array") for k, u in enumerate(torque)), float, len(torque)
+            )
+            self.grid = time_grid(
+                start, start + len(self.values) * step if stop is None else stop, step, max_steps, check_memory
+            )
+            if len(self.grid) - 1 != len(self.values):
+                raise InvalidInput(f"the torque array has {len(self.values)} values for {len(self.grid) - 1} steps")
+        else:
+            self.grid = time_grid(start, _DEFAULT_STOP_TIME if stop is None else stop, step, max_steps, check_memory)
+            if callable(torque):
+                self.sample = torque
+            else:  # a constant: checked once, at the first point, as a callable's first sample is
+                self.constant = torque_value(torque, f"at t = {float(self.grid[0])}")
+        self.steps = len(self.grid) - 1
+
+    def window_grid(self, k0: int, k1: int) -> Grid:
+        """The grid points k0 to k1, as fractions made only when asked for."""
+        grid = self.grid
+        end = grid.stop if k1 == self.steps else grid.start + k1 * grid.step
+        return Grid(grid.start + k0 * grid.step, grid.step, k1 - k0, end)
+
+    def window(self, k0: int, k1: int) -> Pieces:
+        """The pieces of grid steps k0 to k1; their values_after holds, past the window's end (a
+        report there), the value the next window starts with, unless the run ends there.
+        """
+        grid, step, final = self.window_grid(k0, k1), self.step, k1 == self.steps
+        if self.file is not None:
+            signal, points = self.file, with_extra(grid, self.extra)
+            if self.ramp:
+                # The file's own piecewise-linear signal: a piece between consecutive row times.
+                start, stop = grid[0], grid[-1]
+                inside = signal.times[bisect.bisect_right(signal.times, start) : bisect.bisect_left(signal.times, stop)]
+                rows = sorted({start, stop, *inside})
+                u0 = [signal.after(a) for a in rows[:-1]]
+                rate = [(signal.before(b) - signal.after(a)) / float(b - a) for a, b in itertools.pairwise(rows)]
+                return Pieces(
+                    rows[:-1],
+                    stop,
+                    u0,
+                    rate,
+                    points,
+                    lambda times: np.array(
+                        [signal.after(signal.latest_event_near(exact_time(t), step)) for t in times.tolist()]
+                    ),
+                )
+            held = signal.held_after(points[:-1] if final else points, step)
+            u0 = held[: len(points) - 1]
+            return Pieces(
+                points[:-1], grid[-1], u0, np.zeros(len(u0)), points, Holding(points, held, step).values_after
+            )
+        if self.values is not None:
+            values = self.values[k0 : k1 + 1]
+        elif self.sample is None:
+            values = np.full(k1 - k0 + 1, self.constant)
+        else:
+            values = self._samples(k0, grid)
+        if self.ramp and self.sample is not None:
+            rate = [(b - a) / float(t1 - t0) for a, b, t0, t1 in zip(values, values[1:], grid, grid[1:], strict=False)]
+        else:  # held, or a constant's ramp: no slope
+            rate = np.zeros(k1 - k0)
+        u0 = values[: k1 - k0]
+        return Pieces(grid[:-1], grid[-1], u0, rate, grid, Holding(grid, u0 if final else values, step).values_after)
+
+    def _samples(self, k0: int, grid: Grid) -> list[float]:
+        """The callable at each point of the window, once a point as the windows are walked."""
+        sample, values = self.sample, []
+        doubles = time_doubles(grid).tolist()
+        if self._carried is not None and self._carried[0] == k0:
+            values, doubles = [self._carried[1]], doubles[1:]
+        values += [torque_value(sample(p), f"at t = {p}") for p in doubles]
+        self._carried = (k0 + len(values) - 1, values[-1])
+        return values
 
 
 class Holding:

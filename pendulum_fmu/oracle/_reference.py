@@ -16,6 +16,8 @@ boundary.
 
 from __future__ import annotations
 
+import contextlib
+import numbers
 from collections.abc import Callable
 from fractions import Fraction
 from pathlib import Path
@@ -23,132 +25,117 @@ from pathlib import Path
 import numpy as np
 
 from .._errors import InvalidInput, WrongType
-from ..fmu import _results as results
-from ..fmu._parameters import Fmu, start_value, total_inertia
-from ..fmu._simulate import resolve_parameters
+from ..fmu._parameters import Fmu
+from ..signals._time_grid import WINDOW_STEPS
 from ..signals._torque_schedule import TorqueSchedule
-from ._exact_signal import Holding, Pieces, event_tolerance, seconds, signal_pieces, time_doubles
-from ._taylor import Diverged, check_tolerances, integrate_piece
-from ._work import Spans, check_steps, progress, taylor_steps
+from ._exact_signal import Holding, Pieces, SignalWindows, event_tolerance, seconds, time_doubles
+from ._integration import COMPUTED, Model, Runs, equation_of_motion, integrate_window, model_constants
+from ._work import Work, check_steps, progress
 
-# What the reference computes, whatever an FMU records.
-COMPUTED = ("torque", "theta", "omega", "alpha")
+# model_constants and equation_of_motion are _integration's, imported from here by the judge and
+# the closed loop.
+__all__ = [
+    "COMPUTED",
+    "ReferenceWindows",
+    "equation_of_motion",
+    "model_constants",
+    "reference",
+    "reference_schedule",
+    "reference_windows",
+]
 
 
-def equation_of_motion(parameters: dict[str, float]) -> Callable:
-    """alpha(theta, omega, torque) of the pendulum with these (resolved) parameters, in rad/s2;
-    works on scalars and numpy arrays alike.
+class ReferenceWindows:
+    """A run integrated a window of grid steps at a time, the state carried from each window's
+    end to the next: what reference_windows() returns (see there).
 
-    Parameters
+    Attributes
     ----------
-    parameters : dict
-        mass, length, inertia, gravity and damping, as resolve_parameters gives them.
-
-    Returns
-    -------
-    callable
-        acceleration(theta, omega, torque).
+    windows : int
+        The number of windows; next() integrates the next one.
+    steps : float
+        The work estimate of the whole run, in Taylor steps.
     """
-    gravity_moment, damping, inverse_inertia = model_constants(parameters)
 
-    def acceleration(theta, omega, u):
-        return (u - gravity_moment * np.sin(theta) - damping * omega) * inverse_inertia
+    def __init__(
+        self,
+        window: Callable[[int, int], Pieces],
+        grid_steps: int,
+        step: Fraction | None,
+        model: Model,
+        window_steps: int,
+        *,
+        first: Pieces | None = None,
+        show_progress: bool = True,
+    ):
+        self._window, self._grid_steps, self._step, self._model = window, grid_steps, step, model
+        self._window_steps, self._show_progress = window_steps, show_progress
+        self.windows = -(-grid_steps // window_steps)
+        self._done, self._state = 0, (float(model.theta0), float(model.omega0))
+        self._stack: contextlib.ExitStack | None = None
+        self._on_step: Callable[[float], None] | None = None
+        # The whole run's work, before anything is integrated: each window's pieces made and let
+        # go, but the first's, which next() integrates first.
+        self._first = Runs(first if first is not None else window(*self._bounds(0)))
+        work = Work(model.constants, model.theta0, model.omega0, model.tolerance)
+        work.add(self._first.spans())
+        last = self._first
+        for j in range(1, self.windows):
+            last = Runs(window(*self._bounds(j)))
+            work.add(last.spans())
+        self.start, self.stop = float(self._first.starts[0]), float(last.ends[-1])
+        self.steps = work.steps
+        check_steps(self.steps, self.start, self.stop, model.rtol)
 
-    return acceleration
+    def _bounds(self, j: int) -> tuple[int, int]:
+        k0 = j * self._window_steps
+        return k0, min(k0 + self._window_steps, self._grid_steps)
 
+    def __enter__(self) -> ReferenceWindows:
+        self._stack = contextlib.ExitStack()
+        if self._show_progress:
+            self._on_step = self._stack.enter_context(progress(self.steps, self.start, self.stop))
+        return self
 
-def model_constants(parameters: dict[str, float]) -> tuple[float, float, float]:
-    """mass*gravity*length, damping and 1/total inertia: the equation's three constants, as
-    _taylor.integrate_piece takes them.
+    def __exit__(self, *raised) -> bool | None:
+        stack, self._stack, self._on_step = self._stack, None, None
+        return stack.__exit__(*raised) if stack is not None else None
 
-    Parameters
-    ----------
-    parameters : dict
-        mass, length, inertia, gravity and damping, as resolve_parameters gives them.
+    def next(self, at: np.ndarray) -> np.ndarray:
+        """Integrate the next window, from the state the one before it ended with.
 
-    Returns
-    -------
-    (float, float, float)
-    """
-    with np.errstate(over="ignore"):  # values past the largest double fail where they are used
-        return (
-            parameters["mass"] * parameters["gravity"] * parameters["length"],
-            parameters["damping"],
-            1.0 / total_inertia(parameters),
-        )
+        Parameters
+        ----------
+        at : numpy.ndarray
+            The times to report, in s, increasing (may be empty): each within the window's first
+            and last grid points, widened by the event tolerance.
 
+        Returns
+        -------
+        numpy.ndarray
+            Same result format as reference(), at the times `at`.
 
-def _integrate(
-    pieces: Pieces,
-    at: np.ndarray,
-    parameters: dict | None,
-    theta0: float,
-    omega0: float,
-    rtol: float,
-    atol: float,
-    fmu_path: Fmu,
-) -> np.ndarray:
-    theta0, omega0 = start_value("theta0", theta0, "rad"), start_value("omega0", omega0, "rad/s")
-    check_tolerances(rtol, atol)
-    parameters = resolve_parameters(parameters, fmu_path)
-    acceleration, model = equation_of_motion(parameters), model_constants(parameters)
-    starts = time_doubles(pieces.starts)
-    ends = np.append(starts[1:], float(pieces.stop))
-    u0s, rates = np.asarray(pieces.u0, dtype=float), np.asarray(pieces.rate, dtype=float)
-    # Pieces that continue one another (the same held torque) are one run, so that the series
-    # restarts only where the torque changes.
-    continues = (rates[1:] == 0) & (rates[:-1] == 0) & (u0s[1:] == u0s[:-1])
-    firsts = np.flatnonzero(np.r_[True, ~continues])
-    lasts = np.r_[firsts[1:] - 1, len(starts) - 1]
-    # The reports in time order (a result's are: no copy is made). Each belongs to the first piece
-    # that reaches it, so a run's are a slice: those after the run before's end, up to its own (a
-    # time a rounding past the end of the run belongs to the last).
-    order = None if np.all(at[1:] >= at[:-1]) else np.argsort(at, kind="stable")
-    ordered = at if order is None else at[order]
-    bounds = np.searchsorted(ordered, ends[lasts], side="right")
-    bounds[-1] = len(at)
-    runs = np.stack([firsts, lasts, np.r_[0, bounds[:-1]], bounds])
-    out = results.empty(len(at), COMPUTED)
-    out["time"] = at
-    spans = Spans(starts[firsts], ends[lasts], u0s[firsts], rates[firsts])
-    steps = taylor_steps(spans, model, theta0, omega0, (rtol, atol))
-    check_steps(steps, starts[0], ends[-1], rtol)
-    theta, omega = float(theta0), float(omega0)
-    with progress(steps, float(starts[0]), float(ends[-1])) as on_step:
-        for first, last, lo, hi in runs.T.tolist():
-            t0, t1, u0, rate = float(starts[first]), float(ends[last]), float(u0s[first]), float(rates[first])
-            try:
-                thetas, omegas, theta, omega = integrate_piece(
-                    theta, omega, (t0, t1), (u0, rate), model, (rtol, atol), np.clip(ordered[lo:hi], t0, t1), on_step
-                )
-            except Diverged as error:
-                raise _failed(str(error), t0, parameters, theta0, omega0, pieces) from None
-            mine = slice(lo, hi) if order is None else order[lo:hi]
-            out["theta"][mine], out["omega"][mine] = thetas, omegas
-    out["torque"] = pieces.values_after(at)
-    # The end of the run reports the torque the last piece reached, as a master reads it back.
-    at_end = at >= ends[-1]
-    out["torque"][at_end] = u0s[-1] + rates[-1] * (ends[-1] - starts[-1])
-    with np.errstate(over="ignore", invalid="ignore"):
-        out["alpha"] = acceleration(out["theta"], out["omega"], out["torque"])
-    if not np.isfinite(out["alpha"]).all():  # the states stayed finite, the acceleration did not
-        at_time = float(out["time"][np.flatnonzero(~np.isfinite(out["alpha"]))[0]])
-        raise _failed("the acceleration is not finite", at_time, parameters, theta0, omega0, pieces)
-    return out
+        Raises
+        ------
+        InvalidInput
+            A time of `at` outside the window, every window integrated already, or values with
+            which the series does not converge.
+        """
+        return self._next(at, check=True)
 
-
-def _failed(why: str, t: float, parameters: dict, theta0: float, omega0: float, pieces: Pieces) -> InvalidInput:
-    """The one-line error for an integration these values break, naming every value."""
-    values = ", ".join(
-        f"{name} = {value:g}" for name, value in {**parameters, "theta0": theta0, "omega0": omega0}.items()
-    )
-    torque = max(abs(u) for u in pieces.u0)
-    return InvalidInput(
-        f"the reference cannot integrate the pendulum from t = {t:g} s with {values} "
-        f"and torques up to {torque:g}: {why.rstrip('.')}; values near the largest "
-        "double (mass*gravity*length, mass*length^2, the torque over the inertia) "
-        "break it: give physically meaningful values"
-    )
+    def _next(self, at, *, check: bool) -> np.ndarray:
+        j = self._done
+        if j >= self.windows:
+            raise InvalidInput(f"the run's {self.windows} windows are integrated: next() has no window left")
+        runs, self._first = (self._first, None) if j == 0 else (Runs(self._window(*self._bounds(j))), None)
+        times = np.asarray(at, dtype=float)
+        if check:
+            what = "the run" if self.windows == 1 else f"window {j} of the run"
+            times = _times(at, runs.pieces, self._step, what)
+        final = j == self.windows - 1
+        out, *state = integrate_window(runs, times, self._model, self._state, self._on_step, final)
+        self._state, self._done = tuple(state), j + 1
+        return out
 
 
 def reference(
@@ -212,6 +199,17 @@ def reference(
     >>> bool(abs(simulate(20.0, stop_time=1.0)["theta"] - oracle["theta"]).max() < 1e-9)
     True
     """
+    signal = _read_signal(torque, start_time, stop_time, step_size, ramp, max_steps, check_memory=True)
+    # The whole run is one window: reference_windows' code, so that the two cannot part.
+    pieces = signal.window(0, signal.steps)
+    at = _times(time_doubles(pieces.points) if at is None else at, pieces, signal.step)
+    model = Model(parameters, theta0, omega0, rtol, atol, fmu_path)
+    with ReferenceWindows(signal.window, signal.steps, signal.step, model, signal.steps, first=pieces) as oracle:
+        return oracle._next(at, check=False)
+
+
+def _read_signal(torque, start_time, stop_time, step_size, ramp, max_steps, check_memory: bool) -> SignalWindows:
+    """The signal, read by the oracle's own reader once; InvalidInput in reference()'s words."""
     if not (isinstance(torque, (str, Path, list, tuple, np.ndarray, int, float)) or callable(torque)):
         raise InvalidInput(
             f"the reference takes a constant, a callable, a per-step array or a CSV path, "
@@ -221,14 +219,11 @@ def reference(
         raise InvalidInput("a per-step torque array is held over each step; ramp needs a CSV or a callable")
     step, start = seconds("step size", step_size), seconds("start time", start_time)
     stop = None if stop_time is None else seconds("stop time", stop_time)
-    pieces = signal_pieces(torque, start, stop, step, ramp, max_steps)
-    if at is None:
-        at = time_doubles(pieces.points)
-    return _integrate(pieces, _times(at, pieces, step), parameters, theta0, omega0, rtol, atol, fmu_path)
+    return SignalWindows(torque, start, stop, step, ramp, max_steps, check_memory=check_memory)
 
 
-def _times(at, pieces: Pieces, step: Fraction) -> np.ndarray:
-    """The times to report: within the run, or a rounding past its ends."""
+def _times(at, pieces: Pieces, step: Fraction, what: str = "the run") -> np.ndarray:
+    """The times to report: within the run (or the window), or a rounding past its ends."""
     try:
         times = np.asarray(at, dtype=float)
     except (TypeError, ValueError):
@@ -238,7 +233,7 @@ def _times(at, pieces: Pieces, step: Fraction) -> np.ndarray:
     outside = times.ravel()[~((times.ravel() >= earliest) & (times.ravel() <= latest))]
     if times.ndim != 1 or len(outside):
         shown = float(outside[0]) if len(outside) else at
-        raise InvalidInput(f"at: {shown!r} is no time of the run, {float(start):g} to {float(stop):g} s")
+        raise InvalidInput(f"at: {shown!r} is no time of {what}, {float(start):g} to {float(stop):g} s")
     return times
 
 
@@ -252,6 +247,7 @@ def reference_schedule(
     rtol: float = 1e-14,
     atol: float = 1e-14,
     fmu_path: Fmu = None,
+    show_progress: bool = True,
 ) -> np.ndarray:
     """Integrate exactly the torques of a schedule, reported at its communication points (or at
     the times `at`): the judge of a tool that was fed that schedule, and the judge's variants of
@@ -265,6 +261,9 @@ def reference_schedule(
         As reference() takes them.
     at : numpy.ndarray, optional
         The times to report, in s (default: the schedule's communication points).
+    show_progress : bool, optional
+        Show the progress bar of a long run (False: a caller showing its own, the judge's a
+        window of the run at a time); the run is refused past MAX_STEPS either way.
 
     Returns
     -------
@@ -295,13 +294,71 @@ def reference_schedule(
     points, u0, rate = plan.time, plan.torque, plan.torque_rate
     # The schedule's points are the tools' own: no tolerance beyond rounding.
     pieces = Pieces(points[:-1], points[-1], u0, rate, points, Holding(points, u0, Fraction(0)).values_after)
-    return _integrate(
-        pieces,
-        np.asarray(plan.time if at is None else at, dtype=float),
-        parameters,
-        theta0,
-        omega0,
-        rtol,
-        atol,
-        fmu_path,
-    )
+    model = Model(parameters, theta0, omega0, rtol, atol, fmu_path)
+    oracle = ReferenceWindows(lambda k0, k1: pieces, 1, None, model, 1, first=pieces, show_progress=show_progress)
+    with oracle:
+        return oracle._next(plan.time if at is None else at, check=False)
+
+
+def reference_windows(
+    torque=20.0,
+    *,
+    start_time: float = 0.0,
+    stop_time: float | None = None,
+    step_size: float = 1e-3,
+    ramp: bool = False,
+    parameters: dict | None = None,
+    theta0: float = 0.0,
+    omega0: float = 0.0,
+    rtol: float = 1e-14,
+    atol: float = 1e-14,
+    fmu_path: Fmu = None,
+    max_steps: int | None = None,
+    window_steps: int = WINDOW_STEPS,
+) -> ReferenceWindows:
+    """reference()'s run integrated a window of grid steps at a time, for a run too long to hold.
+
+    Window j is the grid steps j * window_steps to min((j + 1) * window_steps, N) of the oracle's
+    own grid, as schedule_windows() splits the schedule's. Each check reference() makes is made
+    here, at the call, in its words: the signal is read (once, by the oracle's own reader), and
+    the whole run's work estimated, window by window, and refused past MAX_STEPS before anything
+    is integrated (a callable is sampled for the estimate, then again as each window is
+    integrated). Memory: a window's pieces and reports at a time, beside a CSV's table.
+
+    Parameters
+    ----------
+    torque, start_time, stop_time, step_size, ramp, parameters, theta0, omega0, rtol, atol, fmu_path, max_steps
+        As reference() takes them; the machine's free memory is not checked against the run,
+        whose arrays are never held whole.
+    window_steps : int, optional
+        Grid steps per window (default WINDOW_STEPS).
+
+    Returns
+    -------
+    ReferenceWindows
+        A context manager: within ``with``, a progress bar of the whole run from BAR_FROM
+        estimated steps. windows is their number; next(at) integrates the next window from the
+        state the one before ended with (at its last grid point, whatever the times reported)
+        and returns the result at the times `at`, increasing, each within the window's first and
+        last grid points widened by the event tolerance.
+
+    Raises
+    ------
+    InvalidInput
+        As reference() raises it, at the call; from next(), a time outside its window, or a
+        call past the last window.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from pendulum_fmu.oracle._reference import reference, reference_windows
+    >>> with reference_windows(20.0, stop_time=1.0, window_steps=300) as oracle:
+    ...     runs = [oracle.next(np.linspace(0.3 * j, min(0.3 * (j + 1), 1.0), 4)) for j in range(oracle.windows)]
+    >>> oracle.windows, round(float(runs[-1]["theta"][-1]), 6)
+    (4, 0.187205)
+    """
+    if not (isinstance(window_steps, numbers.Integral) and window_steps >= 1):
+        raise InvalidInput(f"window steps {window_steps!r} must be a whole number of steps, at least 1")
+    signal = _read_signal(torque, start_time, stop_time, step_size, ramp, max_steps, check_memory=False)
+    model = Model(parameters, theta0, omega0, rtol, atol, fmu_path)
+    return ReferenceWindows(signal.window, signal.steps, signal.step, model, int(window_steps))
