@@ -31,7 +31,6 @@ from pendulum_fmu.judging._diagnoses import (
 )
 from pendulum_fmu.judging._judge import judge
 from pendulum_fmu.judging._result_file import ResultFileError, read_result
-from pendulum_fmu.oracle._reference import reference
 from pendulum_fmu.scenarios._scenario_settings import KIT_FMU, read_settings
 from pendulum_fmu.scenarios._scenarios import write_scenarios
 
@@ -75,7 +74,7 @@ def test_the_diagnosed_variant_holds_at_fewer_points_than_steps(kit):
     lines = out.read_text().splitlines()
     out.write_text("\n".join(lines[:1] + lines[1::10]) + "\n")
     judgement = _judged(kit, "random_steps")
-    assert judgement.diagnosis == LATE and len(judgement.result) == 401
+    assert judgement.diagnosis == LATE and judgement.points == 401
     assert judgement.residual < 1e-10
 
 
@@ -280,7 +279,8 @@ def _same_judgement(together, alone):
     assert together.candidates == alone.candidates
     assert together.smallest_input_effect == alone.smallest_input_effect
     assert together.regression_tools == alone.regression_tools
-    assert np.array_equal(together.reference, alone.reference)
+    for name in together.drawn.dtype.names:
+        assert np.array_equal(together.drawn[name], alone.drawn[name], equal_nan=True)
 
 
 def _results_of(kit, tmp_path, name, mistakes):
@@ -310,7 +310,15 @@ def test_many_results_judged_together_are_judged_as_each_alone(kit, tmp_path, na
     settings = read_settings(kit / f"{name}.json")
     settings.pop("output")
     references = []
-    monkeypatch.setattr(_judge, "reference", lambda *a, **k: references.append(k["at"]) or reference(*a, **k))
+    oracle_of = _judge.reference_windows
+
+    def counted(*args, **kwargs):
+        oracle = oracle_of(*args, **kwargs)
+        integrate = oracle.next
+        oracle.next = lambda at: references.append(at) or integrate(at)
+        return oracle
+
+    monkeypatch.setattr(_judge, "reference_windows", counted)
     together = judge_results(paths, **settings)
     monkeypatch.undo()
     assert len(together) == len(paths)

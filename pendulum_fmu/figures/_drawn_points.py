@@ -5,7 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 
-def drawn_points(time: np.ndarray, *series: np.ndarray, columns: int = 2000) -> np.ndarray:
+def drawn_points(
+    time: np.ndarray, *series: np.ndarray, columns: int = 2000, span: tuple[float, float] | None = None
+) -> np.ndarray:
     """The indices of the points a figure of a long run draws: in each of `columns` equal spans
     of time (more than a figure's columns of pixels), the first and last point and where each
     series is least and greatest, so that no extreme is lost; every point of a short run.
@@ -18,6 +20,10 @@ def drawn_points(time: np.ndarray, *series: np.ndarray, columns: int = 2000) -> 
         The values drawn against them.
     columns : int, optional
         The spans of time.
+    span : (float, float), optional
+        The first span's start and the last one's end (s; default: the first and last time): a
+        stretch of a longer run, whose points are drawn again with the others, takes the run's
+        spans, so that an extreme kept of each stretch is the extreme of its span.
 
     Returns
     -------
@@ -35,8 +41,9 @@ def drawn_points(time: np.ndarray, *series: np.ndarray, columns: int = 2000) -> 
     count = len(time)
     if count <= 2 * columns * (len(series) + 1):
         return np.arange(count)
-    span = float(time[-1] - time[0])
-    column = np.minimum(((time - time[0]) * (columns / span)).astype(np.int64), columns - 1)
+    start, stop = (float(time[0]), float(time[-1])) if span is None else span
+    width = (stop - start) or 1.0
+    column = np.clip(((time - start) * (columns / width)).astype(np.int64), 0, columns - 1)
     starts = np.flatnonzero(np.r_[True, np.diff(column) != 0])
     sizes = np.diff(np.r_[starts, count])
     kept = [starts, starts + sizes - 1]

@@ -19,7 +19,6 @@ from numpy.typing import ArrayLike
 from .._atomic_files import replacing_path
 from .._errors import InvalidInput
 from ..fmu._parameters import Fmu, merged_parameters, unit
-from ._drawn_points import drawn_points
 
 THETA_LABEL = r"Position $\theta$ in rad"
 OMEGA_LABEL = r"Velocity $\omega$ in rad/s"
@@ -394,21 +393,18 @@ def plot_judgement(judgement, path: str | Path, title: str) -> Path:
     reference (rad, log), with the tolerance. Exact zeros are said in words, not drawn. A long
     run is drawn from drawn_points: a few thousand points that keep every extreme.
     """
-    result, reference, variant = judgement.result, judgement.reference, judgement.explanation
-    difference = result["theta"] - reference["theta"]
-    zeros, points = int(np.count_nonzero(difference == 0)), len(difference)
-    drawn = [reference["torque"], reference["theta"], result["theta"], difference]
-    if variant is not None:
-        drawn += [variant["torque"], variant["theta"] - reference["theta"]]
-    kept = drawn_points(result["time"], *drawn)
-    time, torque, theta, given, difference = (values[kept] for values in [result["time"], *drawn[:4]])
+    drawn = judgement.drawn
+    time, torque, theta, given = drawn["time"], drawn["torque"], drawn["reference"], drawn["result"]
+    difference = given - theta
+    explained = not np.all(np.isnan(drawn["explained_theta"]))
+    zeros, points = judgement.exact_zeros, judgement.points
     fig = _figure(10, 8)
     axes = fig.subplots(3, 1, sharex=True)
     axes[0].step(time, torque, where="post", linewidth=2, label="the run's torque")
-    if variant is not None and not np.array_equal(variant["torque"], reference["torque"]):
+    if explained and not np.array_equal(drawn["explained_torque"], torque):
         axes[0].step(
             time,
-            drawn[4][kept],
+            drawn["explained_torque"],
             where="post",
             linestyle="--",
             linewidth=1.5,
@@ -419,11 +415,11 @@ def plot_judgement(judgement, path: str | Path, title: str) -> Path:
     axes[1].plot(time, given, linestyle="--", linewidth=1.5, label=judgement.source)
     axes[1].set_ylabel(THETA_LABEL)
     _log_difference(axes[2], time, difference, "|result - reference|", linewidth=1.5)
-    if variant is not None:
+    if explained:
         _log_difference(
             axes[2],
             time,
-            drawn[5][kept],
+            drawn["explained_theta"] - theta,
             f"|{judgement.diagnosis} - reference|",
             linestyle="--",
             linewidth=1.5,

@@ -48,30 +48,37 @@ from pathlib import Path
 import numpy as np
 
 from .._errors import InvalidInput
+from ..fmu import _results as results
 from ..fmu._model import FmuModel, fmu_model
 from ..fmu._simulate import resolve_parameters
-from ..oracle._reference import reference
+from ..oracle._reference import reference_windows
 from ..scenarios._scenario_settings import JUDGE_TOLERANCE as DEFAULT_TOLERANCE, read_settings, settings_files
-from ..signals._torque_schedule import schedule
+from ..signals._time_grid import WINDOW_STEPS, event_tolerance
+from ..signals._torque_csv import read_torque_csv
+from ..signals._torque_schedule import schedule_windows
 from ._diagnoses import AGREES, INTEGRATION, INTEGRATORS, diagnose
-from ._judgement import Judgement, score_variants
-from ._regression_tools import regression_verdicts
-from ._result_file import ResultFileError, check_span, read_result
-from ._variants import KEEP_ROWS, Run, Variant, candidate_variants, shared_variants
+from ._judgement import Judgement
+from ._regression_tools import series_verdicts
+from ._result_file import ResultFileError, result_blocks
+from ._theta_series import ThetaSeries
+from ._variants import Run, run_variants
+from ._window_walk import KEEP_ROWS, Rows, Walk, check_first, check_last, frames, make_window, scored, window_rows
 
 
 class JudgedRun:
     """One run's definition, and what every result of it is judged against.
 
-    The schedule is made once. The reference and the variants of the candidate mistakes that do
-    not depend on the result (all but state not restored) are made once per set of result times
-    and kept for the next result on the same times: the results of one scenario share them. A
-    result of more than KEEP_ROWS rows keeps none: its variants are made one at a time.
+    A result is judged a window of WINDOW_STEPS grid steps of the run at a time (_window_walk.py),
+    in memory bounded by the window however long the run. A run of one window keeps its reference
+    and the variants that do not depend on the result (all but state not restored and single
+    precision) for the next result on the same times: the results of one scenario share them.
 
     Parameters
     ----------
     torque, start_time, stop_time, step_size, ramp, parameters, theta0, omega0, tolerance, fmu_path, max_steps
         As judge() takes them.
+    window_steps : int, optional
+        The grid steps of a window (default WINDOW_STEPS).
 
     Raises
     ------
@@ -97,50 +104,44 @@ class JudgedRun:
         tolerance: float | None = None,
         fmu_path: str | Path | FmuModel | None = None,
         max_steps: int | None = None,
+        window_steps: int = WINDOW_STEPS,
     ):
         tolerance = DEFAULT_TOLERANCE if tolerance is None else tolerance
         if not (math.isfinite(tolerance) and tolerance > 0):
             raise InvalidInput(f"the tolerance {tolerance} must be a positive finite number (rad)")
-        self.torque, self.tolerance = torque, tolerance
-        self.start_time, self.stop_time, self.step_size, self.ramp = start_time, stop_time, step_size, ramp
-        self.theta0, self.omega0, self.max_steps = theta0, omega0, max_steps
+        self.tolerance, self.ramp, self.theta0, self.omega0 = tolerance, ramp, theta0, omega0
         self.model = fmu_model(fmu_path)
         self.parameters = resolve_parameters(parameters, self.model)
-        self.plan = schedule(
-            torque, start_time=start_time, stop_time=stop_time, step_size=step_size, ramp=ramp, max_steps=max_steps
-        )
-        self.held = schedule(torque, start_time=start_time, stop_time=stop_time, step_size=step_size) if ramp else None
+        self.definition = {
+            "start_time": start_time,
+            "stop_time": stop_time,
+            "step_size": step_size,
+            "max_steps": max_steps,
+            "window_steps": window_steps,
+        }
+        # The signal as the variants sample it, read once; the oracle reads it on its own.
+        self.torque = torque
+        self.signal = read_torque_csv(torque) if isinstance(torque, (str, Path)) else torque
+        if isinstance(self.signal, (list, tuple)):
+            self.signal = np.asarray(self.signal, dtype=float)
+        self._windows(ramp)  # a run simulate() would refuse is refused here, before any result is read
         self.start_torque = float(self.model.variables["torque"].start or 0.0)
-        self._kept: dict[bytes, tuple[np.ndarray, Run, dict[str, list[Variant]]]] = {}
+        self.run = Run(self.parameters, theta0, omega0, step_size, self.model)
+        self._kept: dict[bytes, tuple] = {}
 
-    def _shared(self, times: np.ndarray) -> tuple[np.ndarray, Run, dict[str, list[Variant]]]:
-        """The reference at these times, the frame of the run's variants, and the variants every
-        result on these times shares (made here the first time, kept for the next: for a result
-        of up to KEEP_ROWS rows).
-        """
-        key = times.tobytes() if len(times) <= KEEP_ROWS else None
-        if key is None or key not in self._kept:
-            correct = reference(
-                self.torque,
-                start_time=self.start_time,
-                stop_time=self.stop_time,
-                step_size=self.step_size,
-                ramp=self.ramp,
-                parameters=self.parameters,
-                theta0=self.theta0,
-                omega0=self.omega0,
-                at=times,
-                fmu_path=self.model,
-                max_steps=self.max_steps,
-            )
-            run = Run(self.plan, times, self.step_size, self.parameters, self.theta0, self.omega0, self.model)
-            run.keep = key is not None
-            if key is None:
-                return correct, run, shared_variants(run, self.torque, self.held, self.start_torque)
-            if len(self._kept) >= self.KEPT_TIMES:
-                del self._kept[next(iter(self._kept))]
-            self._kept[key] = (correct, run, shared_variants(run, self.torque, self.held, self.start_torque))
-        return self._kept[key]
+    def _windows(self, ramp: bool):
+        return schedule_windows(self.signal, ramp=ramp, **self.definition)
+
+    def _oracle(self):
+        return reference_windows(
+            self.torque,
+            ramp=self.ramp,
+            parameters=self.parameters,
+            theta0=self.theta0,
+            omega0=self.omega0,
+            fmu_path=self.model,
+            **self.definition,
+        )
 
     def judge(self, result, mapping: str | dict | None = None) -> Judgement:
         """Judge one result of this run (judge() says how).
@@ -148,7 +149,7 @@ class JudgedRun:
         Parameters
         ----------
         result : str, Path or numpy.ndarray
-            A result CSV (read_result) or an array with fields time and theta (omega, alpha: optional).
+            A result CSV (result_blocks) or an array with fields time and theta (omega, alpha: optional).
         mapping : str or dict, optional
             The result's column names and unit factors (--map), for a CSV.
 
@@ -168,39 +169,95 @@ class JudgedRun:
         source = str(result) if isinstance(result, (str, Path)) else "result"
         if isinstance(result, (str, Path)):
             # The fields of this run's FMU: a judge of a named FMU looks no other up.
-            result = read_result(result, mapping, self.model.recorded)
+            blocks = result_blocks(result, mapping, self.model.recorded)
         elif mapping:
             raise InvalidInput(
                 "a map renames and scales a result file's columns: an array result is "
                 "judged as it is, in the fields time and theta (rad); leave out mapping"
             )
-        check_span(result, self.plan, self.step_size, source)
-        times = np.asarray(result["time"], dtype=float)
-        correct, run, shared = self._shared(times)
-        difference = np.abs(result["theta"] - correct["theta"])
-        raw = float(np.max(difference))
-        variants = candidate_variants(shared, run, correct, result, self.tolerance)
-        scores, best, smallest_input_effect = score_variants(variants, result, correct, self.tolerance)
+        else:
+            blocks = [_as_result(result, self.model.recorded)]
+        with ThetaSeries() as series, self._oracle() as oracle:
+            walk = self._walk(Rows(blocks), oracle, series, source)
+            regression_tools = series_verdicts(series)
+        by_candidate = walk.scores_by_candidate()
+        scores, best, smallest_input_effect = scored(by_candidate, self.tolerance)
+        raw = walk.raw
         if raw <= self.tolerance:
             diagnosis, residual, explained = AGREES, raw, False
         else:
             diagnosis, residual, explained = diagnose(raw, self.tolerance, scores, smallest_input_effect)
+        integrator = None
+        if explained and diagnosis == INTEGRATION:
+            integrator = next(
+                i for i, s in zip(INTEGRATORS, by_candidate[INTEGRATION], strict=False) if s is best[INTEGRATION]
+            )
         return Judgement(
             verdict="pass" if raw <= self.tolerance else "fail",
             diagnosis=diagnosis,
             residual=residual,
             max_abs_dtheta=raw,
-            worst_time=float(times[int(np.argmax(difference))]),
+            worst_time=walk.worst_time,
             tolerance=self.tolerance,
             candidates=scores,
             smallest_input_effect=smallest_input_effect,
-            result=result,
-            reference=correct,
-            explanation=variants[diagnosis][best[diagnosis]]() if diagnosis in best else None,
+            points=walk.rows,
+            exact_zeros=walk.exact_zeros,
+            optional_differences={
+                f"max_abs_d{name}": value for name, value in walk.optional.items() if not math.isnan(value)
+            },
+            drawn=walk.drawn_array(best.get(diagnosis)),
             source=source,
-            integrator=INTEGRATORS[best[INTEGRATION]] if explained and diagnosis == INTEGRATION else None,
-            regression_tools=regression_verdicts(times, correct["theta"], result["theta"]),
+            integrator=integrator,
+            regression_tools=regression_tools,
         )
+
+    def _walk(self, rows: Rows, oracle, series: ThetaSeries, source: str) -> Walk:
+        """Walk the result's rows through the run's windows (_window_walk.py)."""
+        plans = self._windows(self.ramp)
+        span = (plans.start_time, plans.stop_time)
+        empty = results.empty(0, self.model.recorded)
+        step_size = self.definition["step_size"]
+        walk = variants = None
+        held = self._windows(False) if self.ramp else None
+        for number, (frame, held_frame, last) in enumerate(frames(plans, held)):
+            taken = window_rows(rows, frame, last, step_size, empty)
+            times = np.asarray(taken["time"], dtype=float)
+            points = frame.plan.time
+            slack = float(event_tolerance(max(abs(span[0]), abs(span[1])), step_size))
+            if number == 0:
+                first = float(times[0]) if len(times) else rows.first_time
+                check_first(source, first, span[0], float(points[1] - points[0]), slack)
+            if last:
+                # Refused before the reference integrates a row outside the run.
+                final = float(times[-1]) if len(times) else rows.last_time
+                check_last(source, final, span[1], float(points[frame.end] - points[frame.end - 1]), slack)
+            window = make_window(frame, held_frame, times, number == 0, last, step_size)
+            key = times.tobytes() if number == 0 and last and len(times) <= KEEP_ROWS else None
+            kept = self._kept.get(key) if key is not None else None
+            if kept is not None:
+                correct, variants, outputs = kept
+            else:
+                correct = oracle.next(times)
+                variants = variants or run_variants(self.run, frame.plan, self.signal, self.ramp, self.start_torque)
+                outputs = {} if key is not None else None
+            walk = walk or Walk(variants, self.tolerance, span, series)
+            walk.window(window, taken, correct, outputs)
+            if key is not None and kept is None:
+                if len(self._kept) >= self.KEPT_TIMES:
+                    del self._kept[next(iter(self._kept))]
+                self._kept[key] = (correct, variants, outputs)
+        return walk
+
+
+def _as_result(result: np.ndarray, recorded) -> np.ndarray:
+    """An array result (fields time and theta; omega and alpha optional) as a result array."""
+    names = result.dtype.names or ()
+    out = results.empty(len(result), recorded)
+    for name in ("time", "theta", "omega", "alpha"):
+        if name in names:
+            out[name] = result[name]
+    return out
 
 
 def judge(

@@ -11,10 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from .._atomic_files import replacing
-from ._diagnoses import INPUT_TIMING
 from ._regression_tools import format_verdicts
-from ._result_file import OPTIONAL
-from ._variants import Variant
 
 
 @dataclass
@@ -34,8 +31,17 @@ class Judgement:
         Per candidate mistake, the residual of its best variant (rad); None where it does not apply.
     smallest_input_effect : float or None
         The smallest difference an input-timing variant makes to this run (rad).
-    result, reference, explanation : numpy.ndarray
-        The result as read, the reference at its times, the variant the diagnosis names.
+    points : int
+        The result's rows.
+    exact_zeros : int
+        The rows where theta equals the reference's exactly.
+    optional_differences : dict
+        max |domega| (rad/s) and max |dalpha| (rad/s2), of those the result gives at every row.
+    drawn : numpy.ndarray
+        The points a figure draws: every row of a short result; of a long one, every extreme per
+        column of time (drawn_points). Fields time, torque (the run's, N.m), reference and result
+        (theta, rad), explained_torque and explained_theta (the variant the diagnosis names; NaN
+        for agrees and unexplained).
     source : str
         The result file's name, as reports show it.
     integrator : str or None
@@ -69,10 +75,10 @@ class Judgement:
     # The smallest difference from the reference an input-timing variant that changes this run
     # makes (rad; None when none does): an integration error must be small beside it.
     smallest_input_effect: float | None
-    result: np.ndarray = field(repr=False)
-    reference: np.ndarray = field(repr=False)
-    # The variant the diagnosis names, at the result's times (None for agrees and unexplained).
-    explanation: np.ndarray | None = field(default=None, repr=False)
+    points: int
+    exact_zeros: int
+    optional_differences: dict[str, float]
+    drawn: np.ndarray = field(repr=False)
     source: str = "result"
     integrator: str | None = None
     # csv-compare's tube and the FMI cross-check's band on theta (regression_tools.regression_verdicts).
@@ -85,11 +91,6 @@ class Judgement:
 
     def summary(self) -> dict:
         """What --json writes: plain numbers, rad and s."""
-        worst = {}
-        for name in OPTIONAL:
-            given = self.result[name] if name in (self.result.dtype.names or ()) else np.nan
-            if np.all(np.isfinite(given)):
-                worst[f"max_abs_d{name}"] = float(np.max(np.abs(given - self.reference[name])))
         return {
             "result": self.source,
             "verdict": self.verdict,
@@ -97,10 +98,10 @@ class Judgement:
             "integrator": self.integrator,
             "residual": self.residual,
             "max_abs_dtheta": self.max_abs_dtheta,
-            **worst,
+            **self.optional_differences,
             "worst_time": self.worst_time,
             "tolerance": self.tolerance,
-            "points": len(self.result),
+            "points": self.points,
             "candidates": self.candidates,
             "smallest_input_effect": self.smallest_input_effect,
             "regression_tools": self.regression_tools,
@@ -115,33 +116,6 @@ class Judgement:
                 "smallest_input_effect": "rad",
             },
         }
-
-
-def score_variants(
-    variants: dict[str, list[Variant]], result: np.ndarray, correct: np.ndarray, tolerance: float
-) -> tuple[dict[str, dict | None], dict[str, int], float | None]:
-    """Per candidate, the residual and effect of its best variant (None where it does not apply);
-    that variant's index in its list; and the smallest effect above the tolerance of an
-    input-timing variant. Each variant is made, scored and let go before the next is made.
-    """
-    scores: dict[str, dict | None] = {}
-    best: dict[str, int] = {}
-    timing_effects: list[float] = []
-    for name, made in variants.items():
-        if not made:
-            scores[name] = None
-            continue
-        residuals, effects = [], []
-        for make in made:
-            theta = make()["theta"]
-            residuals.append(float(np.max(np.abs(result["theta"] - theta))))
-            effects.append(float(np.max(np.abs(theta - correct["theta"]))))
-        if name in INPUT_TIMING:
-            timing_effects += [effect for effect in effects if effect > tolerance]
-        i = int(np.argmin(residuals))
-        best[name] = i
-        scores[name] = {"residual": residuals[i], "effect": effects[i]}
-    return scores, best, min(timing_effects, default=None)
 
 
 def format_judgement(judgement: Judgement) -> str:
@@ -162,7 +136,7 @@ def format_judgement(judgement: Judgement) -> str:
     lines = [
         f"{judgement.source}: {judgement.verdict}: {named} (residual {judgement.residual:.2e} rad)",
         f"max |dtheta| = {judgement.max_abs_dtheta:.3e} rad at t = {judgement.worst_time!r} s "
-        f"(tolerance {judgement.tolerance:g} rad; {len(judgement.result)} points)",
+        f"(tolerance {judgement.tolerance:g} rad; {judgement.points} points)",
         f"{'candidate':<28} {'residual rad':>12} {'effect rad':>11}",
     ]
     for name, score in judgement.candidates.items():
@@ -239,4 +213,4 @@ def write_json(verdicts: dict[str, Judgement | None] | Judgement | list[Judgemen
     return Path(path)
 
 
-__all__ = ["Judgement", "format_judgement", "format_kit", "score_variants", "write_json"]
+__all__ = ["Judgement", "format_judgement", "format_kit", "write_json"]

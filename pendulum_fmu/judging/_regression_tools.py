@@ -28,6 +28,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from ._theta_series import ThetaSeries, series_of
+
 CSV_COMPARE_TOLERANCE = 0.002  # csv-compare's default --tolerance
 # The tube's times taken at once (tube_envelopes).
 _BLOCK = 1 << 16
@@ -52,6 +54,9 @@ class ToolVerdict:
         The tube's half-width in time (s); for the band, half its running window (s).
     half_height : float
         The tube's or band's half-height beside the reference (the signal's unit).
+    note : str or None
+        What the verdict rests on beyond the tool's rule: for the band of a long run, that its
+        1,000 samples of the reference miss the reference's swings.
     """
 
     tool: str
@@ -60,6 +65,7 @@ class ToolVerdict:
     points: int
     half_width: float
     half_height: float
+    note: str | None = None
 
 
 def _base(values: np.ndarray, smallest: float) -> float:
@@ -264,13 +270,91 @@ def regression_verdicts(times, reference, result) -> list[dict]:
     >>> [v["passed"] for v in regression_verdicts(t, t**2, (t - 0.01) ** 2)]
     [True, True]
     """
+    arrays = (np.asarray(values, dtype=float) for values in (times, reference, result))
+    with series_of(*arrays) as series:
+        return series_verdicts(series)
+
+
+def series_verdicts(series: ThetaSeries) -> list[dict]:
+    """regression_verdicts of a result judged a window at a time: two passes over its spilled
+    rows, a block at a time (the tube's reach either side of a block read with it).
+
+    Parameters
+    ----------
+    series : ThetaSeries
+        The result's times and theta, and the reference's theta at them.
+
+    Returns
+    -------
+    list of dict
+        As regression_verdicts.
+    """
+    first, last = series.first_time, series.last_time
+    half_width = CSV_COMPARE_TOLERANCE * ((last - first) or abs(last) or 1.0)
+    span = series.highest - series.lowest
+    half_height = CSV_COMPARE_TOLERANCE * (span or abs(series.highest) or 1e-16)
+    samples, window = 1000, 21  # fmpy.cross_check.validate_signal's defaults, the rules' band
+    band_time = np.linspace(first, last, samples)
+    band = _resampled(series, band_time)
+    low, high = float(np.min(band)), float(np.max(band))
+    if low == high:
+        width = 0.5 if low == 0 else abs(low) * 0.1
+    else:
+        width = (high - low) * 0.1
+    band_lower, band_upper = _running(band, window, np.min) - width, _running(band, window, np.max) + width
+    tube_outside = band_outside = reference_outside = 0
+    for time, reference, theta in series.blocks():
+        near_time, near_theta = series.reference_between(time[0] - half_width, time[-1] + half_width)
+        lower, upper = tube_envelopes(near_time, near_theta, time, half_width, half_height)
+        tube_outside += int(np.count_nonzero((theta < lower) | (theta > upper)))
+        lower, upper = np.interp(time, band_time, band_lower), np.interp(time, band_time, band_upper)
+        band_outside += int(np.count_nonzero((theta < lower) | (theta > upper)))
+        reference_outside += int(np.count_nonzero((reference < lower) | (reference > upper)))
     return [
-        asdict(verdict)
-        for verdict in (
-            csv_compare_tube(times, reference, times, result),
-            cross_check_band(times, reference, times, result),
-        )
+        asdict(ToolVerdict("csv-compare tube", tube_outside == 0, tube_outside, series.rows, half_width, half_height)),
+        asdict(
+            ToolVerdict(
+                "FMI cross-check band",
+                band_outside <= CROSS_CHECK_OUTSIDE_SHARE * series.rows,
+                band_outside,
+                series.rows,
+                float((window // 2) * (band_time[-1] - band_time[0]) / (samples - 1)),
+                0.1 * (high - low or abs(high) or 5.0),
+                _coarse_band(reference_outside, series.rows, band_time),
+            )
+        ),
     ]
+
+
+def _coarse_band(reference_outside: int, rows: int, band_time: np.ndarray) -> str | None:
+    """A line saying the band cannot follow the signal: the reference itself lies outside it
+    (its 1,000 samples, one every band_time's spacing, miss the reference's swings); or None.
+    """
+    if not reference_outside:
+        return None
+    return (
+        f"the reference itself lies outside it at {reference_outside:,} of {rows:,} points: its 1,000 "
+        f"samples, one every {band_time[1] - band_time[0]:.3g} s, are coarser than the signal"
+    )
+
+
+def _resampled(series: ThetaSeries, at: np.ndarray) -> np.ndarray:
+    """The reference's line at the times `at` (increasing, within the series), of repeated times
+    the first row's value, as fmpy keeps them: a block at a time, with the last row kept before it.
+    """
+    out = np.empty(len(at))
+    done = 0
+    kept_time, kept_theta = np.empty(0), np.empty(0)
+    for time, theta, _ in series.blocks():
+        xp, fp = np.r_[kept_time, time], np.r_[kept_theta, theta]
+        first = np.r_[True, np.diff(xp) > 0]
+        xp, fp = xp[first], fp[first]
+        reached = done + int(np.searchsorted(at[done:], xp[-1], side="right"))
+        out[done:reached] = np.interp(at[done:reached], xp, fp)
+        done = reached
+        kept_time, kept_theta = xp[-1:], fp[-1:]
+    out[done:] = kept_theta[-1]
+    return out
 
 
 def format_verdicts(verdicts: list[dict]) -> list[str]:
@@ -294,6 +378,7 @@ def format_verdicts(verdicts: list[dict]) -> list[str]:
     return [
         f"{v['tool']}: {'pass' if v['passed'] else 'fail'} ({v['outside']} of {v['points']} points "
         f"outside; +-{v['half_width']:.3g} s, +-{v['half_height']:.3g} rad)"
+        + (f"; {v['note']}" if v.get("note") else "")
         for v in verdicts
     ]
 
@@ -305,5 +390,6 @@ __all__ = [
     "csv_compare_tube",
     "format_verdicts",
     "regression_verdicts",
+    "series_verdicts",
     "tube_envelopes",
 ]

@@ -20,8 +20,6 @@ from .._errors import InvalidInput
 from .._received_files import bounded_lines, shortened
 from ..comparing._mapped_fmu import as_map
 from ..fmu import _results as results
-from ..signals._time_grid import event_tolerance
-from ..signals._torque_schedule import TorqueSchedule
 
 RESULT_QUANTITIES = ("time", "theta", "omega", "alpha")
 
@@ -65,9 +63,7 @@ def read_result(
 ) -> np.ndarray:
     """A result CSV as a result array (_results.py); omega and alpha are NaN where it has none.
 
-    The file is read as it is when the reading starts (its size then): a file larger than
-    ARROW_BYTES by pyarrow's CSV reader, in blocks, only the judged columns converted; a smaller
-    one, or one pyarrow refuses, row by row, which names the first row that cannot be judged.
+    The blocks of result_blocks, joined: a long result is better judged block by block.
 
     Parameters
     ----------
@@ -87,20 +83,61 @@ def read_result(
     Raises
     ------
     ResultFileError
+        As result_blocks.
+    """
+    return np.concatenate(list(result_blocks(path, mapping, recorded)))
+
+
+def result_blocks(
+    path: str | Path, mapping: str | dict | None = None, recorded: Sequence[str] | None = None
+) -> Iterator[np.ndarray]:
+    """A result CSV as result arrays of consecutive rows, a block at a time, checked as read.
+
+    The file is read as it is when the reading starts (its size then): a file larger than
+    ARROW_BYTES by pyarrow's CSV reader, a block of about 16 MB at a time, only the judged columns
+    converted; a smaller one, or the rest of one where pyarrow refuses a block, row by row, which
+    names the first row that cannot be judged. Nothing of the file is held beyond a block.
+
+    Parameters
+    ----------
+    path, mapping, recorded
+        As read_result takes them.
+
+    Yields
+    ------
+    numpy.ndarray
+        Fields time (s), torque (NaN: not judged), theta (rad), omega (rad/s), alpha (rad/s2):
+        at least one block, none empty.
+
+    Raises
+    ------
+    ResultFileError
         One line naming the file, the line and the problem: no time column, a mapped column
         missing, a cell that is not a finite number, times that go backwards, a last line cut
-        short, no rows; or a file that grew or shrank while it was read (a master still writing it).
+        short, no rows; or a file that grew or shrank while it was read (a master still writing
+        it), said once the last block is read.
     """
     path = Path(path)
     mapped = as_map(mapping, RESULT_QUANTITIES)
     try:
-        with open(path, "rb") as raw:
+        raw = open(path, "rb")
+    except OSError as error:
+        raise ResultFileError(f"{path}: cannot read: {error.strerror}") from None
+    with raw:
+        try:
             regular = stat.S_ISREG(os.fstat(raw.fileno()).st_mode)
             # A pipe (judge <(...)) is read once, whole: it cannot be read again from its start.
             whole = b"" if regular else raw.read()
-            source = raw if regular else io.BytesIO(whole)
-            size = os.fstat(raw.fileno()).st_size if regular else len(whole)
-            values = _read(path, source, size, mapped)
+        except OSError as error:
+            raise ResultFileError(f"{path}: cannot read: {error.strerror}") from None
+        source = raw if regular else io.BytesIO(whole)
+        size = os.fstat(raw.fileno()).st_size if regular else len(whole)
+        for columns in _read(path, source, size, mapped):
+            out = results.empty(len(columns["time"]), recorded)
+            for quantity, values in columns.items():
+                out[quantity] = values
+            yield out
+    try:
         now = path.stat().st_size if regular else size
     except OSError as error:
         raise ResultFileError(f"{path}: cannot read: {error.strerror}") from None
@@ -109,24 +146,12 @@ def read_result(
             f"{path}: the file went from {size:,} to {now:,} bytes while it was read: a master is "
             "still writing it; judge it once the run has finished"
         )
-    out = results.empty(sum(map(len, values["time"])), recorded)
-    out["torque"] = np.nan
-    for quantity in OPTIONAL:
-        out[quantity] = np.nan
-    # Block by block into the result: no whole column is made beside it.
-    for quantity, parts in values.items():
-        begin = 0
-        for part in parts:
-            out[quantity][begin : begin + len(part)] = part
-            begin += len(part)
-    del values
-    if "pyarrow" in sys.modules:  # it read the blocks, now let go: its pool hands their memory back
-        sys.modules["pyarrow"].default_memory_pool().release_unused()
-    return out
 
 
-def _read(path: Path, raw: io.BufferedIOBase, size: int, mapped: dict) -> dict[str, list[np.ndarray]]:
-    """{quantity: its column in SI, in blocks} of the file's first size bytes (read_result)."""
+def _read(path: Path, raw: io.BufferedIOBase, size: int, mapped: dict) -> Iterator[dict[str, np.ndarray]]:
+    """{quantity: its column in SI} of the file's first size bytes, a block of rows at a time
+    (result_blocks).
+    """
     cut = _ends_mid_line(raw, size)
     try:
         with _text(raw, size) as text:
@@ -136,16 +161,26 @@ def _read(path: Path, raw: io.BufferedIOBase, size: int, mapped: dict) -> dict[s
                 raise ResultFileError(f"{path}: the file is empty; expected a header such as time,theta")
             header = [cell.strip() for cell in found[1]]
             columns = _columns(path, header, mapped)
-            if found[0] == 1 and size > ARROW_BYTES:
-                fast = _read_arrow(raw, size, len(header), columns)
-                if fast is not None:
-                    return fast
-                # Read again row by row: the first row pyarrow could not take is named.
-                with _text(raw, size) as again:
-                    rows = _numbered_rows(path, again)
-                    next(rows)
-                    return _read_rows(path, rows, columns, cut)
-            return _read_rows(path, rows, columns, cut)
+            if not (found[0] == 1 and size > ARROW_BYTES):
+                yield from _read_rows(path, rows, columns, cut)
+                return
+        read = 0
+        for block in _read_arrow(raw, size, len(header), columns):
+            if block is None:
+                break
+            read += len(block["time"])
+            yield block
+        else:
+            if read:
+                if pyarrow := sys.modules.get("pyarrow"):  # its blocks let go: its pool hands their memory back
+                    pyarrow.default_memory_pool().release_unused()
+                return
+        # Read again row by row from the start: the first row pyarrow could not take is named,
+        # or the rows it could not take are read.
+        with _text(raw, size) as again:
+            rows = _numbered_rows(path, again)
+            next(rows)
+            yield from _read_rows(path, rows, columns, cut, skip=read)
     except csv.Error as error:  # a quoted cell across lines, over csv.field_size_limit()
         raise ResultFileError(f"{path}: not a CSV the judge reads ({error}); {_GIVE_CSV}") from None
     except UnicodeDecodeError:
@@ -210,16 +245,18 @@ def _ends_mid_line(raw: io.BufferedIOBase, size: int) -> bool:
     return raw.read(1) not in (b"\n", b"\r")
 
 
-def _read_arrow(raw: io.BufferedIOBase, size: int, width: int, columns: dict) -> dict[str, list[np.ndarray]] | None:
-    """The columns in blocks by pyarrow's CSV reader, only those judged converted; None when it
-    refuses a row or one is not finite, or the times go backwards (_read_rows then names the row).
-    pyarrow is imported here only: it takes longer to import than a short result to read.
+def _read_arrow(raw: io.BufferedIOBase, size: int, width: int, columns: dict) -> Iterator[dict[str, np.ndarray] | None]:
+    """The columns a block at a time by pyarrow's CSV reader, only those judged converted, then
+    None where it refuses a row, one is not finite or the times go backwards (_read_rows then
+    names the row). pyarrow is imported here only: it takes longer to import than a short result
+    to read.
     """
     import pyarrow as pa
     from pyarrow import csv as pa_csv
 
     names = [f"c{index}" for index in range(width)]
     wanted = {quantity: names[index] for quantity, (index, _) in columns.items()}
+    last = -math.inf
     try:
         reader = pa_csv.open_csv(
             io.BufferedReader(_Snapshot(raw, size), buffer_size=_BLOCK_BYTES),
@@ -228,26 +265,24 @@ def _read_arrow(raw: io.BufferedIOBase, size: int, width: int, columns: dict) ->
                 include_columns=list(wanted.values()), column_types=dict.fromkeys(wanted.values(), pa.float64())
             ),
         )
-        # Each block's columns as arrays over pyarrow's own memory (no copy without nulls), in SI.
-        blocks = [
-            {
+        for batch in reader:
+            if not batch.num_rows:
+                continue
+            block = {
                 q: _in_si(batch.column(wanted[q]).to_numpy(zero_copy_only=False), factor)
                 for q, (_, factor) in columns.items()
             }
-            for batch in reader
-        ]
+            time = block["time"]
+            # Nulls (an empty cell, NA) are NaN too.
+            if not all(np.isfinite(values).all() for values in block.values()) or (
+                time[0] < last or np.any(np.diff(time) < 0)
+            ):
+                yield None
+                return
+            last = time[-1]
+            yield block
     except (pa.ArrowException, ValueError):
-        return None
-    last = -math.inf
-    for block in blocks:
-        # Nulls (an empty cell, NA) are NaN too.
-        if not all(np.isfinite(values).all() for values in block.values()):
-            return None
-        time = block["time"]
-        if len(time) and (time[0] < last or np.any(np.diff(time) < 0)):
-            return None
-        last = time[-1] if len(time) else last
-    return {quantity: [block[quantity] for block in blocks] for quantity in columns} if blocks else None
+        yield None
 
 
 def _in_si(values: np.ndarray, factor: float) -> np.ndarray:
@@ -263,16 +298,20 @@ def _number(cell: str) -> float:
         return math.nan
 
 
+# Rows the row reader gives in one block.
+_ROWS = 1 << 17
+
+
 def _read_rows(
-    path: Path, rows: Iterator[tuple[int, list[str]]], columns: dict, ends_mid_line: bool
-) -> dict[str, list[np.ndarray]]:
-    """The columns from numbered rows, read one by one: ResultFileError at the first that cannot
-    be judged (a cell missing, not a number or not finite, a time that goes backwards, the last
-    line cut short).
+    path: Path, rows: Iterator[tuple[int, list[str]]], columns: dict, ends_mid_line: bool, skip: int = 0
+) -> Iterator[dict[str, np.ndarray]]:
+    """The columns from numbered rows, read one by one, in blocks of _ROWS rows: ResultFileError
+    at the first that cannot be judged (a cell missing, not a number or not finite, a time that
+    goes backwards, the last line cut short). The first `skip` rows are checked, not given.
     """
     read = {quantity: array("d") for quantity in columns}
     wanted = [(quantity, column, factor, read[quantity].append) for quantity, (column, factor) in columns.items()]
-    previous = -math.inf
+    previous, given = -math.inf, 0
     for number, row in rows:
         if not any(cell.strip() for cell in row):
             continue
@@ -298,39 +337,15 @@ def _read_rows(
                 f"row: {previous:.17g}); a result's times must not decrease"
             )
         previous = time
-    if not read["time"]:
+        given += 1
+        if given <= skip:
+            for values in read.values():
+                del values[:]
+        elif len(read["time"]) == _ROWS:
+            yield {quantity: np.frombuffer(values, dtype=float).copy() for quantity, values in read.items()}
+            for values in read.values():
+                del values[:]
+    if not given:
         raise ResultFileError(f"{path}: no data rows after the header")
-    return {quantity: [np.frombuffer(values, dtype=float)] for quantity, values in read.items()}
-
-
-def check_span(result: np.ndarray, plan: TorqueSchedule, step_size: float, source: str) -> None:
-    """Refuse a result that is not a record of this run: times outside it, or a first or last row
-    that is not the run's start or stop. A result that stops short (a master that crashed, a file
-    cut off, only the t = 0 row) agrees with the reference wherever it has rows, so judged it would
-    pass a run that never happened.
-    """
-    start, stop = float(plan.time[0]), float(plan.time[-1])
-    slack = float(event_tolerance(max(abs(start), abs(stop)), step_size))
-    first, last = float(result["time"][0]), float(result["time"][-1])
-    if first < start - slack:
-        raise ResultFileError(
-            f"{source}: time {first:.17g} is before the run's start time {start:g} s; give the run's --start-time"
-        )
-    if last > stop + slack:
-        raise ResultFileError(
-            f"{source}: time {last:.17g} is after the run's stop time {stop:g} s; give the run's --stop-time"
-        )
-    # Half the first and the last step: a master's times may drift off the grid (a diagnosis of
-    # its own), but a first or last row nearer another communication point is another run's.
-    if first > start + (plan.time[1] - start) / 2:
-        raise ResultFileError(
-            f"{source}: the result starts at {first:.17g} s, not at the run's start "
-            f"time {start:g} s: write a row per communication point from the start "
-            "(judging a file alone, give the run's --start-time)"
-        )
-    if last < stop - (stop - plan.time[-2]) / 2:
-        raise ResultFileError(
-            f"{source}: the result ends at {last:.17g} s, before the run's stop "
-            f"time {stop:g} s, so it covers only part of the run: run it to the stop "
-            "time (judging a file alone, give the run's --stop-time)"
-        )
+    if read["time"]:
+        yield {quantity: np.frombuffer(values, dtype=float) for quantity, values in read.items()}

@@ -1,16 +1,17 @@
-"""The variants of a run with a candidate mistake made: the schedule changed as the mistake
-changes it, integrated exactly (reference_schedule) at the result's times; integration error's
-variants stepped by each of INTEGRATORS. _diagnoses.py names the candidates and decides.
+"""The variants of a run with a candidate mistake made, made a window of the run at a time.
+
+A variant is the schedule changed as the mistake changes it, integrated exactly
+(reference_schedule) at the result's times; integration error's variants are the run stepped by
+each of INTEGRATORS. The judge walks a run in windows of grid steps (Window); each variant carries
+its own state (theta, omega) from one window to the next, so a run of any length is held a window
+at a time. _diagnoses.py names the candidates and decides.
 """
 
 from __future__ import annotations
 
-import functools
 import math
 from array import array
-from collections.abc import Callable
-from dataclasses import dataclass, field
-from pathlib import Path
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -18,7 +19,7 @@ from ..fmu import _results as results
 from ..fmu._model import FmuModel
 from ..oracle._reference import model_constants, reference_schedule
 from ..signals._time_grid import event_tolerance
-from ..signals._torque_csv import TorqueTable, read_torque_csv
+from ..signals._torque_csv import TorqueTable
 from ..signals._torque_schedule import TorqueSchedule
 from ._diagnoses import (
     DIAGNOSES,
@@ -35,9 +36,52 @@ from ._diagnoses import (
     SINGLE,
 )
 
+# Steps of integration error's Euler taken as floats at once.
+_BLOCK = 1 << 16
 
-def _plan_index(plan: TorqueSchedule, times: np.ndarray, step_size: float) -> np.ndarray | None:
+
+@dataclass(frozen=True)
+class Frame:
+    """A window's stretch of a schedule: its steps, with the step before and the step after where
+    the run has them (a late input reads the one before, an early input the one after); the
+    window's first and last points are plan.time[begin] and plan.time[end].
+    """
+
+    plan: TorqueSchedule
+    begin: int
+    end: int
+
+
+@dataclass(frozen=True)
+class Window:
+    """One window of the run as the judge walks it: its frame of the run's schedule (and, for a
+    ramp run, of the same signal held), the result's rows in it, each row's point of the frame
+    (None where a row is off the points), and whether it is the run's first and last window.
+    """
+
+    frame: Frame
+    held: Frame | None
+    times: np.ndarray
+    index: np.ndarray | None
+    first: bool
+    last: bool
+
+
+@dataclass(frozen=True)
+class Run:
+    """What every variant of one run needs: its parameters, initial state, step and FMU."""
+
+    parameters: dict
+    theta0: float
+    omega0: float
+    step_size: float
+    model: FmuModel
+
+
+def plan_index(plan: TorqueSchedule, times: np.ndarray, step_size: float) -> np.ndarray | None:
     """For each time, the index of the communication point it is; None when one is off them."""
+    if not len(times):
+        return np.empty(0, dtype=np.int64)
     index = np.clip(np.searchsorted(plan.time, times), 1, len(plan.time) - 1)
     index = np.where(np.abs(plan.time[index] - times) < np.abs(plan.time[index - 1] - times), index, index - 1)
     on_grid = np.abs(plan.time[index] - times) <= event_tolerance(times, step_size)
@@ -48,302 +92,349 @@ def _changed(plan: TorqueSchedule, torque: np.ndarray, rate: np.ndarray | None =
     return TorqueSchedule(time=plan.time, torque=torque, torque_rate=plan.torque_rate if rate is None else rate)
 
 
-def _late(plan: TorqueSchedule, start_torque: float) -> list[TorqueSchedule]:
-    """Step k holds what step k-1 should; the first step the signal's first value or the FMU's
-    start value (whatever the master set before it began).
+def _integrated(
+    run: Run, plan: TorqueSchedule, begin: int, end: int, at: np.ndarray, state: tuple[float, float]
+) -> tuple[np.ndarray, tuple[float, float]]:
+    """The schedule's steps from point begin, integrated exactly from state there, at the times
+    `at`; and the state at point end, where the next window starts.
     """
-    variants = []
-    for first in dict.fromkeys((float(plan.torque[0]), start_torque)):
-        first_rate = plan.torque_rate[0] if first == plan.torque[0] else 0.0
-        variants.append(_changed(plan, np.r_[first, plan.torque[:-1]], np.r_[first_rate, plan.torque_rate[:-1]]))
-    return variants
-
-
-def _early(plan: TorqueSchedule) -> list[TorqueSchedule]:
-    return [_changed(plan, np.r_[plan.torque[1:], plan.torque[-1]], np.r_[plan.torque_rate[1:], 0.0])]
-
-
-def _interpolated(plan: TorqueSchedule) -> list[TorqueSchedule]:
-    """Each step ramps from its value to the next step's; the last one holds."""
-    return [_changed(plan, plan.torque, np.r_[np.diff(plan.torque) / plan.step_size[:-1], 0.0])]
-
-
-def _signal_values(torque, times: np.ndarray, side: str) -> np.ndarray | None:
-    """The signal just after (side "after") or before each time, sampled as a master would,
-    without the definition's snapping of events onto communication points; None for a per-step
-    array, which has no value between its steps.
-    """
-    if isinstance(torque, (str, Path)):
-        torque = read_torque_csv(torque)
-    if isinstance(torque, TorqueTable):
-        return torque.value_after(times) if side == "after" else torque.value_before(times)
-    if callable(torque):
-        return np.array([float(torque(t)) for t in times.tolist()])
-    if isinstance(torque, (list, tuple, np.ndarray)):
-        return None
-    return np.full(len(times), float(torque))
-
-
-def _drifted(torque, times: np.ndarray, ramp: bool) -> list[TorqueSchedule]:
-    """The master's steps are the result's own times; each samples the signal at its start."""
-    points = np.unique(times)
-    start = _signal_values(torque, points[:-1], "after")
-    if start is None or len(points) < 2:
-        return []
-    rate = (_signal_values(torque, points[1:], "before") - start) / np.diff(points) if ramp else np.zeros(len(start))
-    return [TorqueSchedule(time=points, torque=start, torque_rate=rate)]
-
-
-def _summed_clock(run: Run, ramp: bool) -> list[Variant]:
-    """Masters whose clock is summed step by step and compared with times without a tolerance.
-
-    One steps the FMU while its own time, the result's, is at or past the FMU's next communication
-    point on that clock (FMI++'s FixedStepSizeFMU.sync), and after each row sets the torque of the
-    step that starts at the row's time: where the clocks round apart a step is skipped, the FMU a
-    step behind (its rows a step old, its input a step early) until a row takes two. Only for a
-    row per communication point, where a step is skipped. The other applies a change of the
-    torque only where its clock equals the change's time (a scenario's actions, ECOS's through
-    ecospy): a change it misses never reaches the FMU. Only where a change is missed.
-    """
-    plan, times = run.plan, run.times
-    if ramp:
-        return []
-    clock = np.cumsum(np.r_[plan.time[0], np.full(len(plan.step_size), run.step_size)])
-    variants = []
-    index = _plan_index(plan, times, run.step_size)
-    if index is not None and np.array_equal(index, np.arange(len(plan.time))):
-        # The FMU's steps done when each row is written (none before the start: a row within rounding of it).
-        done = np.maximum(np.searchsorted(clock, times, side="right") - 1, 0)
-        if done[-1] >= 1 and not np.array_equal(done, np.arange(len(times))):
-            # Step j runs with what the row before the first row that has it done set.
-            setter = np.searchsorted(done, np.arange(done[-1]) + 1, side="left") - 1
-            steps = TorqueSchedule(
-                time=plan.time[: done[-1] + 1], torque=plan.torque[setter], torque_rate=np.zeros(done[-1])
-            )
-            variants.append(run.variant(functools.partial(run.integrate, steps, at=plan.time[done])))
-    changes = np.flatnonzero(np.diff(plan.torque)) + 1
-    applied = np.r_[0, changes[clock[changes] == plan.time[changes]]]
-    if len(applied) <= len(changes):
-        last_applied = applied[np.searchsorted(applied, np.arange(len(plan.torque)), side="right") - 1]
-        variants.append(run.variant(functools.partial(run.integrate, _changed(plan, plan.torque[last_applied]))))
-    return variants
-
-
-def _shifted(run: Run) -> list[Variant]:
-    """Each row holds the run's state one communication point after its time (a master that files
-    a step's result under the step's start), or one before; the first row the initial state. The
-    last row's next point is one more step of the run's last torque, as the FMU makes it.
-    """
-    index = _plan_index(run.plan, run.times, run.step_size)
-    if index is None:
-        return []
-    return [run.variant(functools.partial(_shifted_by, run, index, shift)) for shift in (1, -1)]
-
-
-def _shifted_by(run: Run, index: np.ndarray, shift: int) -> np.ndarray:
-    """The run one more step long, at the plan's points index + shift (the first at the start)."""
-    plan = run.plan
-    end_torque = plan.torque[-1] + plan.torque_rate[-1] * plan.step_size[-1]
-    beyond = TorqueSchedule(
-        time=np.r_[plan.time, plan.time[-1] + plan.step_size[-1]],
-        torque=np.r_[plan.torque, end_torque],
-        torque_rate=np.r_[plan.torque_rate, 0.0],
+    part = TorqueSchedule(time=plan.time[begin:], torque=plan.torque[begin:], torque_rate=plan.torque_rate[begin:])
+    out = reference_schedule(
+        part,
+        parameters=run.parameters,
+        theta0=state[0],
+        omega0=state[1],
+        at=np.r_[at, plan.time[end]],
+        fmu_path=run.model,
+        show_progress=False,
     )
-    return run.integrate(beyond, at=beyond.time[np.maximum(index + shift, 0)])
+    return out[:-1], (float(out["theta"][-1]), float(out["omega"][-1]))
 
 
-def _single_precision(correct: np.ndarray, result: np.ndarray) -> list[Variant]:
-    """The reference with theta rounded to float32, where every theta of the result is a float32
-    value (a master that hands observations out in single precision); else none.
+class Variant:
+    """One variant of a candidate mistake, made window by window: at_window gives its result at
+    the window's rows (time, torque, theta, ...), or None where the variant does not apply to the
+    run (then it never does again). Its state is the one at the window's last point.
     """
-    theta = np.asarray(result["theta"], dtype=float)
-    if not np.array_equal(theta.astype(np.float32).astype(float), theta):
-        return []
-    return [functools.partial(_rounded_to_single, correct)]
+
+    def __init__(self, run: Run):
+        self.run = run
+        self.state = (run.theta0, run.omega0)
+
+    def at_window(self, window: Window, correct: np.ndarray) -> np.ndarray | None:
+        frame = window.frame
+        plan = self.changed(frame.plan, window)
+        if plan is None:
+            return None
+        out, self.state = _integrated(self.run, plan, frame.begin, frame.end, window.times, self.state)
+        return out
+
+    def changed(self, plan: TorqueSchedule, window: Window) -> TorqueSchedule | None:
+        """The frame's schedule with the mistake made."""
+        raise NotImplementedError
 
 
-def _rounded_to_single(correct: np.ndarray) -> np.ndarray:
+class Late(Variant):
+    """Step k holds what step k-1 should; the first step `first` (the signal's first value, or
+    the FMU's start value: whatever the master set before it began).
+    """
+
+    def __init__(self, run: Run, first: float, first_rate: float):
+        super().__init__(run)
+        self.first, self.first_rate = first, first_rate
+
+    def changed(self, plan, window):
+        return _changed(plan, np.r_[self.first, plan.torque[:-1]], np.r_[self.first_rate, plan.torque_rate[:-1]])
+
+
+class Early(Variant):
+    """Step k holds what step k+1 should; the run's last step its own."""
+
+    def changed(self, plan, window):
+        return _changed(plan, np.r_[plan.torque[1:], plan.torque[-1]], np.r_[plan.torque_rate[1:], 0.0])
+
+
+class Interpolated(Variant):
+    """Each step ramps from its value to the next step's; the run's last step holds."""
+
+    def changed(self, plan, window):
+        return _changed(plan, plan.torque, np.r_[np.diff(plan.torque) / plan.step_size[:-1], 0.0])
+
+
+class Held(Variant):
+    """A ramp run's signal held over each step: the one variant of input held."""
+
+    def at_window(self, window, correct):
+        frame = window.held
+        out, self.state = _integrated(self.run, frame.plan, frame.begin, frame.end, window.times, self.state)
+        return out
+
+
+class MissedChanges(Variant):
+    """A master that applies a change of the torque only where its clock, summed step by step,
+    equals the change's time (ECOS's scenarios through ecospy): a change it misses never reaches
+    the FMU. It applies to a run where a change is missed (`missed`, once the run is walked).
+    """
+
+    def __init__(self, run: Run):
+        super().__init__(run)
+        self.clock: float | None = None  # the summed clock at the window's first point
+        self.applied: float | None = None  # the torque applied there
+        self.missed = False
+
+    def changed(self, plan, window):
+        frame = window.frame
+        points = plan.time[frame.begin : frame.end + 1]
+        torque = plan.torque[frame.begin : frame.end]
+        start = points[0] if self.clock is None else self.clock
+        clock = np.cumsum(np.r_[start, np.full(len(torque), self.run.step_size)])
+        before = plan.torque[frame.begin - 1] if frame.begin else torque[0]
+        change = torque != np.r_[before, torque[:-1]]
+        applied = change & (clock[:-1] == points[:-1])
+        if window.first:
+            applied[0] = True
+        self.missed |= bool(np.any(change & ~applied))
+        last = np.maximum.accumulate(np.where(applied, np.arange(len(torque)), -1))
+        values = np.where(last >= 0, torque[np.maximum(last, 0)], self.applied if self.applied is not None else 0.0)
+        self.clock, self.applied = float(clock[-1]), float(values[-1])
+        full = plan.torque.copy()
+        full[frame.begin : frame.end] = values
+        return _changed(plan, full, np.zeros(len(full)))
+
+
+class Drifted(Variant):
+    """The master's steps are the result's own times; each samples the signal at its start (a
+    master off the communication points). Its state is at the last row so far.
+    """
+
+    def __init__(self, run: Run, signal, ramp: bool):
+        super().__init__(run)
+        self.signal, self.ramp = signal, ramp
+        self.last_time: float | None = None
+
+    def at_window(self, window, correct):
+        rows = np.unique(window.times)
+        points = rows if self.last_time is None else np.r_[self.last_time, rows[rows > self.last_time]]
+        if len(points) < 2:
+            if self.last_time is None and len(rows):
+                return None  # a result of one time: no step of the master's
+            return _held_state(self, window.times)
+        start = signal_values(self.signal, points[:-1], "after")
+        rate = (
+            (signal_values(self.signal, points[1:], "before") - start) / np.diff(points) if self.ramp else 0.0 * start
+        )
+        plan = TorqueSchedule(time=points, torque=start, torque_rate=rate)
+        out, self.state = _integrated(self.run, plan, 0, len(points) - 1, window.times, self.state)
+        self.last_time = float(points[-1])
+        return out
+
+
+def _held_state(variant: Variant, times: np.ndarray) -> np.ndarray:
+    """The variant's state at rows all at the time it reached (or none)."""
+    out = results.empty(len(times), variant.run.model.recorded)
+    out["time"] = times
+    out["theta"], out["omega"] = variant.state
+    return out
+
+
+def signal_values(signal, times: np.ndarray, side: str) -> np.ndarray:
+    """The signal just after (side "after") or before each time, sampled as a master would,
+    without the definition's snapping of events onto communication points.
+    """
+    if isinstance(signal, TorqueTable):
+        return signal.value_after(times) if side == "after" else signal.value_before(times)
+    if callable(signal):
+        return np.array([float(signal(t)) for t in times.tolist()])
+    return np.full(len(times), float(signal))
+
+
+class SteppedOnClock(Variant):
+    """A master whose clock is summed step by step and compared with times without a tolerance:
+    it steps the FMU while its own time, the result's, is at or past the FMU's next communication
+    point on that clock (FMI++'s FixedStepSizeFMU.sync), and after each row sets the torque of the
+    step that starts at the row's time. Where the clocks round apart a step is skipped, the FMU a
+    step behind (its rows a step old, its input a step early) until a row takes two. Only for a
+    row per communication point; it applies where a step is skipped (`skipped`, once walked).
+    """
+
+    def __init__(self, run: Run):
+        super().__init__(run)
+        self.clock: float | None = None  # the summed clock at the window's first point
+        self.done: int | None = None  # the FMU's steps done at the last row, as a point of the window's frame
+        self.skipped = False
+
+    def at_window(self, window, correct):
+        frame, times, index = window.frame, window.times, window.index
+        first_row = 0 if window.first else frame.begin + 1
+        if index is None or not np.array_equal(index, np.arange(first_row, frame.end + 1)):
+            return None
+        plan = frame.plan
+        points = plan.time[frame.begin :]
+        clock = np.cumsum(
+            np.r_[points[0] if self.clock is None else self.clock, np.full(len(points) - 1, self.run.step_size)]
+        )
+        # The FMU's steps done when each row is written (none before the start: a row within
+        # rounding of it), as points of the frame.
+        done = np.maximum(np.searchsorted(clock, times, side="right") - 1, 0) + frame.begin
+        self.skipped |= not np.array_equal(done, index)
+        before = frame.begin if self.done is None else self.done
+        dones, rows = (done, index) if window.first else (np.r_[before, done], np.r_[frame.begin, index])
+        # Step j runs with what the row before the first row that has it done set.
+        steps = np.arange(before, done[-1])
+        setter = np.searchsorted(dones, steps + 1, side="left") - 1
+        stepped = TorqueSchedule(
+            time=plan.time[before : done[-1] + 1], torque=plan.torque[rows[setter]], torque_rate=np.zeros(len(steps))
+        )
+        out, self.state = _integrated(self.run, stepped, 0, len(steps), plan.time[done], self.state)
+        self.clock = float(clock[frame.end - frame.begin])
+        # As a point of the next window's frame, whose first point (1) is this one's last.
+        self.done = int(done[-1]) - frame.end + 1
+        out["time"] = times
+        return out
+
+
+class Shifted(Variant):
+    """Each row holds the run's state one communication point after its time (a master that
+    files a step's result under the step's start), or one before; the first row the initial state.
+    The last row's next point is one more step of the run's last torque, as the FMU makes it.
+    """
+
+    def __init__(self, run: Run, shift: int):
+        super().__init__(run)
+        self.shift = shift
+
+    def at_window(self, window, correct):
+        if window.index is None:
+            return None
+        frame = window.frame
+        plan = frame.plan
+        if window.last:
+            end_torque = plan.torque[-1] + plan.torque_rate[-1] * plan.step_size[-1]
+            plan = TorqueSchedule(
+                time=np.r_[plan.time, plan.time[-1] + plan.step_size[-1]],
+                torque=np.r_[plan.torque, end_torque],
+                torque_rate=np.r_[plan.torque_rate, 0.0],
+            )
+        at = plan.time[np.maximum(window.index + self.shift, frame.begin)]
+        out, self.state = _integrated(self.run, plan, frame.begin, frame.end, at, self.state)
+        out["time"] = window.times
+        return out
+
+
+class Restarted(Variant):
+    """Up to a point the reference; from there the run restarts from its initial state, as a
+    resumed run that did not restore its saved FMU state. The restart is where the first row that
+    disagrees is (it shows the initial state), or the row before it (it shows the old instance's
+    state, the next row the new one's): `before` rows before the first wrong row.
+    """
+
+    def __init__(self, run: Run, before: int):
+        super().__init__(run)
+        self.before = before
+
+    def start(
+        self, window: Window, correct: np.ndarray, first_wrong: int, rows_before: int, previous_time: float | None
+    ) -> np.ndarray | None:
+        """In the window holding the first wrong row (first_wrong, its index in the window;
+        rows_before, the run's rows before the window; previous_time, the last of those rows'
+        time): the reference before it, the restarted run from it; None where no restart fits.
+        """
+        restart_row = first_wrong - self.before
+        if rows_before + restart_row < 1:  # a restart at the very start is no restart
+            return None
+        restart = window.times[restart_row] if restart_row >= 0 else previous_time
+        plan = window.frame.plan
+        k = int(np.argmin(np.abs(plan.time - restart)))
+        off = abs(plan.time[k] - restart) > event_tolerance(restart, self.run.step_size)
+        if off or k < window.frame.begin or (window.last and k >= window.frame.end):
+            return None
+        tail, self.state = _integrated(
+            self.run, plan, k, window.frame.end, window.times[first_wrong:], (self.run.theta0, self.run.omega0)
+        )
+        out = correct.copy()
+        out[first_wrong:] = tail
+        return out
+
+    def at_window(self, window, correct):
+        frame = window.frame
+        out, self.state = _integrated(self.run, frame.plan, frame.begin, frame.end, window.times, self.state)
+        return out
+
+
+class Stepped(Variant):
+    """The equation of motion stepped once per communication step of the run's plan, holding each
+    step's start torque: explicit Euler, or semi-implicit (the new omega moves theta); integration
+    error's variants, one per INTEGRATORS.
+    """
+
+    def __init__(self, run: Run, integrator: str):
+        super().__init__(run)
+        self.semi_implicit = integrator == SEMI_IMPLICIT_EULER
+
+    def at_window(self, window, correct):
+        if window.index is None:
+            return None
+        frame = window.frame
+        plan = frame.plan
+        theta, omega = self.state
+        # The equation written out with math.sin: a step in Python costs a third of one through numpy.
+        gravity_moment, damping, inverse_inertia = model_constants(self.run.parameters)
+        thetas, omegas = array("d"), array("d")
+        # The steps' lengths and torques as floats a block at a time: lists of a window's would
+        # take 64 bytes a step.
+        for begin in range(frame.begin, frame.end, _BLOCK):
+            block = slice(begin, min(begin + _BLOCK, frame.end))
+            for h, u in zip(plan.step_size[block].tolist(), plan.torque[block].tolist(), strict=True):
+                thetas.append(theta)
+                omegas.append(omega)
+                alpha = (u - gravity_moment * math.sin(theta) - damping * omega) * inverse_inertia
+                if self.semi_implicit:
+                    omega += h * alpha
+                    theta += h * omega
+                else:
+                    theta, omega = theta + h * omega, omega + h * alpha
+        thetas.append(theta)
+        omegas.append(omega)
+        self.state = (theta, omega)
+        at = window.index - frame.begin
+        out = results.empty(len(at), self.run.model.recorded)  # its FMU's fields: no other looked up
+        out["time"] = window.times
+        out["theta"], out["omega"] = np.frombuffer(thetas)[at], np.frombuffer(omegas)[at]
+        out["torque"] = plan.torque[np.minimum(window.index, len(plan.torque) - 1)]
+        return out
+
+
+def run_variants(run: Run, first: TorqueSchedule, signal, ramp: bool, start_torque: float) -> dict[str, list[Variant]]:
+    """{candidate: its variants}, in DIAGNOSES' order, of every candidate that may apply to the
+    run, before it is walked (first: the first window's frame's schedule). Time grid drift's are
+    both kinds: the steps on the result's times (they apply where a row is off the points) and the
+    summed clocks (where every row is on them); result in single precision's are made from the
+    reference (single_precision).
+    """
+    firsts = dict.fromkeys((float(first.torque[0]), start_torque))
+    late = [Late(run, u, first.torque_rate[0] if u == first.torque[0] else 0.0) for u in firsts]
+    drift: list[Variant] = [] if isinstance(signal, np.ndarray) else [Drifted(run, signal, ramp)]
+    if not ramp:
+        drift += [SteppedOnClock(run), MissedChanges(run)]
+    return {
+        LATE: late,
+        EARLY: [Early(run)],
+        INTERPOLATED: [] if ramp else [Interpolated(run)],
+        HELD: [Held(run)] if ramp else [],
+        DRIFT: drift,
+        SHIFTED: [Shifted(run, 1), Shifted(run, -1)],
+        NOT_RESTORED: [Restarted(run, 0), Restarted(run, 1)],
+        INTEGRATION: [Stepped(run, integrator) for integrator in INTEGRATORS],
+    }
+
+
+def single_precision(correct: np.ndarray) -> np.ndarray:
+    """The reference with theta rounded to float32 (a master that hands observations out in
+    single precision).
+    """
     variant = correct.copy()
     variant["theta"] = correct["theta"].astype(np.float32)
     return variant
 
 
-def _euler(run: Run, semi_implicit: bool, index: np.ndarray) -> np.ndarray:
-    """The equation of motion stepped once per communication step of the run's plan, holding
-    each step's start torque: explicit Euler, or semi-implicit (the new omega moves theta); at
-    the plan's points index (the result's rows).
-    """
-    plan, theta, omega = run.plan, run.theta0, run.omega0
-    # The equation written out with math.sin: a step in Python costs a third of one through numpy.
-    gravity_moment, damping, inverse_inertia = model_constants(run.parameters)
-    thetas, omegas = array("d"), array("d")
-    # The steps' lengths and torques as floats a block at a time: lists of a whole long run's
-    # would take 64 bytes a step.
-    for begin in range(0, len(plan.torque), _BLOCK):
-        block = slice(begin, begin + _BLOCK)
-        for h, u in zip(plan.step_size[block].tolist(), plan.torque[block].tolist(), strict=True):
-            thetas.append(theta)
-            omegas.append(omega)
-            alpha = (u - gravity_moment * math.sin(theta) - damping * omega) * inverse_inertia
-            if semi_implicit:
-                omega += h * alpha
-                theta += h * omega
-            else:
-                theta, omega = theta + h * omega, omega + h * alpha
-    thetas.append(theta)
-    omegas.append(omega)
-    out = results.empty(len(index), run.model.recorded)  # its FMU's fields: no other looked up
-    out["time"] = plan.time[index]
-    out["theta"], out["omega"] = np.frombuffer(thetas)[index], np.frombuffer(omegas)[index]
-    out["torque"] = plan.torque[np.minimum(index, len(plan.torque) - 1)]
-    return out
-
-
-_SCHEDULE = ("time", "torque", "torque_rate")
-
-
-# Steps of integration error's Euler taken as floats at once.
-_BLOCK = 1 << 16
-
-
-# A variant at the result's times, made when called.
-Variant = Callable[[], np.ndarray]
-
-
-# Results up to this many rows keep their variants once made (for the next result on the same
-# times; 40 bytes a row each); a longer one's are made one at a time, scored and let go.
-KEEP_ROWS = 200_000
-
-
-@dataclass
-class Run:
-    """What every variant of one run needs."""
-
-    plan: TorqueSchedule
-    times: np.ndarray
-    step_size: float
-    parameters: dict
-    theta0: float
-    omega0: float
-    model: FmuModel
-
-    # Kept: whether this run's variants stay made once made (KEEP_ROWS), and the run's own
-    # schedule integrated, which variants of a run holding its torque for long stretches often
-    # are (a constant torque one step late).
-    keep: bool = True
-    _own: np.ndarray | None = field(default=None, repr=False)
-
-    def integrate(self, plan: TorqueSchedule, at: np.ndarray | None = None) -> np.ndarray:
-        """The schedule from the run's initial state, exactly, at the result's times (or at)."""
-        own = at is None and all(np.array_equal(getattr(plan, name), getattr(self.plan, name)) for name in _SCHEDULE)
-        if own and self._own is not None:
-            return self._own
-        integrated = reference_schedule(
-            plan,
-            parameters=self.parameters,
-            theta0=self.theta0,
-            omega0=self.omega0,
-            at=self.times if at is None else at,
-            fmu_path=self.model,
-        )
-        if own:
-            self._own = integrated
-        return integrated
-
-    def variant(self, make: Callable[[], np.ndarray]) -> Variant:
-        """A variant made by make() when it is first asked for: kept then for a short run (its
-        results share it), made anew each time for a long one, which holds one at a time.
-        """
-        if not self.keep:
-            return make
-        return functools.cache(make)
-
-
-def _not_restored(run: Run, correct: np.ndarray, first_wrong: int) -> list[Variant]:
-    """Up to a point the reference; from there the run restarts from its initial state, as a
-    resumed run that did not restore its saved FMU state. The restart is where the first row that
-    disagrees is (it shows the initial state), or the row before it (it shows the old instance's
-    state, the next row the new one's).
-    """
-    variants: list[Variant] = []
-    for restart_row in (first_wrong, first_wrong - 1):
-        if restart_row < 1:  # a restart at the very start is no restart
-            continue
-        restart = run.times[restart_row]
-        k = int(np.argmin(np.abs(run.plan.time - restart)))
-        off = abs(run.plan.time[k] - restart) > event_tolerance(restart, run.step_size)
-        if off or k + 1 >= len(run.plan.time):
-            continue
-        tail = TorqueSchedule(time=run.plan.time[k:], torque=run.plan.torque[k:], torque_rate=run.plan.torque_rate[k:])
-        variants.append(functools.partial(_restarted, run, correct, first_wrong, tail))
-    return variants
-
-
-def _restarted(run: Run, correct: np.ndarray, first_wrong: int, tail: TorqueSchedule) -> np.ndarray:
-    """The reference up to first_wrong, the tail of the schedule from the initial state after."""
-    variant = correct.copy()
-    variant[first_wrong:] = run.integrate(tail, at=run.times[first_wrong:])
-    return variant
-
-
-def _integration(run: Run) -> list[Variant]:
-    """The run stepped by each of INTEGRATORS, in their order, at the result's times."""
-    index = _plan_index(run.plan, run.times, run.step_size)
-    if index is None:
-        return []
-    return [run.variant(functools.partial(_stepped, run, integrator, index)) for integrator in INTEGRATORS]
-
-
-def _stepped(run: Run, integrator: str, index: np.ndarray) -> np.ndarray:
-    """The run stepped by the integrator (one of INTEGRATORS), at the result's rows (index)."""
-    return _euler(run, integrator == SEMI_IMPLICIT_EULER, index)
-
-
-def shared_variants(run: Run, torque, held: TorqueSchedule | None, start_torque: float) -> dict[str, list[Variant]]:
-    """{candidate: its variants at the result's times} of every candidate whose variants do not
-    depend on the result (all but state not restored): made once for the results of a run that
-    share their times (Run.variant). An empty list where a candidate does not apply.
-    held: for a ramp run, the same signal held over each step (schedule without ramp).
-    """
-    plan, ramp = run.plan, held is not None
-    off_grid = _plan_index(plan, run.times, run.step_size) is None
-
-    def integrated(make: Callable[..., list[TorqueSchedule]], *args) -> list[Variant]:
-        # The schedules are made again by each variant when it is made: a long run's would
-        # hold 24 bytes a step each, all the while.
-        return [run.variant(functools.partial(_integrated, run, make, args, i)) for i in range(len(make(*args)))]
-
-    return {
-        LATE: integrated(_late, plan, start_torque),
-        EARLY: integrated(_early, plan),
-        INTERPOLATED: [] if ramp else integrated(_interpolated, plan),
-        HELD: integrated(_held, held) if held is not None else [],
-        DRIFT: integrated(_drifted, torque, run.times, ramp) if off_grid else _summed_clock(run, ramp),
-        SHIFTED: _shifted(run),
-        INTEGRATION: _integration(run),
-    }
-
-
-def _integrated(run: Run, make: Callable[..., list[TorqueSchedule]], args: tuple, i: int) -> np.ndarray:
-    """The i-th schedule make(*args) gives, integrated at the result's times."""
-    return run.integrate(make(*args)[i])
-
-
-def _held(held: TorqueSchedule) -> list[TorqueSchedule]:
-    """A ramp run's signal held over each step: the one variant of input held."""
-    return [held]
-
-
-def candidate_variants(
-    shared: dict[str, list[Variant]], run: Run, correct: np.ndarray, result: np.ndarray, tolerance: float
-) -> dict[str, list[Variant]]:
-    """{candidate: its variants at the result's times}, in DIAGNOSES' order: the shared ones
-    (shared_variants), state not restored, which restarts where this result first disagrees, and
-    single precision, which applies to a result whose theta are all float32 values.
-    """
-    wrong = np.flatnonzero(np.abs(result["theta"] - correct["theta"]) > tolerance)
-    own = {
-        NOT_RESTORED: _not_restored(run, correct, int(wrong[0])) if len(wrong) else [],
-        SINGLE: _single_precision(correct, result),
-    }
-    return {name: own[name] if name in own else shared[name] for name in DIAGNOSES if name in own or name in shared}
+__all__ = ["DIAGNOSES", "SINGLE", "Frame", "Run", "Variant", "Window", "plan_index", "run_variants", "single_precision"]

@@ -303,12 +303,29 @@ def schedule_windows(
     if not (isinstance(window_steps, numbers.Integral) and window_steps >= 1):
         raise InvalidInput(f"window steps {window_steps!r} must be a whole number of steps, at least 1")
     signal = _Signal(torque, start_time, stop_time, step_size, ramp, max_steps, check_memory=False)
-    return _walk(signal, int(window_steps))
+    return ScheduleWindows(signal, int(window_steps))
 
 
-def _walk(signal: _Signal, window_steps: int) -> Iterator[TorqueSchedule]:
-    for k0 in range(0, signal.steps, window_steps):
-        yield signal.window(k0, min(k0 + window_steps, signal.steps))
+class ScheduleWindows(Iterator[TorqueSchedule]):
+    """schedule_windows' windows, in time order, and what is known of the run before they are
+    made: its first and last communication points (start_time, stop_time, s), its grid steps
+    and its windows.
+    """
+
+    def __init__(self, signal: _Signal, window_steps: int):
+        self._signal, self._window_steps = signal, window_steps
+        self.steps = signal.steps
+        self.windows = -(-signal.steps // window_steps)
+        self.start_time, self.stop_time = (
+            float(t) for t in signal.points(0, 0)[:1].tolist() + signal.points(signal.steps, signal.steps).tolist()
+        )
+        self._k0 = 0
+
+    def __next__(self) -> TorqueSchedule:
+        if self._k0 >= self.steps:
+            raise StopIteration
+        k0, self._k0 = self._k0, self._k0 + self._window_steps
+        return self._signal.window(k0, min(self._k0, self.steps))
 
 
 class _Signal:
