@@ -12,6 +12,7 @@ import ctypes
 import os
 import threading
 from collections import OrderedDict
+from collections.abc import Iterable, Iterator
 from functools import lru_cache
 from pathlib import Path
 from typing import Any
@@ -272,11 +273,26 @@ def simulate_plan(
     platform: str | None = None,
 ) -> np.ndarray:
     """A schedule through this thread's Simulator of the FMU's binary for platform (see simulate)."""
+    options = dict(parameters=parameters, theta0=theta0, omega0=omega0, tolerance=tolerance)
+    return next(simulate_windows((plan,), fmu_path=fmu_path, platform=platform, **options))
+
+
+def simulate_windows(
+    windows: Iterable[TorqueSchedule],
+    *,
+    fmu_path: str | Path | FmuModel | None = None,
+    platform: str | None = None,
+    **options,
+) -> Iterator[np.ndarray]:
+    """Consecutive windows of one schedule through one run of this thread's Simulator (see
+    Simulator.run_windows): results that concatenate to simulate_plan's of the whole schedule;
+    options: simulate_plan's parameters, theta0, omega0 and tolerance.
+    """
     runner = simulator(fmu_path, platform)
     try:
-        return runner.run(plan, parameters=parameters, theta0=theta0, omega0=omega0, tolerance=tolerance)
+        yield from runner.run_windows(windows, **options)
     except FmuError:
-        resolve_parameters(parameters, fmu_path)  # refused with the same words as every other tool
+        resolve_parameters(options.get("parameters"), fmu_path)  # refused with the same words as every other tool
         raise
 
 
@@ -352,12 +368,34 @@ class Simulator:
         tolerance: float | None = None,
     ) -> np.ndarray:
         """The result array of a schedule (see simulate); FmuError when the FMU refuses."""
+        return next(self.run_windows((plan,), parameters=parameters, theta0=theta0, omega0=omega0, tolerance=tolerance))
+
+    def run_windows(
+        self,
+        windows: Iterable[TorqueSchedule],
+        *,
+        parameters: dict | None = None,
+        theta0: float = 0.0,
+        omega0: float = 0.0,
+        tolerance: float | None = None,
+    ) -> Iterator[np.ndarray]:
+        """The result of a run given as consecutive windows of its schedule, a window at a time:
+        the instance restarts before the first and carries its state into the next, so the
+        results concatenate to run()'s of the whole schedule, bit for bit.
+
+        Consecutive windows share their boundary point. Its row is the later window's (read
+        after that step's torque was set, as the whole run reads it), so each result but the last
+        leaves out its last row; a window is taken from windows only once the one before has run.
+        """
         start = [
             *(merged_with(self.defaults, parameters) if parameters else self.defaults).values(),
             start_value("theta0", theta0, "rad"),
             start_value("omega0", omega0, "rad/s"),
         ]
         self.slave.messages.lines.clear()
+        recorded = self.slave.model.recorded
+        windows = iter(windows)
+        window = next(windows)
         if self.stepper is None:
             self.slave.reset()
             initialize(
@@ -366,13 +404,20 @@ class Simulator:
                 theta0=theta0,
                 omega0=omega0,
                 tolerance=tolerance,
-                start_time=float(plan.time[0]),
+                start_time=float(window.time[0]),
             )
-            if self.loop is None:
-                return run_schedule_python(self.slave, plan)
-            check_held(plan)
-            return _result(plan, self.slave.model.recorded, self.loop(self.slave, plan))
-        return _stepped(self.stepper, plan, self.slave.model.recorded, start_values=start, tolerance=tolerance)
+        restart: dict = {"start_values": start, "tolerance": tolerance}
+        while window is not None:
+            if self.stepper is not None:
+                result = _stepped(self.stepper, window, recorded, **restart)
+                restart = {}  # the instance goes on where the window before left it
+            elif self.loop is None:
+                result = run_schedule_python(self.slave, window)
+            else:
+                check_held(window)
+                result = _result(window, recorded, self.loop(self.slave, window))
+            window = next(windows, None)
+            yield result if window is None else result[:-1]
 
     def close(self) -> None:
         self.slave.freeInstance()
