@@ -60,12 +60,15 @@ def _stepper(slave, start_names: tuple[str, ...] = ()) -> cs_loop.Stepper:
     return cs_loop.Stepper(slave, references(["torque"]), references(slave.model.recorded), references(start_names))
 
 
-def _stepped(stepper: cs_loop.Stepper, plan: TorqueSchedule, recorded_names: tuple[str, ...], **restart) -> np.ndarray:
+def _stepped(
+    stepper: cs_loop.Stepper, plan: TorqueSchedule, recorded_names: tuple[str, ...], ramped: bool = False, **restart
+) -> np.ndarray:
     """The result array of a schedule through the native loop, which records recorded_names;
-    restart: Stepper.run's start_values and tolerance.
+    ramped: set the rates even if all are zero; restart: Stepper.run's start_values and tolerance.
     """
     recorded = np.empty((len(plan.time), len(recorded_names)))
-    rates = np.ascontiguousarray(plan.torque_rate)[:, None] if np.count_nonzero(plan.torque_rate) else None
+    ramped = ramped or bool(np.count_nonzero(plan.torque_rate))
+    rates = np.ascontiguousarray(plan.torque_rate)[:, None] if ramped else None
     stepper.run(plan.time, np.ascontiguousarray(plan.torque)[:, None], rates, recorded, **restart)
     return _result(plan, recorded_names, recorded)
 
@@ -79,16 +82,16 @@ def _result(plan: TorqueSchedule, recorded_names: tuple[str, ...], recorded: np.
     return out
 
 
-def run_schedule_python(slave: FmuInstance, plan: TorqueSchedule) -> np.ndarray:
+def run_schedule_python(slave: FmuInstance, plan: TorqueSchedule, ramped: bool = False) -> np.ndarray:
     """run_schedule in Python: the reference the native loop is checked against, and the loop for
-    FMI 3.0.
+    FMI 3.0; ramped: set the rates even if all are zero.
 
     The FMI functions are bound once from the library fmpy loaded, without fmpy's argtypes (with
     them ctypes converts every argument on every call), and every argument is a ctypes object
     allocated before the loop, so a step costs little more than the FMU's own work.
     """
     dll, messages, fmi3 = slave.dll, slave.messages, slave.fmi_version == 3
-    ramped = bool(np.any(plan.torque_rate))
+    ramped = ramped or bool(np.any(plan.torque_rate))
     if fmi3:
         check_held(plan)
     names = (
@@ -379,13 +382,10 @@ class Simulator:
         omega0: float = 0.0,
         tolerance: float | None = None,
     ) -> Iterator[np.ndarray]:
-        """The result of a run given as consecutive windows of its schedule, a window at a time:
-        the instance restarts before the first and carries its state into the next, so the
-        results concatenate to run()'s of the whole schedule, bit for bit.
-
-        Consecutive windows share their boundary point. Its row is the later window's (read
-        after that step's torque was set, as the whole run reads it), so each result but the last
-        leaves out its last row; a window is taken from windows only once the one before has run.
+        """The results of a schedule given as consecutive windows sharing their boundary points,
+        a window at a time: restarted before the first, the instance carries its state on, and the
+        results concatenate to run()'s of the whole schedule, bit for bit. A boundary's row is the
+        later window's (read after that step's torque was set, as the whole run reads it).
         """
         start = [
             *(merged_with(self.defaults, parameters) if parameters else self.defaults).values(),
@@ -398,24 +398,22 @@ class Simulator:
         window = next(windows)
         if self.stepper is None:
             self.slave.reset()
-            initialize(
-                self.slave,
-                parameters=parameters,
-                theta0=theta0,
-                omega0=omega0,
-                tolerance=tolerance,
-                start_time=float(window.time[0]),
-            )
+            options = dict(parameters=parameters, theta0=theta0, omega0=omega0, tolerance=tolerance)
+            initialize(self.slave, **options, start_time=float(window.time[0]))
         restart: dict = {"start_values": start, "tolerance": tolerance}
+        ramped = False
         while window is not None:
+            # The FMU keeps an input's rate until it is set again: once a window ramped, every
+            # later one sets its rates, zero or not, as the whole run sets them.
             if self.stepper is not None:
-                result = _stepped(self.stepper, window, recorded, **restart)
+                result = _stepped(self.stepper, window, recorded, ramped, **restart)
                 restart = {}  # the instance goes on where the window before left it
             elif self.loop is None:
-                result = run_schedule_python(self.slave, window)
+                result = run_schedule_python(self.slave, window, ramped)
             else:
                 check_held(window)
                 result = _result(window, recorded, self.loop(self.slave, window))
+            ramped = ramped or bool(np.count_nonzero(window.torque_rate))
             window = next(windows, None)
             yield result if window is None else result[:-1]
 
