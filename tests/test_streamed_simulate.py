@@ -74,6 +74,11 @@ def test_an_fmi3_fmu_streams_the_same_file(fmu3, tmp_path):
     _same_as_whole(tmp_path, 20.0, {**CASE, "fmu_path": fmu3}, 11)
 
 
+def test_the_webassembly_binary_streams_the_same_file(tmp_path):
+    pytest.importorskip("wasmtime", reason="the wasm extra (wasmtime) is not installed")
+    _same_as_whole(tmp_path, 20.0, {**CASE, "platform": "wasm32-wasip2"}, 13)
+
+
 @pytest.mark.slow
 def test_a_run_of_300001_rows_in_six_windows_is_the_whole_runs_byte_for_byte(fmu, tmp_path):
     torque = lambda t: 20.0 + 5.0 * np.sin(t)  # noqa: E731
