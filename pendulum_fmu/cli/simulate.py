@@ -52,27 +52,35 @@ def run(args) -> int:
     """Run `pendulum-fmu simulate` with the parsed arguments; returns the exit status."""
     from ..fmu import _results as results
     from ..fmu._model import fmu_model
-    from ..fmu._simulate import simulate
 
     check_outputs(
         {"--output": args.output, "--plot": args.plot}, {"--torque-file": args.torque_file, "--fmu": args.fmu}
     )
-    run = simulate(torque_signal(args), tolerance=args.tolerance, platform=args.platform, **signal_options(args))
-    last = run[-1]
+    options = dict(tolerance=args.tolerance, platform=args.platform, **signal_options(args))
+    if args.output:
+        # Written as it runs: the memory it takes is a window's, however long the run.
+        from ..fmu._streamed import simulate_to_csv
+
+        drawn = ("theta", "omega") if args.plot else ()
+        streamed = simulate_to_csv(args.output, torque_signal(args), drawn=drawn, **options)
+        fields, steps, last, largest = streamed.fields, streamed.steps, streamed.last[0], streamed.largest["theta"]
+        drawn_run = streamed.drawn.rows if drawn else None
+    else:
+        from ..fmu._simulate import simulate
+
+        drawn_run = simulate(torque_signal(args), **options)
+        fields, steps, last = results.fields(drawn_run), len(drawn_run) - 1, drawn_run[-1]
+        largest = np.max(np.abs(drawn_run["theta"]))
     # The fields and units of the FMU that ran, --fmu's or the default one: its outputs, as many
     # as it has, after time and torque.
-    units = results.units(results.fields(run), fmu_model(args.fmu))
+    units = results.units(fields, fmu_model(args.fmu))
     outputs = ", ".join(f"{name} = {last[name]:.12g} {units[name]}" for name in list(units)[2:])
-    print(
-        f"{len(run) - 1} steps to t = {last['time']:g} s: {outputs}; "
-        f"max |theta| = {np.max(np.abs(run['theta'])):.6g} rad"
-    )
+    print(f"{steps} steps to t = {last['time']:g} s: {outputs}; max |theta| = {largest:.6g} rad")
     if args.output:
-        results.write_csv(run, args.output)
         print(f"wrote {args.output} ({','.join(units)}; units {', '.join(units.values())})")
     if args.plot:
         from ..figures._plot import case_title, plot_overlay
 
         title = case_title(torque_signal(args), parameters_of(args.assignments), args.theta0, args.omega0, args.fmu)
-        print(f"wrote {plot_overlay({'FMU': run}, args.plot, title)}")
+        print(f"wrote {plot_overlay({'FMU': drawn_run}, args.plot, title)}")
     return 0

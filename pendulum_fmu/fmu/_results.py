@@ -217,12 +217,28 @@ def write_csv(run: np.ndarray, path: str | os.PathLike) -> Path:
         path cannot be written.
     """
     with replacing(path) as file:
-        np.savetxt(
-            file,
-            run.view(np.float64).reshape(len(run), -1),
-            delimiter=",",
-            header=",".join(fields(run)),
-            comments="",
-            fmt="%.17g",
-        )
+        write_rows(file, run, header=True)
     return Path(path)
+
+
+def write_rows(file, run: np.ndarray, header: bool = False) -> None:
+    """Append a result's rows to an open CSV as write_csv writes them, so that a run written a
+    block at a time (the first with the header) reads the same, byte for byte, as written whole.
+
+    Parameters
+    ----------
+    file : text file
+        Open for writing.
+    run : numpy.ndarray
+        A result array, or a block of consecutive rows of one.
+    header : bool, optional
+        Write the line of field names first.
+    """
+    np.savetxt(
+        file,
+        run.view(np.float64).reshape(len(run), -1),
+        delimiter=",",
+        header=",".join(fields(run)) if header else "",
+        comments="",
+        fmt="%.17g",
+    )

@@ -12,6 +12,7 @@ import ctypes
 import os
 import threading
 from collections import OrderedDict
+from collections.abc import Iterable, Iterator
 from functools import lru_cache
 from pathlib import Path
 from typing import Any
@@ -59,12 +60,15 @@ def _stepper(slave, start_names: tuple[str, ...] = ()) -> cs_loop.Stepper:
     return cs_loop.Stepper(slave, references(["torque"]), references(slave.model.recorded), references(start_names))
 
 
-def _stepped(stepper: cs_loop.Stepper, plan: TorqueSchedule, recorded_names: tuple[str, ...], **restart) -> np.ndarray:
+def _stepped(
+    stepper: cs_loop.Stepper, plan: TorqueSchedule, recorded_names: tuple[str, ...], ramped: bool = False, **restart
+) -> np.ndarray:
     """The result array of a schedule through the native loop, which records recorded_names;
-    restart: Stepper.run's start_values and tolerance.
+    ramped: set the rates even if all are zero; restart: Stepper.run's start_values and tolerance.
     """
     recorded = np.empty((len(plan.time), len(recorded_names)))
-    rates = np.ascontiguousarray(plan.torque_rate)[:, None] if np.count_nonzero(plan.torque_rate) else None
+    ramped = ramped or bool(np.count_nonzero(plan.torque_rate))
+    rates = np.ascontiguousarray(plan.torque_rate)[:, None] if ramped else None
     stepper.run(plan.time, np.ascontiguousarray(plan.torque)[:, None], rates, recorded, **restart)
     return _result(plan, recorded_names, recorded)
 
@@ -78,16 +82,16 @@ def _result(plan: TorqueSchedule, recorded_names: tuple[str, ...], recorded: np.
     return out
 
 
-def run_schedule_python(slave: FmuInstance, plan: TorqueSchedule) -> np.ndarray:
+def run_schedule_python(slave: FmuInstance, plan: TorqueSchedule, ramped: bool = False) -> np.ndarray:
     """run_schedule in Python: the reference the native loop is checked against, and the loop for
-    FMI 3.0.
+    FMI 3.0; ramped: set the rates even if all are zero.
 
     The FMI functions are bound once from the library fmpy loaded, without fmpy's argtypes (with
     them ctypes converts every argument on every call), and every argument is a ctypes object
     allocated before the loop, so a step costs little more than the FMU's own work.
     """
     dll, messages, fmi3 = slave.dll, slave.messages, slave.fmi_version == 3
-    ramped = bool(np.any(plan.torque_rate))
+    ramped = ramped or bool(np.any(plan.torque_rate))
     if fmi3:
         check_held(plan)
     names = (
@@ -272,11 +276,26 @@ def simulate_plan(
     platform: str | None = None,
 ) -> np.ndarray:
     """A schedule through this thread's Simulator of the FMU's binary for platform (see simulate)."""
+    options = dict(parameters=parameters, theta0=theta0, omega0=omega0, tolerance=tolerance)
+    return next(simulate_windows((plan,), fmu_path=fmu_path, platform=platform, **options))
+
+
+def simulate_windows(
+    windows: Iterable[TorqueSchedule],
+    *,
+    fmu_path: str | Path | FmuModel | None = None,
+    platform: str | None = None,
+    **options,
+) -> Iterator[np.ndarray]:
+    """Consecutive windows of one schedule through one run of this thread's Simulator (see
+    Simulator.run_windows): results that concatenate to simulate_plan's of the whole schedule;
+    options: simulate_plan's parameters, theta0, omega0 and tolerance.
+    """
     runner = simulator(fmu_path, platform)
     try:
-        return runner.run(plan, parameters=parameters, theta0=theta0, omega0=omega0, tolerance=tolerance)
+        yield from runner.run_windows(windows, **options)
     except FmuError:
-        resolve_parameters(parameters, fmu_path)  # refused with the same words as every other tool
+        resolve_parameters(options.get("parameters"), fmu_path)  # refused with the same words as every other tool
         raise
 
 
@@ -352,27 +371,51 @@ class Simulator:
         tolerance: float | None = None,
     ) -> np.ndarray:
         """The result array of a schedule (see simulate); FmuError when the FMU refuses."""
+        return next(self.run_windows((plan,), parameters=parameters, theta0=theta0, omega0=omega0, tolerance=tolerance))
+
+    def run_windows(
+        self,
+        windows: Iterable[TorqueSchedule],
+        *,
+        parameters: dict | None = None,
+        theta0: float = 0.0,
+        omega0: float = 0.0,
+        tolerance: float | None = None,
+    ) -> Iterator[np.ndarray]:
+        """The results of a schedule given as consecutive windows sharing their boundary points,
+        a window at a time: restarted before the first, the instance carries its state on, and the
+        results concatenate to run()'s of the whole schedule, bit for bit. A boundary's row is the
+        later window's (read after that step's torque was set, as the whole run reads it).
+        """
         start = [
             *(merged_with(self.defaults, parameters) if parameters else self.defaults).values(),
             start_value("theta0", theta0, "rad"),
             start_value("omega0", omega0, "rad/s"),
         ]
         self.slave.messages.lines.clear()
+        recorded = self.slave.model.recorded
+        windows = iter(windows)
+        window = next(windows)
         if self.stepper is None:
             self.slave.reset()
-            initialize(
-                self.slave,
-                parameters=parameters,
-                theta0=theta0,
-                omega0=omega0,
-                tolerance=tolerance,
-                start_time=float(plan.time[0]),
-            )
-            if self.loop is None:
-                return run_schedule_python(self.slave, plan)
-            check_held(plan)
-            return _result(plan, self.slave.model.recorded, self.loop(self.slave, plan))
-        return _stepped(self.stepper, plan, self.slave.model.recorded, start_values=start, tolerance=tolerance)
+            options = dict(parameters=parameters, theta0=theta0, omega0=omega0, tolerance=tolerance)
+            initialize(self.slave, **options, start_time=float(window.time[0]))
+        restart: dict = {"start_values": start, "tolerance": tolerance}
+        ramped = False
+        while window is not None:
+            # The FMU keeps an input's rate until it is set again: once a window ramped, every
+            # later one sets its rates, zero or not, as the whole run sets them.
+            if self.stepper is not None:
+                result = _stepped(self.stepper, window, recorded, ramped, **restart)
+                restart = {}  # the instance goes on where the window before left it
+            elif self.loop is None:
+                result = run_schedule_python(self.slave, window, ramped)
+            else:
+                check_held(window)
+                result = _result(window, recorded, self.loop(self.slave, window))
+            ramped = ramped or bool(np.count_nonzero(window.torque_rate))
+            window = next(windows, None)
+            yield result if window is None else result[:-1]
 
     def close(self) -> None:
         self.slave.freeInstance()

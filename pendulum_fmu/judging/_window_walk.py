@@ -11,11 +11,11 @@ points a figure draws, and the rows the regression tools read again at the end (
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
-from ..figures._drawn_points import drawn_points
+from ..figures._drawn_points import DrawnRows, drawn_points
 from ..signals._time_grid import event_tolerance
 from ..signals._torque_schedule import TorqueSchedule
 from ._diagnoses import DRIFT, INPUT_TIMING, NOT_RESTORED, SINGLE
@@ -40,6 +40,9 @@ KEEP_ROWS = 200_000
 # Columns of time a figure's points are chosen in (drawn_points).
 DRAWN_COLUMNS = 2000
 
+# The fields of the drawn rows before the variants': the last four are those whose extremes are kept.
+_BASE_FIELDS = ("time", "torque", "reference", "result", "difference")
+
 # What Judgement.drawn holds at each drawn point.
 DRAWN_FIELDS = ("time", "torque", "reference", "result", "explained_torque", "explained_theta")
 
@@ -47,15 +50,14 @@ DRAWN_FIELDS = ("time", "torque", "reference", "result", "explained_torque", "ex
 @dataclass
 class Score:
     """One variant's residual (max |theta_result - theta_variant|) and effect (max |theta_variant
-    - theta_reference|) so far, rad; whether it still applies; its torque and theta at the points
-    kept for the figure.
+    - theta_reference|) so far, rad; whether it still applies; the fields its torque and theta
+    have among the drawn rows (Walk.drawn).
     """
 
+    column: int
     residual: float = 0.0
     effect: float = 0.0
     applies: bool = True
-    torque: list = field(default_factory=list)
-    theta: list = field(default_factory=list)
 
 
 class Walk:
@@ -75,15 +77,21 @@ class Walk:
 
     def __init__(self, variants: dict[str, list[Variant]], tolerance: float, span: tuple[float, float], series):
         self.variants, self.tolerance, self.span, self.series = variants, tolerance, span, series
-        self.scores = {name: [Score() for _ in made] for name, made in variants.items()}
-        self.single = Score()
+        columns = iter(range(1, 1 + sum(map(len, variants.values()))))
+        self.scores = {name: [Score(next(columns)) for _ in made] for name, made in variants.items()}
+        self.single = Score(0)
         self.raw, self.worst_time, self.exact_zeros, self.rows = 0.0, math.nan, 0, 0
         self.first_wrong: int | None = None  # the run's first row that disagrees
         self.previous_time: float | None = None
         self.off_grid = False
         self.float32 = True
         self.optional = {name: 0.0 for name in OPTIONAL}  # max |d omega|, |d alpha|; NaN: not all given
-        self.drawn: dict[str, list] = {name: [] for name in DRAWN_FIELDS[:4]}
+        # The drawn rows: the result's and the reference's, and each variant's torque and theta.
+        self.fields = [*_BASE_FIELDS, *(f"{what}{j}" for j in range(1 + self._count()) for what in ("torque", "theta"))]
+        self.drawn = DrawnRows(_BASE_FIELDS[1:], span, DRAWN_COLUMNS)
+
+    def _count(self) -> int:
+        return sum(map(len, self.variants.values()))
 
     def window(self, window: Window, result: np.ndarray, correct: np.ndarray, outputs: dict | None = None) -> None:
         """Take one window: its rows of the result and the reference at them. outputs: the
@@ -107,11 +115,12 @@ class Walk:
             elif len(given):
                 self.optional[name] = math.nan
         kept = self._kept(window.times, correct, theta, difference)
+        drawn = np.full(len(kept), np.nan, dtype=[(name, float) for name in self.fields])
         for name, values in zip(
-            DRAWN_FIELDS[:4], (window.times, correct["torque"], correct["theta"], theta), strict=True
+            _BASE_FIELDS, (window.times, correct["torque"], correct["theta"], theta, difference), strict=True
         ):
-            self.drawn[name].append(values[kept])
-        self._score(self.single, theta, correct, single_precision(correct), kept)
+            drawn[name] = values[kept]
+        self._score(self.single, theta, correct, single_precision(correct), kept, drawn)
         wrong = np.flatnonzero(magnitude > self.tolerance)
         starting = self.first_wrong is None and len(wrong)
         for name, made in self.variants.items():
@@ -134,7 +143,8 @@ class Walk:
                 if out is None:
                     score.applies = False
                     continue
-                self._score(score, theta, correct, out, kept)
+                self._score(score, theta, correct, out, kept, drawn)
+        self.drawn.add(drawn)
         if starting:
             self.first_wrong = self.rows + int(wrong[0])
         self.rows += len(window.times)
@@ -151,12 +161,13 @@ class Walk:
         )
 
     @staticmethod
-    def _score(score: Score, theta: np.ndarray, correct: np.ndarray, variant: np.ndarray, kept: np.ndarray) -> None:
+    def _score(score: Score, theta: np.ndarray, correct: np.ndarray, variant: np.ndarray, kept, drawn) -> None:
+        """Score a variant's window, and keep its torque and theta at the drawn rows."""
         if len(theta):
             score.residual = max(score.residual, float(np.max(np.abs(theta - variant["theta"]))))
             score.effect = max(score.effect, float(np.max(np.abs(variant["theta"] - correct["theta"]))))
-        score.torque.append(variant["torque"][kept])
-        score.theta.append(variant["theta"][kept])
+        drawn[f"torque{score.column}"] = variant["torque"][kept]
+        drawn[f"theta{score.column}"] = variant["theta"][kept]
 
     def scores_by_candidate(self) -> dict[str, list[Score]]:
         """{candidate: the scores of its variants that apply}, in DIAGNOSES' order: time grid
@@ -184,19 +195,16 @@ class Walk:
         return out
 
     def drawn_array(self, explanation: Score | None) -> np.ndarray:
-        """The drawn points (DRAWN_FIELDS): of the kept rows, every extreme per column again."""
-        columns = {name: np.concatenate(parts) for name, parts in self.drawn.items()}
-        if explanation is not None:
-            columns["explained_torque"] = np.concatenate(explanation.torque)
-            columns["explained_theta"] = np.concatenate(explanation.theta)
-        difference = columns["result"] - columns["reference"]
-        kept = drawn_points(
-            columns["time"], columns["torque"], columns["reference"], columns["result"], difference,
-            columns=DRAWN_COLUMNS, span=self.span,
-        )  # fmt: skip
-        out = np.full(len(kept), np.nan, dtype=[(name, float) for name in DRAWN_FIELDS])
-        for name, values in columns.items():
-            out[name] = values[kept]
+        """The drawn rows (DRAWN_FIELDS), the explanation's torque and theta those of the variant
+        scored by `explanation` (NaN for None).
+        """
+        rows = self.drawn.rows
+        out = np.full(len(rows), np.nan, dtype=[(name, float) for name in DRAWN_FIELDS])
+        for name in DRAWN_FIELDS[:4]:
+            out[name] = rows[name] if len(rows) else []
+        if explanation is not None and len(rows):
+            out["explained_torque"] = rows[f"torque{explanation.column}"]
+            out["explained_theta"] = rows[f"theta{explanation.column}"]
         return out
 
 
