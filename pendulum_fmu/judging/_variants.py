@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 from array import array
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -65,6 +65,17 @@ class Window:
     index: np.ndarray | None
     first: bool
     last: bool
+    # The run's own schedule integrated over the window, per state it starts from (own_run).
+    own: dict = field(default_factory=dict, compare=False, repr=False)
+
+    @property
+    def on_points(self) -> bool:
+        """Whether the rows are the frame's points exactly, one per point from the window's
+        first after the last window's (from the run's start in the first window).
+        """
+        first = 0 if self.first else self.frame.begin + 1
+        points = self.frame.plan.time[first : self.frame.end + 1]
+        return self.index is not None and np.array_equal(self.times, points)
 
 
 @dataclass(frozen=True)
@@ -111,6 +122,48 @@ def _integrated(
     return out[:-1], (float(out["theta"][-1]), float(out["omega"][-1]))
 
 
+def _beyond(plan: TorqueSchedule) -> TorqueSchedule:
+    """The schedule one more step long: the last step's length, holding the torque it reached (as
+    the FMU makes a step past the run's end).
+    """
+    end_torque = plan.torque[-1] + plan.torque_rate[-1] * plan.step_size[-1]
+    return TorqueSchedule(
+        time=np.r_[plan.time, plan.time[-1] + plan.step_size[-1]],
+        torque=np.r_[plan.torque, end_torque],
+        torque_rate=np.r_[plan.torque_rate, 0.0],
+    )
+
+
+def own_run(run: Run, window: Window, state: tuple[float, float]) -> tuple[np.ndarray, tuple[float, float]]:
+    """The run's own schedule integrated from state over the window, at each point of its frame
+    from the window's first on (in the run's last window one step past its end: a time column
+    one step off reads it), and the state at the window's last point. Made once per window and
+    state: the variants whose schedule is the run's own there (a constant torque one step late,
+    early or interpolated; a time column one step off) share it.
+    """
+    if state not in window.own:
+        frame = window.frame
+        plan = _beyond(frame.plan) if window.last else frame.plan
+        window.own[state] = _integrated(run, plan, frame.begin, frame.end, plan.time[frame.begin :], state)
+    return window.own[state]
+
+
+def _own_at_rows(run: Run, window: Window, state: tuple[float, float]) -> tuple[np.ndarray, tuple[float, float]]:
+    """own_run at the window's rows, which are its points (Window.on_points)."""
+    out, state = own_run(run, window, state)
+    at = out[window.index - window.frame.begin]
+    at["time"] = window.times
+    return at, state
+
+
+def _same_steps(plan: TorqueSchedule, window: Window) -> bool:
+    """Whether the schedule's steps from the window's first are the run's own."""
+    own, begin = window.frame.plan, window.frame.begin
+    return np.array_equal(plan.torque[begin:], own.torque[begin:]) and np.array_equal(
+        plan.torque_rate[begin:], own.torque_rate[begin:]
+    )
+
+
 class Variant:
     """One variant of a candidate mistake, made window by window: at_window gives its result at
     the window's rows (time, torque, theta, ...), or None where the variant does not apply to the
@@ -126,7 +179,10 @@ class Variant:
         plan = self.changed(frame.plan, window)
         if plan is None:
             return None
-        out, self.state = _integrated(self.run, plan, frame.begin, frame.end, window.times, self.state)
+        if window.on_points and _same_steps(plan, window):
+            out, self.state = _own_at_rows(self.run, window, self.state)
+        else:
+            out, self.state = _integrated(self.run, plan, frame.begin, frame.end, window.times, self.state)
         return out
 
     def changed(self, plan: TorqueSchedule, window: Window) -> TorqueSchedule | None:
@@ -306,19 +362,10 @@ class Shifted(Variant):
     def at_window(self, window, correct):
         if window.index is None:
             return None
-        frame = window.frame
-        plan = frame.plan
-        if window.last:
-            end_torque = plan.torque[-1] + plan.torque_rate[-1] * plan.step_size[-1]
-            plan = TorqueSchedule(
-                time=np.r_[plan.time, plan.time[-1] + plan.step_size[-1]],
-                torque=np.r_[plan.torque, end_torque],
-                torque_rate=np.r_[plan.torque_rate, 0.0],
-            )
-        at = plan.time[np.maximum(window.index + self.shift, frame.begin)]
-        out, self.state = _integrated(self.run, plan, frame.begin, frame.end, at, self.state)
-        out["time"] = window.times
-        return out
+        out, self.state = own_run(self.run, window, self.state)
+        at = out[np.maximum(window.index + self.shift, window.frame.begin) - window.frame.begin]
+        at["time"] = window.times
+        return at
 
 
 class Restarted(Variant):
@@ -356,6 +403,9 @@ class Restarted(Variant):
         return out
 
     def at_window(self, window, correct):
+        if window.on_points:
+            out, self.state = _own_at_rows(self.run, window, self.state)
+            return out
         frame = window.frame
         out, self.state = _integrated(self.run, frame.plan, frame.begin, frame.end, window.times, self.state)
         return out
