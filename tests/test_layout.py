@@ -17,7 +17,7 @@ PACKAGE = Path(pendulum_fmu.__file__).parent
 # The modules at the top beside the folders: the face, the program, and the basics every folder
 # may use, which import no folder.
 PROGRAM = {"__init__", "__main__", "_entry"}
-BASICS = {"_errors", "_atomic_files", "_received_files", "_stop_signals", "_checkout", "_progress_bar"}
+BASICS = {"_errors", "_atomic_files", "_received_files", "_stop_signals", "_checkout", "_progress_bar", "_drawn_points"}
 FOLDERS = sorted(path.parent.name for path in PACKAGE.glob("*/__init__.py"))
 
 

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from pendulum_fmu import simulate
+from pendulum_fmu._drawn_points import drawn_points
 from pendulum_fmu.cli import main
-from pendulum_fmu.figures._drawn_points import drawn_points
 from pendulum_fmu.fmu._results import write_csv
 from pendulum_fmu.judging import _result_file
 from pendulum_fmu.judging._result_file import ARROW_BYTES, ResultFileError, read_result
@@ -93,3 +93,27 @@ def test_a_long_series_is_drawn_from_few_points_keeping_every_extreme():
     for span in spans:
         drawn = np.intersect1d(kept, span)
         assert spiky[drawn].max() >= spiky[span].max() - 0.05 and spiky[drawn].min() <= spiky[span].min() + 0.05
+
+
+@pytest.mark.slow
+def test_the_memory_a_judge_takes_does_not_grow_with_the_result(tmp_path):
+    """Three times the rows, the same peak: the result, the reference and the variants are held a
+    window at a time, the regression tools' rows spilled to a temporary file (issue 48). Both
+    results are longer than what pyarrow reads ahead (about 16 blocks of 1 MB).
+    """
+    import tracemalloc
+
+    from pendulum_fmu.fmu._streamed import simulate_to_csv
+    from pendulum_fmu.judging._judge import JudgedRun
+
+    peaks = []
+    for stop in (300.0, 900.0):
+        result = simulate_to_csv(tmp_path / f"run{stop:g}.csv", 20.0, stop_time=stop).path
+        run = JudgedRun(20.0, stop_time=stop, window_steps=4096)
+        tracemalloc.start()
+        judgement = run.judge(result)
+        peaks.append(tracemalloc.get_traced_memory()[1])
+        tracemalloc.stop()
+        assert (judgement.verdict, judgement.points) == ("pass", int(stop * 1000) + 1)
+    # The whole result alone would be 40 bytes a row: 24 MB more for the longer run.
+    assert peaks[1] < peaks[0] + 2_000_000, [f"{peak / 1e6:.1f} MB" for peak in peaks]

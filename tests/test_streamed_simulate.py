@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from pendulum_fmu import InvalidInput
+from pendulum_fmu._drawn_points import DrawnRows, drawn_points
 from pendulum_fmu.cli import main
-from pendulum_fmu.figures._drawn_points import DrawnRows, drawn_points
 from pendulum_fmu.fmu import _native_loop
 from pendulum_fmu.fmu._results import write_csv
 from pendulum_fmu.fmu._simulate import simulate

@@ -1,6 +1,6 @@
 """Every figure the package draws: runs overlaid, their differences, a sweep's cases, a judgement.
 
-_plot draws them; _drawn_points keeps a long run's extremes in a few thousand points.
+_plot draws them; a long run comes to it thinned (pendulum_fmu._drawn_points: every extreme kept).
 
 matplotlib is imported here and only here, and only by a command that draws.
 

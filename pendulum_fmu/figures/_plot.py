@@ -391,7 +391,7 @@ def plot_judgement(judgement, path: str | Path, title: str) -> Path:
     names a variant, the torque that variant applies (N.m); theta of the result and of the
     reference (rad); |theta_result - theta_reference| and the variant's own difference from the
     reference (rad, log), with the tolerance. Exact zeros are said in words, not drawn. A long
-    run is drawn from drawn_points: a few thousand points that keep every extreme.
+    run comes drawn from Judgement.drawn: a few thousand points that keep every extreme.
     """
     drawn = judgement.drawn
     time, torque, theta, given = drawn["time"], drawn["torque"], drawn["reference"], drawn["result"]

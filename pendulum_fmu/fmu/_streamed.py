@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from .._atomic_files import replacing
-from ..figures._drawn_points import DrawnRows
+from .._drawn_points import DrawnRows
 from ..signals._time_grid import WINDOW_STEPS
 from ..signals._torque_schedule import TorqueSignal, schedule_windows
 from . import _results as results

@@ -248,41 +248,60 @@ def _ends_mid_line(raw: io.BufferedIOBase, size: int) -> bool:
 
 
 def _read_arrow(raw: io.BufferedIOBase, size: int, width: int, columns: dict) -> Iterator[dict[str, np.ndarray] | None]:
-    """The columns a block at a time by pyarrow's CSV reader, only those judged converted, then
-    None where it refuses a row, one is not finite or the times go backwards (_read_rows then
-    names the row). pyarrow is imported here only: it takes longer to import than a short result
-    to read.
+    """The columns a block of whole lines at a time by pyarrow's CSV parser, only those judged
+    converted, then None where it refuses a row, one is not finite or the times go backwards
+    (_read_rows then names the row). pyarrow is imported here only: it takes longer to import than
+    a short result to read.
+
+    The blocks are read here, one at a time, and each is parsed on its own: pyarrow's streaming
+    reader reads ahead of its consumer on threads of its own, up to 32 blocks measured, and a
+    judge that integrates each block's rows consumes slowly.
     """
     import pyarrow as pa
     from pyarrow import csv as pa_csv
 
     names = [f"c{index}" for index in range(width)]
     wanted = {quantity: names[index] for quantity, (index, _) in columns.items()}
+    read_options = pa_csv.ReadOptions(column_names=names, use_threads=True)
+    convert_options = pa_csv.ConvertOptions(
+        include_columns=list(wanted.values()), column_types=dict.fromkeys(wanted.values(), pa.float64())
+    )
     last = -math.inf
+    snapshot = io.BufferedReader(_Snapshot(raw, size), buffer_size=_BLOCK_BYTES)
+    snapshot.readline()  # the header, read already
+    rest = b""
     try:
-        reader = pa_csv.open_csv(
-            io.BufferedReader(_Snapshot(raw, size), buffer_size=_BLOCK_BYTES),
-            read_options=pa_csv.ReadOptions(column_names=names, skip_rows=1, block_size=_BLOCK_BYTES),
-            convert_options=pa_csv.ConvertOptions(
-                include_columns=list(wanted.values()), column_types=dict.fromkeys(wanted.values(), pa.float64())
-            ),
-        )
-        for batch in reader:
-            if not batch.num_rows:
+        while True:
+            read = snapshot.read(_BLOCK_BYTES)
+            # Whole lines: the part of a line a block ends in is read with the next.
+            if read:
+                cut = read.rfind(b"\n") + 1
+                if not cut:
+                    rest += read
+                    continue
+                lines, rest = rest + read[:cut], read[cut:]
+            else:
+                lines, rest = rest, b""
+            if not lines.strip():
+                if not read:
+                    return
                 continue
-            block = {
-                q: _in_si(batch.column(wanted[q]).to_numpy(zero_copy_only=False), factor)
-                for q, (_, factor) in columns.items()
-            }
+            table = pa_csv.read_csv(pa.py_buffer(lines), read_options=read_options, convert_options=convert_options)
+            block = {q: _in_si(table.column(wanted[q]).to_numpy(), factor) for q, (_, factor) in columns.items()}
             time = block["time"]
             # Nulls (an empty cell, NA) are NaN too.
-            if not all(np.isfinite(values).all() for values in block.values()) or (
-                time[0] < last or np.any(np.diff(time) < 0)
+            if len(time) and (
+                not all(np.isfinite(values).all() for values in block.values())
+                or time[0] < last
+                or np.any(np.diff(time) < 0)
             ):
                 yield None
                 return
-            last = time[-1]
-            yield block
+            if len(time):
+                last = time[-1]
+                yield block
+            if not read:
+                return
     except (pa.ArrowException, ValueError):
         yield None
 

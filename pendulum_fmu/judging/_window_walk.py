@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..figures._drawn_points import DrawnRows, drawn_points
+from .._drawn_points import DrawnRows, drawn_points
 from ..signals._time_grid import event_tolerance
 from ..signals._torque_schedule import TorqueSchedule
 from ._diagnoses import DRIFT, INPUT_TIMING, NOT_RESTORED, SINGLE
