@@ -36,8 +36,11 @@ explains the result leaves only rounding and solver noise (about 1e-11 rad). The
   Pendulum-v1's semi-implicit Euler); when one of them leaves only noise, the judgement names it
   (Judgement.integrator).
 
-The reading is _result_file.py's, the variants' integration _variants.py's, the verdict and
-what is printed of it _judgement.py's.
+A result is judged a window of WINDOW_STEPS grid steps of its run at a time (_window_walk.py):
+the file read a block at a time (_result_file.py), the schedule, the reference and each
+variant made window by window, each carrying its state to the next (_variants.py), the rows
+spilled for the regression tools' second pass (_theta_series.py). Memory is a window's, however
+long the run; the verdict and what is printed of it are _judgement.py's.
 """
 
 from __future__ import annotations
