@@ -13,6 +13,7 @@ import pytest
 
 from pendulum_fmu.comparing import _compare_tools as compare_tools
 from pendulum_fmu.comparing._compare import compare
+from pendulum_fmu.comparing._walk import TEXT_ROWS, trajectory_block, write_trajectory_rows
 from pendulum_fmu.fmu._results import fields
 from pendulum_fmu.fmu._simulate import simulate
 from pendulum_fmu.oracle._reference import reference
@@ -46,6 +47,22 @@ def read_columns(path) -> dict[str, list[str]]:
     with open(path, newline="") as file:
         rows = list(csv.reader(file))
     return {name: [row[i] for row in rows[1:]] for i, name in enumerate(rows[0])}
+
+
+def test_trajectory_rows_are_the_csv_modules_text_of_each_numbers_repr():
+    rng = np.random.default_rng(48)
+    runs = {}
+    for label in ("reference", "fmu"):
+        run = np.zeros(3 * TEXT_ROWS + 5, dtype=[(name, "f8") for name in ("time", "torque", "theta", "omega")])
+        for name in run.dtype.names:
+            run[name] = rng.standard_normal(len(run)) * 10.0 ** rng.integers(-300, 300, len(run))
+        runs[label] = run
+    runs["fmu"]["theta"][:4] = [np.nan, np.inf, -np.inf, -0.0]
+    text = io.StringIO(newline="")
+    block = trajectory_block(runs)
+    write_trajectory_rows(text, block[:7], header=True)
+    write_trajectory_rows(text, block[7:])
+    assert text.getvalue().encode() == old_trajectories(runs)
 
 
 def test_a_walked_compare_writes_the_trajectories_of_its_runs_byte_for_byte(tmp_path):
