@@ -124,6 +124,7 @@ def test_a_tool_that_runs_whole_is_cut_into_the_same_windows(tmp_path, monkeypat
         assert {**row, "seconds_per_step": 0} == {**other, "seconds_per_step": 0}
 
 
+@pytest.mark.filterwarnings("ignore:gymnasium. Pendulum-v1 clipped the torque")
 def test_engines_and_windowed_tools_compare_together(tmp_path):
     pytest.importorskip("gymnasium")
     comparison = run_compare(tmp_path, "mixed", "fmu,gymnasium,reference", window_steps=WINDOW)
