@@ -82,7 +82,7 @@ def run(args) -> int:
         # Past a window, what such a tool holds is what the run's memory grows with.
         print(
             f"{', '.join(comparison.whole)} ran the whole run at once, held in memory "
-            "(only fmu and wasm run a window at a time)"
+            "(fmu, wasm and Co-Simulation FMUs run a window at a time)"
         )
     for path in (comparison.trajectories, comparison.table, comparison.figure):
         print(f"wrote {path}")

@@ -150,7 +150,8 @@ class Comparison:
         max |torque| of the signal over the run, in N.m, the scale of torque_limit.
     whole : tuple of str
         The tools that ran the whole schedule at once, holding the run in memory: those that
-        cannot run it a window at a time (the engines, Pendulum-v1, an FMU through a --map).
+        cannot run it a window at a time (the engines, Pendulum-v1, a Model Exchange FMU through
+        a --map).
     worst, torque_worst, torque_limit : float
         The largest difference in theta or omega; the largest difference between the torque a tool
         received and the signal, and the rounding allowed for it.
@@ -249,9 +250,10 @@ def compare(
     window_steps : int, optional
         Grid steps walked at a time (default WINDOW_STEPS): the reference is integrated, and the
         FMU's binaries (fmu, wasm) run, a window at a time, their state carried on, and each
-        window's rows written to trajectories.csv as they come. A comparison of those tools only
-        takes memory bounded by a window, however long the run; the engines, Pendulum-v1 and an
-        FMU through a --map run the whole schedule at once first (Comparison.whole).
+        window's rows written to trajectories.csv as they come, as is a Co-Simulation FMU through
+        a --map. A comparison of those tools only takes memory bounded by a window, however long
+        the run; the engines, Pendulum-v1 and a Model Exchange FMU through a --map run the whole
+        schedule at once first (Comparison.whole).
 
     Returns
     -------

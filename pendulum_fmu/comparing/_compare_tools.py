@@ -14,8 +14,9 @@ the next (the FMU's binaries, native or WebAssembly), has a windowed runner besi
 
     tool.run_windows(windows, parameters=..., theta0=..., omega0=...) -> its rows, window by window
 
-which compare walks in memory bounded by a window; the others (the engines, Pendulum-v1, an FMU
-through a --map) run the whole schedule at once.
+which compare walks in memory bounded by a window, as it does a Co-Simulation FMU through a --map;
+the others (the engines, Pendulum-v1, a Model Exchange FMU through a --map) run the whole
+schedule at once.
 
 A tool returns the time, the torque and the outputs it computes; Tool.run hands back the outputs
 asked for (the FMU's, FmuModel.outputs, unless told otherwise), one it cannot compute as NaN with a
@@ -360,9 +361,12 @@ def _mapped_fmu(label: str, path: str, mapping: str | dict | None, fmu: str | Pa
             f"--tools {label}={path}: the label must be a name (letters, digits, _ . -) other than {', '.join(KINDS)}"
         )
     try:
-        return Tool(label, MappedFmu(path, mapping, label=label).run, fmu)
+        mapped = MappedFmu(path, mapping, label=label)
     except ValueError as error:
         raise ToolSpecError(str(error)) from None
+    # Model Exchange runs through fmpy's simulate_fmu, which integrates a whole schedule at once.
+    windowed = mapped.run_windows if mapped.interface == "CoSimulation" else None
+    return Tool(label, mapped.run, fmu, windowed)
 
 
 def _named(item: str, fmu_path: str | Path | FmuModel | None) -> Tool:
