@@ -4,6 +4,10 @@ Every tool is fed the schedule that `torque_schedule.schedule` makes of the user
 reference (`reference.reference`) reads the signal itself and shares no code with that schedule,
 so a schedule that does not carry the signal shows as a difference: in theta and omega, and in
 the torque each tool received against the signal's value at the start of each step.
+
+The run is walked a window of the schedule at a time (_walk.py), the reference restarted from
+its own state at each window, so that a comparison of the tools that can run that way takes the
+memory of a window however long the run.
 """
 
 from __future__ import annotations
@@ -312,7 +316,7 @@ def compare(
             started = clock.perf_counter()
             runs[tool.label] = tool.run(plan, **start)
             seconds[tool.label] = clock.perf_counter() - started
-        del plan
+        del plan  # the walk makes its own windows of it
     tally, walked = walk(windows, oracle, others, runs, outputs["trajectories.csv"], start)
     seconds.update(walked)
     steps = tally.differences.rows - 1
