@@ -14,10 +14,10 @@ from fmu_build import MODEL_DESCRIPTION, PENDULUM_DIR, SOURCE_DIR, build_fmu
 from pendulum_fmu._errors import NotComputed, Skipped
 from pendulum_fmu.cli import main
 from pendulum_fmu.comparing import _compare_tools as compare_tools
-from pendulum_fmu.comparing._compare import run_tools
+from pendulum_fmu.comparing._compare import compare, run_tools
 from pendulum_fmu.comparing._mapped_fmu import MapError, Mapped, MappedFmu, parse_map
 from pendulum_fmu.oracle._reference import reference_schedule
-from pendulum_fmu.signals._torque_schedule import schedule
+from pendulum_fmu.signals._torque_schedule import schedule, schedule_windows
 
 RENAMES = {
     "torque": "u",
@@ -131,6 +131,19 @@ def test_another_fmu_under_other_names_matches_the_reference(renamed_fmu, interf
     )
     assert max_error(run, expected) < 1e-9
     assert max_error(run, expected, "alpha") < 1e-7
+
+
+def test_a_co_simulation_fmu_walked_in_windows_is_its_whole_run(renamed_fmu, tmp_path):
+    signal = lambda t: 50.0 if t < 0.25 else -80.0  # noqa: E731  PLAN's
+    windows = schedule_windows(signal, stop_time=0.5, step_size=1e-3, window_steps=37)
+    theirs = MappedFmu(renamed_fmu, FULL_MAP, interface="CoSimulation")
+    blocks = list(theirs.run_windows(windows, parameters={"damping": 3.0}, theta0=0.2))
+    assert len(blocks) == 14
+    assert np.array_equal(np.concatenate(blocks), theirs.run(PLAN, parameters={"damping": 3.0}, theta0=0.2))
+    comparison = compare(
+        signal, f"theirs={renamed_fmu},reference", mapping=FULL_MAP, output_dir=tmp_path, stop_time=0.5, window_steps=37
+    )
+    assert comparison.whole == () and comparison.agree  # Co-Simulation, the FMU's first interface
 
 
 def test_a_scale_factor_converts_both_ways(renamed_fmu):

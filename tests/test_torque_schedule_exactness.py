@@ -6,8 +6,6 @@ below them, running-sum times, kinks between communication points under --ramp, 
 and randomized signals over step sizes that include the awkward ones.
 """
 
-from importlib import import_module
-
 import numpy as np
 import pytest
 
@@ -15,10 +13,7 @@ from benchmarks.signal_cases import random_step_rows, write_rows
 from pendulum_fmu.comparing._compare import compare
 from pendulum_fmu.fmu._simulate import simulate
 from pendulum_fmu.oracle._reference import reference
-from pendulum_fmu.signals._torque_schedule import schedule
-
-# The module; the package's attribute of that name is its function.
-compare_module = import_module("pendulum_fmu.comparing._compare")
+from pendulum_fmu.signals._torque_schedule import ScheduleWindows
 
 # 0.0003, 0.0006, 0.0007, 0.0009, 0.009, 0.03 and 0.3 are doubles below their decimals, so k*h
 # falls an ulp below a jump written at a multiple of them; 1/3 ms is no decimal at all.
@@ -133,13 +128,17 @@ def test_compare_catches_a_schedule_that_does_not_carry_the_signal(tmp_path, mon
     # The old schedule read the value at a grid point an ulp below the jump: the pre-jump value.
     csv = write_rows(tmp_path / "j.csv", [(0, 10), (0.027, 10), (0.027, -20), (0.5, -20)])
 
-    def late_by_one_step(*args, **kwargs):
-        plan = schedule(*args, **kwargs)
-        jump = np.flatnonzero(np.diff(plan.torque))[0] + 1
-        plan.torque[jump] = plan.torque[jump - 1]
+    made = ScheduleWindows.__next__
+
+    def late_by_one_step(windows):
+        # compare walks the schedule's windows (one here): each carries its first jump a step late.
+        plan = made(windows)
+        jumps = np.flatnonzero(np.diff(plan.torque))
+        if len(jumps):
+            plan.torque[jumps[0] + 1] = plan.torque[jumps[0]]
         return plan
 
-    monkeypatch.setattr(compare_module, "schedule", late_by_one_step)
+    monkeypatch.setattr(ScheduleWindows, "__next__", late_by_one_step)
     comparison = compare(csv, ["fmu", "reference"], output_dir=tmp_path / "out", step_size=0.009)
     assert not comparison.agree
     assert comparison.worst > 1e-5

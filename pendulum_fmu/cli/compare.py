@@ -66,6 +66,7 @@ def add_parser(commands) -> argparse.ArgumentParser:
 def run(args) -> int:
     """Run `pendulum-fmu compare` with the parsed arguments; returns the exit status."""
     from ..comparing._compare import compare, format_comparison
+    from ..signals._time_grid import WINDOW_STEPS
 
     comparison = compare(
         torque_signal(args),
@@ -76,6 +77,13 @@ def run(args) -> int:
         **signal_options(args),
     )
     print(format_comparison(comparison))
+    steps = len(next(iter(comparison.runs.values()))) - 1  # every row, where a tool ran whole
+    if comparison.whole and steps > WINDOW_STEPS:
+        # Past a window, what such a tool holds is what the run's memory grows with.
+        print(
+            f"{', '.join(comparison.whole)} ran the whole run at once, held in memory "
+            "(fmu, wasm and Co-Simulation FMUs run a window at a time)"
+        )
     for path in (comparison.trajectories, comparison.table, comparison.figure):
         print(f"wrote {path}")
     return 0 if comparison.agree else 1

@@ -4,12 +4,15 @@ Every tool is fed the schedule that `torque_schedule.schedule` makes of the user
 reference (`reference.reference`) reads the signal itself and shares no code with that schedule,
 so a schedule that does not carry the signal shows as a difference: in theta and omega, and in
 the torque each tool received against the signal's value at the start of each step.
+
+The run is walked a window of the schedule at a time (_walk.py), the reference restarted from
+its own state at each window, so that a comparison of the tools that can run that way takes the
+memory of a window however long the run.
 """
 
 from __future__ import annotations
 
 import csv
-import itertools
 import math
 import os
 import time as clock
@@ -21,14 +24,14 @@ import numpy as np
 from .._atomic_files import check_writable, replacing
 from .._errors import InvalidInput, WrongType
 from ..figures._plot import case_title, plot_comparison
-from ..fmu import _results as results
 from ..fmu._model import fmu_model
 from ..fmu._simulate import resolve_parameters
-from ..oracle._reference import reference
-from ..signals._torque_schedule import TorqueSchedule, TorqueSignal, schedule
+from ..oracle._reference import reference_windows
+from ..signals._time_grid import WINDOW_STEPS
+from ..signals._torque_schedule import TorqueSchedule, TorqueSignal, schedule, schedule_windows
 from ._compare_tools import ToolSpecError, installed_defaults, parse_tools
+from ._walk import REFERENCE, walk
 
-REFERENCE = "reference"
 # The torque a tool received may differ from the signal by rounding only (relative to the
 # signal's size; on a steep ramp an ulp of time is more than an ulp of torque).
 TORQUE_ROUNDING = 1e-9
@@ -60,22 +63,6 @@ def check_tolerance(tolerance: float) -> float:
     if not (math.isfinite(tolerance) and tolerance > 0):
         raise InvalidInput(f"the tolerance {tolerance} must be a positive finite number (rad, rad/s)")
     return float(tolerance)
-
-
-def differences(run: np.ndarray, judge: np.ndarray) -> dict[str, float]:
-    """Max and RMS |run - judge| of each output (theta, omega, alpha: the fields after time and
-    torque), and max |torque difference|.
-    """
-    row = {}
-    # A tool whose numbers run past the largest double (a --map factor of 1e308) differs by inf:
-    # that is its verdict, and numpy's overflow warnings on the way say nothing more.
-    with np.errstate(over="ignore", invalid="ignore"):
-        for name in results.fields(run)[2:]:
-            difference = np.abs(run[name] - judge[name])
-            row[f"{name}_max"] = float(np.max(difference))
-            row[f"{name}_rms"] = float(np.sqrt(np.mean(difference**2)))
-        row["torque_max"] = float(np.max(np.abs(run["torque"] - judge["torque"])))
-    return row
 
 
 COLUMNS = (
@@ -135,23 +122,6 @@ def format_table(rows: list[dict]) -> str:
     return "\n".join(lines)
 
 
-def write_trajectories(runs: dict[str, np.ndarray], path: str | Path) -> Path:
-    """One CSV: time, then torque, theta, omega, alpha (every field after time) of each tool
-    (torque_fmu, theta_fmu, ...).
-    """
-    columns = {"time": next(iter(runs.values()))["time"]}
-    for tool, run in runs.items():
-        for name in results.fields(run)[1:]:
-            columns[f"{name}_{tool}"] = run[name]
-    with replacing(path, newline="") as file:
-        writer = csv.writer(file)
-        writer.writerow(columns)
-        writer.writerows(
-            zip(*(map(repr, np.asarray(values, dtype=float).tolist()) for values in columns.values()), strict=False)
-        )
-    return Path(path)
-
-
 def write_differences(rows: list[dict], path: str | Path) -> Path:
     """Write differences.csv: the rows of COLUMNS, then any other output's differences."""
     with replacing(path, newline="") as file:
@@ -169,13 +139,23 @@ class Comparison:
     Attributes
     ----------
     runs : dict of str to numpy.ndarray
-        Each tool's results array (_results.py), by its label; "reference" is the judge.
+        Each tool's results array (_results.py), by its label; "reference" (the judge) first.
+        Every row where a tool ran the whole schedule at once (whole), or where the run is short
+        (a few thousand rows); else, the run having been walked a window at a time, the rows its
+        figure draws: in each of 2000 columns of time, the first and last row and where theta,
+        omega or a tool's difference from the reference is least and greatest.
     differences : list of dict
         The rows of differences.csv: each tool against the reference, then each pair of tools.
     tolerance : float
         The largest difference in theta (rad) or omega (rad/s) for the tools to agree.
     trajectories, table, figure : Path
         trajectories.csv, differences.csv and comparison.png.
+    largest_torque : float
+        max |torque| of the signal over the run, in N.m, the scale of torque_limit.
+    whole : tuple of str
+        The tools that ran the whole schedule at once, holding the run in memory: those that
+        cannot run it a window at a time (the engines, Pendulum-v1, a Model Exchange FMU through
+        a --map).
     worst, torque_worst, torque_limit : float
         The largest difference in theta or omega; the largest difference between the torque a tool
         received and the signal, and the rounding allowed for it.
@@ -197,6 +177,8 @@ class Comparison:
     trajectories: Path
     table: Path
     figure: Path
+    largest_torque: float
+    whole: tuple[str, ...] = ()
 
     @property
     def worst(self) -> float:
@@ -211,7 +193,7 @@ class Comparison:
     @property
     def torque_limit(self) -> float:
         """The rounding allowed between the torque a tool received and the signal, in N.m."""
-        return TORQUE_ROUNDING * (1.0 + float(np.max(np.abs(self.runs[REFERENCE]["torque"]))))
+        return TORQUE_ROUNDING * (1.0 + self.largest_torque)
 
     @property
     def agree(self) -> bool:
@@ -236,6 +218,7 @@ def compare(
     fmu_path: str | Path | None = None,
     mapping: str | dict | None = None,
     max_steps: int | None = None,
+    window_steps: int = WINDOW_STEPS,
 ) -> Comparison:
     """Run one signal through each tool and judge each against the reference.
 
@@ -268,6 +251,13 @@ def compare(
     mapping : str or dict, optional
         The --map of the tools given as LABEL=path, as its text or as a dict such as
         {"theta": "phi*0.0174532925"} (mapped_fmu.as_map).
+    window_steps : int, optional
+        Grid steps walked at a time (default WINDOW_STEPS): the reference is integrated, and the
+        FMU's binaries (fmu, wasm) run, a window at a time, their state carried on, and each
+        window's rows written to trajectories.csv as they come, as is a Co-Simulation FMU through
+        a --map. A comparison of those tools only takes memory bounded by a window, however long
+        the run; the engines, Pendulum-v1 and a Model Exchange FMU through a --map run the whole
+        schedule at once first (Comparison.whole).
 
     Returns
     -------
@@ -309,48 +299,38 @@ def compare(
     # Refused here before any tool runs; and every tool gets the whole set, so the defaults are
     # fmu_path's for all of them.
     parameters = resolve_parameters(parameters, model)
-    plan = schedule(
-        torque, start_time=start_time, stop_time=stop_time, step_size=step_size, ramp=ramp, max_steps=max_steps
-    )
+    times = dict(start_time=start_time, stop_time=stop_time, step_size=step_size, ramp=ramp, max_steps=max_steps)
+    windows = schedule_windows(torque, **times, window_steps=window_steps)
     output_dir = Path(output_dir)
     outputs = {name: output_dir / name for name in ("trajectories.csv", "differences.csv", "comparison.png")}
     check_writable(*outputs.values())
-    steps = len(plan.time) - 1
+    start = dict(parameters=parameters, theta0=theta0, omega0=omega0)
+    # The judge's work estimated, and refused past its bound, before any tool runs.
+    oracle = reference_windows(torque, **times, **start, fmu_path=model, window_steps=window_steps)
+    others = [tool for tool in parsed if tool.label != REFERENCE]  # the judge takes the reference's place
+    whole = [tool for tool in others if tool.windowed is None]
     runs, seconds = {}, {}
-    runs[REFERENCE] = reference(
-        torque,
-        start_time=start_time,
-        stop_time=stop_time,
-        step_size=step_size,
-        ramp=ramp,
-        parameters=parameters,
-        theta0=theta0,
-        omega0=omega0,
-        at=plan.time,
-        fmu_path=model,
-    )
-    for tool in parsed:
-        if tool.label != REFERENCE:  # the judge above takes the reference's place
+    if whole:
+        plan = schedule(torque, **times)  # held whole, as those tools take it: memory is checked
+        for tool in whole:
             started = clock.perf_counter()
-            runs[tool.label] = tool.run(plan, parameters=parameters, theta0=theta0, omega0=omega0)
-            seconds[tool.label] = (clock.perf_counter() - started) / steps
-    judge = runs[REFERENCE]
-    others = [tool for tool in runs if tool != REFERENCE]
-    rows = [
-        {"tool": tool, "against": REFERENCE, **differences(runs[tool], judge), "seconds_per_step": seconds[tool]}
-        for tool in others
-    ]
-    rows += [
-        {"tool": a, "against": b, **differences(runs[a], runs[b]), "seconds_per_step": None}
-        for a, b in itertools.combinations(others, 2)
-    ]
+            runs[tool.label] = tool.run(plan, **start)
+            seconds[tool.label] = clock.perf_counter() - started
+        del plan  # the walk makes its own windows of it
+    tally, walked = walk(windows, oracle, others, runs, outputs["trajectories.csv"], start)
+    seconds.update(walked)
+    steps = tally.differences.rows - 1
+    rows = tally.differences.table({label: spent / steps for label, spent in seconds.items()})
+    runs = tally.runs()
     return Comparison(
         runs=runs,
         differences=rows,
         tolerance=tolerance,
-        trajectories=write_trajectories(runs, outputs["trajectories.csv"]),
+        trajectories=outputs["trajectories.csv"],
         table=write_differences(rows, outputs["differences.csv"]),
         figure=plot_comparison(runs, outputs["comparison.png"], title or f"{shown}; tools {', '.join(runs)}"),
+        largest_torque=tally.largest_torque,
+        whole=tuple(tool.label for tool in whole),
     )
 
 

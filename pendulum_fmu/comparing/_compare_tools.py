@@ -9,6 +9,15 @@ _mapped_fmu.py). Every tool has the same runner:
 
     tool.run(plan, parameters=..., theta0=..., omega0=...) -> results array (_results.py)
 
+A tool that can also run a schedule a window at a time, its state carried from one window into
+the next (the FMU's binaries, native or WebAssembly), has a windowed runner besides:
+
+    tool.run_windows(windows, parameters=..., theta0=..., omega0=...) -> its rows, window by window
+
+which compare walks in memory bounded by a window, as it does a Co-Simulation FMU through a --map;
+the others (the engines, Pendulum-v1, a Model Exchange FMU through a --map) run the whole
+schedule at once.
+
 A tool returns the time, the torque and the outputs it computes; Tool.run hands back the outputs
 asked for (the FMU's, FmuModel.outputs, unless told otherwise), one it cannot compute as NaN with a
 one-line warning (errors.NotComputed), never zeros.
@@ -24,7 +33,7 @@ import importlib
 import importlib.util
 import re
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
@@ -35,7 +44,7 @@ from .._errors import InvalidInput, Skipped, WrongType
 from ..engines import MODES, check_mode
 from ..fmu import WASM_PLATFORM, _results as results
 from ..fmu._model import FmuModel, fmu_model
-from ..fmu._simulate import resolve_parameters, simulate_plan
+from ..fmu._simulate import resolve_parameters, simulate_windows
 from ..oracle._reference import reference_schedule
 from ..signals._torque_schedule import TorqueSchedule
 
@@ -53,6 +62,9 @@ class Tool:
     label: str
     runner: Callable[..., np.ndarray]
     fmu: str | Path | FmuModel | None = None
+    # The runner of consecutive windows of a schedule, for a tool that carries its state across
+    # them; None for a tool that runs a whole schedule only.
+    windowed: Callable[..., Iterator[np.ndarray]] | None = None
 
     def run(
         self,
@@ -87,8 +99,46 @@ class Tool:
             One line naming the outputs the tool cannot compute; their columns are NaN.
         """
         run = self.runner(plan, parameters=parameters, theta0=theta0, omega0=omega0)
-        asked = fmu_model(self.fmu).outputs if outputs is None else tuple(outputs)
-        return results.with_outputs(run, asked, self.label)
+        return results.with_outputs(run, self._asked(outputs), self.label)
+
+    def run_windows(
+        self,
+        windows: Iterable[TorqueSchedule],
+        *,
+        parameters: dict | None = None,
+        theta0: float = 0.0,
+        omega0: float = 0.0,
+        outputs: Sequence[str] | None = None,
+    ) -> Iterator[np.ndarray]:
+        """The tool's result for a schedule given as consecutive windows (schedule_windows), a
+        window at a time, for a tool whose windowed is set.
+
+        Parameters
+        ----------
+        windows : iterable of TorqueSchedule
+            Consecutive windows of one schedule, sharing their boundary points.
+        parameters, theta0, omega0, outputs
+            As run() takes them.
+
+        Returns
+        -------
+        iterator of numpy.ndarray
+            Result arrays, one a window, that concatenate to run()'s of the whole schedule, bit
+            for bit: a boundary's row is the later window's.
+
+        Raises
+        ------
+        TypeError
+            The tool has no windowed runner.
+        """
+        if self.windowed is None:
+            raise TypeError(f"{self.label} runs a whole schedule only")
+        asked = self._asked(outputs)
+        for block in self.windowed(windows, parameters=parameters, theta0=theta0, omega0=omega0):
+            yield results.with_outputs(block, asked, self.label)
+
+    def _asked(self, outputs: Sequence[str] | None) -> tuple[str, ...]:
+        return fmu_model(self.fmu).outputs if outputs is None else tuple(outputs)
 
 
 def run_fmu(
@@ -104,18 +154,36 @@ def run_fmu(
     """The project's FMU (the checkout's, or fmu_path) through fmpy; ramps are passed on.
     platform: its binary, as simulate's (the wasm tool's: WASM_PLATFORM).
     """
+    options = dict(parameters=parameters, theta0=theta0, omega0=omega0, mode=mode, fmu_path=fmu_path)
+    return next(fmu_windows((plan,), **options, platform=platform))
+
+
+def fmu_windows(
+    windows: Iterable[TorqueSchedule],
+    *,
+    parameters: dict | None = None,
+    theta0: float = 0.0,
+    omega0: float = 0.0,
+    mode: str = "accurate",
+    fmu_path: str | Path | FmuModel | None = None,
+    platform: str | None = None,
+) -> Iterator[np.ndarray]:
+    """run_fmu's result for consecutive windows of one schedule, through one run of the FMU
+    (simulate_windows): a window's rows at a time.
+    """
     check_mode(mode, "fmu")
     if platform:
         # A set the FMU refuses, in its words as every tool says them, before the binary is looked for.
         resolve_parameters(parameters, fmu_path)
-    return simulate_plan(
-        plan, parameters=parameters, theta0=theta0, omega0=omega0, fmu_path=fmu_path, platform=platform
+    return simulate_windows(
+        windows, parameters=parameters, theta0=theta0, omega0=omega0, fmu_path=fmu_path, platform=platform
     )
 
 
 # The wasm tool: the FMU's WebAssembly binary through wasmtime, fmu_path's (FMI 3.0) or the
 # checkout's FMI 3.0 FMU; the torque held over each step.
 run_wasm = partial(run_fmu, platform=WASM_PLATFORM)
+wasm_windows = partial(fmu_windows, platform=WASM_PLATFORM)
 
 
 def run_reference(
@@ -140,21 +208,29 @@ class Kind:
     package: str | None = None  # the module its extra installs
     extra: str | None = None
     modes: tuple[str, ...] = ("accurate",)
+    windowed: str | None = None  # "module:function" of its runner of windows, if it has one
 
-    def load(self) -> Callable[..., np.ndarray]:
-        """The tool's runner, its module imported now."""
-        module, function = self.runner.split(":")
+    def load(self, runner: str | None = None) -> Callable:
+        """The tool's runner (or the one named "module:function"), its module imported now."""
+        module, function = (runner or self.runner).split(":")
         return getattr(importlib.import_module(module), function)
 
 
 KINDS = {
-    "fmu": Kind("pendulum_fmu.comparing._compare_tools:run_fmu"),
+    "fmu": Kind(
+        "pendulum_fmu.comparing._compare_tools:run_fmu", windowed="pendulum_fmu.comparing._compare_tools:fmu_windows"
+    ),
     "reference": Kind("pendulum_fmu.comparing._compare_tools:run_reference"),
     "opensim": Kind("pendulum_fmu.engines.opensim:run", "opensim", "opensim", MODES),
     "mujoco": Kind("pendulum_fmu.engines.mujoco:run", "mujoco", "mujoco", MODES),
     "drake": Kind("pendulum_fmu.engines.drake:run", "pydrake", "drake", MODES),
     "pybullet": Kind("pendulum_fmu.engines.pybullet:run", "pybullet", "pybullet", MODES),
-    "wasm": Kind("pendulum_fmu.comparing._compare_tools:run_wasm", "wasmtime", "wasm"),
+    "wasm": Kind(
+        "pendulum_fmu.comparing._compare_tools:run_wasm",
+        "wasmtime",
+        "wasm",
+        windowed="pendulum_fmu.comparing._compare_tools:wasm_windows",
+    ),
     # Pendulum-v1, the reinforcement-learning pendulum: semi-implicit Euler at the communication
     # step, with its torque and speed clips; one mode, its own.
     "gymnasium": Kind("pendulum_fmu.engines.gymnasium:run", "gymnasium", "gym"),
@@ -285,9 +361,12 @@ def _mapped_fmu(label: str, path: str, mapping: str | dict | None, fmu: str | Pa
             f"--tools {label}={path}: the label must be a name (letters, digits, _ . -) other than {', '.join(KINDS)}"
         )
     try:
-        return Tool(label, MappedFmu(path, mapping, label=label).run, fmu)
+        mapped = MappedFmu(path, mapping, label=label)
     except ValueError as error:
         raise ToolSpecError(str(error)) from None
+    # Model Exchange runs through fmpy's simulate_fmu, which integrates a whole schedule at once.
+    windowed = mapped.run_windows if mapped.interface == "CoSimulation" else None
+    return Tool(label, mapped.run, fmu, windowed)
 
 
 def _named(item: str, fmu_path: str | Path | FmuModel | None) -> Tool:
@@ -302,7 +381,8 @@ def _named(item: str, fmu_path: str | Path | FmuModel | None) -> Tool:
         raise ToolSpecError(f"--tools {name}: {kind.package} is not installed; install it with: {install_hint(name)}")
     # Every runner takes the FMU whose defaults (and, for fmu, whose binary) apply.
     runner = partial(kind.load(), mode=mode, fmu_path=fmu_path)
-    return Tool(_label(name, mode), runner, fmu_path)
+    windowed = None if kind.windowed is None else partial(kind.load(kind.windowed), mode=mode, fmu_path=fmu_path)
+    return Tool(_label(name, mode), runner, fmu_path, windowed)
 
 
 def parse_tools(

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -31,7 +32,7 @@ from fmpy.fmi2 import FMU2Slave
 from fmpy.fmi3 import FMU3Slave
 
 from .._errors import InvalidInput, WrongType
-from ..engines import check_held, check_mode, held_results
+from ..engines import ToolCannotRamp, check_held, check_mode, held_results
 from ..fmu._instance import FmuError, MessageLog, fmi2_library, instantiate
 from ..fmu._model import START_VALUES, FmuFileError, fmu_model
 from ..fmu._parameters import default_parameters
@@ -194,12 +195,35 @@ class MappedFmu:
     ) -> np.ndarray:
         """The FMU's result for a held schedule, mapped to the pendulum's quantities (see Tool.run)."""
         check_held(plan, self.label)
+        options = dict(parameters=parameters, theta0=theta0, omega0=omega0, mode=mode)
+        if self.interface == "CoSimulation":
+            return next(self.run_windows((plan,), **options))
         check_mode(mode, self.label)
         start = self._start_values(parameters, theta0, omega0)
-        step = self._co_simulation if self.interface == "CoSimulation" else self._model_exchange
-        raw = step(plan, start, TOLERANCE[mode])
-        out = held_results(plan)  # an output the map does not name stays NaN
-        for name, values in raw.items():
+        return self._mapped(plan, self._model_exchange(plan, start, TOLERANCE[mode]))
+
+    def run_windows(
+        self,
+        windows: Iterable[TorqueSchedule],
+        *,
+        parameters: dict | None = None,
+        theta0: float = 0.0,
+        omega0: float = 0.0,
+        mode: str = "accurate",
+    ) -> Iterator[np.ndarray]:
+        """A Co-Simulation FMU's result for consecutive windows of one held schedule, through one
+        instance stepped on from window to window: run()'s rows of the whole schedule, a window at
+        a time, a boundary's row the later window's (see Tool.run_windows).
+        """
+        check_mode(mode, self.label)
+        start = self._start_values(parameters, theta0, omega0)
+        for plan, raw in self._co_simulation(windows, start, TOLERANCE[mode]):
+            yield self._mapped(plan, raw)
+
+    def _mapped(self, plan: TorqueSchedule, raw: dict[str, np.ndarray]) -> np.ndarray:
+        """The FMU's outputs (their first rows of the schedule's points) in the pendulum's units."""
+        out = held_results(plan)[: len(raw["theta"])]  # theta is always mapped
+        for name, values in raw.items():  # an output the map does not name stays NaN
             out[name] = values * self.mapping[name].factor
         return out
 
@@ -207,14 +231,20 @@ class MappedFmu:
         """{pendulum output: the FMU's variable} of the outputs the map names."""
         return {name: self.mapping[name].variable for name in fmu_model().outputs if name in self.mapping}
 
-    def _co_simulation(self, plan, start, tolerance):
-        """Hold each step's torque, read the outputs at each communication point."""
+    def _co_simulation(self, windows, start, tolerance):
+        """Hold each step's torque, read the outputs at each communication point: for each window
+        of the schedule, the window and its outputs, less the boundary's row that the next window
+        reads (after setting its torque, as one run of the whole schedule reads it).
+        """
         fmi3 = self.description.fmiVersion == "3.0"
         folder = self.model.folder
         identifier = self.description.coSimulation.modelIdentifier
         arguments = dict(
             guid=self.description.guid, unzipDirectory=folder, modelIdentifier=identifier, instanceName=self.label
         )
+        windows = iter(windows)
+        plan = next(windows)
+        check_held(plan, self.label)
         try:
             slave = (
                 FMU3Slave(**arguments) if fmi3 else FMU2Slave(**arguments, libraryPath=fmi2_library(folder, identifier))
@@ -234,7 +264,6 @@ class MappedFmu:
         output_vrs = [vr[variable] for variable in outputs.values()]
         set_values = slave.setFloat64 if fmi3 else slave.setReal
         get_values = slave.getFloat64 if fmi3 else slave.getReal
-        recorded = np.full((len(plan.time), len(outputs)), np.nan)
         t0 = float(plan.time[0])
         instantiate(slave, messages, f"{self.label}: {self.path}")
         try:
@@ -250,20 +279,29 @@ class MappedFmu:
             else:
                 slave.enterInitializationMode()
             slave.exitInitializationMode()
-            for k, (t, h, u) in enumerate(
-                zip(plan.time.tolist(), plan.step_size.tolist(), plan.torque.tolist(), strict=False)
-            ):
-                call = f"the step from t = {t:.17g}"
-                set_values(torque_vr, [u / torque.factor])
-                recorded[k] = get_values(output_vrs)
-                slave.doStep(currentCommunicationPoint=t, communicationStepSize=h)
-            recorded[-1] = get_values(output_vrs)
-            slave.terminate()
+            while plan is not None:
+                recorded = np.full((len(plan.time), len(outputs)), np.nan)
+                for k, (t, h, u) in enumerate(
+                    zip(plan.time.tolist(), plan.step_size.tolist(), plan.torque.tolist(), strict=False)
+                ):
+                    call = f"the step from t = {t:.17g}"
+                    set_values(torque_vr, [u / torque.factor])
+                    recorded[k] = get_values(output_vrs)
+                    slave.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+                window, plan = plan, next(windows, None)
+                if plan is None:
+                    recorded[-1] = get_values(output_vrs)
+                    slave.terminate()
+                else:
+                    check_held(plan, self.label)
+                    recorded = recorded[:-1]
+                yield window, {name: recorded[:, i] for i, name in enumerate(outputs)}
+        except ToolCannotRamp:
+            raise
         except Exception as error:
             raise FmuError(f"{self.label}: {call} failed: {error}") from None
         finally:
             slave.freeInstance()
-        return {name: recorded[:, i] for i, name in enumerate(outputs)}
 
     def _model_exchange(self, plan, start, tolerance):
         """Fmpy's CVode on the FMU's derivatives, with the torque as a table that jumps where the
