@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from .._atomic_files import replacing
-from ..figures._drawn_points import DrawnRows
+from .._drawn_points import DrawnRows
 from ..fmu import _results as results
 from ._compare_tools import Tool
 
