@@ -209,7 +209,9 @@ class JudgedRun:
             optional_differences={
                 f"max_abs_d{name}": value for name, value in walk.optional.items() if not math.isnan(value)
             },
-            drawn=walk.drawn_array(best.get(diagnosis)),
+            # The variant drawn is the one that explains the result: an integration error without an
+            # integrator of its own draws none.
+            drawn=walk.drawn_array(best.get(diagnosis) if explained else None),
             source=source,
             integrator=integrator,
             regression_tools=regression_tools,

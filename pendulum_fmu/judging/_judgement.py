@@ -40,8 +40,8 @@ class Judgement:
     drawn : numpy.ndarray
         The points a figure draws: every row of a short result; of a long one, every extreme per
         column of time (drawn_points). Fields time, torque (the run's, N.m), reference and result
-        (theta, rad), explained_torque and explained_theta (the variant the diagnosis names; NaN
-        for agrees and unexplained).
+        (theta, rad), explained_torque and explained_theta (the variant that explains the result;
+        NaN where none does: agrees, unexplained, an integration error without an integrator).
     source : str
         The result file's name, as reports show it.
     integrator : str or None
