@@ -299,7 +299,8 @@ def template_pattern(command: str) -> re.Pattern:
     """
     module = importlib.import_module(command.split(" -m ", 1)[1].split()[0])
     parts = re.split(r"\{\w+\}", " ".join(module.TEMPLATE.split()))
-    return re.compile(".+?".join(re.escape(part) for part in parts))
+    # A figure may be empty: a benchmark's options where it ran with its defaults.
+    return re.compile(".*?".join(re.escape(part) for part in parts))
 
 
 def measured_figures(command: str) -> dict[str, str]:
@@ -308,7 +309,7 @@ def measured_figures(command: str) -> dict[str, str]:
     The names are those its benchmark's TEMPLATE gives the figures.
     """
     module = importlib.import_module(command.split(" -m ", 1)[1].split()[0])
-    pattern = re.sub(r"\\\{(\w+)\\\}", r"(?P<\1>.+?)", re.escape(" ".join(module.TEMPLATE.split())))
+    pattern = re.sub(r"\\\{(\w+)\\\}", r"(?P<\1>.*?)", re.escape(" ".join(module.TEMPLATE.split())))
     for document in DOCUMENTS:
         for block in blocks(document.read_text(encoding="utf-8").splitlines()):
             if block.kind == "measured" and block.command == command:
