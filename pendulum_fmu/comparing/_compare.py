@@ -151,7 +151,7 @@ class Comparison:
     trajectories, table, figure : Path
         trajectories.csv, differences.csv and comparison.png.
     largest_torque : float
-        max |torque| of the signal over the run, in N.m, the scale of torque_limit.
+        ``max |torque|`` of the signal over the run, in N.m, the scale of torque_limit.
     whole : tuple of str
         The tools that ran the whole schedule at once, holding the run in memory: those that
         cannot run it a window at a time (the engines, Pendulum-v1, a Model Exchange FMU through

@@ -36,7 +36,7 @@ class Judgement:
     exact_zeros : int
         The rows where theta equals the reference's exactly.
     optional_differences : dict
-        max |domega| (rad/s) and max |dalpha| (rad/s2), of those the result gives at every row.
+        ``max |domega|`` (rad/s) and ``max |dalpha|`` (rad/s2), of those the result gives at every row.
     drawn : numpy.ndarray
         The points a figure draws: every row of a short result; of a long one, every extreme per
         column of time (drawn_points). Fields time, torque (the run's, N.m), reference and result
