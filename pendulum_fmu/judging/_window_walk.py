@@ -77,8 +77,9 @@ class Walk:
 
     def __init__(self, variants: dict[str, list[Variant]], tolerance: float, span: tuple[float, float], series):
         self.variants, self.tolerance, self.span, self.series = variants, tolerance, span, series
-        columns = iter(range(1, 1 + sum(map(len, variants.values()))))
-        self.scores = {name: [Score(next(columns)) for _ in made] for name, made in variants.items()}
+        columns_of = range(1, 1 + sum(map(len, variants.values())))
+        numbered = iter(columns_of)
+        self.scores = {name: [Score(next(numbered)) for _ in made] for name, made in variants.items()}
         self.single = Score(0)
         self.raw, self.worst_time, self.exact_zeros, self.rows = 0.0, math.nan, 0, 0
         self.first_wrong: int | None = None  # the run's first row that disagrees
@@ -87,11 +88,10 @@ class Walk:
         self.float32 = True
         self.optional = {name: 0.0 for name in OPTIONAL}  # max |d omega|, |d alpha|; NaN: not all given
         # The drawn rows: the result's and the reference's, and each variant's torque and theta.
-        self.fields = [*_BASE_FIELDS, *(f"{what}{j}" for j in range(1 + self._count()) for what in ("torque", "theta"))]
+        # Column 0 is single precision's, the variants' the columns their scores hold.
+        columns = 1 + len(columns_of)
+        self.fields = [*_BASE_FIELDS, *(f"{what}{j}" for j in range(columns) for what in ("torque", "theta"))]
         self.drawn = DrawnRows(_BASE_FIELDS[1:], span, DRAWN_COLUMNS)
-
-    def _count(self) -> int:
-        return sum(map(len, self.variants.values()))
 
     def window(self, window: Window, result: np.ndarray, correct: np.ndarray, outputs: dict | None = None) -> None:
         """Take one window: its rows of the result and the reference at them. outputs: the
