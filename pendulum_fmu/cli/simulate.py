@@ -64,13 +64,13 @@ def run(args) -> int:
         drawn = ("theta", "omega") if args.plot else ()
         streamed = simulate_to_csv(args.output, torque_signal(args), drawn=drawn, **options)
         fields, steps, last, largest = streamed.fields, streamed.steps, streamed.last[0], streamed.largest["theta"]
-        drawn_run = streamed.drawn.rows if drawn else None
+        drawn_run = streamed.drawn.rows if streamed.drawn else None
     else:
         from ..fmu._simulate import simulate
 
-        drawn_run = simulate(torque_signal(args), **options)
-        fields, steps, last = results.fields(drawn_run), len(drawn_run) - 1, drawn_run[-1]
-        largest = np.max(np.abs(drawn_run["theta"]))
+        run = simulate(torque_signal(args), **options)
+        fields, steps, last, largest = results.fields(run), len(run) - 1, run[-1], np.max(np.abs(run["theta"]))
+        drawn_run = run
     # The fields and units of the FMU that ran, --fmu's or the default one: its outputs, as many
     # as it has, after time and torque.
     units = results.units(fields, fmu_model(args.fmu))

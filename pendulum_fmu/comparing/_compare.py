@@ -18,6 +18,7 @@ import os
 import time as clock
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -299,12 +300,14 @@ def compare(
     # Refused here before any tool runs; and every tool gets the whole set, so the defaults are
     # fmu_path's for all of them.
     parameters = resolve_parameters(parameters, model)
-    times = dict(start_time=start_time, stop_time=stop_time, step_size=step_size, ramp=ramp, max_steps=max_steps)
+    times: dict[str, Any] = dict(
+        start_time=start_time, stop_time=stop_time, step_size=step_size, ramp=ramp, max_steps=max_steps
+    )
     windows = schedule_windows(torque, **times, window_steps=window_steps)
     output_dir = Path(output_dir)
     outputs = {name: output_dir / name for name in ("trajectories.csv", "differences.csv", "comparison.png")}
     check_writable(*outputs.values())
-    start = dict(parameters=parameters, theta0=theta0, omega0=omega0)
+    start: dict[str, Any] = dict(parameters=parameters, theta0=theta0, omega0=omega0)
     # The judge's work estimated, and refused past its bound, before any tool runs.
     oracle = reference_windows(torque, **times, **start, fmu_path=model, window_steps=window_steps)
     others = [tool for tool in parsed if tool.label != REFERENCE]  # the judge takes the reference's place

@@ -154,8 +154,10 @@ def run_fmu(
     """The project's FMU (the checkout's, or fmu_path) through fmpy; ramps are passed on.
     platform: its binary, as simulate's (the wasm tool's: WASM_PLATFORM).
     """
-    options = dict(parameters=parameters, theta0=theta0, omega0=omega0, mode=mode, fmu_path=fmu_path)
-    return next(fmu_windows((plan,), **options, platform=platform))
+    windows = fmu_windows(
+        (plan,), parameters=parameters, theta0=theta0, omega0=omega0, mode=mode, fmu_path=fmu_path, platform=platform
+    )
+    return next(windows)
 
 
 def fmu_windows(

@@ -195,9 +195,8 @@ class MappedFmu:
     ) -> np.ndarray:
         """The FMU's result for a held schedule, mapped to the pendulum's quantities (see Tool.run)."""
         check_held(plan, self.label)
-        options = dict(parameters=parameters, theta0=theta0, omega0=omega0, mode=mode)
         if self.interface == "CoSimulation":
-            return next(self.run_windows((plan,), **options))
+            return next(self.run_windows((plan,), parameters=parameters, theta0=theta0, omega0=omega0, mode=mode))
         check_mode(mode, self.label)
         start = self._start_values(parameters, theta0, omega0)
         return self._mapped(plan, self._model_exchange(plan, start, TOLERANCE[mode]))

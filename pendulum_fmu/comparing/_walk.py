@@ -71,7 +71,7 @@ def write_trajectory_rows(file, block: np.ndarray, header: bool = False) -> None
         Write the line of column names first.
     """
     if header:
-        csv.writer(file).writerow(block.dtype.names)
+        csv.writer(file).writerow(results.fields(block))
     numbers = block.view(np.float64).reshape(len(block), -1)
     # A few thousand rows at a time: their text and its copies stay a few MB.
     for start in range(0, len(numbers), TEXT_ROWS):
@@ -158,7 +158,7 @@ class Tally:
     def add(self, blocks: dict[str, np.ndarray]) -> None:
         """Take in the next rows of every tool, by label, the judge first."""
         block = trajectory_block(blocks)
-        if self.differences is None:
+        if self.differences is None or self.drawn is None:
             self.differences = Differences(blocks)
             self._fields = {label: results.fields(run) for label, run in blocks.items()}
             others = [label for label in blocks if label != REFERENCE]
@@ -178,6 +178,7 @@ class Tally:
         """
         if self._whole is not None:
             return {label: np.concatenate(parts) for label, parts in self._whole.items()}
+        assert self.drawn is not None, "a comparison has rows"
         drawn = self.drawn.rows
         runs = {}
         for label, names in self._fields.items():
@@ -205,7 +206,7 @@ def _with_differences(block: np.ndarray, blocks: dict[str, np.ndarray]) -> np.nd
         for name in DRAWN
     }
     out = np.empty(len(block), dtype=block.dtype.descr + [(name, "f8") for name in apart])
-    for name in block.dtype.names:
+    for name in results.fields(block):
         out[name] = block[name]
     with np.errstate(over="ignore", invalid="ignore"):
         for name, values in apart.items():

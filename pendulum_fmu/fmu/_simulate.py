@@ -395,11 +395,18 @@ class Simulator:
         self.slave.messages.lines.clear()
         recorded = self.slave.model.recorded
         windows = iter(windows)
-        window = next(windows)
+        first = next(windows)
+        window: TorqueSchedule | None = first
         if self.stepper is None:
             self.slave.reset()
-            options = dict(parameters=parameters, theta0=theta0, omega0=omega0, tolerance=tolerance)
-            initialize(self.slave, **options, start_time=float(window.time[0]))
+            initialize(
+                self.slave,
+                parameters=parameters,
+                theta0=theta0,
+                omega0=omega0,
+                tolerance=tolerance,
+                start_time=float(first.time[0]),
+            )
         restart: dict = {"start_values": start, "tolerance": tolerance}
         ramped = False
         while window is not None:

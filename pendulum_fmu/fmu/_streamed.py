@@ -47,7 +47,7 @@ class StreamedRun:
     path: Path
     fields: tuple[str, ...] = ()
     steps: int = -1
-    last: np.ndarray | None = None
+    last: np.ndarray = field(default_factory=lambda: np.empty(0))
     largest: dict[str, float] = field(default_factory=dict)
     drawn: DrawnRows | None = None
 
@@ -130,6 +130,6 @@ def simulate_to_csv(
     run = StreamedRun(Path(path), drawn=DrawnRows(drawn, (windows.start_time, windows.stop_time)) if drawn else None)
     with replacing(path) as file:
         for block in simulate_windows(itertools.chain((first,), windows), **options):
-            results.write_rows(file, block, header=run.last is None)
+            results.write_rows(file, block, header=not run.fields)
             run.add(block)
     return run

@@ -46,7 +46,9 @@ long the run; the verdict and what is printed of it are _judgement.py's.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -115,7 +117,7 @@ class JudgedRun:
         self.tolerance, self.ramp, self.theta0, self.omega0 = tolerance, ramp, theta0, omega0
         self.model = fmu_model(fmu_path)
         self.parameters = resolve_parameters(parameters, self.model)
-        self.definition = {
+        self.definition: dict[str, Any] = {
             "start_time": start_time,
             "stop_time": stop_time,
             "step_size": step_size,
@@ -170,6 +172,7 @@ class JudgedRun:
             A map given with an array result, or values with which the reference fails.
         """
         source = str(result) if isinstance(result, (str, Path)) else "result"
+        blocks: Iterable[np.ndarray]
         if isinstance(result, (str, Path)):
             # The fields of this run's FMU: a judge of a named FMU looks no other up.
             blocks = result_blocks(result, mapping, self.model.recorded)
@@ -252,6 +255,7 @@ class JudgedRun:
                 if len(self._kept) >= self.KEPT_TIMES:
                     del self._kept[next(iter(self._kept))]
                 self._kept[key] = (correct, variants, outputs)
+        assert walk is not None, "a run has a window"
         return walk
 
 

@@ -270,8 +270,8 @@ def regression_verdicts(times, reference, result) -> list[dict]:
     >>> [v["passed"] for v in regression_verdicts(t, t**2, (t - 0.01) ** 2)]
     [True, True]
     """
-    arrays = (np.asarray(values, dtype=float) for values in (times, reference, result))
-    with series_of(*arrays) as series:
+    time, reference_theta, result_theta = (np.asarray(values, dtype=float) for values in (times, reference, result))
+    with series_of(time, reference_theta, result_theta) as series:
         return series_verdicts(series)
 
 

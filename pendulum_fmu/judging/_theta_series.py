@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 import tempfile
 from collections.abc import Iterator
+from typing import IO
 
 import numpy as np
 
@@ -35,7 +36,7 @@ class ThetaSeries:
     """
 
     def __init__(self):
-        self._file = None
+        self._file: IO[bytes] | None = None
         self._starts: list[int] = []  # each block's first row
         self._times: list[float] = []  # and its time
         self.rows = 0
@@ -68,6 +69,7 @@ class ThetaSeries:
         self.highest = max(self.highest, float(np.max(reference)))
 
     def _read(self, begin: int, end: int) -> np.ndarray:
+        assert self._file is not None, "rows are read only once some were appended"
         self._file.seek(begin * _WIDTH * 8)
         return np.fromfile(self._file, count=(end - begin) * _WIDTH).reshape(-1, _WIDTH)
 

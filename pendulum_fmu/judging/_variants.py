@@ -151,6 +151,7 @@ def own_run(run: Run, window: Window, state: tuple[float, float]) -> tuple[np.nd
 def _own_at_rows(run: Run, window: Window, state: tuple[float, float]) -> tuple[np.ndarray, tuple[float, float]]:
     """own_run at the window's rows, which are its points (Window.on_points)."""
     out, state = own_run(run, window, state)
+    assert window.index is not None, "rows on the points have their points"
     at = out[window.index - window.frame.begin]
     at["time"] = window.times
     return at, state
@@ -462,7 +463,7 @@ def run_variants(run: Run, first: TorqueSchedule, signal, ramp: bool, start_torq
     reference (single_precision).
     """
     firsts = dict.fromkeys((float(first.torque[0]), start_torque))
-    late = [Late(run, u, first.torque_rate[0] if u == first.torque[0] else 0.0) for u in firsts]
+    late: list[Variant] = [Late(run, u, first.torque_rate[0] if u == first.torque[0] else 0.0) for u in firsts]
     drift: list[Variant] = [] if isinstance(signal, np.ndarray) else [Drifted(run, signal, ramp)]
     if not ramp:
         drift += [SteppedOnClock(run), MissedChanges(run)]

@@ -287,6 +287,9 @@ class SignalWindows:
         report there), the value the next window starts with, unless the run ends there.
         """
         grid, step, final = self.window_grid(k0, k1), self.step, k1 == self.steps
+        u0: Values
+        rate: Values
+        values: Values
         if self.file is not None:
             signal, points = self.file, with_extra(grid, self.extra)
             if self.ramp:
@@ -327,6 +330,7 @@ class SignalWindows:
     def _samples(self, k0: int, grid: Grid) -> list[float]:
         """The callable at each point of the window, once a point as the windows are walked."""
         sample, values = self.sample, []
+        assert sample is not None, "a callable's signal is sampled"
         doubles = time_doubles(grid).tolist()
         if self._carried is not None and self._carried[0] == k0:
             values, doubles = [self._carried[1]], doubles[1:]

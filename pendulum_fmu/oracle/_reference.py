@@ -61,7 +61,7 @@ class ReferenceWindows:
         self,
         window: Callable[[int, int], Pieces],
         grid_steps: int,
-        step: Fraction | None,
+        step: Fraction,
         model: Model,
         window_steps: int,
         *,
@@ -76,14 +76,14 @@ class ReferenceWindows:
         self._on_step: Callable[[float], None] | None = None
         # The whole run's work, before anything is integrated: each window's pieces made and let
         # go, but the first's, which next() integrates first.
-        self._first = Runs(first if first is not None else window(*self._bounds(0)))
+        last = first_runs = Runs(first if first is not None else window(*self._bounds(0)))
+        self._first: Runs | None = first_runs
         work = Work(model.constants, model.theta0, model.omega0, model.tolerance)
-        work.add(self._first.spans())
-        last = self._first
+        work.add(first_runs.spans())
         for j in range(1, self.windows):
             last = Runs(window(*self._bounds(j)))
             work.add(last.spans())
-        self.start, self.stop = float(self._first.starts[0]), float(last.ends[-1])
+        self.start, self.stop = float(first_runs.starts[0]), float(last.ends[-1])
         self.steps = work.steps
         check_steps(self.steps, self.start, self.stop, model.rtol)
 
@@ -127,14 +127,16 @@ class ReferenceWindows:
         j = self._done
         if j >= self.windows:
             raise InvalidInput(f"the run's {self.windows} windows are integrated: next() has no window left")
-        runs, self._first = (self._first, None) if j == 0 else (Runs(self._window(*self._bounds(j))), None)
+        # Only the first window's pieces are kept from the estimate; the others are made again.
+        runs = self._first if self._first is not None else Runs(self._window(*self._bounds(j)))
+        self._first = None
         times = np.asarray(at, dtype=float)
         if check:
             what = "the run" if self.windows == 1 else f"window {j} of the run"
             times = _times(at, runs.pieces, self._step, what)
         final = j == self.windows - 1
-        out, *state = integrate_window(runs, times, self._model, self._state, self._on_step, final)
-        self._state, self._done = tuple(state), j + 1
+        out, theta, omega = integrate_window(runs, times, self._model, self._state, self._on_step, final)
+        self._state, self._done = (theta, omega), j + 1
         return out
 
 
@@ -295,7 +297,9 @@ def reference_schedule(
     # The schedule's points are the tools' own: no tolerance beyond rounding.
     pieces = Pieces(points[:-1], points[-1], u0, rate, points, Holding(points, u0, Fraction(0)).values_after)
     model = Model(parameters, theta0, omega0, rtol, atol, fmu_path)
-    oracle = ReferenceWindows(lambda k0, k1: pieces, 1, None, model, 1, first=pieces, show_progress=show_progress)
+    oracle = ReferenceWindows(
+        lambda k0, k1: pieces, 1, Fraction(0), model, 1, first=pieces, show_progress=show_progress
+    )
     with oracle:
         return oracle._next(plan.time if at is None else at, check=False)
 

@@ -259,7 +259,7 @@ def schedule_windows(
     ramp: bool = False,
     max_steps: int | None = None,
     window_steps: int = WINDOW_STEPS,
-) -> Iterator[TorqueSchedule]:
+) -> ScheduleWindows:
     """schedule()'s schedule a window of grid steps at a time, for a run too long to hold whole.
 
     Window j covers the grid steps k0 = j * window_steps to k1 = min(k0 + window_steps, N): its
