@@ -73,9 +73,10 @@ EXCLUDED = {
     r"jupyter notebook": "starts a server that runs until stopped; tests/test_notebook.py runs the notebook",
 }
 
-# A command that needs longer than this is a README bug: the README's commands are what a
-# newcomer runs first.
-COMMAND_TIMEOUT = 180
+# A guard against a command that hangs, not a speed goal (those are the benchmarks', such as
+# benchmarks.install): building the wheel took 1.5 min on a quiet 2-core machine and over 3 min
+# on a loaded one.
+COMMAND_TIMEOUT = 600
 
 
 def fenced_language(line: str):
