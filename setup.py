@@ -3,7 +3,8 @@
 - build_py also builds the FMI 2.0 and 3.0 FMUs and the closed loop's PID controller FMU into the
   wheel's pendulum_fmu/data/, from this source tree (a clone or the unpacked sdist), for every
   platform whose compiler is installed.
-- build_ext builds the native co-simulation loop, pendulum_fmu/fmu/_cs_loop.c, through the project's
+- build_ext builds the native co-simulation loop, pendulum_fmu/fmu/_cs_loop.c, and with it the
+  oracle's Taylor stepping, pendulum_fmu/oracle/_taylor_native.c, through the project's
   one build description (CMakeLists.txt, driven by fmu_build/) with this machine's
   compiler. It is plain C loaded with ctypes (pendulum_fmu/fmu/_native_loop.py), not a CPython module:
   it has the platform's plain name (_cs_loop.so, _cs_loop.pyd) and the wheel is tagged
@@ -180,7 +181,11 @@ setup(
     ext_modules=[
         Extension(
             "pendulum_fmu.fmu._cs_loop",
-            sources=["pendulum_fmu/fmu/_cs_loop.c", "pendulum_fmu/fmu/_cs_batch.c"],
+            sources=[
+                "pendulum_fmu/fmu/_cs_loop.c",
+                "pendulum_fmu/fmu/_cs_batch.c",
+                "pendulum_fmu/oracle/_taylor_native.c",
+            ],
             depends=["pendulum_fmu/fmu/_cs_loop.h"],
         )
     ],

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from pendulum_fmu import InvalidInput
-from pendulum_fmu.oracle import _reference
+from pendulum_fmu.oracle import _reference, _taylor_native
 from pendulum_fmu.oracle._reference import reference, reference_schedule, reference_windows
 from pendulum_fmu.signals._torque_schedule import schedule, schedule_windows
 
@@ -124,6 +124,8 @@ def test_the_progress_bar_spans_the_windows(monkeypatch):
         yield lambda t: seen.append(t)
 
     monkeypatch.setattr(_reference, "progress", counting)
+    # Every Taylor step, as the Python integrator reports them (the native one: a chunk of runs).
+    monkeypatch.setattr(_taylor_native, "available", lambda: False)
     with reference_windows(300.0, stop_time=30.0, step_size=1.0, window_steps=4) as oracle:
         for j in range(oracle.windows):
             oracle.next(np.array([4.0 * j]))

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from pendulum_fmu import InvalidInput, reference
-from pendulum_fmu.oracle import _reference, _work
+from pendulum_fmu.oracle import _reference, _taylor_native, _work
 from pendulum_fmu.oracle._reference import model_constants
 from pendulum_fmu.oracle._work import MAX_STEPS, Spans, speed_bound
 
@@ -52,6 +52,9 @@ def steps_taken(monkeypatch, arguments, keywords) -> tuple[float, int, np.ndarra
         yield count
 
     monkeypatch.setattr(_reference, "progress", counting)
+    # The Python integrator hears every Taylor step; the native one, which takes the same steps
+    # to the bit (tests/test_taylor_native.py), a chunk of runs at a time.
+    monkeypatch.setattr(_taylor_native, "available", lambda: False)
     run = reference(*arguments, **keywords)
     return seen["estimate"], seen["taken"], run
 

@@ -3,7 +3,9 @@ reference(), reference_windows() and reference_schedule() share (_reference.py).
 
 The pieces that continue one another (the same held torque) are one run, integrated by the
 Taylor series (_taylor.py) restarting only where the torque changes; a window's reports are
-summed where they fall, and the state at the window's end is carried to the next.
+summed where they fall, and the state at the window's end is carried to the next. Where the
+native Taylor stepping was compiled (_taylor_native.c) it integrates a window's runs in a few
+calls, to the same bits as _taylor.integrate_piece run by run, which is the fallback.
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ from .._errors import InvalidInput
 from ..fmu import _results as results
 from ..fmu._parameters import Fmu, start_value, total_inertia
 from ..fmu._simulate import resolve_parameters
+from . import _taylor_native
 from ._exact_signal import Pieces, time_doubles
 from ._taylor import Diverged, check_tolerances, integrate_piece
 from ._work import Spans
@@ -142,27 +145,44 @@ def integrate_window(
     ordered = at if order is None else at[order]
     bounds = np.searchsorted(ordered, ends[lasts], side="right")
     bounds[-1] = len(at)
-    window_runs = np.stack([firsts, lasts, np.r_[0, bounds[:-1]], bounds])
     out = results.empty(len(at), COMPUTED)
     out["time"] = at
-    theta, omega = state
-    for first, last, lo, hi in window_runs.T.tolist():
-        t0, t1, u0, rate = float(starts[first]), float(ends[last]), float(u0s[first]), float(rates[first])
+    if _taylor_native.available():
+        # The numbers of integrate_piece below, without a Python call per run: with a torque that
+        # changes every communication step, a run is one step.
         try:
-            thetas, omegas, theta, omega = integrate_piece(
-                theta,
-                omega,
-                (t0, t1),
-                (u0, rate),
+            thetas, omegas, theta, omega = _taylor_native.integrate_runs(
+                (starts[firsts], ends[lasts], u0s[firsts], rates[firsts]),
+                np.r_[0, bounds],
+                ordered,
+                state,
                 model.constants,
                 model.tolerance,
-                np.clip(ordered[lo:hi], t0, t1),
                 on_step,
             )
-        except Diverged as error:
-            raise _failed(str(error), t0, model, pieces) from None
-        mine = slice(lo, hi) if order is None else order[lo:hi]
+        except _taylor_native.RunDiverged as error:
+            raise _failed(str(error), error.start, model, pieces) from None
+        mine = slice(None) if order is None else order
         out["theta"][mine], out["omega"][mine] = thetas, omegas
+    else:
+        theta, omega = state
+        for first, last, lo, hi in np.stack([firsts, lasts, np.r_[0, bounds[:-1]], bounds]).T.tolist():
+            t0, t1, u0, rate = float(starts[first]), float(ends[last]), float(u0s[first]), float(rates[first])
+            try:
+                thetas, omegas, theta, omega = integrate_piece(
+                    theta,
+                    omega,
+                    (t0, t1),
+                    (u0, rate),
+                    model.constants,
+                    model.tolerance,
+                    np.clip(ordered[lo:hi], t0, t1),
+                    on_step,
+                )
+            except Diverged as error:
+                raise _failed(str(error), t0, model, pieces) from None
+            mine = slice(lo, hi) if order is None else order[lo:hi]
+            out["theta"][mine], out["omega"][mine] = thetas, omegas
     out["torque"] = pieces.values_after(at)
     if final:
         # The end of the run reports the torque the last piece reached, as a master reads it back.

@@ -14,6 +14,12 @@ Why not scipy's solve_ivp: it is what the oracle used until issue 42, and import
 scipy.integrate took 0.3 s of a 0.7-s `judge`. This code is the pendulum's equation and two
 recurrences, shares nothing with the FMU's integrator (C, fmu_src/), and is held to solve_ivp at
 tight tolerance and to closed-form solutions by tests/test_taylor.py.
+
+_taylor_native.c is this integrator in C, operation for operation, for a window's runs in one
+call (a Python call per run was most of a judge of a torque that changes every step); where it
+was compiled integrate_window uses it, and it gives these numbers bit for bit
+(tests/test_taylor_native.py). This stays the readable reference and the fallback: a change here
+is a change there.
 """
 
 from __future__ import annotations
