@@ -19,7 +19,7 @@ import numpy as np
 
 from .._errors import InvalidInput
 from ..signals._time_grid import step_count
-from ..signals._torque_csv import read_torque_csv
+from ..signals._torque_csv import check_torque_csv
 from ._file_rows import TOLERANCE_STEPS, TOLERANCE_ULPS, FileRows, TorqueFile, event_tolerance
 
 # Times whose torque Holding looks up at once.
@@ -177,7 +177,7 @@ class SignalWindows:
         # A callable's sample at the end of the window last made, for the next one to start from.
         self._carried: tuple[int, float] | None = None
         if isinstance(torque, (str, Path)):
-            read_torque_csv(torque)  # a file that is no signal refused where it is wrong; read below anew
+            check_torque_csv(torque)  # a file that is no signal refused where it is wrong; read below anew
             self.file = FileRows(Path(torque))
             stop = self.file.last if stop is None else stop
             self.grid = time_grid(start, stop, step, max_steps, check_memory)
