@@ -294,8 +294,9 @@ def _read(path: Path, file: IO[bytes]) -> TorqueTable:
     # line is too long or holds a NUL byte, anywhere, then whatever byte is not UTF-8.
     line_fault: TorqueFileError | None = None
     text_fault: TorqueFileError | None = None
-    header_line, content = "", False
+    header_line, content, lines = "", False, 0
     for number, block in _blocks(file):
+        lines += block.count(b"\n") + 1
         if number == 1:
             header_line = block[: block.find(b"\n") if b"\n" in block else len(block)].decode("utf-8", "replace")
         content = content or bool(block.strip())
@@ -322,7 +323,7 @@ def _read(path: Path, file: IO[bytes]) -> TorqueTable:
                 "the first line must name the columns, e.g. time,torque"
             )
     columns = (header.index("time"), header.index("torque"))
-    times, torques = _numbers(path, file, header, columns)
+    times, torques = _numbers(path, file, header, columns, lines)
     if len(times) == 0:
         raise TorqueFileError(f"{path}: no data rows after the header")
     backwards = np.flatnonzero(np.diff(times) < 0)
@@ -342,11 +343,14 @@ def _read(path: Path, file: IO[bytes]) -> TorqueTable:
     return TorqueTable(times, torques)
 
 
-def _numbers(path: Path, file: IO[bytes], header: list[str], columns: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
-    """The time and torque columns, a block at a time; a row that is not two finite numbers
-    refused with the line of the first such row of the file.
+def _numbers(
+    path: Path, file: IO[bytes], header: list[str], columns: tuple[int, int], lines: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """The time and torque columns, a block at a time, into arrays of the most rows the file's
+    lines can hold (no list of blocks joined: the table once in memory); a row that is not two
+    finite numbers refused with the line of the file's first such row.
     """
-    parts: list[tuple[np.ndarray, np.ndarray]] = []
+    times, torques, rows = np.empty(lines), np.empty(lines), 0
     header_bytes = b""
     for number, block in _blocks(file):
         if number == 1:
@@ -361,7 +365,9 @@ def _numbers(path: Path, file: IO[bytes], header: list[str], columns: tuple[int,
         if data is None or not all(np.all(np.isfinite(column)) for column in data):
             bad_row = _first_bad_row(path, _lines(file), columns)
             raise bad_row or TorqueFileError(f"{path}: rows must have as many columns as the header ({len(header)})")
-        parts.append(data)
-    if len(parts) == 1:
-        return np.ascontiguousarray(parts[0][0]), np.ascontiguousarray(parts[0][1])
-    return np.concatenate([part[0] for part in parts]), np.concatenate([part[1] for part in parts])
+        count = len(data[0])
+        if rows + count > len(times):  # lines ended by a lone carriage return, which pyarrow splits
+            times, torques = (np.concatenate([column, np.empty(rows + count)]) for column in (times, torques))
+        times[rows : rows + count], torques[rows : rows + count] = data
+        rows += count
+    return times[:rows], torques[:rows]
