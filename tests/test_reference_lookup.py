@@ -15,7 +15,15 @@ import numpy as np
 import pytest
 
 from benchmarks.signal_cases import random_step_rows, write_rows
-from pendulum_fmu.oracle._exact_signal import TOLERANCE_STEPS, Holding, exact_time, time_doubles, time_grid, with_events
+from pendulum_fmu.oracle._exact_signal import (
+    TOLERANCE_STEPS,
+    Holding,
+    exact_time,
+    exact_times,
+    time_doubles,
+    time_grid,
+    with_events,
+)
 from pendulum_fmu.oracle._file_rows import FileRows
 
 AWKWARD_STEPS = (3e-4, 7e-4, 9e-4, 1e-3, 9e-3, 0.03, 0.3, 1 / 3000)
@@ -107,4 +115,5 @@ def test_held_after_equals_the_exact_look_up_on_random_files(tmp_path, seed, run
     signal = file.rows(Fraction(-1), file.last + 1)
     points = with_events(time_grid(Fraction(0), Fraction(2), step), signal.jumps(), step)
     exact = [signal.after(signal.latest_event_near(p, step)) for p in points]
-    assert signal.held_after(points, step, time_doubles(points)).tolist() == exact
+    assert signal.held_after(points, step, time_doubles(points), exact_times(points, signal)).tolist() == exact
+    assert signal.held_after(points, step, time_doubles(points), None).tolist() == exact

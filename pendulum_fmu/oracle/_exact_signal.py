@@ -20,6 +20,7 @@ import numpy as np
 from .._errors import InvalidInput
 from ..signals._time_grid import step_count
 from ..signals._torque_csv import check_torque_csv
+from ._decimal_times import common_digits, scaled, scaled_steps
 from ._file_rows import TOLERANCE_STEPS, TOLERANCE_ULPS, FileRows, TorqueFile, event_tolerance
 
 # Times whose torque Holding looks up at once.
@@ -94,6 +95,21 @@ def time_doubles(points: Times) -> np.ndarray:
     if isinstance(points, np.ndarray):
         return points.astype(float)
     return np.array([float(p) for p in points])
+
+
+def exact_times(points: Sequence[Fraction], signal: TorqueFile) -> tuple[int, np.ndarray] | None:
+    """The points times 10**digits (_decimal_times), digits those of a decimal denominator
+    common to the points and the signal's rows; None where there is none.
+    """
+    stop = [points.stop] if isinstance(points, Grid) and points.stop is not None else []
+    ends = [points.start, points.step, *stop] if isinstance(points, Grid) else points
+    digits = common_digits(itertools.chain((t.denominator for t in ends), signal.denominators()))
+    if digits is None:
+        return None
+    if not isinstance(points, Grid):
+        return digits, scaled(points, digits)
+    regular = scaled_steps(points.start, points.step, points.regular, digits)
+    return digits, np.concatenate([regular, scaled(stop, digits)])
 
 
 def time_grid(
@@ -233,7 +249,7 @@ class SignalWindows:
                     ),
                 )
             held_points = points[:-1] if final else points
-            held = signal.held_after(held_points, step, time_doubles(held_points))
+            held = signal.held_after(held_points, step, time_doubles(held_points), exact_times(held_points, signal))
             u0 = held[: len(points) - 1]
             return Pieces(
                 points[:-1], grid[-1], u0, np.zeros(len(u0)), points, Holding(points, held, step).values_after

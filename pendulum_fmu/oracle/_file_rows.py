@@ -15,6 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ._decimal_times import scaled
+
 # Bytes read a chunk (some 25,000 rows of a recorded torque).
 CHUNK_BYTES = 1 << 20
 # docs/signals.md: an event within max(1e-9 step, 64 ulp of its time) of a communication point
@@ -35,6 +37,7 @@ class TorqueFile:
     def __init__(self, times: list[Fraction], torques: list[float], doubles: Sequence[float]):
         # doubles: each time's nearest double (float of the decimal written, as float(times[i])).
         self.times, self.torques, self.doubles = times, torques, np.asarray(doubles, dtype=float)
+        self._exact: tuple[int, np.ndarray] | None = None
 
     def after(self, t: Fraction) -> float:
         return self._after(t, 0, len(self.times))
@@ -81,31 +84,85 @@ class TorqueFile:
         j = bisect.bisect_right(self.times, t + tolerance, lo, hi)
         return max(t, self.times[j - 1]) if j > lo and self.times[j - 1] >= t - tolerance else t
 
-    def held_after(self, points: Sequence[Fraction], step: Fraction, doubles: np.ndarray) -> np.ndarray:
-        """after(latest_event_near(p, step)) of each point (doubles: each point's nearest
-        double), the same values: the row times as doubles decide each point with no row near it
-        on a flat stretch (its value is the row's), and narrow the exact look-ups of the others
-        to the rows whose doubles are within reach of the point's.
+    def held_after(
+        self, points: Sequence[Fraction], step: Fraction, doubles: np.ndarray, exact: tuple[int, np.ndarray] | None
+    ) -> np.ndarray:
+        """after(latest_event_near(p, step)) of each point, the same values (doubles: each
+        point's nearest double; exact: the points times 10**digits, as _decimal_times scales
+        them, or None).
+
+        The row times as doubles find the rows that may be within a point's tolerance (within
+        reach) and those that surely are. A point with no row within reach on a flat stretch
+        holds the row's value; one whose rows within reach surely all are within its tolerance
+        is decided with the times as exact integers (exact), a whole array at once; every other
+        point by the exact look-ups of fractions, narrowed to the rows within reach.
         """
-        times, torques = self.times, self.torques
-        row_doubles = self.doubles
-        reach = np.maximum(float(TOLERANCE_STEPS * step), TOLERANCE_ULPS * np.spacing(np.abs(doubles)))
-        # Widened by what the doubles may be off by (each time's rounding, the tolerance's):
-        # a few ulp, bounded here by 16.
-        reach += 16 * np.spacing(np.maximum(np.abs(doubles), reach))
+        times, row_doubles, torques = self.times, self.doubles, np.array(self.torques)
+        tolerance = np.maximum(float(TOLERANCE_STEPS * step), TOLERANCE_ULPS * np.spacing(np.abs(doubles)))
+        # What the doubles may be off by (each time's rounding, the tolerance's): a few ulp,
+        # bounded here by 16.
+        slack = 16 * np.spacing(np.maximum(np.abs(doubles), tolerance))
         # Rows before lo are exactly before p less its tolerance, rows from hi after p plus it.
-        lo = np.searchsorted(row_doubles, doubles - reach, "left")
-        hi = np.searchsorted(row_doubles, doubles + reach, "right")
+        lo = np.searchsorted(row_doubles, doubles - (tolerance + slack), "left")
+        hi = np.searchsorted(row_doubles, doubles + (tolerance + slack), "right")
+        near, last = hi > lo, len(times) - 1
+        # A point with no row within reach on a flat stretch holds the row's value.
         after = np.searchsorted(row_doubles, doubles, "right")  # times[j-1] <= p < times[j]
-        before = np.clip(after - 1, 0, len(times) - 1)
-        torque_doubles = np.array(torques)
-        sloped = torque_doubles[before] != torque_doubles[np.minimum(after, len(times) - 1)]
-        values = torque_doubles[before]
-        for k in np.flatnonzero((hi > lo) | sloped).tolist():
+        before = np.clip(after - 1, 0, last)
+        values = torques[before]
+        unsure = near | (values != torques[np.minimum(after, last)])
+        if exact is not None:
+            rows = self._exact_rows(exact[0])
+            # Those whose rows within reach all surely are within the tolerance, the latest row
+            # hi - 1, are decided in exact integers; the others below.
+            inner = tolerance - slack
+            decided = unsure & ~(
+                near
+                & (
+                    (doubles - row_doubles[np.clip(lo, 0, last)] > inner)
+                    | (row_doubles[np.clip(hi - 1, 0, last)] - doubles > inner)
+                )
+            )
+            chosen = np.flatnonzero(decided)
+            point = exact[1][chosen]
+            event = np.where(near[chosen], np.maximum(point, rows[np.clip(hi[chosen] - 1, 0, last)]), point)
+            values[chosen] = self._exact_after(rows, torques, event)
+            unsure &= ~decided
+        for k in np.flatnonzero(unsure).tolist():
             first, end = int(lo[k]), int(hi[k])
-            event = self._latest_event_near(points[k], step, first, end)
-            values[k] = self._after(event, first, end)
+            values[k] = self._after(self._latest_event_near(points[k], step, first, end), first, end)
         return values
+
+    def _exact_rows(self, digits: int) -> np.ndarray:
+        """The row times times 10**digits in int64 (_decimal_times.scaled), made once a stretch."""
+        if self._exact is None or self._exact[0] != digits:
+            self._exact = (digits, scaled(self.times, digits))
+        return self._exact[1]
+
+    def denominators(self) -> set[int]:
+        return {t.denominator for t in self.times}
+
+    @staticmethod
+    def _exact_after(rows: np.ndarray, torques: np.ndarray, event: np.ndarray) -> np.ndarray:
+        """after() of each exact integer time, as after() and _between() compute it."""
+        if len(rows) == 1:
+            return np.full(len(event), torques[0])
+        j = np.clip(np.searchsorted(rows, event, "right"), 1, len(rows) - 1)  # rows[j-1] <= t < rows[j]
+        inside = (event >= rows[0]) & (event < rows[-1])
+        offset, length, u0, u1 = event - rows[j - 1], rows[j] - rows[j - 1], torques[j - 1], torques[j]
+        # Python's integers are divided by Python, correctly rounded as float(Fraction) is; so is
+        # one IEEE division of int64 below 2**53 (exact as doubles); larger int64 go to Python.
+        share = np.zeros(len(event))
+        exact = inside & (offset != 0)
+        if offset.dtype != object:
+            by_numpy = exact & (np.abs(offset) < 2**53) & (length < 2**53)
+            share[by_numpy] = offset[by_numpy] / length[by_numpy]
+            exact &= ~by_numpy
+        share[exact] = [a / b for a, b in zip(offset[exact].tolist(), length[exact].tolist(), strict=True)]
+        with np.errstate(invalid="ignore", over="ignore"):
+            value = u0 + (u1 - u0) * share
+            value = np.where(np.isfinite(value), value, u0 * (1 - share) + u1 * share)
+        return np.where(event >= rows[-1], torques[-1], np.where(event < rows[0], torques[0], value))
 
 
 class FileRows:
