@@ -139,3 +139,44 @@ def test_a_stretch_of_rows_answers_as_the_whole_file(tmp_path, monkeypatch, seed
         for t in [start, stop, *(exact_time(x) for x in rng.uniform(float(start), float(stop), 8).tolist())]:
             assert stretch.after(t) == whole.after(t) and stretch.before(t) == whole.before(t)
             assert stretch.latest_event_near(t, step) == whole.latest_event_near(t, step)
+
+
+@pytest.mark.parametrize(
+    "written", ["0", "12", "-0.5", ".5", "-.5", "1.", "2999.9990000000002", "1e-3", "-1.5E+2", "+1.25"]
+)
+def test_a_decimal_cell_is_the_fraction_written(written):
+    assert _file_rows.decimal(written) == Fraction(written)
+
+
+def test_the_memory_reading_a_torque_file_takes_does_not_grow_with_it(tmp_path, monkeypatch):
+    """Three times the rows of a recorded torque (a row per step), read as a judge reads it (the
+    table, the schedule's windows, the oracle's windows integrated): the peak some 16 bytes a row
+    more, the table's, the one thing held whole. The oracle reads a window's rows at a time; its
+    whole file of fractions, as it read it before, took over 400 bytes a row. Every block and
+    window is made small, so that both files span many; the judge's own buffers, the same with
+    any signal, are bounded in rows (tests/test_long_results.py).
+    """
+    import tracemalloc
+
+    from pendulum_fmu.oracle._reference import reference_windows
+
+    monkeypatch.setattr(_torque_csv, "BLOCK_BYTES", 1 << 16)
+    monkeypatch.setattr(_file_rows, "CHUNK_BYTES", 1 << 14)
+    monkeypatch.setattr(_torque_schedule, "WINDOW_STEPS", 2048)
+    peaks = []
+    for rows in (20_000, 60_000):
+        time = np.arange(rows + 1) / 1000
+        torque = tmp_path / f"torque{rows}.csv"
+        with open(torque, "w") as file:
+            file.write("time,torque\n")
+            np.savetxt(file, np.c_[time, np.where(time % 1 < 0.5, 20.0, -20.0)], delimiter=",", fmt="%.17g")
+        tracemalloc.start()
+        table = read_torque_csv(torque)
+        for _ in _torque_schedule.schedule_windows(table, stop_time=rows / 1000, window_steps=2048):
+            pass
+        with reference_windows(torque, stop_time=rows / 1000, window_steps=2048) as oracle:
+            for _ in range(oracle.windows):
+                oracle.next(np.array([]))
+        peaks.append(tracemalloc.get_traced_memory()[1])
+        tracemalloc.stop()
+    assert peaks[1] < peaks[0] + 40 * 40_000, [f"{peak / 1e6:.1f} MB" for peak in peaks]
