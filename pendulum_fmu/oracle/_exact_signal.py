@@ -169,7 +169,7 @@ class Pieces:
 
 
 class SignalWindows:
-    """A signal read once, its pieces made a window of grid steps at a time: window(k0, k1) is
+    """A signal checked once, its pieces made a window of grid steps at a time: window(k0, k1) is
     the pieces of the oracle's own grid steps k0 to k1 (and the events between them), so that a
     run of millions of steps holds one window's pieces at a time. A CSV's rows are read as the
     windows are made, those near a window at a time (FileRows).
