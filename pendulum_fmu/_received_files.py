@@ -315,8 +315,11 @@ def bounded_lines(
         yield line
 
 
-def check_lines(raw: bytes, shown: str, error: type[Exception], advice: str, bound: int = MAX_LINE_CHARS) -> None:
-    """bounded_lines' checks on a file already read whole (in C, for a file of millions of lines).
+def check_lines(
+    raw: bytes, shown: str, error: type[Exception], advice: str, bound: int = MAX_LINE_CHARS, first_line: int = 1
+) -> None:
+    """bounded_lines' checks on a file already read whole (in C, for a file of millions of lines),
+    or on a block of a file's whole lines whose first is line first_line.
 
     Raises
     ------
@@ -330,10 +333,10 @@ def check_lines(raw: bytes, shown: str, error: type[Exception], advice: str, bou
     long_lines = np.flatnonzero(lengths > bound)
     faults = []
     if len(long_lines):
-        faults.append((int(long_lines[0]) + 1, f"the line is longer than {bound:,} bytes"))
+        faults.append((int(long_lines[0]) + first_line, f"the line is longer than {bound:,} bytes"))
     nul = raw.find(b"\0")
     if nul >= 0:
-        faults.append((raw.count(b"\n", 0, nul) + 1, "a NUL byte, which no text holds"))
+        faults.append((raw.count(b"\n", 0, nul) + first_line, "a NUL byte, which no text holds"))
     if faults:
         number, fault = min(faults)
         raise error(f"{shown}:{number}: {fault}; {advice}")
@@ -382,14 +385,29 @@ def bounded_read(file: IO[bytes], shown: str, limit: int, error: type[Exception]
     study.json: over 8 bytes, longer than any such file; write it again
     """
     try:  # refused by its size where the file has one, before anything is read
-        size = file.seek(0, 2)
-        file.seek(0)
+        check_size(file, shown, limit, error, advice)
     except OSError:  # a pipe: read as far as the limit to see
-        size = 0
-    raw = b"" if size > limit else file.read(limit + 1)
-    if size > limit or len(raw) > limit:
+        pass
+    raw = file.read(limit + 1)
+    if len(raw) > limit:
         raise error(f"{shown}: over {limit:,} bytes, longer than any such file; {advice}")
     return raw
+
+
+def check_size(file: IO[bytes], shown: str, limit: int, error: type[Exception], advice: str) -> None:
+    """Refuse a file over limit bytes by its size (bounded_read's words), before anything is read;
+    the file is left at its start.
+
+    Raises
+    ------
+    error
+        The file is longer than limit bytes.
+    OSError
+        A file with no size to seek to (a pipe).
+    """
+    if file.seek(0, 2) > limit:
+        raise error(f"{shown}: over {limit:,} bytes, longer than any such file; {advice}")
+    file.seek(0)
 
 
 def bounded_text(path: Path, limit: int, error: type[Exception], advice: str, encoding: str = "utf-8") -> str:

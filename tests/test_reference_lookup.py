@@ -15,7 +15,16 @@ import numpy as np
 import pytest
 
 from benchmarks.signal_cases import random_step_rows, write_rows
-from pendulum_fmu.oracle._exact_signal import TOLERANCE_STEPS, Holding, TorqueFile, exact_time, time_grid, with_events
+from pendulum_fmu.oracle._exact_signal import (
+    TOLERANCE_STEPS,
+    Holding,
+    exact_time,
+    exact_times,
+    time_doubles,
+    time_grid,
+    with_events,
+)
+from pendulum_fmu.oracle._file_rows import FileRows
 
 AWKWARD_STEPS = (3e-4, 7e-4, 9e-4, 1e-3, 9e-3, 0.03, 0.3, 1 / 3000)
 
@@ -102,7 +111,9 @@ def test_held_after_equals_the_exact_look_up_on_random_files(tmp_path, seed, run
     added += [(repr(t), u) for t, u in zip(edges, rng.uniform(-40, 40, size=len(edges)).tolist(), strict=True)]
     taken = {float(t) for t, _ in added}
     rows = sorted([*[row for row in rows if float(row[0]) not in taken], *added], key=lambda row: float(row[0]))
-    signal = TorqueFile(write_rows(tmp_path / "signal.csv", rows))
+    file = FileRows(write_rows(tmp_path / "signal.csv", rows))
+    signal = file.rows(Fraction(-1), file.last + 1)
     points = with_events(time_grid(Fraction(0), Fraction(2), step), signal.jumps(), step)
     exact = [signal.after(signal.latest_event_near(p, step)) for p in points]
-    assert signal.held_after(points, step).tolist() == exact
+    assert signal.held_after(points, step, time_doubles(points), exact_times(points, signal)).tolist() == exact
+    assert signal.held_after(points, step, time_doubles(points), None).tolist() == exact

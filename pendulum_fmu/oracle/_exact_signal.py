@@ -1,5 +1,5 @@
 """The torque signal as the oracle reads it, on its own: times as exact fractions of the decimals
-written, its own reader of a torque CSV (TorqueFile), the communication points (Grid), the pieces
+written, its own reader of a torque CSV (_file_rows.py), the communication points (Grid), the pieces
 on which the torque is linear (Pieces, SignalWindows: a window of the run at a time) and the torque held at given times
 (Holding). _reference.py integrates what this gives; docs/signals.md is the definition both follow.
 """
@@ -7,7 +7,6 @@ on which the torque is linear (Pieces, SignalWindows: a window of the run at a t
 from __future__ import annotations
 
 import bisect
-import csv
 import heapq
 import itertools
 import math
@@ -20,11 +19,10 @@ import numpy as np
 
 from .._errors import InvalidInput
 from ..signals._time_grid import step_count
-from ..signals._torque_csv import read_torque_csv
+from ..signals._torque_csv import check_torque_csv
+from ._decimal_times import common_digits, scaled, scaled_steps
+from ._file_rows import TOLERANCE_STEPS, TOLERANCE_ULPS, FileRows, TorqueFile, event_tolerance
 
-# docs/signals.md: an event within max(1e-9 step, 64 ulp of its time) of a communication point
-# is that point. Written again here on purpose: the oracle must not borrow the schedule's code.
-TOLERANCE_STEPS, TOLERANCE_ULPS = Fraction(1, 10**9), 64
 # Times whose torque Holding looks up at once.
 _BLOCK = 1 << 16
 _DEFAULT_STOP_TIME = Fraction(3)
@@ -53,81 +51,6 @@ def torque_value(value, where: str) -> float:
     if not (isinstance(value, numbers.Real) and math.isfinite(value)):
         raise InvalidInput(f"the torque is {value!r} {where}; it must be a finite number of N.m")
     return float(value)
-
-
-def event_tolerance(time: Fraction | float, step: Fraction) -> Fraction:
-    return max(TOLERANCE_STEPS * step, Fraction(TOLERANCE_ULPS * math.ulp(float(time))))
-
-
-class TorqueFile:
-    """A time,torque CSV as exact times and float torques: linear between rows, a jump where a
-    time repeats, held outside.
-    """
-
-    def __init__(self, path: Path):
-        with open(path, newline="", encoding="utf-8-sig") as file:
-            rows = [row for row in csv.reader(file) if any(cell.strip() for cell in row)]
-        header = [cell.strip() for cell in rows[0]]
-        time_column, torque_column = header.index("time"), header.index("torque")
-        self.times = [Fraction(row[time_column].strip()) for row in rows[1:]]
-        self.torques = [float(row[torque_column]) for row in rows[1:]]
-
-    def after(self, t: Fraction) -> float:
-        times, torques = self.times, self.torques
-        if t >= times[-1]:
-            return torques[-1]
-        if t < times[0]:
-            return torques[0]
-        j = bisect.bisect_right(times, t)  # times[j-1] <= t < times[j]
-        return self._between(j, t)
-
-    def before(self, t: Fraction) -> float:
-        times, torques = self.times, self.torques
-        if t > times[-1]:
-            return torques[-1]
-        if t <= times[0]:
-            return torques[0]
-        j = bisect.bisect_left(times, t)  # times[j-1] < t <= times[j]
-        return self._between(j, t)
-
-    def _between(self, j: int, t: Fraction) -> float:
-        t0, t1, u0, u1 = self.times[j - 1], self.times[j], self.torques[j - 1], self.torques[j]
-        share = float((t - t0) / (t1 - t0))
-        value = u0 + (u1 - u0) * share
-        # docs/signals.md's form, unless rows near the largest double differ by inf.
-        return value if math.isfinite(value) else u0 * (1 - share) + u1 * share
-
-    def jumps(self) -> list[Fraction]:
-        return sorted({a for a, b in zip(self.times, self.times[1:], strict=False) if a == b})
-
-    def latest_event_near(self, t: Fraction, step: Fraction) -> Fraction:
-        """t, or the latest row time within the tolerance of t: that event is at t."""
-        tolerance = event_tolerance(t, step)
-        j = bisect.bisect_right(self.times, t + tolerance)
-        return max(t, self.times[j - 1]) if j and self.times[j - 1] >= t - tolerance else t
-
-    def held_after(self, points: Sequence[Fraction], step: Fraction) -> np.ndarray:
-        """after(latest_event_near(p, step)) of each point, the same values: the row times as
-        doubles decide each point with no row near it on a flat stretch (its value is the row's);
-        the exact methods decide the others.
-        """
-        times, torques = self.times, self.torques
-        row_doubles, doubles = np.array([float(t) for t in times]), time_doubles(points)
-        reach = np.maximum(float(TOLERANCE_STEPS * step), TOLERANCE_ULPS * np.spacing(np.abs(doubles)))
-        # Widened by what the doubles may be off by (each time's rounding, the tolerance's):
-        # a few ulp, bounded here by 16.
-        reach += 16 * np.spacing(np.maximum(np.abs(doubles), reach))
-        near = np.searchsorted(row_doubles, doubles + reach, "right") > np.searchsorted(
-            row_doubles, doubles - reach, "left"
-        )
-        after = np.searchsorted(row_doubles, doubles, "right")  # times[j-1] <= p < times[j]
-        before = np.clip(after - 1, 0, len(times) - 1)
-        torque_doubles = np.array(torques)
-        sloped = torque_doubles[before] != torque_doubles[np.minimum(after, len(times) - 1)]
-        values = torque_doubles[before]
-        for k in np.flatnonzero(near | sloped).tolist():
-            values[k] = self.after(self.latest_event_near(points[k], step))
-        return values
 
 
 class Grid(Sequence[Fraction]):
@@ -172,6 +95,21 @@ def time_doubles(points: Times) -> np.ndarray:
     if isinstance(points, np.ndarray):
         return points.astype(float)
     return np.array([float(p) for p in points])
+
+
+def exact_times(points: Sequence[Fraction], signal: TorqueFile) -> tuple[int, np.ndarray] | None:
+    """The points times 10**digits (_decimal_times), digits those of a decimal denominator
+    common to the points and the signal's rows; None where there is none.
+    """
+    stop = [points.stop] if isinstance(points, Grid) and points.stop is not None else []
+    ends = [points.start, points.step, *stop] if isinstance(points, Grid) else points
+    digits = common_digits(itertools.chain((t.denominator for t in ends), signal.denominators()))
+    if digits is None:
+        return None
+    if not isinstance(points, Grid):
+        return digits, scaled(points, digits)
+    regular = scaled_steps(points.start, points.step, points.regular, digits)
+    return digits, np.concatenate([regular, scaled(stop, digits)])
 
 
 def time_grid(
@@ -231,9 +169,10 @@ class Pieces:
 
 
 class SignalWindows:
-    """A signal read once, its pieces made a window of grid steps at a time: window(k0, k1) is
+    """A signal checked once, its pieces made a window of grid steps at a time: window(k0, k1) is
     the pieces of the oracle's own grid steps k0 to k1 (and the events between them), so that a
-    run of millions of steps holds one window's pieces at a time. A CSV's table is held whole.
+    run of millions of steps holds one window's pieces at a time. A CSV's rows are read as the
+    windows are made, those near a window at a time (FileRows).
     """
 
     def __init__(
@@ -248,17 +187,16 @@ class SignalWindows:
         check_memory: bool = True,
     ):
         self.step, self.ramp = step, ramp
-        self.file: TorqueFile | None = None
+        self.file: FileRows | None = None
         self.values: np.ndarray | None = None
         self.sample: Callable | None = None
         # A callable's sample at the end of the window last made, for the next one to start from.
         self._carried: tuple[int, float] | None = None
         if isinstance(torque, (str, Path)):
-            read_torque_csv(torque)  # a file that is no signal refused where it is wrong; read below anew
-            self.file = TorqueFile(Path(torque))
-            stop = self.file.times[-1] if stop is None else stop
+            check_torque_csv(torque)  # a file that is no signal refused where it is wrong; read below anew
+            self.file = FileRows(Path(torque))
+            stop = self.file.last if stop is None else stop
             self.grid = time_grid(start, stop, step, max_steps, check_memory)
-            self.extra = off_grid(self.grid, self.file.times if ramp else self.file.jumps(), step)
         elif isinstance(torque, (list, tuple, np.ndarray)):
             self.values = np.fromiter(
                 (torque_value(u, f"at step {k} of the array") for k, u in enumerate(torque)), float, len(torque)
@@ -291,7 +229,8 @@ class SignalWindows:
         rate: Values
         values: Values
         if self.file is not None:
-            signal, points = self.file, with_extra(grid, self.extra)
+            signal = self._rows(grid)
+            points = with_events(grid, signal.times if self.ramp else signal.jumps(), step)
             if self.ramp:
                 # The file's own piecewise-linear signal: a piece between consecutive row times.
                 start, stop = grid[0], grid[-1]
@@ -309,7 +248,8 @@ class SignalWindows:
                         [signal.after(signal.latest_event_near(exact_time(t), step)) for t in times.tolist()]
                     ),
                 )
-            held = signal.held_after(points[:-1] if final else points, step)
+            held_points = points[:-1] if final else points
+            held = signal.held_after(held_points, step, time_doubles(held_points), exact_times(held_points, signal))
             u0 = held[: len(points) - 1]
             return Pieces(
                 points[:-1], grid[-1], u0, np.zeros(len(u0)), points, Holding(points, held, step).values_after
@@ -326,6 +266,14 @@ class SignalWindows:
             rate = np.zeros(k1 - k0)
         u0 = values[: k1 - k0]
         return Pieces(grid[:-1], grid[-1], u0, rate, grid, Holding(grid, u0 if final else values, step).values_after)
+
+    def _rows(self, grid: Grid) -> TorqueFile:
+        """The file's rows that answer for the window's times, its reports' and their tolerances."""
+        assert self.file is not None, "a CSV's rows are read"
+        first, last = grid[0], grid[-1]
+        # A step's margin: far wider than any tolerance the look-ups add to a time.
+        margin = self.step + 2 * event_tolerance(max(abs(first), abs(last)), self.step)
+        return self.file.rows(first - margin, last + margin)
 
     def _samples(self, k0: int, grid: Grid) -> list[float]:
         """The callable at each point of the window, once a point as the windows are walked."""

@@ -211,7 +211,7 @@ def reference(
 
 
 def _read_signal(torque, start_time, stop_time, step_size, ramp, max_steps, check_memory: bool) -> SignalWindows:
-    """The signal, read by the oracle's own reader once; InvalidInput in reference()'s words."""
+    """The signal, checked and read by the oracle's own reader; InvalidInput in reference()'s words."""
     if not (isinstance(torque, (str, Path, list, tuple, np.ndarray, int, float)) or callable(torque)):
         raise InvalidInput(
             f"the reference takes a constant, a callable, a per-step array or a CSV path, "
@@ -324,10 +324,11 @@ def reference_windows(
 
     Window j is the grid steps j * window_steps to min((j + 1) * window_steps, N) of the oracle's
     own grid, as schedule_windows() splits the schedule's. Each check reference() makes is made
-    here, at the call, in its words: the signal is read (once, by the oracle's own reader), and
-    the whole run's work estimated, window by window, and refused past MAX_STEPS before anything
-    is integrated (a callable is sampled for the estimate, then again as each window is
-    integrated). Memory: a window's pieces and reports at a time, beside a CSV's table.
+    here, at the call, in its words: the signal is checked, and the whole run's work estimated,
+    window by window, and refused past MAX_STEPS before anything is integrated (a callable is
+    sampled for the estimate, then again as each window is integrated; a CSV is read by the
+    oracle's own reader for the estimate, then again as the windows are integrated). Memory: a
+    window's pieces and reports at a time, and a CSV's rows near the window.
 
     Parameters
     ----------

@@ -8,22 +8,33 @@ TorqueFileError, naming the file, the line and the problem (docs/signals.md).
 from __future__ import annotations
 
 import csv
+import io
+import itertools
 import math
 import re
+import zlib
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Literal
+from typing import IO, Literal
 
 import numpy as np
 
 from .._errors import InvalidInput
-from .._received_files import MAX_TORQUE_CSV_BYTES, bounded_read, check_lines, shortened
+from .._received_files import MAX_TORQUE_CSV_BYTES, bounded_read, check_lines, check_size, shortened
 from ._time_grid import event_tolerance, nearest
 
 # A file up to this size whose numbers are all plain is read in Python, in a few ms: importing
 # pyarrow takes ~30 ms of the start-up of a judge or a simulate given a short signal. A larger file,
 # or one with anything else in it, is pyarrow's to read, to accept or to refuse.
 SMALL_FILE_BYTES = 2**16
+# Whole lines parsed at a time: a file of millions of rows is never held whole as bytes (1 MB:
+# pyarrow's and the checks' transients of a block some 50 MB less than 8 MB blocks', and quicker).
+BLOCK_BYTES = 1 << 20
+ADVICE = "give a CSV of time,torque rows"
+# Files read and accepted lately (check_torque_csv): the oracle checks the file the judge read.
+ACCEPTED_FILES = 8
+_ACCEPTED: dict[tuple[str, int, int], None] = {}
 # A cell pyarrow and Python's float both read, to the same double (both round correctly): an
 # optional minus, ASCII digits with a point, an exponent. Each takes forms the other refuses
 # (pyarrow: +1, inf, spaces around; Python: 1_0, other scripts' digits): those go to pyarrow.
@@ -96,23 +107,54 @@ class TorqueTable:
         return TorqueTable(np.where(close, closest, self.time), self.torque)
 
 
-def _decode(path: Path, raw: bytes) -> str:
+def _undecodable(path: Path, raw: bytes, first_line: int) -> TorqueFileError | None:
+    """The one-line error for a block of whole lines (the first line first_line) that is not
+    UTF-8, or None.
+    """
     try:
-        return raw.decode("utf-8")
+        raw.decode("utf-8")
     except UnicodeDecodeError as error:
-        line = raw[: error.start].count(b"\n") + 1
-        raise TorqueFileError(
+        line = raw[: error.start].count(b"\n") + first_line
+        return TorqueFileError(
             f"{path}:{line}: byte 0x{raw[error.start]:02x} is not UTF-8; save the "
             "file as UTF-8 (with or without a byte-order mark)"
-        ) from None
+        )
+    return None
 
 
-def _first_bad_row(path: Path, lines: list[str], columns: tuple[int, int]) -> TorqueFileError | None:
+def _blocks(file: IO[bytes]) -> Iterator[tuple[int, bytes]]:
+    """The file's bytes, less a byte-order mark, in blocks of whole lines (the last may end
+    without a newline), each with the number of its first line.
+    """
+    file.seek(0)
+    number, carry, first = 1, b"", True
+    while True:
+        read = file.read(BLOCK_BYTES)
+        at_end = len(read) < BLOCK_BYTES
+        if first:  # spreadsheets write a byte-order mark
+            read, first = read[3:] if read.startswith(b"\xef\xbb\xbf") else read, False
+        data = carry + read
+        cut = len(data) if at_end else data.rfind(b"\n") + 1
+        carry = data[cut:]
+        if cut:  # no newline in a whole block: a line longer than any (check_lines), read on
+            yield number, data[:cut]
+            number += data.count(b"\n", 0, cut)
+        if at_end:
+            return
+
+
+def _lines(file: IO[bytes]) -> Iterator[str]:
+    """The lines of a file checked as UTF-8, as str.splitlines of the whole text gives them."""
+    for _, block in _blocks(file):
+        yield from block.decode("utf-8").splitlines()
+
+
+def _first_bad_row(path: Path, lines: Iterator[str], columns: tuple[int, int]) -> TorqueFileError | None:
     """The one-line error for the first row that is not two finite numbers, or has more
     columns than the header, or None.
     """
-    header = len(next(csv.reader([lines[0]])))
-    for number, line in enumerate(lines[1:], start=2):
+    header = len(next(csv.reader([next(lines)])))
+    for number, line in enumerate(lines, start=2):
         if not line.strip():
             continue
         cells = next(csv.reader([line]))  # as pyarrow reads it: "1,5" is one quoted cell
@@ -132,15 +174,15 @@ def _first_bad_row(path: Path, lines: list[str], columns: tuple[int, int]) -> To
     return None
 
 
-def _line_of_row(lines: list[str], row: int) -> int:
+def _line_of_row(lines: Iterator[str], row: int) -> int:
     """The file line (1-based) of data row `row` (0-based), skipping blank lines."""
-    seen = -1
-    for number, line in enumerate(lines[1:], start=2):
+    seen, number = -1, 1
+    for number, line in enumerate(itertools.islice(lines, 1, None), start=2):
         if line.strip():
             seen += 1
             if seen == row:
                 return number
-    return len(lines)
+    return number
 
 
 def _parse_plain_numbers(
@@ -191,23 +233,84 @@ def _parse_numbers(raw: bytes, names: list[str], columns: tuple[int, int]) -> tu
     return tuple(table.column(name).to_numpy() for name in wanted)
 
 
+def check_torque_csv(path: str | Path) -> None:
+    """Refuse a torque CSV as read_torque_csv() does, without reading it again where it read
+    and accepted the same file, unchanged (its size and checksum), lately.
+
+    Parameters
+    ----------
+    path : str or Path
+        The CSV.
+
+    Raises
+    ------
+    TorqueFileError
+        As read_torque_csv() raises it.
+    """
+    if _stamp(Path(path)) not in _ACCEPTED:
+        read_torque_csv(path)
+
+
+def _stamp(path: Path) -> tuple[str, int, int] | None:
+    """The file's path, size and checksum (zlib's CRC-32, in C, a block at a time), or None
+    where it cannot be read (read_torque_csv says why).
+    """
+    checksum = size = 0
+    try:
+        with open(path, "rb") as file:
+            while block := file.read(BLOCK_BYTES):
+                checksum, size = zlib.crc32(block, checksum), size + len(block)
+    except OSError:
+        return None
+    return str(path.resolve()), size, checksum
+
+
 def read_torque_csv(path: str | Path) -> TorqueTable:
     """Read a ``time,torque`` CSV (UTF-8, with or without a byte-order mark; other columns are
     ignored). A bad file raises TorqueFileError naming the file, line and problem. The numbers
-    are parsed in C in one pass, with no Python object per row.
+    are parsed in C a block of lines at a time, with no Python object per row: the file is
+    never held whole, as bytes or as text, only the table's two arrays.
     """
     path = Path(path)
+    stamp = _stamp(path)  # before it is read: a file changed meanwhile is read again when checked
     try:
         with open(path, "rb") as file:
-            raw = bounded_read(file, str(path), MAX_TORQUE_CSV_BYTES, TorqueFileError, "give a CSV of time,torque rows")
+            source: IO[bytes] = file
+            try:
+                check_size(file, str(path), MAX_TORQUE_CSV_BYTES, TorqueFileError, ADVICE)
+            except OSError:  # a pipe: read whole, as far as the limit, to be read twice
+                source = io.BytesIO(bounded_read(file, str(path), MAX_TORQUE_CSV_BYTES, TorqueFileError, ADVICE))
+            table = _read(path, source)
     except OSError as error:
         raise TorqueFileError(f"{path}: cannot read: {error.strerror}") from None
-    raw = raw[3:] if raw.startswith(b"\xef\xbb\xbf") else raw  # spreadsheets write a byte-order mark
-    check_lines(raw, str(path), TorqueFileError, "give a CSV of time,torque rows")
-    _decode(path, raw)  # only to refuse another encoding here, with its line
-    header_line = raw[: raw.find(b"\n") if b"\n" in raw else len(raw)].decode("utf-8")
+    if stamp is not None:
+        _ACCEPTED[stamp] = None
+        while len(_ACCEPTED) > ACCEPTED_FILES:
+            del _ACCEPTED[next(iter(_ACCEPTED))]
+    return table
+
+
+def _read(path: Path, file: IO[bytes]) -> TorqueTable:
+    # The refusals in the order the checks of a file read whole make them: first whatever
+    # line is too long or holds a NUL byte, anywhere, then whatever byte is not UTF-8.
+    line_fault: TorqueFileError | None = None
+    text_fault: TorqueFileError | None = None
+    header_line, content, lines = "", False, 0
+    for number, block in _blocks(file):
+        lines += block.count(b"\n") + 1
+        if number == 1:
+            header_line = block[: block.find(b"\n") if b"\n" in block else len(block)].decode("utf-8", "replace")
+        content = content or bool(block.strip())
+        if line_fault is None:
+            try:
+                check_lines(block, str(path), TorqueFileError, ADVICE, first_line=number)
+            except TorqueFileError as fault:
+                line_fault = fault
+        text_fault = text_fault or _undecodable(path, block, number)
+    if line_fault or text_fault:
+        raise line_fault or text_fault  # type: ignore[misc]
     if not header_line.strip():
-        if raw.strip():
+        if content:
             raise TorqueFileError(
                 f"{path}:1: the line is blank; the header, e.g. time,torque, must be "
                 "the first line: remove the blank lines before it"
@@ -221,29 +324,51 @@ def read_torque_csv(path: str | Path) -> TorqueTable:
                 "the first line must name the columns, e.g. time,torque"
             )
     columns = (header.index("time"), header.index("torque"))
-    data = _parse_plain_numbers(raw, header, columns) if len(raw) <= SMALL_FILE_BYTES else None
-    if data is None:
-        data = _parse_numbers(raw, header, columns)
-    if data is None or not all(np.all(np.isfinite(column)) for column in data):
-        lines = _decode(path, raw).splitlines()
-        bad_row = _first_bad_row(path, lines, columns)
-        raise bad_row or TorqueFileError(f"{path}: rows must have as many columns as the header ({len(header)})")
-    times, torques = data
+    times, torques = _numbers(path, file, header, columns, lines)
     if len(times) == 0:
         raise TorqueFileError(f"{path}: no data rows after the header")
-    backwards = np.flatnonzero(np.diff(times) < 0)
+    backwards = np.flatnonzero(times[1:] < times[:-1])  # np.diff's sign, without its array of doubles
     triple = np.flatnonzero((times[2:] == times[1:-1]) & (times[1:-1] == times[:-2]))
-    if len(backwards) or len(triple):
-        lines = _decode(path, raw).splitlines()
-        if len(backwards) and (not len(triple) or backwards[0] < triple[0] + 1):
-            row = backwards[0] + 1
-            raise TorqueFileError(
-                f"{path}:{_line_of_row(lines, row)}: time {times[row]:g} goes backwards "
-                f"(previous row: {times[row - 1]:g}); sort the rows by time"
-            )
+    if len(backwards) and (not len(triple) or backwards[0] < triple[0] + 1):
+        row = backwards[0] + 1
+        raise TorqueFileError(
+            f"{path}:{_line_of_row(_lines(file), row)}: time {times[row]:g} goes backwards "
+            f"(previous row: {times[row - 1]:g}); sort the rows by time"
+        )
+    if len(triple):
         row = triple[0] + 2
         raise TorqueFileError(
-            f"{path}:{_line_of_row(lines, row)}: time {times[row]:g} appears three "
+            f"{path}:{_line_of_row(_lines(file), row)}: time {times[row]:g} appears three "
             "times; a jump is two rows with the same time"
         )
-    return TorqueTable(np.ascontiguousarray(times), np.ascontiguousarray(torques))
+    return TorqueTable(times, torques)
+
+
+def _numbers(
+    path: Path, file: IO[bytes], header: list[str], columns: tuple[int, int], lines: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """The time and torque columns, a block at a time, into arrays of the most rows the file's
+    lines can hold (no list of blocks joined: the table once in memory); a row that is not two
+    finite numbers refused with the line of the file's first such row.
+    """
+    times, torques, rows = np.empty(lines), np.empty(lines), 0
+    header_bytes = b""
+    for number, block in _blocks(file):
+        if number == 1:
+            header_bytes = block[: block.find(b"\n") + 1] if b"\n" in block else block
+            # A small file of plain numbers (one block) is read in Python, quicker than pyarrow.
+            data = _parse_plain_numbers(block, header, columns) if len(block) <= SMALL_FILE_BYTES else None
+            raw = block
+        else:
+            data, raw = None, header_bytes + block
+        if data is None:
+            data = _parse_numbers(raw, header, columns)
+        if data is None or not all(np.all(np.isfinite(column)) for column in data):
+            bad_row = _first_bad_row(path, _lines(file), columns)
+            raise bad_row or TorqueFileError(f"{path}: rows must have as many columns as the header ({len(header)})")
+        count = len(data[0])
+        if rows + count > len(times):  # lines ended by a lone carriage return, which pyarrow splits
+            times, torques = (np.concatenate([column, np.empty(rows + count)]) for column in (times, torques))
+        times[rows : rows + count], torques[rows : rows + count] = data
+        rows += count
+    return times[:rows], torques[:rows]

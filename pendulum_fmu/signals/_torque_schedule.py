@@ -274,7 +274,8 @@ def schedule_windows(
     largest double. A callable is sampled once a point (the boundary's sample is carried to the
     next window). Memory: no array of the whole run is made (nor is the machine's free memory
     checked against one); a window holds O(window_steps + the CSV rows inside it), beside the
-    CSV's table, which is held whole, and a per-step array, which is the caller's.
+    CSV's table (read whole, snapped a window's rows at a time) and a per-step array, which is the
+    caller's.
 
     Parameters
     ----------
@@ -372,8 +373,9 @@ class _Signal:
                     f"{self.source} ends at {stop:g} s, not after the start time {start_time:g} s; give a stop time"
                 )
             self._count(start_time, stop, max_steps, check_memory)
-            self.table = torque.snapped(self._points_near(torque.time), step_size)
-            self.events = self._off_grid(self.table.time if ramp else self.table.jumps())
+            # The table as given (the caller's, not copied), snapped a window's rows at a time.
+            self.table = torque
+            self.events = self._events()
         else:
             self._count(start_time, DEFAULT_STOP_TIME if stop_time is None else stop_time, max_steps, check_memory)
             first = self.points(0, 0)
@@ -410,6 +412,30 @@ class _Signal:
             guess = np.clip(np.floor((times - self.start_time) / self.step_size), 0, self.steps)
         return self._grid(np.unique(np.clip(guess[:, None] + np.arange(-2, 4), 0, self.steps).astype(np.int64)))
 
+    def _snapped(self, table: TorqueTable) -> TorqueTable:
+        """The rows snapped onto the grid, row by row: a stretch's as in the whole table."""
+        return table.snapped(self._points_near(table.time), self.step_size)
+
+    def _events(self) -> np.ndarray:
+        """The snapped table's events off the grid (_off_grid), found a block of rows at a time."""
+        assert self.table is not None, "a CSV's events"
+        table, found = self.table, []
+        for begin in range(0, len(table.time), WINDOW_STEPS):
+            # A block less its first row starts one row early, for a jump across the blocks' border.
+            first, end = max(begin - 1, 0), begin + WINDOW_STEPS
+            rows = self._snapped(TorqueTable(table.time[first:end], table.torque[first:end]))
+            found.append(self._off_grid(rows.time[begin - first :] if self.ramp else rows.jumps()))
+        return np.unique(np.concatenate(found))
+
+    def _rows_near(self, time: np.ndarray) -> TorqueTable:
+        """The snapped rows that answer for time[0] to time[-1] as the whole snapped table does."""
+        assert self.table is not None, "a CSV's rows"
+        table, reach = self.table, max(abs(time[0]), abs(time[-1]))
+        margin = self.step_size + 2 * event_tolerance(reach, self.step_size)
+        lo = max(int(np.searchsorted(table.time, time[0] - margin, "left")) - 2, 0)
+        hi = int(np.searchsorted(table.time, time[-1] + margin, "right")) + 2
+        return self._snapped(TorqueTable(table.time[lo:hi], table.torque[lo:hi]))
+
     def _off_grid(self, events: np.ndarray) -> np.ndarray:
         """The events strictly inside the run not within event_tolerance of a grid point, sorted."""
         first, last = self._grid(np.array([0, self.steps]))
@@ -426,7 +452,8 @@ class _Signal:
             lo, hi = np.searchsorted(self.events, time[0], "right"), np.searchsorted(self.events, time[-1])
             inside = self.events[lo:hi]
             time = np.union1d(time, inside) if len(inside) else time
-            start_values, end_values = self.table.value_after(time[:-1]), self.table.value_before(time[1:])
+            rows = self._rows_near(time)
+            start_values, end_values = rows.value_after(time[:-1]), rows.value_before(time[1:])
         elif self.values is not None:
             start_values = end_values = self.values[k0:k1]
         else:
