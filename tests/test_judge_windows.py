@@ -6,9 +6,13 @@ inside the mistake (a late input's carried step, a skipped step, a restart, a dr
 
 import math
 
+import numpy as np
 import pytest
 
 from benchmarks.masters import WRONG_MASTERS, run
+from pendulum_fmu.fmu._results import write_csv
+from pendulum_fmu.fmu._simulate import simulate
+from pendulum_fmu.judging._diagnoses import AGREES
 from pendulum_fmu.judging._judge import JudgedRun
 from pendulum_fmu.scenarios._scenario_settings import read_settings
 from pendulum_fmu.scenarios._scenarios import write_scenarios
@@ -60,3 +64,26 @@ def test_a_wrong_master_judged_in_windows_is_judged_as_in_one(kit, name, mistake
                 k: v for k, v in theirs.items() if k != "half_height"
             }
             assert _close(ours["half_height"], theirs["half_height"])
+
+
+def test_a_run_with_events_between_its_points_is_judged_in_windows_as_in_one(tmp_path):
+    # Changes at random times, between the 1-ms points and on them, some twice (a jump): the
+    # result has a row at each change between points, rows the summed-clock master
+    # (SteppedOnClock) cannot make. Its lag once left a window's frame (an IndexError).
+    rng = np.random.default_rng(0)
+    between, on = rng.uniform(0.0, 0.4, 40), np.round(rng.uniform(0.0, 0.4, 20), 3)
+    times = np.sort(np.r_[between, on, between[:5]])
+    torque = tmp_path / "torque.csv"
+    values = rng.uniform(-30.0, 30.0, len(times))
+    np.savetxt(torque, np.c_[times, values], delimiter=",", header="time,torque", comments="")
+    result = tmp_path / "result.csv"
+    write_csv(simulate(str(torque), stop_time=0.4), result)
+    whole = JudgedRun(str(torque), stop_time=0.4, window_steps=1 << 30).judge(result)
+    windowed = JudgedRun(str(torque), stop_time=0.4, window_steps=20).judge(result)
+    assert (windowed.verdict, windowed.diagnosis) == (whole.verdict, whole.diagnosis) == ("pass", AGREES)
+    assert windowed.candidates.keys() == whole.candidates.keys()
+    for candidate, score in whole.candidates.items():
+        other = windowed.candidates[candidate]
+        assert (score is None) == (other is None), candidate
+        if score is not None:
+            assert _close(other["residual"], score["residual"]), candidate

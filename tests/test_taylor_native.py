@@ -91,8 +91,10 @@ def test_a_run_of_zero_length_reports_its_start():
     assert thetas.tolist() == [0.5, 0.5] and omegas.tolist() == [2.0, 2.0] and (theta, omega) == (0.5, 2.0)
 
 
-def test_the_progress_bar_hears_each_chunk(monkeypatch):
-    monkeypatch.setattr(_taylor_native, "CHUNK", 3)
+def test_the_progress_bar_hears_each_calls_steps(monkeypatch):
+    # Seven runs of one step each, three steps a call: the time reached after the third, the
+    # sixth and the last.
+    monkeypatch.setattr(_taylor_native, "STEPS_PER_CALL", 3)
     ends = np.arange(1, 8) * 1e-3
     runs = (ends - 1e-3, ends, np.ones(7), np.zeros(7))
     reached = []
@@ -100,6 +102,24 @@ def test_the_progress_bar_hears_each_chunk(monkeypatch):
         runs, np.zeros(8, int), np.empty(0), (0.0, 0.0), (1.0, 0.0, 1.0), (1e-14, 1e-14), reached.append
     )
     assert reached == [ends[2], ends[5], ends[6]]
+
+
+@pytest.mark.parametrize("steps_per_call", [1, 2, 7])
+def test_a_run_taken_up_again_after_a_pause_gives_the_same_bits(monkeypatch, steps_per_call):
+    # One long run of a held torque with reports inside its steps: paused every few Taylor steps,
+    # it is integrate_piece's run straight through.
+    runs = (np.array([0.0]), np.array([3.0]), np.array([20.0]), np.array([0.0]))
+    reports = np.linspace(0.0, 3.0, 301)
+    model, tolerance = (GRAVITY_MOMENT, 0.5, INVERSE_INERTIA), (1e-14, 1e-14)
+    expected = integrate_piece(0.3, -0.2, (0.0, 3.0), (20.0, 0.0), model, tolerance, reports)
+    reached = []
+    monkeypatch.setattr(_taylor_native, "STEPS_PER_CALL", steps_per_call)
+    got = _taylor_native.integrate_runs(
+        runs, np.array([0, 301]), reports, (0.3, -0.2), model, tolerance, reached.append
+    )
+    assert np.array_equal(got[0], expected[0]) and np.array_equal(got[1], expected[1])
+    assert got[2:] == expected[2:]
+    assert len(reached) > 1 and reached == sorted(reached) and reached[-1] == 3.0
 
 
 @pytest.mark.parametrize(

@@ -333,6 +333,10 @@ class SteppedOnClock(Variant):
         # The FMU's steps done when each row is written (none before the start: a row within
         # rounding of it), as points of the frame.
         done = np.maximum(np.searchsorted(clock, times, side="right") - 1, 0) + frame.begin
+        if np.any(index - done > 1):
+            # This master falls one step behind at most before a row takes two: rows its clock
+            # cannot reach (a torque's event between communication points) are not its.
+            return None
         self.skipped |= not np.array_equal(done, index)
         before = frame.begin if self.done is None else self.done
         dones, rows = (done, index) if window.first else (np.r_[before, done], np.r_[frame.begin, index])

@@ -26,11 +26,12 @@
 /* _taylor._FEW: up to this many reports in a step are summed as _sum does, more as polyval. */
 #define TAYLOR_FEW 8
 
-/* What cs_loop_taylor_window returns; _taylor_native.py words each as _taylor.py raises it. */
-enum { TAYLOR_OK = 0, TAYLOR_COEFFICIENT = 1, TAYLOR_UNDERFLOW = 2, TAYLOR_STATE = 3 };
+/* What cs_loop_taylor_window returns; _taylor_native.py words each failure as _taylor.py raises
+   it. TAYLOR_PAUSED: the steps asked for are taken, call again to go on. */
+enum { TAYLOR_OK = 0, TAYLOR_COEFFICIENT = 1, TAYLOR_UNDERFLOW = 2, TAYLOR_STATE = 3, TAYLOR_PAUSED = 4 };
 
 /* Changes whenever cs_loop_taylor_window's arguments do (_taylor_native.py checks it). */
-TAYLOR_EXPORT int cs_loop_taylor_interface(void) { return 1; }
+TAYLOR_EXPORT int cs_loop_taylor_interface(void) { return 2; }
 
 /* _taylor._sum: Horner's rule from the last coefficient. */
 static double sum_series(const double *coefficients, int n, double tau)
@@ -63,16 +64,19 @@ typedef struct {
     int order;
 } Model;
 
-/* One run of integrate_piece: from *theta, *omega at start to end under u0 + rate*(t - start),
-   thetas[i], omegas[i] at reports[i] clipped into [start, end]. */
-static int integrate_run(const Model *model, double *theta_io, double *omega_io, double start, double end,
-                         double u0, double rate, const double *reports, size_t n_reports, double *thetas,
-                         double *omegas, double *failed_time)
+/* One run of integrate_piece: from state (theta, omega at time t) to end under
+   u0 + rate*(t - start), thetas[i], omegas[i] at reports[i] clipped into [start, end], from
+   report *next_io on. Each step takes one of *budget; where none is left before the end, the
+   state and *next_io say where the run stands and it returns TAYLOR_PAUSED. A step starts from
+   theta, omega and t alone, so a run taken up again gives the bits of one run straight through. */
+static int integrate_run(const Model *model, double *state, size_t *next_io, double start, double end, double u0,
+                         double rate, const double *reports, size_t n_reports, double *thetas, double *omegas,
+                         long *budget, double *failed_time)
 {
     double x[TAYLOR_MAX_ORDER + 2], v[TAYLOR_MAX_ORDER + 1];
     double sines[TAYLOR_MAX_ORDER], cosines[TAYLOR_MAX_ORDER];
-    double theta = *theta_io, omega = *omega_io, t = start, reach = INFINITY;
-    size_t next_report = 0;
+    double theta = state[0], omega = state[1], t = state[2], reach = INFINITY;
+    size_t next_report = *next_io;
 
     for (;;) {
         const double remaining = end - t;
@@ -155,18 +159,24 @@ static int integrate_run(const Model *model, double *theta_io, double *omega_io,
         omega = sum_series(v, k + 2, stop - t);
         if (!(isfinite(theta) && isfinite(omega))) return TAYLOR_STATE;
         t = stop;
-        if (t == end) {
-            *theta_io = theta;
-            *omega_io = omega;
-            return TAYLOR_OK;
+        --*budget;
+        if (t == end || *budget <= 0) {
+            state[0] = theta;
+            state[1] = omega;
+            state[2] = t;
+            *next_io = next_report;
+            return t == end ? TAYLOR_OK : TAYLOR_PAUSED;
         }
     }
 }
 
-/* Integrates runs first..until-1 of a window, each from the state the one before reached.
+/* Integrates runs position[0]..until-1 of a window, each from the state the one before reached,
+   taking at most budget Taylor steps (then TAYLOR_PAUSED: call again, with what it left in state
+   and position, to go on), so that the caller's progress bar and Ctrl-C are heard within a run.
 
-   state[0], state[1]        theta and omega at the first run's start; on return, at the end of
-                             the last run integrated
+   state[0..2]               theta, omega and the time they hold at (the first run's start, at the
+                             first call); on return, where the integration stands
+   position[0], position[1]  the run it stands in, and its next report (0 at a run's start)
    starts[r], ends[r]        run r's span, in s
    u0s[r], rates[r]          its torque at its start and the torque's rate
    bounds[r], bounds[r + 1]  its reports: reports[bounds[r]..bounds[r + 1]), sorted, clipped
@@ -175,25 +185,29 @@ static int integrate_run(const Model *model, double *theta_io, double *omega_io,
    order                     _taylor.order_limit(min(rtol, atol)), at most TAYLOR_MAX_ORDER
    thetas[i], omegas[i]      written: the state at reports[i]
 
-   Returns TAYLOR_OK; -1 for an order the arrays cannot hold; or the failure's TAYLOR_ code with *failed_run = its run and, for
-   TAYLOR_UNDERFLOW, *failed_time = the time the step underflows at. */
-TAYLOR_EXPORT int cs_loop_taylor_window(double *state, size_t first, size_t until, const double *starts,
+   Returns TAYLOR_OK once run until-1 ends; TAYLOR_PAUSED; -1 for an order the arrays cannot hold;
+   or the failure's TAYLOR_ code, position[0] its run and, for TAYLOR_UNDERFLOW, *failed_time the
+   time the step underflows at. */
+TAYLOR_EXPORT int cs_loop_taylor_window(double *state, int64_t *position, size_t until, const double *starts,
                                         const double *ends, const double *u0s, const double *rates,
-                                        const int64_t *bounds, const double *reports, const double *model,
-                                        int order, double *thetas, double *omegas, size_t *failed_run,
-                                        double *failed_time)
+                                        const int64_t *bounds, const double *reports, const double *model, int order,
+                                        long budget, double *thetas, double *omegas, double *failed_time)
 {
     const Model pendulum = {model[0], model[1], model[2], model[3], model[4], order};
-    size_t r;
+    size_t r = (size_t)position[0];
     if (order < 2 || order > TAYLOR_MAX_ORDER) return -1;
-    for (r = first; r < until; r++) {
+    while (r < until) {
         const int64_t lo = bounds[r];
-        const int status = integrate_run(&pendulum, &state[0], &state[1], starts[r], ends[r], u0s[r], rates[r],
-                                         reports + lo, (size_t)(bounds[r + 1] - lo), thetas + lo, omegas + lo,
-                                         failed_time);
-        if (status != TAYLOR_OK) {
-            *failed_run = r;
-            return status;
+        size_t next = (size_t)position[1];
+        const int status = integrate_run(&pendulum, state, &next, starts[r], ends[r], u0s[r], rates[r], reports + lo,
+                                         (size_t)(bounds[r + 1] - lo), thetas + lo, omegas + lo, &budget, failed_time);
+        position[1] = (int64_t)next;
+        if (status != TAYLOR_OK) return status;
+        position[0] = (int64_t)++r;
+        position[1] = 0;
+        if (r < until) {
+            state[2] = starts[r];
+            if (budget <= 0) return TAYLOR_PAUSED;
         }
     }
     return TAYLOR_OK;

@@ -1,7 +1,7 @@
 """The oracle's Taylor stepping in C (`_taylor_native.c`), loaded with ctypes when it was compiled.
 
 integrate_runs integrates a window's runs of linear torque (what integrate_window loops over) a
-chunk of runs per call, carrying theta and omega across, as _taylor.integrate_piece does one run
+budget of Taylor steps per call, carrying theta and omega across, as _taylor.integrate_piece does one run
 at a time in Python, and gives the same numbers bit for bit: the C code is that function
 transcribed, operation for operation, built without FMA contraction. With a torque that changes
 every communication step a run is one step of a millisecond, and a Python call per run was most
@@ -25,9 +25,12 @@ import numpy as np
 from ._taylor import Diverged, order_limit
 
 # What _taylor_native.c's cs_loop_taylor_interface() returns for the arguments this module passes.
-INTERFACE = 1
-# Runs per call: the progress bar advances between calls, a few milliseconds apart.
-CHUNK = 4096
+INTERFACE = 2
+# Taylor steps per call, about 0.1 s of them: the progress bar advances and Ctrl-C is heard
+# between calls, within a run too (a held torque is one run, up to the oracle's 10,000,000 steps).
+STEPS_PER_CALL = 1 << 17
+# _taylor_native.c's TAYLOR_PAUSED: the steps of a call taken, the window not yet done.
+_PAUSED = 4
 # _taylor_native.c's TAYLOR_ codes, as integrate_piece words them; the underflow's takes the time.
 _FAILURES = {
     1: "a Taylor coefficient is not finite",
@@ -59,7 +62,7 @@ def library() -> ctypes.CDLL | None:
         return None
     pointer, size = ctypes.c_void_p, ctypes.c_size_t
     window = loaded.cs_loop_taylor_window
-    window.argtypes = [pointer, size, size, *[pointer] * 7, ctypes.c_int, pointer, pointer, pointer, pointer]
+    window.argtypes = [pointer, pointer, size, *[pointer] * 7, ctypes.c_int, ctypes.c_long, pointer, pointer, pointer]
     window.restype = ctypes.c_int
     return loaded
 
@@ -94,7 +97,8 @@ def integrate_runs(
     model, tolerance
         As integrate_piece takes them.
     on_step : callable, optional
-        Called with the time reached after each chunk of runs (a progress bar's).
+        Called with the time reached after each call's STEPS_PER_CALL steps, and at the end
+        (a progress bar's).
 
     Returns
     -------
@@ -119,25 +123,27 @@ def integrate_runs(
         raise ValueError("bounds must rise from 0 to the number of reports")
     rtol, atol = tolerance
     constants = np.array([*model, rtol, atol], dtype=np.float64)
-    carried = np.array(state, dtype=np.float64)
+    # theta, omega and the time they hold at; the run and report the integration stands at.
+    carried = np.array([*state, starts[0] if count else 0.0], dtype=np.float64)
+    position = np.zeros(2, dtype=np.int64)
     thetas, omegas = np.empty(len(reports)), np.empty(len(reports))
-    failed_run, failed_time = ctypes.c_size_t(), ctypes.c_double()
+    failed_time = ctypes.c_double()
     addresses = [array.ctypes.data for array in (starts, ends, u0s, rates, bounds, reports, constants)]
-    for first in range(0, count, CHUNK):
-        until = min(first + CHUNK, count)
+    status = _PAUSED
+    while count and status == _PAUSED:
         status = loaded.cs_loop_taylor_window(
             carried.ctypes.data,
-            first,
-            until,
+            position.ctypes.data,
+            count,
             *addresses,
             order_limit(min(rtol, atol)),
+            STEPS_PER_CALL,
             thetas.ctypes.data,
             omegas.ctypes.data,
-            ctypes.byref(failed_run),
             ctypes.byref(failed_time),
         )
-        if status:
-            raise RunDiverged(_FAILURES[status].format(time=failed_time.value), float(starts[failed_run.value]))
+        if status not in (0, _PAUSED):
+            raise RunDiverged(_FAILURES[status].format(time=failed_time.value), float(starts[position[0]]))
         if on_step is not None:
-            on_step(float(ends[until - 1]))
+            on_step(float(carried[2]))
     return thetas, omegas, float(carried[0]), float(carried[1])
