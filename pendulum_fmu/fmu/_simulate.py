@@ -399,14 +399,8 @@ class Simulator:
         window: TorqueSchedule | None = first
         if self.stepper is None:
             self.slave.reset()
-            initialize(
-                self.slave,
-                parameters=parameters,
-                theta0=theta0,
-                omega0=omega0,
-                tolerance=tolerance,
-                start_time=float(first.time[0]),
-            )
+            options: dict[str, Any] = dict(parameters=parameters, theta0=theta0, omega0=omega0, tolerance=tolerance)
+            initialize(self.slave, **options, start_time=float(first.time[0]))
         restart: dict = {"start_values": start, "tolerance": tolerance}
         ramped = False
         while window is not None:
