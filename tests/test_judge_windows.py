@@ -36,6 +36,17 @@ def _close(a, b):
     return a == b or math.isclose(a, b, rel_tol=1e-6, abs_tol=1e-12)
 
 
+def _same_candidates(windowed, whole):
+    """Every candidate applies in both judgements or in neither, with the same residual and effect."""
+    assert windowed.candidates.keys() == whole.candidates.keys()
+    for candidate, score in whole.candidates.items():
+        other = windowed.candidates[candidate]
+        assert (score is None) == (other is None), candidate
+        if score is not None:
+            assert _close(other["residual"], score["residual"]), candidate
+            assert _close(other["effect"], score["effect"]), candidate
+
+
 @pytest.mark.parametrize(("name", "mistake", "expected"), WRONG_MASTERS, ids=[f"{n}-{m}" for n, m, _ in WRONG_MASTERS])
 def test_a_wrong_master_judged_in_windows_is_judged_as_in_one(kit, name, mistake, expected):
     run(kit, name, mistake)
@@ -52,13 +63,7 @@ def test_a_wrong_master_judged_in_windows_is_judged_as_in_one(kit, name, mistake
         # rounding differs.
         assert windowed.points == whole.points
         assert _close(windowed.max_abs_dtheta, whole.max_abs_dtheta)
-        assert windowed.candidates.keys() == whole.candidates.keys()
-        for candidate, score in whole.candidates.items():
-            other = windowed.candidates[candidate]
-            assert (score is None) == (other is None), candidate
-            if score is not None:
-                assert _close(other["residual"], score["residual"]), candidate
-                assert _close(other["effect"], score["effect"]), candidate
+        _same_candidates(windowed, whole)
         for ours, theirs in zip(windowed.regression_tools, whole.regression_tools, strict=True):
             assert {k: v for k, v in ours.items() if k != "half_height"} == {
                 k: v for k, v in theirs.items() if k != "half_height"
@@ -81,9 +86,4 @@ def test_a_run_with_events_between_its_points_is_judged_in_windows_as_in_one(tmp
     whole = JudgedRun(str(torque), stop_time=0.4, window_steps=1 << 30).judge(result)
     windowed = JudgedRun(str(torque), stop_time=0.4, window_steps=20).judge(result)
     assert (windowed.verdict, windowed.diagnosis) == (whole.verdict, whole.diagnosis) == ("pass", AGREES)
-    assert windowed.candidates.keys() == whole.candidates.keys()
-    for candidate, score in whole.candidates.items():
-        other = windowed.candidates[candidate]
-        assert (score is None) == (other is None), candidate
-        if score is not None:
-            assert _close(other["residual"], score["residual"]), candidate
+    _same_candidates(windowed, whole)
