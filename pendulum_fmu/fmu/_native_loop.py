@@ -51,17 +51,28 @@ _FMI_FUNCTIONS = (
 INTERFACE = 7
 
 
-@lru_cache(maxsize=1)
-def library() -> ctypes.CDLL | None:
-    """The compiled loop (_cs_loop.c, _cs_batch.c) with its functions' argument types set, or None
-    when it was not built (or is a stale build).
+def opened(interface_function: str, interface: int) -> ctypes.CDLL | None:
+    """The compiled library (_cs_loop), or None when it was not built or interface_function()
+    does not return interface (a build of other sources): the check of each of its parts, the
+    loop's here and the oracle's Taylor stepping (oracle/_taylor_native.py).
     """
     # setup.py gives it the platform's plain extension name (_cs_loop.so, _cs_loop.pyd).
     path = Path(__file__).resolve().parent / f"_cs_loop{importlib.machinery.EXTENSION_SUFFIXES[-1]}"
     if not path.is_file():
         return None
     loaded = ctypes.CDLL(str(path))
-    if not hasattr(loaded, "cs_loop_interface") or loaded.cs_loop_interface() != INTERFACE:
+    if not hasattr(loaded, interface_function) or getattr(loaded, interface_function)() != interface:
+        return None
+    return loaded
+
+
+@lru_cache(maxsize=1)
+def library() -> ctypes.CDLL | None:
+    """The compiled loop (_cs_loop.c, _cs_batch.c) with its functions' argument types set, or None
+    when it was not built (or is a stale build).
+    """
+    loaded = opened("cs_loop_interface", INTERFACE)
+    if loaded is None:
         return None
     pointer, size = ctypes.c_void_p, ctypes.c_size_t
     signatures = {

@@ -15,13 +15,12 @@ to the same bits; monkeypatching `available` to return False forces the Python p
 from __future__ import annotations
 
 import ctypes
-import importlib.machinery
 from collections.abc import Callable
 from functools import lru_cache
-from pathlib import Path
 
 import numpy as np
 
+from ..fmu._native_loop import opened
 from ._taylor import Diverged, order_limit
 
 # What _taylor_native.c's cs_loop_taylor_interface() returns for the arguments this module passes.
@@ -52,13 +51,9 @@ def library() -> ctypes.CDLL | None:
     """The compiled library holding _taylor_native.c, its function's argument types set, or None
     when it was not built (or is a build of older sources).
     """
-    # The native loop's library (setup.py names it: _cs_loop.so, _cs_loop.pyd), which this file joins.
-    name = f"_cs_loop{importlib.machinery.EXTENSION_SUFFIXES[-1]}"
-    path = Path(__file__).resolve().parent.parent / "fmu" / name
-    if not path.is_file():
-        return None
-    loaded = ctypes.CDLL(str(path))
-    if not hasattr(loaded, "cs_loop_taylor_interface") or loaded.cs_loop_taylor_interface() != INTERFACE:
+    # The native loop's library, which this file joins.
+    loaded = opened("cs_loop_taylor_interface", INTERFACE)
+    if loaded is None:
         return None
     pointer, size = ctypes.c_void_p, ctypes.c_size_t
     window = loaded.cs_loop_taylor_window
