@@ -180,3 +180,18 @@ def test_the_memory_reading_a_torque_file_takes_does_not_grow_with_it(tmp_path, 
         peaks.append(tracemalloc.get_traced_memory()[1])
         tracemalloc.stop()
     assert peaks[1] < peaks[0] + 40 * 40_000, [f"{peak / 1e6:.1f} MB" for peak in peaks]
+
+
+def test_a_file_replaced_while_the_oracle_reads_it_is_refused_in_one_line(tmp_path, monkeypatch):
+    # A master writing the torque file again while a judge reads it: the oracle's rows would mix
+    # two files (an IndexError once); the next chunk read says what happened instead.
+    monkeypatch.setattr(_file_rows, "CHUNK_BYTES", 50)
+    path = tmp_path / "t.csv"
+    path.write_text("time,torque\n" + "".join(f"{k / 1000},{k}\n" for k in range(200)))
+    rows = FileRows(path)
+    rows.rows(Fraction(0), Fraction(1, 1000))
+    other = tmp_path / "other.csv"
+    other.write_text("time,torque\n" + "".join(f"{k / 1000},{-k}\n" for k in range(200)))
+    other.replace(path)
+    with pytest.raises(TorqueFileError, match=r"t\.csv: the file changed while it was read"):
+        rows.rows(Fraction(0), Fraction(150, 1000))

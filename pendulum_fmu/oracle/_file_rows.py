@@ -9,12 +9,14 @@ import bisect
 import csv
 import io
 import math
+import os
 from collections.abc import Sequence
 from fractions import Fraction
 from pathlib import Path
 
 import numpy as np
 
+from ..signals._torque_csv import TorqueFileError
 from ._decimal_times import scaled
 
 # Bytes read a chunk (some 25,000 rows of a recorded torque).
@@ -175,6 +177,11 @@ class TorqueFile:
         return np.where(event >= rows[-1], torques[-1], np.where(event < rows[0], torques[0], value))
 
 
+def _identity(status: os.stat_result) -> tuple[int, int, int, int]:
+    """What tells a file from the same file changed or another moved to its path."""
+    return status.st_dev, status.st_ino, status.st_size, status.st_mtime_ns
+
+
 class FileRows:
     """A torque CSV read forward a chunk of lines at a time: rows(a, b) is the stretch of the
     file's rows that answers for the times a to b as the whole file does. Stretches asked for in
@@ -188,6 +195,8 @@ class FileRows:
 
     def __init__(self, path: Path):
         self.path = path
+        # The file as it was first read: each chunk is read from it, or refused.
+        self._identity = _identity(os.stat(path))
         self._rewind()
         self.last = self._last_time()
 
@@ -202,6 +211,11 @@ class FileRows:
     def _text(self) -> str:
         """The next chunk of whole lines ("" at the end of the file)."""
         with open(self.path, "rb") as file:
+            if _identity(os.fstat(file.fileno())) != self._identity:
+                raise TorqueFileError(
+                    f"{self.path}: the file changed while it was read (a master still writing it, or "
+                    "another file moved there); judge once it is written"
+                )
             file.seek(self._offset)
             lines = file.readlines(CHUNK_BYTES)
             raw, first, self._offset = b"".join(lines), self._offset == 0, file.tell()
