@@ -4,11 +4,12 @@
   wheel's pendulum_fmu/data/, from this source tree (a clone or the unpacked sdist), for every
   platform whose compiler is installed.
 - build_ext builds the native co-simulation loop, pendulum_fmu/fmu/_cs_loop.c, and with it the
-  oracle's Taylor stepping, pendulum_fmu/oracle/_taylor_native.c, through the project's
-  one build description (CMakeLists.txt, driven by fmu_build/) with this machine's
-  compiler. It is plain C loaded with ctypes (pendulum_fmu/fmu/_native_loop.py), not a CPython module:
-  it has the platform's plain name (_cs_loop.so, _cs_loop.pyd) and the wheel is tagged
-  py3-none-<platform>, one wheel for every Python 3 on a platform.
+  oracle's Taylor stepping, pendulum_fmu/oracle/_taylor_native.c, and the judge's Euler stepping,
+  pendulum_fmu/judging/_euler_native.c, through the project's one build description
+  (CMakeLists.txt, driven by fmu_build/) with this machine's compiler. It is plain C loaded with
+  ctypes (pendulum_fmu/fmu/_native_loop.py), not a CPython module: it has the platform's plain
+  name (_cs_loop.so, _cs_loop.pyd) and the wheel is tagged py3-none-<platform>, one wheel for
+  every Python 3 on a platform.
 - bdist_wheel --linux-glibc 2.17 has both build the Linux binaries with zig for that oldest glibc
   (fmu_build's linux_glibc); build_wheels.py passes it, through
   python -m build -C--build-option=--linux-glibc=2.17.
@@ -185,6 +186,7 @@ setup(
                 "pendulum_fmu/fmu/_cs_loop.c",
                 "pendulum_fmu/fmu/_cs_batch.c",
                 "pendulum_fmu/oracle/_taylor_native.c",
+                "pendulum_fmu/judging/_euler_native.c",
             ],
             depends=["pendulum_fmu/fmu/_cs_loop.h"],
         )

@@ -8,13 +8,14 @@ jumps (a repeated time) and ramps, and refusals of a bad row deep in the file.
 
 from __future__ import annotations
 
+import bisect
 import math
 from fractions import Fraction
 
 import numpy as np
 import pytest
 
-from pendulum_fmu.oracle import _file_rows
+from pendulum_fmu.oracle import _decimal_times, _file_rows
 from pendulum_fmu.oracle._exact_signal import exact_time
 from pendulum_fmu.oracle._file_rows import FileRows
 from pendulum_fmu.signals import _torque_csv, _torque_schedule
@@ -122,14 +123,31 @@ def test_the_schedule_snapped_a_window_at_a_time_is_the_whole_tables(tmp_path, m
     assert np.array_equal(schedule(path, stop_time=0.25, ramp=ramp).torque, expected[1])
 
 
+def exact_value(times: list[Fraction], torques: list[float], t: Fraction, side: str) -> float:
+    """The torque just after (side "right") or before t of rows linear between their times, a jump
+    where a time repeats, held outside: docs/signals.md, in fractions.
+    """
+    if t > times[-1] or (side == "right" and t == times[-1]):
+        return torques[-1]
+    if t < times[0] or (side == "left" and t == times[0]):
+        return torques[0]
+    j = (bisect.bisect_right if side == "right" else bisect.bisect_left)(times, t)
+    share = float((t - times[j - 1]) / (times[j] - times[j - 1]))
+    return torques[j - 1] + (torques[j] - torques[j - 1]) * share
+
+
 @pytest.mark.parametrize("seed", range(4))
-def test_a_stretch_of_rows_answers_as_the_whole_file(tmp_path, monkeypatch, seed):
+@pytest.mark.parametrize("reader", ["python", "pyarrow"])
+def test_a_stretch_of_rows_answers_as_the_whole_file(tmp_path, monkeypatch, seed, reader):
     rng = np.random.default_rng(70 + seed)
-    path = write(tmp_path / "t.csv", random_rows(rng, rows=300), blank_every=9)
-    whole = FileRows(path).rows(Fraction(-1), Fraction(10))
+    written = random_rows(rng, rows=300)
+    path = write(tmp_path / "t.csv", written, ("\n", "\r\n", "\r")[seed % 3], bom=seed == 3, blank_every=9)
+    times, torques = [Fraction(repr(t)) for t, _ in written], [u for _, u in written]
+    if reader == "pyarrow":
+        monkeypatch.setattr(_file_rows, "SMALL_FILE_BYTES", 0)
     monkeypatch.setattr(_file_rows, "CHUNK_BYTES", 50)
     rows = FileRows(path)
-    assert rows.last == whole.times[-1]
+    assert rows.last == times[-1]
     step = Fraction(1, 1000)
     # Forward, then back to the start (read again), stretches of a few steps.
     for a in [*range(-2, 300, 7), 0, 5, *range(200, 320, 13)]:
@@ -137,15 +155,33 @@ def test_a_stretch_of_rows_answers_as_the_whole_file(tmp_path, monkeypatch, seed
         stretch = rows.rows(start - step, stop + step)
         assert len(stretch.times) < 40
         for t in [start, stop, *(exact_time(x) for x in rng.uniform(float(start), float(stop), 8).tolist())]:
-            assert stretch.after(t) == whole.after(t) and stretch.before(t) == whole.before(t)
-            assert stretch.latest_event_near(t, step) == whole.latest_event_near(t, step)
+            assert stretch.after(t) == exact_value(times, torques, t, "right")
+            assert stretch.before(t) == exact_value(times, torques, t, "left")
+            tolerance = max(step / 10**9, Fraction(64 * math.ulp(float(t))))
+            near = [time for time in times if abs(time - t) <= tolerance]
+            assert stretch.latest_event_near(t, step) == max([t, *near])
+    whole = rows.rows(Fraction(-1), Fraction(10))
+    assert whole.times == times and whole.torques.tolist() == torques
+    assert whole.doubles.tolist() == [float(t) for t in times]
 
 
-@pytest.mark.parametrize(
-    "written", ["0", "12", "-0.5", ".5", "-.5", "1.", "2999.9990000000002", "1e-3", "-1.5E+2", "+1.25"]
-)
-def test_a_decimal_cell_is_the_fraction_written(written):
-    assert _file_rows.decimal(written) == Fraction(written)
+DECIMAL_CELLS = [
+    *"0 12 -0.5 .5 -.5 1. 2999.9990000000002 0.30000000000000004 1e-3 -1.5E+2 +1.25 1e-30 -0.0".split(),
+    *"123456789012345678901.5 0.0000000000000000000001 9223372036854775807".split(),
+    " 7.25 ",
+]
+
+
+@pytest.mark.parametrize("reader", ["python", "pyarrow"])
+@pytest.mark.parametrize("cells", [[cell] for cell in DECIMAL_CELLS] + [DECIMAL_CELLS, ["0.001", "0.002", "3"]])
+def test_time_cells_are_read_as_the_fractions_written(reader, cells):
+    import pyarrow as pa
+
+    digits, ticks = (
+        _decimal_times.ticks_of_cells(cells) if reader == "python" else _decimal_times.ticks_of_arrow(pa.array(cells))
+    )
+    assert [Fraction(int(n), 10**digits) for n in ticks.tolist()] == [Fraction(cell) for cell in cells]
+    assert _decimal_times.doubles_of(ticks, digits).tolist() == [float(Fraction(cell)) for cell in cells]
 
 
 def test_the_memory_reading_a_torque_file_takes_does_not_grow_with_it(tmp_path, monkeypatch):

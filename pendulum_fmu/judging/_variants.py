@@ -9,8 +9,6 @@ at a time. _diagnoses.py names the candidates and decides.
 
 from __future__ import annotations
 
-import math
-from array import array
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -35,9 +33,7 @@ from ._diagnoses import (
     SHIFTED,
     SINGLE,
 )
-
-# Steps of integration error's Euler taken as floats at once.
-_BLOCK = 1 << 16
+from ._euler import euler_steps
 
 
 @dataclass(frozen=True)
@@ -431,30 +427,19 @@ class Stepped(Variant):
             return None
         frame = window.frame
         plan = frame.plan
-        theta, omega = self.state
-        # The equation written out with math.sin: a step in Python costs a third of one through numpy.
-        gravity_moment, damping, inverse_inertia = model_constants(self.run.parameters)
-        thetas, omegas = array("d"), array("d")
-        # The steps' lengths and torques as floats a block at a time: lists of a window's would
-        # take 64 bytes a step.
-        for begin in range(frame.begin, frame.end, _BLOCK):
-            block = slice(begin, min(begin + _BLOCK, frame.end))
-            for h, u in zip(plan.step_size[block].tolist(), plan.torque[block].tolist(), strict=True):
-                thetas.append(theta)
-                omegas.append(omega)
-                alpha = (u - gravity_moment * math.sin(theta) - damping * omega) * inverse_inertia
-                if self.semi_implicit:
-                    omega += h * alpha
-                    theta += h * omega
-                else:
-                    theta, omega = theta + h * omega, omega + h * alpha
-        thetas.append(theta)
-        omegas.append(omega)
-        self.state = (theta, omega)
+        block = slice(frame.begin, frame.end)
+        thetas, omegas = euler_steps(
+            self.state,
+            plan.step_size[block],
+            plan.torque[block],
+            model_constants(self.run.parameters),
+            self.semi_implicit,
+        )
+        self.state = (float(thetas[-1]), float(omegas[-1]))
         at = window.index - frame.begin
         out = results.empty(len(at), self.run.model.recorded)  # its FMU's fields: no other looked up
         out["time"] = window.times
-        out["theta"], out["omega"] = np.frombuffer(thetas)[at], np.frombuffer(omegas)[at]
+        out["theta"], out["omega"] = thetas[at], omegas[at]
         out["torque"] = plan.torque[np.minimum(window.index, len(plan.torque) - 1)]
         return out
 

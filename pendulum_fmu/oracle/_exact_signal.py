@@ -103,9 +103,10 @@ def exact_times(points: Sequence[Fraction], signal: TorqueFile) -> tuple[int, np
     """
     stop = [points.stop] if isinstance(points, Grid) and points.stop is not None else []
     ends = [points.start, points.step, *stop] if isinstance(points, Grid) else points
-    digits = common_digits(itertools.chain((t.denominator for t in ends), signal.denominators()))
+    digits = common_digits(t.denominator for t in ends)
     if digits is None:
         return None
+    digits = max(digits, signal.digits)
     if not isinstance(points, Grid):
         return digits, scaled(points, digits)
     regular = scaled_steps(points.start, points.step, points.regular, digits)
