@@ -10,6 +10,7 @@ that a run is tallied the same way, number for number, however its tools ran.
 
 from __future__ import annotations
 
+import collections
 import csv
 import itertools
 import math
@@ -22,6 +23,7 @@ import numpy as np
 from .._atomic_files import replacing
 from .._drawn_points import DrawnRows
 from ..fmu import _results as results
+from ..signals._torque_schedule import TorqueSchedule
 from ._compare_tools import Tool
 
 REFERENCE = "reference"
@@ -241,6 +243,27 @@ class WindowedRun:
         return block
 
 
+def _shared(windows: Iterator[TorqueSchedule], count: int) -> list[Iterator[TorqueSchedule]]:
+    """Iterators (count of them) over the same windows, each window let go once all took it.
+
+    itertools.tee would do, but it holds its items in links of 57, each freed only once every
+    iterator has passed the whole link: 57 windows, the whole of a run of 3.7 million steps.
+    """
+    waiting: list[collections.deque[TorqueSchedule]] = [collections.deque() for _ in range(count)]
+
+    def taker(mine: collections.deque[TorqueSchedule]) -> Iterator[TorqueSchedule]:
+        while True:
+            if not mine:
+                window = next(windows, None)
+                if window is None:
+                    return
+                for queue in waiting:
+                    queue.append(window)
+            yield mine.popleft()
+
+    return [taker(queue) for queue in waiting]
+
+
 def walk(windows, oracle, tools: list[Tool], runs: dict, path: Path, options: dict):
     """Walk the run a window at a time: every window's reference and tools' rows into a Tally.
 
@@ -264,7 +287,7 @@ def walk(windows, oracle, tools: list[Tool], runs: dict, path: Path, options: di
     (Tally, dict)
         What was taken in, and each windowed tool's seconds of running.
     """
-    copies = itertools.tee(windows, 1 + sum(tool.label not in runs for tool in tools))
+    copies = _shared(windows, 1 + sum(tool.label not in runs for tool in tools))
     ours, theirs = copies[0], iter(copies[1:])
     sources = {
         tool.label: WholeRun(runs[tool.label])

@@ -395,12 +395,14 @@ class Simulator:
         self.slave.messages.lines.clear()
         recorded = self.slave.model.recorded
         windows = iter(windows)
-        first = next(windows)
-        window: TorqueSchedule | None = first
+        # The first window, not named past this (a name held it for the whole run).
+        window: TorqueSchedule | None = next(windows)
+        assert window is not None, "next() of windows gives a window"
+        start_time = float(window.time[0])
         if self.stepper is None:
             self.slave.reset()
             options: dict[str, Any] = dict(parameters=parameters, theta0=theta0, omega0=omega0, tolerance=tolerance)
-            initialize(self.slave, **options, start_time=float(first.time[0]))
+            initialize(self.slave, **options, start_time=start_time)
         restart: dict = {"start_values": start, "tolerance": tolerance}
         ramped = False
         while window is not None:
