@@ -33,7 +33,7 @@ _LAZY = {
     # torque signals
     "schedule": "signals._torque_schedule",
     "TorqueSchedule": "signals._torque_schedule",
-    "write_torque_csv": "signals._torque_schedule",
+    "write_torque_csv": "signals._schedule_csv",
     "TorqueFileError": "signals._torque_csv",
     # references and comparisons
     "reference": "oracle._reference",

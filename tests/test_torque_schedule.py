@@ -7,9 +7,10 @@ import numpy as np
 import pytest
 
 from pendulum_fmu.signals import _torque_csv
+from pendulum_fmu.signals._schedule_csv import write_torque_csv
 from pendulum_fmu.signals._time_grid import BYTES_PER_STEP, step_count
 from pendulum_fmu.signals._torque_csv import TorqueFileError, read_torque_csv
-from pendulum_fmu.signals._torque_schedule import schedule, write_torque_csv
+from pendulum_fmu.signals._torque_schedule import schedule
 
 
 def test_csv_jumps_become_communication_points(tmp_path):

@@ -59,7 +59,7 @@ from ..fmu._simulate import resolve_parameters
 from ..oracle._reference import reference_windows
 from ..scenarios._scenario_settings import JUDGE_TOLERANCE as DEFAULT_TOLERANCE, read_settings, settings_files
 from ..signals._time_grid import WINDOW_STEPS, event_tolerance
-from ..signals._torque_csv import read_torque_csv
+from ..signals._torque_rows import torque_rows
 from ..signals._torque_schedule import schedule_windows
 from ._diagnoses import AGREES, INTEGRATION, INTEGRATORS, diagnose
 from ._judgement import Judgement
@@ -126,7 +126,7 @@ class JudgedRun:
         }
         # The signal as the variants sample it, read once; the oracle reads it on its own.
         self.torque = torque
-        self.signal = read_torque_csv(torque) if isinstance(torque, (str, Path)) else torque
+        self.signal = torque_rows(torque) if isinstance(torque, (str, Path)) else torque
         if isinstance(self.signal, (list, tuple)):
             self.signal = np.asarray(self.signal, dtype=float)
         self._windows(ramp)  # a run simulate() would refuse is refused here, before any result is read

@@ -18,6 +18,7 @@ from ..fmu._model import FmuModel
 from ..oracle._reference import model_constants, reference_schedule
 from ..signals._time_grid import event_tolerance
 from ..signals._torque_csv import TorqueTable
+from ..signals._torque_rows import CsvReader, HeldRows, TorqueCsv
 from ..signals._torque_schedule import TorqueSchedule
 from ._diagnoses import (
     DIAGNOSES,
@@ -262,7 +263,9 @@ class Drifted(Variant):
 
     def __init__(self, run: Run, signal, ramp: bool):
         super().__init__(run)
-        self.signal, self.ramp = signal, ramp
+        # A CSV's rows: a reader of its own, forward through the run.
+        self.signal = signal.rows() if isinstance(signal, (TorqueCsv, HeldRows)) else signal
+        self.ramp = ramp
         self.last_time: float | None = None
 
     def at_window(self, window, correct):
@@ -294,6 +297,8 @@ def signal_values(signal, times: np.ndarray, side: str) -> np.ndarray:
     """The signal just after (side "after") or before each time, sampled as a master would,
     without the definition's snapping of events onto communication points.
     """
+    if isinstance(signal, (CsvReader, HeldRows)):
+        signal = signal.near(float(times[0]), float(times[-1]))
     if isinstance(signal, TorqueTable):
         return signal.value_after(times) if side == "after" else signal.value_before(times)
     if callable(signal):

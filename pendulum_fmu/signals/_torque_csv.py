@@ -265,13 +265,52 @@ def _stamp(path: Path) -> tuple[str, int, int] | None:
     return str(path.resolve()), size, checksum
 
 
+@dataclass(frozen=True)
+class CsvLayout:
+    """What a check of a torque CSV learned of it: its header line (bytes, with its line end), the
+    time and torque columns' indices, its number of columns and rows, and its last row's time.
+    """
+
+    header: bytes
+    columns: tuple[int, int]
+    width: int
+    rows: int
+    last: float
+
+
 def read_torque_csv(path: str | Path) -> TorqueTable:
     """Read a ``time,torque`` CSV (UTF-8, with or without a byte-order mark; other columns are
     ignored). A bad file raises TorqueFileError naming the file, line and problem. The numbers
     are parsed in C a block of lines at a time, with no Python object per row: the file is
     never held whole, as bytes or as text, only the table's two arrays.
     """
-    path = Path(path)
+    table, _ = _checked(Path(path), keep=True)
+    assert table is not None, "the table is kept"
+    return table
+
+
+def scan_torque_csv(path: str | Path) -> CsvLayout:
+    """Refuse a torque CSV as read_torque_csv() does, a block at a time, holding none of its rows.
+
+    Parameters
+    ----------
+    path : str or Path
+        The CSV: a file that can be read again (not a pipe).
+
+    Returns
+    -------
+    CsvLayout
+        Its header, columns, rows and last time.
+
+    Raises
+    ------
+    TorqueFileError
+        As read_torque_csv() raises it.
+    """
+    return _checked(Path(path), keep=False)[1]
+
+
+def _checked(path: Path, keep: bool) -> tuple[TorqueTable | None, CsvLayout]:
     stamp = _stamp(path)  # before it is read: a file changed meanwhile is read again when checked
     try:
         with open(path, "rb") as file:
@@ -280,26 +319,27 @@ def read_torque_csv(path: str | Path) -> TorqueTable:
                 check_size(file, str(path), MAX_TORQUE_CSV_BYTES, TorqueFileError, ADVICE)
             except OSError:  # a pipe: read whole, as far as the limit, to be read twice
                 source = io.BytesIO(bounded_read(file, str(path), MAX_TORQUE_CSV_BYTES, TorqueFileError, ADVICE))
-            table = _read(path, source)
+            checked = _read(path, source, keep)
     except OSError as error:
         raise TorqueFileError(f"{path}: cannot read: {error.strerror}") from None
     if stamp is not None:
         _ACCEPTED[stamp] = None
         while len(_ACCEPTED) > ACCEPTED_FILES:
             del _ACCEPTED[next(iter(_ACCEPTED))]
-    return table
+    return checked
 
 
-def _read(path: Path, file: IO[bytes]) -> TorqueTable:
+def _read(path: Path, file: IO[bytes], keep: bool) -> tuple[TorqueTable | None, CsvLayout]:
     # The refusals in the order the checks of a file read whole make them: first whatever
     # line is too long or holds a NUL byte, anywhere, then whatever byte is not UTF-8.
     line_fault: TorqueFileError | None = None
     text_fault: TorqueFileError | None = None
-    header_line, content, lines = "", False, 0
+    header_line, header_bytes, content, lines = "", b"", False, 0
     for number, block in _blocks(file):
         lines += block.count(b"\n") + 1
         if number == 1:
-            header_line = block[: block.find(b"\n") if b"\n" in block else len(block)].decode("utf-8", "replace")
+            header_bytes = block[: block.find(b"\n") + 1] if b"\n" in block else block
+            header_line = header_bytes.rstrip(b"\r\n").decode("utf-8", "replace")
         content = content or bool(block.strip())
         if line_fault is None:
             try:
@@ -324,51 +364,91 @@ def _read(path: Path, file: IO[bytes]) -> TorqueTable:
                 "the first line must name the columns, e.g. time,torque"
             )
     columns = (header.index("time"), header.index("torque"))
-    times, torques = _numbers(path, file, header, columns, lines)
-    if len(times) == 0:
+    order = _Order()
+    times, torques = (np.empty(lines), np.empty(lines)) if keep else (np.empty(0), np.empty(0))
+    rows = 0
+    for block_times, block_torques in _numbers(path, file, header, columns):
+        order.add(block_times)
+        count = len(block_times)
+        if keep and rows + count > len(times):  # lines ended by a lone carriage return, which pyarrow splits
+            times, torques = (np.concatenate([column, np.empty(rows + count)]) for column in (times, torques))
+        if keep:
+            times[rows : rows + count], torques[rows : rows + count] = block_times, block_torques
+        rows += count
+    if rows == 0:
         raise TorqueFileError(f"{path}: no data rows after the header")
-    backwards = np.flatnonzero(times[1:] < times[:-1])  # np.diff's sign, without its array of doubles
-    triple = np.flatnonzero((times[2:] == times[1:-1]) & (times[1:-1] == times[:-2]))
-    if len(backwards) and (not len(triple) or backwards[0] < triple[0] + 1):
-        row = backwards[0] + 1
-        raise TorqueFileError(
-            f"{path}:{_line_of_row(_lines(file), row)}: time {times[row]:g} goes backwards "
-            f"(previous row: {times[row - 1]:g}); sort the rows by time"
-        )
-    if len(triple):
-        row = triple[0] + 2
-        raise TorqueFileError(
-            f"{path}:{_line_of_row(_lines(file), row)}: time {times[row]:g} appears three "
-            "times; a jump is two rows with the same time"
-        )
-    return TorqueTable(times, torques)
+    order.check(path, file)
+    layout = CsvLayout(header_bytes, columns, len(header), rows, order.last)
+    return (TorqueTable(times[:rows], torques[:rows]) if keep else None), layout
+
+
+class _Order:
+    """The rows' times taken a block at a time: the first that goes backwards and the first that
+    appears three times, as the whole column's differences find them, and the last time.
+    """
+
+    def __init__(self):
+        self.rows, self.tail, self.last = 0, np.empty(0), math.nan
+        self.backwards: tuple[int, float, float] | None = None  # row, its time, the previous row's
+        self.triple: tuple[int, float] | None = None  # row, its time
+
+    def add(self, times: np.ndarray) -> None:
+        # The last two times before the block, for a backwards step or a triple across its border.
+        joined, base = np.concatenate([self.tail, times]), self.rows - len(self.tail)
+        if self.backwards is None:
+            found = np.flatnonzero(joined[1:] < joined[:-1])  # np.diff's sign, without its array of doubles
+            if len(found):
+                k = found[0] + 1
+                self.backwards = (base + k, joined[k], joined[k - 1])
+        if self.triple is None:
+            found = np.flatnonzero((joined[2:] == joined[1:-1]) & (joined[1:-1] == joined[:-2]))
+            if len(found):
+                self.triple = (base + found[0] + 2, joined[found[0] + 2])
+        self.rows, self.tail = self.rows + len(times), joined[-2:]
+        self.last = float(joined[-1]) if len(joined) else self.last
+
+    def check(self, path: Path, file: IO[bytes]) -> None:
+        """Refuse the first of the two faults found, by its file line."""
+        if self.backwards and (not self.triple or self.backwards[0] < self.triple[0]):
+            row, time, previous = self.backwards
+            raise TorqueFileError(
+                f"{path}:{_line_of_row(_lines(file), row)}: time {time:g} goes backwards "
+                f"(previous row: {previous:g}); sort the rows by time"
+            )
+        if self.triple:
+            row, time = self.triple
+            raise TorqueFileError(
+                f"{path}:{_line_of_row(_lines(file), row)}: time {time:g} appears three "
+                "times; a jump is two rows with the same time"
+            )
 
 
 def _numbers(
-    path: Path, file: IO[bytes], header: list[str], columns: tuple[int, int], lines: int
-) -> tuple[np.ndarray, np.ndarray]:
-    """The time and torque columns, a block at a time, into arrays of the most rows the file's
-    lines can hold (no list of blocks joined: the table once in memory); a row that is not two
-    finite numbers refused with the line of the file's first such row.
+    path: Path, file: IO[bytes], header: list[str], columns: tuple[int, int]
+) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+    """The time and torque columns, a block at a time; a row that is not two finite numbers
+    refused with the line of the file's first such row.
     """
-    times, torques, rows = np.empty(lines), np.empty(lines), 0
     header_bytes = b""
     for number, block in _blocks(file):
         if number == 1:
             header_bytes = block[: block.find(b"\n") + 1] if b"\n" in block else block
-            # A small file of plain numbers (one block) is read in Python, quicker than pyarrow.
-            data = _parse_plain_numbers(block, header, columns) if len(block) <= SMALL_FILE_BYTES else None
             raw = block
         else:
-            data, raw = None, header_bytes + block
-        if data is None:
-            data = _parse_numbers(raw, header, columns)
+            raw = header_bytes + block
+        data = parse_block(raw, header, columns, small=number == 1)
         if data is None or not all(np.all(np.isfinite(column)) for column in data):
             bad_row = _first_bad_row(path, _lines(file), columns)
             raise bad_row or TorqueFileError(f"{path}: rows must have as many columns as the header ({len(header)})")
-        count = len(data[0])
-        if rows + count > len(times):  # lines ended by a lone carriage return, which pyarrow splits
-            times, torques = (np.concatenate([column, np.empty(rows + count)]) for column in (times, torques))
-        times[rows : rows + count], torques[rows : rows + count] = data
-        rows += count
-    return times[:rows], torques[:rows]
+        yield data
+
+
+def parse_block(
+    raw: bytes, header: list[str], columns: tuple[int, int], small: bool
+) -> tuple[np.ndarray, np.ndarray] | None:
+    """A block of whole lines, its first the header (skipped), as the time and torque columns;
+    None when a row is not numbers (_first_bad_row says which). A small block (small, and up to
+    SMALL_FILE_BYTES) of plain numbers is read in Python, quicker than pyarrow.
+    """
+    data = _parse_plain_numbers(raw, header, columns) if small and len(raw) <= SMALL_FILE_BYTES else None
+    return data if data is not None else _parse_numbers(raw, header, columns)

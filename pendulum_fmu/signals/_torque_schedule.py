@@ -36,15 +36,26 @@ from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
-from typing import Union
 
 import numpy as np
 
 from .._errors import InvalidInput
 from ._time_grid import WINDOW_STEPS, event_tolerance, grid_points, nearest, step_count
 from ._torque_csv import TorqueTable, read_torque_csv
+from ._torque_rows import HeldRows, TorqueCsv, torque_rows
 
-TorqueSignal = Union[float, int, Callable[[float], float], str, Path, Sequence[float], np.ndarray, "TorqueTable"]
+TorqueSignal = (
+    float
+    | int
+    | Callable[[float], float]
+    | str
+    | Path
+    | Sequence[float]
+    | np.ndarray
+    | TorqueTable
+    | TorqueCsv
+    | HeldRows
+)
 
 # stop_time without a CSV to take it from.
 DEFAULT_STOP_TIME = 3.0
@@ -85,68 +96,6 @@ class TorqueSchedule:
     def step_size(self) -> np.ndarray:
         """The length of each step, in s."""
         return np.diff(self.time)
-
-
-def write_torque_csv(path: str | Path, plan: TorqueSchedule) -> Path:
-    """Write a schedule as a torque CSV in fmpy's convention, which schedule() reads back.
-
-    A row where each run of equal steps starts and ends, so a held torque reads as steps and a
-    ramp as a line. Times are written with 17 significant digits, so they read back as the same
-    doubles. The file is written whole or not at all.
-
-    Parameters
-    ----------
-    path : str or Path
-        The CSV to write (replaced if it is there).
-    plan : TorqueSchedule
-        The schedule, from schedule().
-
-    Returns
-    -------
-    Path
-        path.
-
-    Raises
-    ------
-    CannotWrite
-        path cannot be written.
-
-    Examples
-    --------
-    5 N.m for 1 s, then 7 N.m:
-
-    >>> import tempfile
-    >>> from pathlib import Path
-    >>> from pendulum_fmu import schedule, write_torque_csv
-    >>> plan = schedule([5.0, 5.0, 7.0], step_size=0.5)
-    >>> csv = write_torque_csv(Path(tempfile.mkdtemp(), "torque.csv"), plan)
-    >>> print(csv.read_text(), end="")
-    time,torque
-    0.0,5.0
-    1.0,5.0
-    1.0,7.0
-    1.5,7.0
-    >>> schedule(csv, step_size=0.5).torque.tolist()
-    [5.0, 5.0, 7.0]
-    """
-    from .._atomic_files import replacing
-
-    end = plan.torque + plan.torque_rate * plan.step_size
-    points: list[tuple[float, float]] = []
-    for t0, t1, u0, u1 in zip(
-        plan.time[:-1].tolist(), plan.time[1:].tolist(), plan.torque.tolist(), end.tolist(), strict=False
-    ):
-        if not points or points[-1] != (t0, u0):
-            points.append((t0, u0))
-        points.append((t1, u1))
-    # A point inside a run of constant torque adds nothing.
-    rows = [
-        p for i, p in enumerate(points) if i in (0, len(points) - 1) or not points[i - 1][1] == p[1] == points[i + 1][1]
-    ]
-    with replacing(path, newline="") as file:
-        file.write("time,torque\n")
-        file.writelines(f"{t!r},{u!r}\n" for t, u in rows)
-    return Path(path)
 
 
 def _checked_array(values, ramp: bool) -> np.ndarray:
@@ -245,7 +194,7 @@ def schedule(
     >>> schedule([5.0, 7.0], step_size=0.5).time.tolist()  # an array's steps set the stop time
     [0.0, 0.5, 1.0]
     """
-    signal = _Signal(torque, start_time, stop_time, step_size, ramp, max_steps, check_memory=True)
+    signal = _Signal(torque, start_time, stop_time, step_size, ramp, max_steps, check_memory=True, streamed=False)
     # The whole run is one window: the windows' code, so that the two cannot part.
     return signal.window(0, signal.steps)
 
@@ -269,13 +218,14 @@ def schedule_windows(
     first point, are schedule()'s arrays bit for bit.
 
     Every check schedule() makes of the times, the signal and max_steps is made here, at the
-    call, in its words, and a CSV is read here, once. Only what depends on the value at a point
-    is found in the window holding it: a callable's value that is not finite, a ramp past the
-    largest double. A callable is sampled once a point (the boundary's sample is carried to the
-    next window). Memory: no array of the whole run is made (nor is the machine's free memory
-    checked against one); a window holds O(window_steps + the CSV rows inside it), beside the
-    CSV's table (read whole, snapped a window's rows at a time) and a per-step array, which is the
-    caller's.
+    call, in its words: a CSV is checked here, a block at a time, then read again for its events
+    off the grid, and again as the windows are made (_torque_rows.py). Only what depends on the
+    value at a point is found in the window holding it: a callable's value that is not finite, a
+    ramp past the largest double. A callable is sampled once a point (the boundary's sample is
+    carried to the next window). Memory: no array of the whole run is made (nor is the machine's
+    free memory checked against one); a window holds O(window_steps + the CSV rows inside it and
+    a block's), beside a TorqueTable or a per-step array given, which is the caller's. A CSV
+    checked already (a TorqueCsv) is not checked again.
 
     Parameters
     ----------
@@ -303,7 +253,7 @@ def schedule_windows(
     """
     if not (isinstance(window_steps, numbers.Integral) and window_steps >= 1):
         raise InvalidInput(f"window steps {window_steps!r} must be a whole number of steps, at least 1")
-    signal = _Signal(torque, start_time, stop_time, step_size, ramp, max_steps, check_memory=False)
+    signal = _Signal(torque, start_time, stop_time, step_size, ramp, max_steps, check_memory=False, streamed=True)
     return ScheduleWindows(signal, int(window_steps))
 
 
@@ -342,16 +292,22 @@ class _Signal:
         max_steps: int | None,
         *,
         check_memory: bool,
+        streamed: bool,
     ):
         self.source, self.ramp, self.step_size = "the torque table", ramp, step_size
-        self.table: TorqueTable | None = None
+        self.table: TorqueCsv | HeldRows | None = None
         self.values: np.ndarray | None = None
         self.function: Callable | None = None
         self.constant = 0.0
         # A callable's sample at the end of the window last made, for the next one to start from.
         self._carried: tuple[int, float] | None = None
         if isinstance(torque, (str, Path)):
-            self.source, torque = str(torque), read_torque_csv(torque)
+            # A run made whole holds the table anyway: read whole, into arrays of its size.
+            self.source, torque = str(torque), torque_rows(torque) if streamed else HeldRows(read_torque_csv(torque))
+        elif isinstance(torque, TorqueTable):
+            torque = HeldRows(torque)
+        elif isinstance(torque, TorqueCsv):
+            self.source = str(torque.path)
         if isinstance(torque, (list, tuple, np.ndarray)):
             self.values = _checked_array(torque, ramp)
             if stop_time is None:
@@ -366,15 +322,16 @@ class _Signal:
             bad = np.flatnonzero(~np.isfinite(self.values))
             if len(bad):
                 raise InvalidInput(f"the torque array's value {bad[0]} is {self.values[bad[0]]}; values must be finite")
-        elif isinstance(torque, TorqueTable):
-            stop = float(torque.time[-1]) if stop_time is None else stop_time
+        elif isinstance(torque, (TorqueCsv, HeldRows)):
+            stop = torque.last if stop_time is None else stop_time
             if stop <= start_time and stop_time is None:
                 raise InvalidInput(
                     f"{self.source} ends at {stop:g} s, not after the start time {start_time:g} s; give a stop time"
                 )
             self._count(start_time, stop, max_steps, check_memory)
-            # The table as given (the caller's, not copied), snapped a window's rows at a time.
-            self.table = torque
+            # The table as given (the caller's, not copied) or read a block at a time, snapped a
+            # window's rows at a time.
+            self.table, self._reader = torque, torque.rows()
             self.events = self._events()
         else:
             self._count(start_time, DEFAULT_STOP_TIME if stop_time is None else stop_time, max_steps, check_memory)
@@ -423,22 +380,20 @@ class _Signal:
     def _events(self) -> np.ndarray:
         """The snapped table's events off the grid (_off_grid), found a block of rows at a time."""
         assert self.table is not None, "a CSV's events"
-        table, found = self.table, []
-        for begin in range(0, len(table.time), WINDOW_STEPS):
-            # A block less its first row starts one row early, for a jump across the blocks' border.
-            first, end = max(begin - 1, 0), begin + WINDOW_STEPS
-            rows = self._snapped(TorqueTable(table.time[first:end], table.torque[first:end]))
-            found.append(self._off_grid(rows.time[begin - first :] if self.ramp else rows.jumps()))
+        found, before = [], TorqueTable(np.empty(0), np.empty(0))
+        for block in self.table.blocks():
+            # A block after the first starts with the row before it, for a jump across the border.
+            rows = self._snapped(TorqueTable(np.r_[before.time, block.time], np.r_[before.torque, block.torque]))
+            found.append(self._off_grid(rows.time[len(before.time) :] if self.ramp else rows.jumps()))
+            if len(block.time):
+                before = TorqueTable(block.time[-1:], block.torque[-1:])
         return np.unique(np.concatenate(found))
 
     def _rows_near(self, time: np.ndarray) -> TorqueTable:
         """The snapped rows that answer for time[0] to time[-1] as the whole snapped table does."""
-        assert self.table is not None, "a CSV's rows"
-        table, reach = self.table, max(abs(time[0]), abs(time[-1]))
+        reach = max(abs(time[0]), abs(time[-1]))
         margin = self.step_size + 2 * event_tolerance(reach, self.step_size)
-        lo = max(int(np.searchsorted(table.time, time[0] - margin, "left")) - 2, 0)
-        hi = int(np.searchsorted(table.time, time[-1] + margin, "right")) + 2
-        return self._snapped(TorqueTable(table.time[lo:hi], table.torque[lo:hi]))
+        return self._snapped(self._reader.near(time[0] - margin, time[-1] + margin))
 
     def _off_grid(self, events: np.ndarray) -> np.ndarray:
         """The events strictly inside the run not within event_tolerance of a grid point, sorted."""
