@@ -20,7 +20,8 @@ from pendulum_fmu.oracle._exact_signal import exact_time
 from pendulum_fmu.oracle._file_rows import FileRows
 from pendulum_fmu.signals import _torque_csv, _torque_rows, _torque_schedule
 from pendulum_fmu.signals._time_grid import grid_points
-from pendulum_fmu.signals._torque_csv import TorqueFileError, read_torque_csv
+from pendulum_fmu.signals._torque_csv import TorqueFileError, read_torque_csv, scan_torque_csv
+from pendulum_fmu.signals._torque_rows import HeldRows, TorqueCsv
 from pendulum_fmu.signals._torque_schedule import schedule
 
 
@@ -73,13 +74,14 @@ def test_blocks_read_the_numbers_of_the_whole_file(tmp_path, monkeypatch, seed, 
     ],
 )
 @pytest.mark.parametrize("block", [7, 64, 1 << 23])
-def test_a_bad_row_deep_in_the_file_is_refused_with_its_line(tmp_path, monkeypatch, bad, message, block):
+@pytest.mark.parametrize("reader", [read_torque_csv, scan_torque_csv])
+def test_a_bad_row_deep_in_the_file_is_refused_with_its_line(tmp_path, monkeypatch, bad, message, block, reader):
     rows = "".join(f"{k / 1000!r},{k % 7}\n" for k in range(1000))
     path = tmp_path / "t.csv"
     path.write_text("time,torque\n" + rows + bad + "2,1\n")
     monkeypatch.setattr(_torque_csv, "BLOCK_BYTES", block)
     with pytest.raises(TorqueFileError) as refused:
-        read_torque_csv(path)
+        reader(path)
     assert message.format(line=1002, line2=1004) in str(refused.value)
     assert str(refused.value).startswith(str(path)) and "\n" not in str(refused.value)
 
@@ -111,10 +113,11 @@ def whole_table_schedule(path, step, stop, ramp):
 @pytest.mark.parametrize("ramp", [False, True])
 def test_the_schedule_snapped_a_window_at_a_time_is_the_whole_tables(tmp_path, monkeypatch, seed, ramp):
     rng = np.random.default_rng(40 + seed)
-    path = write(tmp_path / "t.csv", random_rows(rng, rows=300))
+    path = write(tmp_path / "t.csv", random_rows(rng, rows=300), ("\n", "\r\n")[seed % 2], bom=seed > 1)
     expected = whole_table_schedule(path, 1e-3, 0.25, ramp)
-    for window_steps in (3, 10**6):
-        monkeypatch.setattr(_torque_schedule, "WINDOW_STEPS", window_steps)
+    # The file read a few rows a block, or whole; its windows a few steps long, or the whole run.
+    for window_steps, block in ((3, 40), (3, 1 << 20), (10**6, 40)):
+        monkeypatch.setattr(_torque_csv, "BLOCK_BYTES", block)
         windows = list(_torque_schedule.schedule_windows(path, stop_time=0.25, ramp=ramp, window_steps=window_steps))
         time = np.concatenate([windows[0].time] + [w.time[1:] for w in windows[1:]])
         assert np.array_equal(time, expected[0])
@@ -230,3 +233,35 @@ def test_a_file_replaced_while_the_oracle_reads_it_is_refused_in_one_line(tmp_pa
     other.replace(path)
     with pytest.raises(TorqueFileError, match=r"t\.csv: the file changed while it was read"):
         rows.rows(Fraction(0), Fraction(150, 1000))
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_rows_near_a_stretch_read_a_block_at_a_time_are_the_whole_tables(tmp_path, monkeypatch, seed):
+    rng = np.random.default_rng(90 + seed)
+    path = write(tmp_path / "t.csv", random_rows(rng, rows=400), ("\n", "\r\n")[seed % 2], bom=seed > 1, blank_every=7)
+    whole = HeldRows(read_torque_csv(path))
+    monkeypatch.setattr(_torque_csv, "BLOCK_BYTES", 60)
+    rows = TorqueCsv(path)
+    assert rows.last == whole.last
+    joined = list(rows.blocks())
+    assert np.array_equal(np.concatenate([block.time for block in joined]), whole.table.time)
+    assert np.array_equal(np.concatenate([block.torque for block in joined]), whole.table.torque)
+    reader = rows.rows()
+    # Forward, then back to the start (read again), stretches of a few steps, and one past the end.
+    for start in [*np.arange(-0.002, 0.45, 0.011), 0.0, 0.1, *np.arange(0.2, 0.5, 0.05)]:
+        stretch, expected = reader.near(start, start + 0.004), whole.near(start, start + 0.004)
+        assert np.array_equal(stretch.time, expected.time) and np.array_equal(stretch.torque, expected.torque)
+
+
+def test_a_file_replaced_while_the_schedule_reads_it_is_refused_in_one_line(tmp_path, monkeypatch):
+    monkeypatch.setattr(_torque_csv, "BLOCK_BYTES", 50)
+    path = tmp_path / "t.csv"
+    path.write_text("time,torque\n" + "".join(f"{k / 1000},{k}\n" for k in range(200)))
+    windows = _torque_schedule.schedule_windows(path, stop_time=0.199, window_steps=20)
+    next(windows)
+    other = tmp_path / "other.csv"
+    other.write_text("time,torque\n" + "".join(f"{k / 1000},{-k}\n" for k in range(200)))
+    other.replace(path)
+    with pytest.raises(TorqueFileError, match=r"t\.csv: the file changed while it was read") as refused:
+        list(windows)
+    assert "\n" not in str(refused.value)
