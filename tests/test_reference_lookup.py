@@ -8,6 +8,7 @@ tolerance; the times are the grid, the jumps, and the doubles around where a tim
 reaches a point, where only exact arithmetic can tell the side.
 """
 
+import itertools
 import math
 from fractions import Fraction
 
@@ -18,6 +19,7 @@ from benchmarks.signal_cases import random_step_rows, write_rows
 from pendulum_fmu.oracle._exact_signal import (
     TOLERANCE_STEPS,
     Holding,
+    SignalWindows,
     exact_time,
     exact_times,
     time_doubles,
@@ -117,3 +119,43 @@ def test_held_after_equals_the_exact_look_up_on_random_files(tmp_path, seed, run
     exact = [signal.after(signal.latest_event_near(p, step)) for p in points]
     assert signal.held_after(points, step, time_doubles(points), exact_times(points, signal)).tolist() == exact
     assert signal.held_after(points, step, time_doubles(points), None).tolist() == exact
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_ramp_pieces_equal_the_exact_look_ups_on_random_files(tmp_path, seed):
+    """A ramp's pieces, made in exact integers a window at once, against the definition in
+    fractions: a piece between consecutive row times, its torque just after its start and its
+    rate to the torque just before its end; its events the rows off the grid; its reports.
+    """
+    rng = np.random.default_rng(500 + seed)
+    step = exact_time(AWKWARD_STEPS[seed % len(AWKWARD_STEPS)])
+    rows = random_step_rows(rng, stop_time=1.0, running_sum=bool(seed % 2))
+    # Rows on the grid as a recorded torque has them, an ulp off and within the tolerance.
+    on_grid = [(repr(float(k * step)), float(rng.uniform(-40, 40))) for k in range(1, 30)]
+    edge = float(17 * step) + 0.5 * float(TOLERANCE_STEPS * step)
+    added = [*on_grid, (repr(math.nextafter(float(31 * step), math.inf)), 5.0), (repr(edge), -5.0)]
+    # Rows around the edge of a point's tolerance, a few ulp either side of it.
+    edges = [float(35 * step) + float(TOLERANCE_STEPS * step)]
+    for _ in range(3):
+        edges = [math.nextafter(edges[0], -math.inf), *edges, math.nextafter(edges[-1], math.inf)]
+    added += [(repr(t), float(u)) for t, u in zip(edges, rng.uniform(-40, 40, size=len(edges)), strict=True)]
+    taken = {float(t) for t, _ in added}
+    rows = sorted([*[row for row in rows if float(row[0]) not in taken], *added], key=lambda row: float(row[0]))
+    path = write_rows(tmp_path / "signal.csv", rows)
+    windows = SignalWindows(str(path), Fraction(0), Fraction(1), step, True, None)
+    for k0 in range(0, windows.steps, 40):
+        k1 = min(k0 + 40, windows.steps)
+        pieces, grid = windows.window(k0, k1), windows.window_grid(k0, k1)
+        signal = windows._rows(grid)
+        times = signal.times
+        inside = [t for t in times if grid[0] < t < grid[-1]]
+        starts = sorted({grid[0], grid[-1], *inside})
+        assert list(pieces.starts) == starts[:-1]
+        assert list(pieces.u0) == [signal.after(a) for a in starts[:-1]]
+        rates = [(signal.before(b) - signal.after(a)) / float(b - a) for a, b in itertools.pairwise(starts)]
+        assert list(pieces.rate) == rates
+        assert list(pieces.points) == list(with_events(grid, times, step))
+        at = _times(rng, list(grid), step)
+        at = at[(at >= float(grid[0])) & (at <= float(grid[-1]))]
+        expected = [signal.after(signal.latest_event_near(exact_time(t), step)) for t in at.tolist()]
+        assert pieces.values_after(at).tolist() == expected

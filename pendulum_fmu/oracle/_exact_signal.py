@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import bisect
 import heapq
-import itertools
 import math
 import numbers
 from collections.abc import Callable, Sequence
@@ -20,7 +19,7 @@ import numpy as np
 from .._errors import InvalidInput
 from ..signals._time_grid import step_count
 from ..signals._torque_csv import check_torque_csv
-from ._decimal_times import common_digits, scaled, scaled_steps
+from ._decimal_times import common_digits, doubles_of, rescaled, scaled, scaled_steps, ticks_of_cells
 from ._file_rows import TOLERANCE_STEPS, TOLERANCE_ULPS, FileRows, TorqueFile, event_tolerance
 
 # Times whose torque Holding looks up at once.
@@ -88,9 +87,55 @@ class Grid(Sequence[Fraction]):
         return out if self.stop is None else np.append(out, float(self.stop))
 
 
+class DecimalTimes(Sequence[Fraction]):
+    """Exact decimal times held as integers, the times 10**digits (ticks): each made a fraction
+    only when asked for, and as doubles in one array (doubles()).
+    """
+
+    def __init__(self, ticks: np.ndarray, digits: int):
+        self.ticks, self.digits = ticks, digits
+
+    def __len__(self) -> int:
+        return len(self.ticks)
+
+    def __getitem__(self, k):
+        if isinstance(k, slice):
+            return DecimalTimes(self.ticks[k], self.digits)
+        return Fraction(int(self.ticks[k]), 10**self.digits)
+
+    def doubles(self) -> np.ndarray:
+        return doubles_of(self.ticks, self.digits)
+
+
+def reported_after(signal: TorqueFile, times: np.ndarray, step: Fraction) -> np.ndarray:
+    """signal.after(signal.latest_event_near(exact_time(t), step)) of each time (s), a whole
+    array at once (held_after), each time read as the decimal a person wrote (exact_time).
+    """
+    times = np.asarray(times, dtype=float)
+    digits, ticks = ticks_of_cells([repr(t) for t in times.tolist()])
+    common = max(digits, signal.digits)
+    return signal.held_after(DecimalTimes(ticks, digits), step, times, (common, rescaled(ticks, common - digits)))
+
+
+def rows_off_grid(grid: Grid, signal: TorqueFile, step: Fraction) -> list[Fraction]:
+    """off_grid(grid, signal.times, step): the rows surely within the tolerance of a grid point
+    (a recorded torque's every row) found with doubles, a whole array at once; the others
+    decided by off_grid in fractions.
+    """
+    doubles, points = signal.doubles, grid.doubles()
+    j = np.clip(np.searchsorted(points, doubles), 1, len(points) - 1)
+    distance = np.minimum(np.abs(points[j] - doubles), np.abs(doubles - points[j - 1]))
+    tolerance = np.maximum(float(TOLERANCE_STEPS * step), TOLERANCE_ULPS * np.spacing(np.abs(doubles)))
+    # What the doubles may be off by (each time's rounding, the difference's and the
+    # tolerance's): a few ulp, bounded here by 16.
+    slack = 16 * np.spacing(np.maximum(np.abs(doubles), tolerance))
+    unsure = np.flatnonzero(~(distance < tolerance - slack)).tolist()
+    return off_grid(grid, [Fraction(int(signal.ticks[k]), 10**signal.digits) for k in unsure], step)
+
+
 def time_doubles(points: Times) -> np.ndarray:
-    """A sequence of times (a Grid, fractions or doubles) as an array of doubles."""
-    if isinstance(points, Grid):
+    """A sequence of times (a Grid, DecimalTimes, fractions or doubles) as an array of doubles."""
+    if isinstance(points, (Grid, DecimalTimes)):
         return points.doubles()
     if isinstance(points, np.ndarray):
         return points.astype(float)
@@ -231,24 +276,9 @@ class SignalWindows:
         values: Values
         if self.file is not None:
             signal = self._rows(grid)
-            points = with_events(grid, signal.times if self.ramp else signal.jumps(), step)
+            points = with_events(grid, signal.jumps(), step)
             if self.ramp:
-                # The file's own piecewise-linear signal: a piece between consecutive row times.
-                start, stop = grid[0], grid[-1]
-                inside = signal.times[bisect.bisect_right(signal.times, start) : bisect.bisect_left(signal.times, stop)]
-                rows = sorted({start, stop, *inside})
-                u0 = [signal.after(a) for a in rows[:-1]]
-                rate = [(signal.before(b) - signal.after(a)) / float(b - a) for a, b in itertools.pairwise(rows)]
-                return Pieces(
-                    rows[:-1],
-                    stop,
-                    u0,
-                    rate,
-                    points,
-                    lambda times: np.array(
-                        [signal.after(signal.latest_event_near(exact_time(t), step)) for t in times.tolist()]
-                    ),
-                )
+                return self._ramp_pieces(grid, signal)
             held_points = points[:-1] if final else points
             held = signal.held_after(held_points, step, time_doubles(held_points), exact_times(held_points, signal))
             u0 = held[: len(points) - 1]
@@ -267,6 +297,23 @@ class SignalWindows:
             rate = np.zeros(k1 - k0)
         u0 = values[: k1 - k0]
         return Pieces(grid[:-1], grid[-1], u0, rate, grid, Holding(grid, u0 if final else values, step).values_after)
+
+    def _ramp_pieces(self, grid: Grid, signal: TorqueFile) -> Pieces:
+        """The file's own piecewise-linear signal: a piece between consecutive row times (and the
+        window's ends), each time, torque and rate found in exact integers, a window at once.
+        """
+        step, start, stop = self.step, grid[0], grid[-1]
+        ends_digits = common_digits([start.denominator, stop.denominator])
+        assert ends_digits is not None, "a window's ends are decimals"
+        digits = max(signal.digits, ends_digits)
+        ends, rows = scaled([start, stop], digits), rescaled(signal.ticks, digits - signal.digits)
+        ticks = np.unique(np.concatenate([ends[:1], rows[(rows > ends[0]) & (rows < ends[1])], ends[1:]]))
+        u0 = signal.values_at(ticks[:-1], digits, "after")
+        rate = (signal.values_at(ticks[1:], digits, "before") - u0) / doubles_of(np.diff(ticks), digits)
+        points = with_extra(grid, rows_off_grid(grid, signal, step))
+        return Pieces(
+            DecimalTimes(ticks[:-1], digits), stop, u0, rate, points, lambda times: reported_after(signal, times, step)
+        )
 
     def _rows(self, grid: Grid) -> TorqueFile:
         """The file's rows that answer for the window's times, its reports' and their tolerances."""

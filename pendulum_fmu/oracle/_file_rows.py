@@ -158,25 +158,35 @@ class TorqueFile:
             chosen = np.flatnonzero(decided)
             point = exact[1][chosen]
             event = np.where(near[chosen], np.maximum(point, rows[np.clip(hi[chosen] - 1, 0, last)]), point)
-            values[chosen] = self._exact_after(rows, torques, event)
+            values[chosen] = self._exact_value(rows, torques, event)
             unsure &= ~decided
         for k in np.flatnonzero(unsure).tolist():
             first, end = int(lo[k]), int(hi[k])
             values[k] = self._after(self._latest_event_near(points[k], step, first, end), first, end)
         return values
 
+    def values_at(self, events: np.ndarray, digits: int, side: str) -> np.ndarray:
+        """after() (side "after") or before() of each exact time, given times 10**digits (digits
+        at least the rows'), a whole array at once.
+        """
+        return self._exact_value(rescaled(self.ticks, digits - self.digits), self.torques, events, side)
+
     @staticmethod
-    def _exact_after(rows: np.ndarray, torques: np.ndarray, event: np.ndarray) -> np.ndarray:
-        """after() of each exact integer time, as after() and _between() compute it."""
+    def _exact_value(rows: np.ndarray, torques: np.ndarray, event: np.ndarray, side: str = "after") -> np.ndarray:
+        """after() or before() of each exact integer time, as they and _between() compute it."""
         if len(rows) == 1:
             return np.full(len(event), torques[0])
-        j = np.clip(np.searchsorted(rows, event, "right"), 1, len(rows) - 1)  # rows[j-1] <= t < rows[j]
-        inside = (event >= rows[0]) & (event < rows[-1])
+        if side == "after":  # rows[j-1] <= t < rows[j]
+            j = np.clip(np.searchsorted(rows, event, "right"), 1, len(rows) - 1)
+            first, last = event < rows[0], event >= rows[-1]
+        else:  # rows[j-1] < t <= rows[j]
+            j = np.clip(np.searchsorted(rows, event, "left"), 1, len(rows) - 1)
+            first, last = event <= rows[0], event > rows[-1]
         offset, length, u0, u1 = event - rows[j - 1], rows[j] - rows[j - 1], torques[j - 1], torques[j]
         # Python's integers are divided by Python, correctly rounded as float(Fraction) is; so is
         # one IEEE division of int64 below 2**53 (exact as doubles); larger int64 go to Python.
         share = np.zeros(len(event))
-        exact = inside & (offset != 0)
+        exact = ~first & ~last & (offset != 0)
         if offset.dtype != object:
             by_numpy = exact & (np.abs(offset) < 2**53) & (length < 2**53)
             share[by_numpy] = offset[by_numpy] / length[by_numpy]
@@ -185,7 +195,7 @@ class TorqueFile:
         with np.errstate(invalid="ignore", over="ignore"):
             value = u0 + (u1 - u0) * share
             value = np.where(np.isfinite(value), value, u0 * (1 - share) + u1 * share)
-        return np.where(event >= rows[-1], torques[-1], np.where(event < rows[0], torques[0], value))
+        return np.where(last, torques[-1], np.where(first, torques[0], value))
 
 
 def _identity(status: os.stat_result) -> tuple[int, int, int, int]:
