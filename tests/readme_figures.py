@@ -110,14 +110,16 @@ def reference_work() -> str:
     from test_work import CASES, ESTIMATE_WITHIN
 
     from pendulum_fmu._progress_bar import LOG_INTERVAL
-    from pendulum_fmu.oracle._work import BAR_FROM, MAX_STEPS
+    from pendulum_fmu.oracle._work import BAR_FROM, MAX_STEPS, STEPS_PER_ALLOWED_STEP
 
     low, high = ESTIMATE_WITHIN
     return _wrapped(
         "Before it integrates, the reference estimates the Taylor steps the run needs (from the "
         "horizon and a bound on |omega| from the energy and the torque's work): over "
         f"{MAX_STEPS:,} steps it refuses the run in one line naming what to change (a shorter stop "
-        "time, smaller torques or speeds, a looser rtol); from "
+        "time, smaller torques or speeds, a looser rtol); a run allowed more steps than that "
+        f"(`--max-steps`) may take {STEPS_PER_ALLOWED_STEP} Taylor steps per step allowed (a torque "
+        "that changes at every step restarts the series at each); from "
         f"{BAR_FROM:,} steps it shows its progress in simulated seconds on stderr (redrawn on a "
         f"terminal, elsewhere a line every {LOG_INTERVAL:g} s), and Ctrl-C stops it with one line. "
         f"Over the {len(CASES)} runs `tests/test_work.py` tries, the estimate is between {low:g} and "

@@ -102,6 +102,17 @@ def test_a_run_of_billions_of_steps_is_refused_before_it_starts():
     assert time.process_time() - started < 10  # refused, not integrated for hours
 
 
+def test_a_run_allowed_more_steps_may_take_as_many_taylor_steps_more(monkeypatch):
+    # A recorded torque changes at every step, and the series restarts at each: an overnight
+    # run allowed 30,000,000 steps (--max-steps) takes as many Taylor steps at least.
+    monkeypatch.setattr(_work, "MAX_STEPS", 1000)
+    torque = 20 * np.sin(np.arange(2000) / 50.0)
+    with pytest.raises(InvalidInput, match="over its limit of 1,000: give a shorter stop time"):
+        reference(torque)
+    allowed = reference(torque, max_steps=2000)
+    assert np.array_equal(allowed["theta"], reference(torque, max_steps=10**6)["theta"])
+
+
 def test_a_long_run_shows_its_progress_and_a_short_one_does_not(monkeypatch, capsys):
     monkeypatch.setattr(_work, "BAR_FROM", 1000)  # the 300-N.m spin for 30 s takes about 2,200
     monkeypatch.setattr(sys.stderr, "isatty", lambda: True)  # the bar a terminal shows

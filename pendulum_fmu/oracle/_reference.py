@@ -67,6 +67,7 @@ class ReferenceWindows:
         *,
         first: Pieces | None = None,
         show_progress: bool = True,
+        max_steps: int | None = None,
     ):
         self._window, self._grid_steps, self._step, self._model = window, grid_steps, step, model
         self._window_steps, self._show_progress = window_steps, show_progress
@@ -85,7 +86,7 @@ class ReferenceWindows:
             work.add(last.spans())
         self.start, self.stop = float(first_runs.starts[0]), float(last.ends[-1])
         self.steps = work.steps
-        check_steps(self.steps, self.start, self.stop, model.rtol)
+        check_steps(self.steps, self.start, self.stop, model.rtol, max_steps)
 
     def _bounds(self, j: int) -> tuple[int, int]:
         k0 = j * self._window_steps
@@ -177,7 +178,8 @@ def reference(
         The FMU whose parameters and defaults apply (default: pendulum_fmu.default_fmu()).
     max_steps : int, optional
         The most communication steps the run may have, as simulate() takes it (default:
-        DEFAULT_MAX_STEPS).
+        DEFAULT_MAX_STEPS); a run allowed more than MAX_STEPS may take up to
+        STEPS_PER_ALLOWED_STEP Taylor steps per step allowed (a torque that changes every step).
 
     Returns
     -------
@@ -206,7 +208,10 @@ def reference(
     pieces = signal.window(0, signal.steps)
     at = _times(time_doubles(pieces.points) if at is None else at, pieces, signal.step)
     model = Model(parameters, theta0, omega0, rtol, atol, fmu_path)
-    with ReferenceWindows(signal.window, signal.steps, signal.step, model, signal.steps, first=pieces) as oracle:
+    windows = ReferenceWindows(
+        signal.window, signal.steps, signal.step, model, signal.steps, first=pieces, max_steps=max_steps
+    )
+    with windows as oracle:
         return oracle._next(at, check=False)
 
 
@@ -366,4 +371,4 @@ def reference_windows(
         raise InvalidInput(f"window steps {window_steps!r} must be a whole number of steps, at least 1")
     signal = _read_signal(torque, start_time, stop_time, step_size, ramp, max_steps, check_memory=False)
     model = Model(parameters, theta0, omega0, rtol, atol, fmu_path)
-    return ReferenceWindows(signal.window, signal.steps, signal.step, model, int(window_steps))
+    return ReferenceWindows(signal.window, signal.steps, signal.step, model, int(window_steps), max_steps=max_steps)

@@ -39,6 +39,10 @@ from ._taylor import order_limit
 # Python (tests/test_work.py prints it), half an hour or more, and a run that long is likelier a
 # stop time in the wrong unit than one meant.
 MAX_STEPS = 10_000_000
+# A run allowed more grid steps than MAX_STEPS (--max-steps) may take this many Taylor steps per
+# grid step: a torque that changes at every step (a recorded one) restarts the series at each,
+# one Taylor step or more apiece.
+STEPS_PER_ALLOWED_STEP = 4
 # From this many steps (a few seconds) the reference shows its progress on stderr.
 BAR_FROM = 20_000
 # A swing's series holds harmonics of w0 too (sin of a swinging theta): its terms grow about as
@@ -242,8 +246,9 @@ def taylor_steps(
     return Work(model, theta0, omega0, tolerance).add(spans)
 
 
-def check_steps(steps: float, start: float, stop: float, rtol: float) -> None:
-    """InvalidInput past MAX_STEPS, naming what to change.
+def check_steps(steps: float, start: float, stop: float, rtol: float, max_steps: int | None = None) -> None:
+    """InvalidInput past MAX_STEPS, or STEPS_PER_ALLOWED_STEP per grid step the run is allowed
+    where that is more, naming what to change.
 
     Parameters
     ----------
@@ -253,12 +258,15 @@ def check_steps(steps: float, start: float, stop: float, rtol: float) -> None:
         The run's start and stop (s), for the message.
     rtol : float
         The tolerance asked for, for the message.
+    max_steps : int, optional
+        The most grid steps the run was allowed (--max-steps), where given.
     """
-    if steps > MAX_STEPS:
+    limit = max(MAX_STEPS, STEPS_PER_ALLOWED_STEP * (max_steps or 0))
+    if steps > limit:
         shown = f"about {steps:,.0f}" if steps < 1e15 else f"about {steps:.3g}" if steps < math.inf else "over 1e308"
         raise InvalidInput(
             f"the reference would take {shown} Taylor steps from {start:g} to {stop:g} s "
-            f"(rtol {rtol:g}), over its limit of {MAX_STEPS:,}: give a shorter stop time, smaller "
+            f"(rtol {rtol:g}), over its limit of {limit:,}: give a shorter stop time, smaller "
             "torques or speeds, or a looser rtol"
         )
 
