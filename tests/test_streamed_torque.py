@@ -265,3 +265,51 @@ def test_a_file_replaced_while_the_schedule_reads_it_is_refused_in_one_line(tmp_
     with pytest.raises(TorqueFileError, match=r"t\.csv: the file changed while it was read") as refused:
         list(windows)
     assert "\n" not in str(refused.value)
+
+
+def _fifo_of(path, text: str):
+    """A named pipe at path that a thread writes text into once it is opened."""
+    import os
+    import threading
+
+    os.mkfifo(path)
+
+    def write():
+        with open(path, "w") as pipe:
+            pipe.write(text)
+
+    threading.Thread(target=write, daemon=True).start()
+    return path
+
+
+@pytest.mark.skipif(not hasattr(__import__("os"), "mkfifo"), reason="no named pipes here")
+def test_a_torque_file_that_is_a_pipe_is_simulated_and_refused_by_the_judge_in_one_line(tmp_path):
+    import signal
+
+    from pendulum_fmu import judge, simulate
+
+    # A pipe opened a second time waits for a writer that never comes: fail, not hang.
+    def hung(*_):
+        raise TimeoutError("a named pipe was opened twice")
+
+    previous = signal.signal(signal.SIGALRM, hung)
+    signal.alarm(60)
+    try:
+        _check_pipes(tmp_path, judge, simulate)
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, previous)
+
+
+def _check_pipes(tmp_path, judge, simulate):
+    text = "time,torque\n" + "".join(f"{k / 1000},{k % 7}\n" for k in range(3001))
+    path = tmp_path / "t.csv"
+    path.write_text(text)
+    expected = simulate(str(path), stop_time=3.0)
+    piped = simulate(str(_fifo_of(tmp_path / "pipe1", text)), stop_time=3.0)
+    assert np.array_equal(piped["theta"], expected["theta"])
+    with pytest.raises(
+        TorqueFileError, match=r"pipe2: the reference reads the torque file on its own, again"
+    ) as refused:
+        judge(expected, str(_fifo_of(tmp_path / "pipe2", text)), stop_time=3.0)
+    assert "\n" not in str(refused.value)

@@ -10,6 +10,7 @@ import bisect
 import heapq
 import math
 import numbers
+import os
 from collections.abc import Callable, Sequence
 from fractions import Fraction
 from pathlib import Path
@@ -18,7 +19,7 @@ import numpy as np
 
 from .._errors import InvalidInput
 from ..signals._time_grid import step_count
-from ..signals._torque_csv import check_torque_csv
+from ..signals._torque_csv import TorqueFileError, check_torque_csv
 from ._decimal_times import common_digits, doubles_of, rescaled, scaled, scaled_steps, ticks_of_cells
 from ._file_rows import TOLERANCE_STEPS, TOLERANCE_ULPS, FileRows, TorqueFile, event_tolerance
 
@@ -239,6 +240,12 @@ class SignalWindows:
         # A callable's sample at the end of the window last made, for the next one to start from.
         self._carried: tuple[int, float] | None = None
         if isinstance(torque, (str, Path)):
+            if os.path.exists(torque) and not (os.path.isfile(torque) or os.path.isdir(torque)):
+                raise TorqueFileError(
+                    f"{torque}: the reference reads the torque file on its own, again, which a pipe "
+                    "cannot be; save it to a file and give that"
+                )
+            # (The tools' reader may have read a pipe already, whole.)
             check_torque_csv(torque)  # a file that is no signal refused where it is wrong; read below anew
             self.file = FileRows(Path(torque))
             stop = self.file.last if stop is None else stop

@@ -11,7 +11,9 @@ import csv
 import io
 import itertools
 import math
+import os
 import re
+import stat
 import zlib
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -253,10 +255,13 @@ def check_torque_csv(path: str | Path) -> None:
 
 def _stamp(path: Path) -> tuple[str, int, int] | None:
     """The file's path, size and checksum (zlib's CRC-32, in C, a block at a time), or None
-    where it cannot be read (read_torque_csv says why).
+    where it cannot be read (read_torque_csv says why) or read again (a pipe, which reading here
+    would empty).
     """
     checksum = size = 0
     try:
+        if not stat.S_ISREG(os.stat(path).st_mode):  # before it is opened: a named pipe's open waits
+            return None
         with open(path, "rb") as file:
             while block := file.read(BLOCK_BYTES):
                 checksum, size = zlib.crc32(block, checksum), size + len(block)
