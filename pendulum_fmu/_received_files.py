@@ -25,6 +25,7 @@ disk or the memory, or keeping a core busy for hours:
 
 from __future__ import annotations
 
+import os
 import stat
 import zipfile
 from collections.abc import Iterator
@@ -422,3 +423,42 @@ def bounded_text(path: Path, limit: int, error: type[Exception], advice: str, en
     """
     with open(path, "rb") as file:
         return bounded_read(file, str(path), limit, error, advice).decode(encoding)
+
+
+class ReadAgain:
+    """A file read a block of whole lines at a time from any offset, again and again (a torque CSV
+    of millions of rows, never held whole), each block from the file first seen at the path: a
+    file written again or another moved there since is refused (error, naming the path), never
+    read as a mix of two files.
+    """
+
+    def __init__(self, path: Path, error: type[Exception], advice: str):
+        self.path, self._error, self._advice = path, error, advice
+        self._identity = self._identity_of(os.stat(path))
+        self.size = self._identity[2]
+
+    @staticmethod
+    def _identity_of(status: os.stat_result) -> tuple[int, int, int, int]:
+        return status.st_dev, status.st_ino, status.st_size, status.st_mtime_ns
+
+    def block(self, offset: int, size: int) -> bytes:
+        """The whole lines from offset, about size bytes of them (b"" at the end of the file): up
+        to the last newline or carriage return (one of a pair cut off starts the next block with a
+        blank line), more where no line ends within size.
+        """
+        with open(self.path, "rb") as file:
+            if self._identity_of(os.fstat(file.fileno())) != self._identity:
+                raise self._error(
+                    f"{self.path}: the file changed while it was read (a master still writing it, or "
+                    f"another file moved there); {self._advice}"
+                )
+            file.seek(offset)
+            raw = b""
+            while True:
+                read = file.read(size)
+                raw += read
+                cut = max(raw.rfind(b"\n"), raw.rfind(b"\r")) + 1
+                if len(read) < size:
+                    return raw
+                if cut:
+                    return raw[:cut]

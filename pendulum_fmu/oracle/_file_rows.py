@@ -9,7 +9,6 @@ from __future__ import annotations
 import csv
 import io
 import math
-import os
 from collections.abc import Sequence
 from fractions import Fraction
 from functools import cached_property
@@ -17,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._received_files import ReadAgain
 from ..signals._torque_csv import TorqueFileError
 from ._decimal_times import (
     count_at_most,
@@ -198,11 +198,6 @@ class TorqueFile:
         return np.where(last, torques[-1], np.where(first, torques[0], value))
 
 
-def _identity(status: os.stat_result) -> tuple[int, int, int, int]:
-    """What tells a file from the same file changed or another moved to its path."""
-    return status.st_dev, status.st_ino, status.st_size, status.st_mtime_ns
-
-
 class FileRows:
     """A torque CSV read forward a chunk of lines at a time: rows(a, b) is the stretch of the
     file's rows that answers for the times a to b as the whole file does. Stretches asked for in
@@ -216,7 +211,7 @@ class FileRows:
     def __init__(self, path: Path):
         self.path = path
         # The file as it was first read: each chunk is read from it, or refused.
-        self._identity = _identity(os.stat(path))
+        self._file = ReadAgain(path, TorqueFileError, "judge once it is written")
         self._rewind()
         self.last = self._last_time()
 
@@ -229,23 +224,7 @@ class FileRows:
 
     def _raw(self) -> bytes:
         """The next chunk of whole lines (b"" at the end of the file), less a byte-order mark."""
-        with open(self.path, "rb") as file:
-            if _identity(os.fstat(file.fileno())) != self._identity:
-                raise TorqueFileError(
-                    f"{self.path}: the file changed while it was read (a master still writing it, or "
-                    "another file moved there); judge once it is written"
-                )
-            file.seek(self._offset)
-            raw = b""
-            while True:
-                read = file.read(CHUNK_BYTES)
-                raw += read
-                # A carriage return ends a line too; one of a pair cut off starts the next
-                # chunk with a blank line, which is skipped.
-                cut = max(raw.rfind(b"\n"), raw.rfind(b"\r")) + 1
-                if len(read) < CHUNK_BYTES or cut:
-                    break
-        raw = raw if len(read) < CHUNK_BYTES else raw[:cut]
+        raw = self._file.block(self._offset, CHUNK_BYTES)
         first, self._offset = self._offset == 0, self._offset + len(raw)
         self._end = not raw
         return raw[3:] if first and raw.startswith(b"\xef\xbb\xbf") else raw
@@ -258,7 +237,7 @@ class FileRows:
             names = [cell.strip() for cell in next(row for row in rows if any(cell.strip() for cell in row))]
             self._columns = (names.index("time"), names.index("torque"), len(names))
         time, torque, width = self._columns
-        if self._identity[2] <= SMALL_FILE_BYTES:
+        if self._file.size <= SMALL_FILE_BYTES:
             cells, torques = _python_cells(raw, time, torque, first=first)
             digits, ticks = ticks_of_cells(cells)
         else:

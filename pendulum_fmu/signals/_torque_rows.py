@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._received_files import ReadAgain
 from . import _torque_csv
 from ._time_grid import WINDOW_STEPS
 from ._torque_csv import TorqueFileError, TorqueTable, parse_block, read_torque_csv, scan_torque_csv
@@ -75,11 +76,6 @@ def torque_rows(path: str | Path) -> TorqueCsv | HeldRows:
     return TorqueCsv(path) if regular else HeldRows(read_torque_csv(path))
 
 
-def _identity(status: os.stat_result) -> tuple[int, int, int, int]:
-    """What tells a file from the same file changed or another moved to its path."""
-    return status.st_dev, status.st_ino, status.st_size, status.st_mtime_ns
-
-
 class TorqueCsv:
     """A torque CSV checked once and read again a block at a time (see the module's docstring).
 
@@ -93,7 +89,7 @@ class TorqueCsv:
     def __init__(self, path: Path):
         self.path = path
         try:
-            self._identity = _identity(os.stat(path))
+            self._file = ReadAgain(path, TorqueFileError, "use it once it is written")
         except OSError as error:
             raise TorqueFileError(f"{path}: cannot read: {error.strerror}") from None
         self.layout = scan_torque_csv(path)
@@ -113,24 +109,7 @@ class TorqueCsv:
 
     def _block(self, offset: int) -> tuple[TorqueTable | None, int]:
         """The rows of the block of whole lines at offset (None at the end) and the next offset."""
-        with open(self.path, "rb") as file:
-            if _identity(os.fstat(file.fileno())) != self._identity:
-                raise TorqueFileError(
-                    f"{self.path}: the file changed while it was read (a master still writing it, or "
-                    "another file moved there); use it once it is written"
-                )
-            file.seek(offset)
-            raw = b""
-            while True:
-                read = file.read(_torque_csv.BLOCK_BYTES)
-                raw += read
-                # A carriage return ends a line too; one of a pair cut off starts the next block
-                # with a blank line, which is skipped.
-                cut = max(raw.rfind(b"\n"), raw.rfind(b"\r")) + 1
-                at_end = len(read) < _torque_csv.BLOCK_BYTES
-                if at_end or cut:
-                    break
-        raw = raw if at_end else raw[:cut]
+        raw = self._file.block(offset, _torque_csv.BLOCK_BYTES)
         if not raw:
             return None, offset
         layout = self.layout
